@@ -1,0 +1,138 @@
+//! Stable diagnostic codes.
+//!
+//! `E` codes are errors, `W` codes warnings. Hundreds group the phase: 0xx lexical, 1xx
+//! syntax, 2xx structure (sections, fields, values). A code, once released, keeps its
+//! meaning forever; retired codes stay in the list. The title and explanation of each code
+//! live in `spec/diagnostics.md` (one `## CODE title` section each), embedded here.
+
+use crate::Severity;
+use serde::{Serialize, Serializer};
+
+const REFERENCE: &str = include_str!("../../../spec/diagnostics.md");
+
+macro_rules! codes {
+    ($($code:ident => $severity:ident,)*) => {
+        /// A stable diagnostic code.
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+        pub enum Code { $($code,)* }
+
+        impl Code {
+            pub const ALL: &'static [Code] = &[$(Code::$code,)*];
+
+            pub fn as_str(self) -> &'static str {
+                match self { $(Code::$code => stringify!($code),)* }
+            }
+
+            /// The severity a diagnostic with this code has unless a profile changes it.
+            pub fn severity(self) -> Severity {
+                match self { $(Code::$code => Severity::$severity,)* }
+            }
+        }
+    };
+}
+
+codes! {
+    E0001 => Error,
+    E0002 => Error,
+    E0003 => Error,
+    E0004 => Error,
+    E0005 => Error,
+    E0100 => Error,
+    E0101 => Error,
+    E0102 => Error,
+    E0200 => Error,
+    E0201 => Error,
+    E0202 => Error,
+    E0203 => Error,
+    E0204 => Error,
+    E0205 => Error,
+    E0206 => Error,
+    E0207 => Error,
+    E0208 => Error,
+    E0209 => Error,
+    E0210 => Error,
+    E0211 => Error,
+    E0212 => Error,
+    W0200 => Warning,
+    W0201 => Warning,
+}
+
+impl Code {
+    /// Parse `E0203` (case-insensitive; `0203` and `203` mean the error code).
+    pub fn parse(text: &str) -> Option<Code> {
+        let text = text.trim().to_ascii_uppercase();
+        let full = if text.starts_with('E') || text.starts_with('W') {
+            text
+        } else {
+            format!("E{:0>4}", text)
+        };
+        Code::ALL.iter().copied().find(|c| c.as_str() == full)
+    }
+
+    /// The section of `spec/diagnostics.md` for this code, heading included.
+    pub fn reference(self) -> &'static str {
+        let heading = format!("## {}", self.as_str());
+        let Some(start) = REFERENCE.find(&heading) else {
+            return "";
+        };
+        let rest = &REFERENCE[start..];
+        let end = rest[heading.len()..].find("\n## ").map_or(rest.len(), |i| i + heading.len() + 1);
+        rest[..end].trim_end()
+    }
+
+    /// The one-line title of this code, e.g. "unknown field".
+    pub fn title(self) -> &'static str {
+        let reference = self.reference();
+        let first = reference.lines().next().unwrap_or("");
+        first.get(3 + self.as_str().len()..).unwrap_or("").trim()
+    }
+
+    /// The reference text without its heading.
+    pub fn explanation(self) -> &'static str {
+        let reference = self.reference();
+        reference.split_once('\n').map_or("", |(_, body)| body.trim())
+    }
+}
+
+impl std::fmt::Display for Code {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl Serialize for Code {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(self.as_str())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_code_has_a_titled_reference_section() {
+        for code in Code::ALL {
+            assert!(!code.title().is_empty(), "{code} has no `## {code} title` section in spec/diagnostics.md");
+            assert!(!code.explanation().is_empty(), "{code} has no explanation");
+            let expected = if code.as_str().starts_with('E') { Severity::Error } else { Severity::Warning };
+            assert_eq!(code.severity(), expected, "{code}: the letter must match the severity");
+        }
+    }
+
+    #[test]
+    fn every_reference_section_names_a_code() {
+        for line in REFERENCE.lines().filter(|l| l.starts_with("## ")) {
+            let name = line[3..].split_whitespace().next().unwrap_or("");
+            assert!(Code::parse(name).is_some_and(|c| c.as_str() == name), "section `{line}` names no code");
+        }
+    }
+
+    #[test]
+    fn parse_accepts_short_forms() {
+        assert_eq!(Code::parse("e0203"), Some(Code::E0203));
+        assert_eq!(Code::parse("203"), Some(Code::E0203));
+        assert_eq!(Code::parse("W0200"), Some(Code::W0200));
+        assert_eq!(Code::parse("E9999"), None);
+    }
+}

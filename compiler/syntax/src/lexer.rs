@@ -1,0 +1,354 @@
+//! The lexer: source text to tokens, never failing.
+//!
+//! Built on logos. Every byte of input ends up in some token: text logos cannot match
+//! becomes [`Token::Error`] with a diagnostic, so the parser always receives a complete
+//! stream and recovers from lexical errors the same way as from syntax errors (lalrpop
+//! recovers only from parser errors). Comments are returned beside the tokens, for the
+//! formatter. Field keys (`weather:`) are one token, name and colon together: that keeps
+//! the grammar LR(1) while values stay free of separators (`speed: 38 km/h lane: 2`).
+
+use logos::Logos;
+use tad_diagnostics::{Code, Diagnostic, Span};
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LexError {
+    #[default]
+    UnexpectedChar,
+    UnterminatedString,
+    UnterminatedTextBlock,
+}
+
+#[derive(Logos, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[logos(error = LexError)]
+#[logos(skip r"[ \t\r\n\f\u{FEFF}]+")]
+pub enum Token {
+    #[token("scenario")]
+    Scenario,
+    #[token("actor")]
+    Actor,
+    #[token("use")]
+    Use,
+    #[token("unspecified")]
+    Unspecified,
+    #[token("of")]
+    Of,
+    #[token("{")]
+    LBrace,
+    #[token("}")]
+    RBrace,
+    #[token("[")]
+    LBracket,
+    #[token("]")]
+    RBracket,
+    #[token(",")]
+    Comma,
+    #[token(".")]
+    Dot,
+    #[token(":")]
+    Colon,
+    /// A field key: a name followed by `:` on the same line (`weather:`).
+    #[regex(r"[A-Za-z_][A-Za-z0-9_]*[ \t]*:")]
+    Key,
+    #[regex(r"[A-Za-z_][A-Za-z0-9_]*")]
+    Ident,
+    #[regex(r"-?[0-9]+(\.[0-9]+)?")]
+    Number,
+    #[token("km/h")]
+    #[token("mph")]
+    #[token("m/s")]
+    #[token("m", priority = 5)]
+    #[token("s", priority = 5)]
+    Unit,
+    #[token("\"", lex_string)]
+    Str,
+    #[token("\"\"\"", lex_text_block)]
+    TextBlock,
+    #[regex(r"//[^\n]*", allow_greedy = true)]
+    Comment,
+    /// Text the lexer could not match; already reported.
+    Error,
+}
+
+/// Every keyword of the language, with its token. A test round-trips each one.
+pub const KEYWORDS: &[(&str, Token)] = &[
+    ("scenario", Token::Scenario),
+    ("actor", Token::Actor),
+    ("use", Token::Use),
+    ("unspecified", Token::Unspecified),
+    ("of", Token::Of),
+];
+
+/// Every unit the lexer knows.
+pub const UNITS: &[&str] = &["km/h", "mph", "m/s", "m", "s"];
+
+fn lex_string(lex: &mut logos::Lexer<'_, Token>) -> Result<(), LexError> {
+    let rest = lex.remainder();
+    let mut chars = rest.char_indices();
+    while let Some((i, c)) = chars.next() {
+        match c {
+            '"' => {
+                lex.bump(i + 1);
+                return Ok(());
+            }
+            '\\' => match chars.next() {
+                Some((_, '\n')) | None => {
+                    lex.bump(i + 1);
+                    return Err(LexError::UnterminatedString);
+                }
+                Some(_) => {}
+            },
+            '\n' => {
+                lex.bump(i);
+                return Err(LexError::UnterminatedString);
+            }
+            _ => {}
+        }
+    }
+    lex.bump(rest.len());
+    Err(LexError::UnterminatedString)
+}
+
+fn lex_text_block(lex: &mut logos::Lexer<'_, Token>) -> Result<(), LexError> {
+    let rest = lex.remainder();
+    match rest.find("\"\"\"") {
+        Some(i) => {
+            lex.bump(i + 3);
+            Ok(())
+        }
+        None => {
+            lex.bump(rest.len());
+            Err(LexError::UnterminatedTextBlock)
+        }
+    }
+}
+
+/// A token with its byte range, as the parser consumes it.
+pub type Spanned = (usize, Token, usize);
+
+/// The result of lexing one text.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Lexed {
+    /// Tokens without comments; lexical errors appear as [`Token::Error`].
+    pub tokens: Vec<Spanned>,
+    pub comments: Vec<Span>,
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+pub fn lex(src: &str) -> Lexed {
+    let mut out = Lexed::default();
+    let mut lexer = Token::lexer(src);
+    // whether the last token is an unexpected-character error that may grow
+    let mut merging = false;
+    while let Some(result) = lexer.next() {
+        let span = lexer.span();
+        match result {
+            Ok(Token::Comment) => out.comments.push(span.into()),
+            Ok(token) => {
+                merging = false;
+                out.tokens.push((span.start, token, span.end));
+            }
+            Err(LexError::UnexpectedChar) if merging && out.tokens.last().is_some_and(|t| t.2 == span.start) => {
+                // A run of unexpected characters is one token and one diagnostic.
+                if let (Some(token), Some(d)) = (out.tokens.last_mut(), out.diagnostics.last_mut()) {
+                    token.2 = span.end;
+                    d.primary.span.end = span.end;
+                    d.message = format!("unexpected characters `{}`", src[token.0..token.2].escape_debug());
+                }
+            }
+            Err(error) => {
+                merging = error == LexError::UnexpectedChar;
+                out.diagnostics.push(lex_error(src, span.clone().into(), error));
+                out.tokens.push((span.start, Token::Error, span.end));
+            }
+        }
+    }
+    out
+}
+
+fn lex_error(src: &str, span: Span, error: LexError) -> Diagnostic {
+    match error {
+        LexError::UnexpectedChar => {
+            let text = &src[span.start..span.end];
+            let mut d = Diagnostic::new(
+                Code::E0001,
+                format!("unexpected character `{}`", text.escape_debug()),
+                span,
+                "not part of the language",
+            );
+            d = match text {
+                "#" => d.with_help("comments start with `//`"),
+                "=" => d.with_help("fields are written `name: value`").with_fix(span, ":"),
+                ";" => d.with_help("fields need no separator; remove the `;`").with_fix(span, ""),
+                "'" => d.with_help("strings use double quotes: `\"...\"`"),
+                "/" => d.with_help("units are written `km/h`, `mph`, `m/s`, `m` or `s`"),
+                "-" => d.with_help("a negative number is written with no space after `-`, e.g. `-1`"),
+                _ if !text.is_ascii() => d.with_help("names are ASCII letters, digits and `_`; other text belongs in a string"),
+                _ => d,
+            };
+            d
+        }
+        LexError::UnterminatedString => {
+            Diagnostic::new(Code::E0002, "unterminated string", span, "this string has no closing `\"`")
+                .with_help("close the string on the same line; use a `\"\"\"` text block for text over several lines")
+        }
+        LexError::UnterminatedTextBlock => Diagnostic::new(
+            Code::E0003,
+            "unterminated text block",
+            Span::new(span.start, span.start + 3),
+            "this text block is never closed",
+        )
+        .with_help("end the text block with `\"\"\"`"),
+    }
+}
+
+/// Decode the escapes of a string token (quotes included in `raw`). `offset` is the byte
+/// offset of `raw` in the file, for diagnostics.
+pub fn unescape(raw: &str, offset: usize, diagnostics: &mut Vec<Diagnostic>) -> String {
+    let inner = raw.strip_prefix('"').unwrap_or(raw);
+    let inner = inner.strip_suffix('"').unwrap_or(inner);
+    let base = offset + 1;
+    let mut out = String::with_capacity(inner.len());
+    let mut chars = inner.char_indices().peekable();
+    while let Some((i, c)) = chars.next() {
+        if c != '\\' {
+            out.push(c);
+            continue;
+        }
+        let Some((j, e)) = chars.next() else {
+            break;
+        };
+        match e {
+            'n' => out.push('\n'),
+            't' => out.push('\t'),
+            'r' => out.push('\r'),
+            '\\' => out.push('\\'),
+            '"' => out.push('"'),
+            'u' => {
+                // \u{XXXX}
+                let rest = &inner[j + 1..];
+                let decoded = rest
+                    .strip_prefix('{')
+                    .and_then(|r| r.find('}').map(|end| &r[..end]))
+                    .filter(|hex| (1..=6).contains(&hex.len()))
+                    .and_then(|hex| u32::from_str_radix(hex, 16).ok().map(|v| (hex.len(), v)))
+                    .and_then(|(len, v)| char::from_u32(v).map(|c| (len, c)));
+                match decoded {
+                    Some((len, c)) => {
+                        out.push(c);
+                        for _ in 0..len + 2 {
+                            chars.next();
+                        }
+                    }
+                    None => diagnostics.push(
+                        Diagnostic::new(Code::E0004, "invalid unicode escape", Span::new(base + i, base + j + 1), "expected `\\u{...}` with 1 to 6 hex digits of a valid character"),
+                    ),
+                }
+            }
+            other => diagnostics.push(
+                Diagnostic::new(
+                    Code::E0004,
+                    format!("invalid escape `\\{}`", other.escape_debug()),
+                    Span::new(base + i, base + j + other.len_utf8()),
+                    "unknown escape",
+                )
+                .with_help("valid escapes are `\\\"`, `\\\\`, `\\n`, `\\t`, `\\r` and `\\u{...}`; write `\\\\` for a backslash"),
+            ),
+        }
+    }
+    out
+}
+
+/// The content of a `"""` text block: the line break after the opening quotes and the
+/// indentation common to all non-blank lines are removed, as are trailing blank lines.
+pub fn text_block_content(raw: &str) -> String {
+    let inner = raw.strip_prefix("\"\"\"").unwrap_or(raw);
+    let inner = inner.strip_suffix("\"\"\"").unwrap_or(inner);
+    let inner = inner.strip_prefix("\r\n").or_else(|| inner.strip_prefix('\n')).unwrap_or(inner);
+    let lines: Vec<&str> = inner.lines().collect();
+    let indent = lines
+        .iter()
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| l.len() - l.trim_start().len())
+        .min()
+        .unwrap_or(0);
+    let mut out: Vec<&str> = lines.iter().map(|l| if l.len() >= indent { &l[indent..] } else { l.trim_start() }).collect();
+    while out.last().is_some_and(|l| l.trim().is_empty()) {
+        out.pop();
+    }
+    out.iter().map(|l| l.trim_end()).collect::<Vec<_>>().join("\n")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn kinds(src: &str) -> Vec<Token> {
+        lex(src).tokens.into_iter().map(|t| t.1).collect()
+    }
+
+    #[test]
+    fn every_keyword_lexes_as_itself() {
+        for (word, token) in KEYWORDS {
+            assert_eq!(kinds(word), vec![*token], "{word}");
+            // followed by a colon it is a field key
+            assert_eq!(kinds(&format!("{word}:")), vec![Token::Key], "{word}:");
+        }
+        for unit in UNITS {
+            assert_eq!(kinds(unit), vec![Token::Unit], "{unit}");
+        }
+    }
+
+    #[test]
+    fn keys_values_and_units() {
+        use Token::*;
+        assert_eq!(
+            kinds("speed: 38 km/h lane : -2 kind: go_forward"),
+            vec![Key, Number, Unit, Key, Number, Key, Ident]
+        );
+        assert_eq!(kinds("x\n: 1"), vec![Ident, Colon, Number]);
+    }
+
+    #[test]
+    fn comments_are_kept_aside() {
+        let lexed = lex("a // one\n// two\nb");
+        assert_eq!(lexed.tokens.len(), 2);
+        assert_eq!(lexed.comments, vec![Span::new(2, 8), Span::new(9, 15)]);
+    }
+
+    #[test]
+    fn strings_and_text_blocks() {
+        use Token::*;
+        assert_eq!(kinds(r#""a \" b" """x"y""""#), vec![Str, TextBlock]);
+        let lexed = lex("\"open\nnext");
+        assert_eq!(lexed.tokens[0].1, Error);
+        assert_eq!(lexed.diagnostics[0].code, Code::E0002);
+        let lexed = lex("x: \"\"\"never closed");
+        assert_eq!(lexed.diagnostics[0].code, Code::E0003);
+    }
+
+    #[test]
+    fn unexpected_characters_merge_into_one_error() {
+        let lexed = lex("a $%^ b");
+        assert_eq!(lexed.diagnostics.len(), 1);
+        assert_eq!(lexed.diagnostics[0].primary.span, Span::new(2, 5));
+        assert_eq!(lexed.tokens.iter().filter(|t| t.1 == Token::Error).count(), 1);
+        let lexed = lex("é");
+        assert_eq!(lexed.diagnostics[0].primary.span, Span::new(0, 2));
+    }
+
+    #[test]
+    fn escapes() {
+        let mut d = Vec::new();
+        assert_eq!(unescape(r#""a\n\"\\\u{e9}""#, 0, &mut d), "a\n\"\\é");
+        assert!(d.is_empty());
+        unescape(r#""bad \q""#, 10, &mut d);
+        assert_eq!(d[0].code, Code::E0004);
+        assert_eq!(d[0].primary.span, Span::new(15, 17));
+    }
+
+    #[test]
+    fn text_blocks_are_dedented() {
+        let raw = "\"\"\"\n    The ego vehicle\n      turns left.\n    \"\"\"";
+        assert_eq!(text_block_content(raw), "The ego vehicle\n  turns left.");
+    }
+}

@@ -1,0 +1,391 @@
+//! Lowering: the concrete tree to the scenario model, checking structure on the way.
+//!
+//! Structure means what the schema ([`crate::schema`]) says: one scenario per file, known
+//! sections and fields, each once, each value of the kind its field takes, units that fit.
+//! Every problem is a coded diagnostic, and lowering always goes on: a bad field is left
+//! out of the model, a multi-word name is reported and then used joined, so one mistake
+//! does not hide the next.
+
+use crate::cst::{self, Name, Value, words_span};
+use crate::lexer;
+use crate::model::*;
+use crate::schema::{self, FieldDef, SectionDef, Unit, ValueType};
+use crate::suggest;
+use tad_diagnostics::{Code, Diagnostic, Span};
+
+pub fn lower(src: &str, file: &cst::File) -> (Module, Vec<Diagnostic>) {
+    let mut lowerer = Lowerer { src, diagnostics: Vec::new() };
+    let module = lowerer.file(file);
+    (module, lowerer.diagnostics)
+}
+
+struct Lowerer<'a> {
+    src: &'a str,
+    diagnostics: Vec<Diagnostic>,
+}
+
+impl Lowerer<'_> {
+    fn report(&mut self, d: Diagnostic) {
+        self.diagnostics.push(d);
+    }
+
+    fn file(&mut self, file: &cst::File) -> Module {
+        let mut module = Module::default();
+        let mut first: Option<Span> = None;
+        for item in &file.items {
+            match item {
+                cst::Item::Use(u) => module.uses.push(u.clone()),
+                cst::Item::Scenario(s) => match first {
+                    None => {
+                        first = Some(s.keyword);
+                        module.scenario = Some(self.scenario(s));
+                    }
+                    Some(first) => self.report(
+                        Diagnostic::new(Code::E0201, "a file holds one scenario", s.keyword, "a second scenario")
+                            .with_secondary(first, "the file's scenario")
+                            .with_help("move this scenario to a file of its own"),
+                    ),
+                },
+                cst::Item::Error(_) => {}
+            }
+        }
+        let recovered = file.items.iter().any(|i| matches!(i, cst::Item::Error(_)));
+        if first.is_none() && !recovered {
+            let end = self.src.len();
+            self.report(
+                Diagnostic::new(Code::E0200, "no scenario in this file", Span::new(end, end), "the file ends here")
+                    .with_help("a file holds one `scenario NAME { ... }`"),
+            );
+        }
+        module
+    }
+
+    fn scenario(&mut self, s: &cst::Scenario) -> Scenario {
+        if s.name.is_none() {
+            self.report(
+                Diagnostic::new(Code::E0210, "this scenario has no name", s.keyword, "a name goes after `scenario`")
+                    .with_help("write `scenario my_scenario { ... }`")
+                    .with_fix(Span::new(s.keyword.end, s.keyword.end), " unnamed"),
+            );
+        }
+        let mut scenario = Scenario { span: s.span, name: s.name.clone(), sections: Vec::new(), actors: Vec::new() };
+        for member in &s.body.items {
+            match member {
+                cst::Member::Section(section) => self.section(section, &mut scenario),
+                cst::Member::Actor(actor) => {
+                    if let Some(group) = self.actor(actor, &scenario) {
+                        scenario.actors.push(group);
+                    }
+                }
+                cst::Member::Error(_) => {}
+            }
+        }
+        scenario
+    }
+
+    fn section(&mut self, section: &cst::Section, scenario: &mut Scenario) {
+        let name = &section.name;
+        let Some(def) = schema::section(&name.text) else {
+            let mut d = Diagnostic::new(
+                Code::E0202,
+                format!("unknown section `{}`", name.text),
+                name.span,
+                "not a section of a scenario",
+            );
+            if let Some(guess) = suggest::closest(&name.text, schema::SECTIONS.iter().map(|s| s.name)) {
+                d = d.with_help(format!("did you mean `{guess}`?")).with_fix(name.span, guess);
+            } else if ["actors", "actor_group", "npc", "npcs", "agents"].contains(&name.text.as_str()) {
+                d = d.with_help("declare each group as `actor NAME: COUNT TYPE { ... }`");
+            } else {
+                d = d.with_note("the sections are `source`, `environment`, `road` and `ego`; groups are `actor` blocks");
+            }
+            self.report(d);
+            return;
+        };
+        if let Some(previous) = scenario.section(def.name) {
+            let first = previous.name_span;
+            self.report(
+                Diagnostic::new(Code::E0204, format!("section `{}` is given twice", def.name), name.span, "given again here")
+                    .with_secondary(first, "first given here")
+                    .with_help("merge the two sections into one"),
+            );
+            return;
+        }
+        if section.body.items.is_empty() {
+            self.report(
+                Diagnostic::new(Code::W0200, format!("section `{}` is empty", def.name), name.span, "has no fields")
+                    .with_help("remove it, or add its fields")
+                    .with_fix(section.span, ""),
+            );
+        }
+        let attrs = self.fields(def, &section.body.items);
+        scenario.sections.push(Section { def, span: section.span, name_span: name.span, attrs });
+    }
+
+    fn actor(&mut self, actor: &cst::Actor, scenario: &Scenario) -> Option<ActorGroup> {
+        let name = &actor.name;
+        if name.text == "ego" {
+            self.report(
+                Diagnostic::new(Code::E0212, "`ego` is reserved for the ego vehicle", name.span, "cannot name an actor group")
+                    .with_help("describe the ego vehicle in the `ego { ... }` section, or rename this group"),
+            );
+        } else if let Some(previous) = scenario.actor(&name.text) {
+            self.report(
+                Diagnostic::new(Code::E0209, format!("actor group `{}` is declared twice", name.text), name.span, "declared again here")
+                    .with_secondary(previous.name.span, "first declared here")
+                    .with_help("give each group its own name"),
+            );
+            return None;
+        }
+        let count = actor.count.as_ref().and_then(|value| {
+            let span = value.span();
+            let value = match value {
+                Value::Unspecified(_) => Known::Unspecified,
+                Value::Number { number, .. } => Known::Given(self.integer(*number, "count")?),
+                _ => return None,
+            };
+            Some(Spanned { value, span })
+        });
+        let kind_value = match &actor.kind {
+            Value::Words(words) => Known::Given(self.symbol_from_words(words)),
+            _ => Known::Unspecified,
+        };
+        let kind = Spanned { value: kind_value, span: actor.kind.span() };
+        let attrs = self.fields(&schema::ACTOR, &actor.body.items);
+        Some(ActorGroup { span: actor.span, name: name.clone(), count, kind, attrs })
+    }
+
+    fn fields(&mut self, def: &'static SectionDef, entries: &[cst::Entry]) -> Vec<Attr> {
+        let mut attrs: Vec<Attr> = Vec::new();
+        for entry in entries {
+            let cst::Entry::Field(field) = entry else { continue };
+            let key = &field.key;
+            let Some(field_def) = def.field(&key.text) else {
+                self.unknown_field(def, key);
+                continue;
+            };
+            if let Some(previous) = attrs.iter().find(|a| a.def.name == field_def.name) {
+                let first = previous.key_span;
+                self.report(
+                    Diagnostic::new(Code::E0204, format!("field `{}` is given twice", key.text), key.span, "given again here")
+                        .with_secondary(first, "first given here")
+                        .with_help("keep one of the two"),
+                );
+                continue;
+            }
+            if let Some(value) = self.value(field_def, &field.value) {
+                attrs.push(Attr { def: field_def, key_span: key.span, value_span: field.value.span(), value });
+            }
+        }
+        attrs
+    }
+
+    fn unknown_field(&mut self, def: &SectionDef, key: &Name) {
+        let mut d = Diagnostic::new(
+            Code::E0203,
+            format!("unknown field `{}` in `{}`", key.text, def.name),
+            key.span,
+            format!("`{}` has no such field", def.name),
+        );
+        if let Some(guess) = suggest::closest(&key.text, def.fields.iter().map(|f| f.name)) {
+            d = d.with_help(format!("did you mean `{guess}`?")).with_fix(key.span, guess);
+        } else {
+            let owners: Vec<&str> = schema::SECTIONS
+                .iter()
+                .chain([&&schema::ACTOR])
+                .filter(|s| s.field(&key.text).is_some())
+                .map(|s| s.name)
+                .collect();
+            if !owners.is_empty() {
+                d = d.with_help(format!("`{}` belongs in {}", key.text, owners.iter().map(|o| format!("`{o}`")).collect::<Vec<_>>().join(" or ")));
+            } else if def.name == "actor" && ["count", "number", "type", "kind"].contains(&key.text.as_str()) {
+                d = d.with_help("the count and type of a group go in its header: `actor NAME: 3 sedan { ... }`");
+            }
+            let fields: Vec<String> = def.fields.iter().map(|f| format!("`{}`", f.name)).collect();
+            d = d.with_note(format!("the fields of `{}` are {}", def.name, fields.join(", ")));
+        }
+        self.report(d);
+    }
+
+    /// Convert one value to what its field takes; `None` after reporting why not.
+    fn value(&mut self, def: &'static FieldDef, value: &Value) -> Option<Known<Val>> {
+        match value {
+            Value::Unspecified(_) => return Some(Known::Unspecified),
+            Value::Error(_) => return None,
+            _ => {}
+        }
+        let val = match (def.ty, value) {
+            (ValueType::Symbol, Value::Words(words)) => Val::Symbol(self.symbol_from_words(words)),
+            (ValueType::SymbolList, Value::List { items, span }) => Val::Symbols(self.symbol_list(def, items, *span)?),
+            (ValueType::SymbolList, Value::Words(words)) => {
+                let symbol = self.symbol_from_words(words);
+                let span = words_span(words);
+                let none = symbol.name == "none";
+                let (help, fix) = if none {
+                    ("write `[]` for an empty list".to_string(), "[]".to_string())
+                } else {
+                    (format!("write a list: `[{}]`", symbol.name), format!("[{}]", symbol.name))
+                };
+                self.report(
+                    Diagnostic::new(Code::E0208, format!("`{}` takes a list", def.name), span, "a single name")
+                        .with_help(help)
+                        .with_fix(span, fix),
+                );
+                Val::Symbols(if none { Vec::new() } else { vec![symbol] })
+            }
+            (ValueType::Integer, Value::Number { number, unit, span }) => {
+                if let Some(unit) = unit {
+                    self.report(
+                        Diagnostic::new(Code::E0206, format!("`{}` takes no unit", def.name), *unit, "remove this unit")
+                            .with_fix(Span::new(number.end, span.end), ""),
+                    );
+                }
+                Val::Integer(self.integer(*number, def.name)?)
+            }
+            (ValueType::Speed | ValueType::Duration | ValueType::Length, Value::Number { number, unit, .. }) => {
+                Val::Quantity(self.quantity(def, *number, *unit)?)
+            }
+            (ValueType::Text, Value::String(span)) => {
+                Val::Text(lexer::unescape(&self.src[span.start..span.end], span.start, &mut self.diagnostics))
+            }
+            (ValueType::Text, Value::TextBlock(span)) => Val::Text(lexer::text_block_content(&self.src[span.start..span.end])),
+            (ValueType::Position, Value::Position { relation, reference, .. }) => Val::Position(Position {
+                relation: self.symbol_from_words(relation),
+                reference: self.symbol_from_words(reference),
+            }),
+            (ValueType::Position, Value::Words(words)) => {
+                let span = words_span(words);
+                self.report(
+                    Diagnostic::new(Code::E0205, "a position needs a reference", span, "a relation alone")
+                        .with_help(format!("say what it is relative to, e.g. `{} of ego`", join(words)))
+                        .with_fix(Span::new(span.end, span.end), " of ego"),
+                );
+                return None;
+            }
+            (expected, found) => {
+                self.report(
+                    Diagnostic::new(
+                        Code::E0205,
+                        format!("`{}` takes {}, found {}", def.name, expected.describe(), found.describe()),
+                        found.span(),
+                        format!("expected {}", expected.describe()),
+                    )
+                    .with_help(format!("for example `{}: {}`", def.name, def.example)),
+                );
+                return None;
+            }
+        };
+        Some(Known::Given(val))
+    }
+
+    fn symbol_from_words(&mut self, words: &[Name]) -> Symbol {
+        let span = words_span(words);
+        let name = join(words);
+        if words.len() > 1 {
+            self.report(
+                Diagnostic::new(Code::E0207, format!("`{}` is several words", words.iter().map(|w| w.text.as_str()).collect::<Vec<_>>().join(" ")), span, "a name is one word")
+                    .with_help(format!("join the words with `_`: `{name}`"))
+                    .with_fix(span, name.clone()),
+            );
+        }
+        Symbol { name, span }
+    }
+
+    fn symbol_list(&mut self, def: &FieldDef, items: &[Value], span: Span) -> Option<Vec<Symbol>> {
+        let mut symbols: Vec<Symbol> = Vec::new();
+        let mut duplicate = None;
+        for item in items {
+            match item {
+                Value::Words(words) => {
+                    let symbol = self.symbol_from_words(words);
+                    if symbols.iter().any(|s| s.name == symbol.name) {
+                        duplicate.get_or_insert(symbol.span);
+                    } else {
+                        symbols.push(symbol);
+                    }
+                }
+                Value::Error(_) => {}
+                other => self.report(
+                    Diagnostic::new(
+                        Code::E0205,
+                        format!("`{}` lists names, found {}", def.name, other.describe()),
+                        other.span(),
+                        "expected a name",
+                    )
+                    .with_help(format!("for example `{}: {}`", def.name, def.example)),
+                ),
+            }
+        }
+        if let Some(at) = duplicate {
+            let deduped = format!("[{}]", symbols.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", "));
+            self.report(
+                Diagnostic::new(Code::W0201, format!("`{}` lists a name twice", def.name), at, "already listed")
+                    .with_help(format!("write `{deduped}`"))
+                    .with_fix(span, deduped),
+            );
+        }
+        Some(symbols)
+    }
+
+    fn integer(&mut self, number: Span, what: &str) -> Option<i64> {
+        let text = &self.src[number.start..number.end];
+        if let Some((whole, fraction)) = text.split_once('.') {
+            let mut d = Diagnostic::new(Code::E0211, format!("`{what}` takes a whole number, found `{text}`"), number, "not a whole number");
+            if fraction.bytes().all(|b| b == b'0') {
+                d = d.with_help(format!("write `{whole}`")).with_fix(number, whole);
+            }
+            self.report(d);
+            return None;
+        }
+        match text.parse::<i64>() {
+            Ok(n) => Some(n),
+            Err(_) => {
+                self.report(Diagnostic::new(Code::E0005, format!("number `{text}` is out of range"), number, "too large"));
+                None
+            }
+        }
+    }
+
+    fn quantity(&mut self, def: &FieldDef, number: Span, unit: Option<Span>) -> Option<Quantity> {
+        let text = &self.src[number.start..number.end];
+        let value: f64 = match text.parse() {
+            Ok(v) if f64::is_finite(v) => v,
+            _ => {
+                self.report(Diagnostic::new(Code::E0005, format!("number `{text}` is out of range"), number, "too large"));
+                return None;
+            }
+        };
+        let (default, units) = match def.ty {
+            ValueType::Speed => ("km/h", "`km/h`, `mph` and `m/s`"),
+            ValueType::Duration => ("s", "`s`"),
+            _ => ("m", "`m`"),
+        };
+        let Some(unit_span) = unit else {
+            self.report(
+                Diagnostic::new(Code::E0206, format!("`{}` needs a unit", def.name), number, format!("{} without a unit", def.ty.describe()))
+                    .with_help(format!("write `{text} {default}`; the units are {units}"))
+                    .with_fix(Span::new(number.end, number.end), format!(" {default}")),
+            );
+            return None;
+        };
+        let unit_text = &self.src[unit_span.start..unit_span.end];
+        let unit = Unit::parse(unit_text)?;
+        if unit.measures() != def.ty {
+            self.report(
+                Diagnostic::new(
+                    Code::E0206,
+                    format!("`{}` takes {}, but `{unit_text}` measures {}", def.name, def.ty.describe(), unit.measures().describe().trim_start_matches("a ")),
+                    unit_span,
+                    format!("not a unit of {}", def.ty.describe().trim_start_matches("a ")),
+                )
+                .with_help(format!("the units of {} are {units}", def.ty.describe().trim_start_matches("a "))),
+            );
+            return None;
+        }
+        Some(Quantity { value, unit })
+    }
+}
+
+fn join(words: &[Name]) -> String {
+    words.iter().map(|w| w.text.as_str()).collect::<Vec<_>>().join("_")
+}

@@ -1,0 +1,169 @@
+//! The scenario model: what a file means once its structure is known.
+//!
+//! Lowered from the concrete tree by [`crate::lower`]. Every attribute keeps the spans of
+//! its key and value, so later phases (vocabulary checks, completeness, backends) can
+//! point at the source. An attribute is absent (not written), [`Known::Unspecified`]
+//! (written as `unspecified`: explicitly unknown) or given.
+
+use crate::cst::Name;
+use crate::schema::{FieldDef, SectionDef, Unit};
+use tad_diagnostics::Span;
+
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Module {
+    pub uses: Vec<crate::cst::Use>,
+    pub scenario: Option<Scenario>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scenario {
+    pub span: Span,
+    pub name: Option<Name>,
+    pub sections: Vec<Section>,
+    pub actors: Vec<ActorGroup>,
+}
+
+impl Scenario {
+    pub fn section(&self, name: &str) -> Option<&Section> {
+        self.sections.iter().find(|s| s.def.name == name)
+    }
+
+    /// The attribute `field` of section `section`, if written.
+    pub fn attr(&self, section: &str, field: &str) -> Option<&Attr> {
+        self.section(section)?.attr(field)
+    }
+
+    pub fn actor(&self, name: &str) -> Option<&ActorGroup> {
+        self.actors.iter().find(|a| a.name.text == name)
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Section {
+    pub def: &'static SectionDef,
+    pub span: Span,
+    pub name_span: Span,
+    pub attrs: Vec<Attr>,
+}
+
+impl Section {
+    pub fn attr(&self, name: &str) -> Option<&Attr> {
+        self.attrs.iter().find(|a| a.def.name == name)
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct ActorGroup {
+    pub span: Span,
+    pub name: Name,
+    /// `None` when the header gives no count: the group is one actor.
+    pub count: Option<Spanned<Known<i64>>>,
+    pub kind: Spanned<Known<Symbol>>,
+    pub attrs: Vec<Attr>,
+}
+
+impl ActorGroup {
+    pub fn attr(&self, name: &str) -> Option<&Attr> {
+        self.attrs.iter().find(|a| a.def.name == name)
+    }
+
+    /// The number of actors, when known (1 when the header gives none).
+    pub fn count(&self) -> Option<i64> {
+        match &self.count {
+            None => Some(1),
+            Some(Spanned { value: Known::Given(n), .. }) => Some(*n),
+            Some(_) => None,
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct Spanned<T> {
+    pub value: T,
+    pub span: Span,
+}
+
+/// A written value: given, or explicitly `unspecified`.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub enum Known<T> {
+    Given(T),
+    Unspecified,
+}
+
+impl<T> Known<T> {
+    pub fn given(&self) -> Option<&T> {
+        match self {
+            Known::Given(v) => Some(v),
+            Known::Unspecified => None,
+        }
+    }
+}
+
+/// One `field: value` of a section or actor block.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Attr {
+    pub def: &'static FieldDef,
+    pub key_span: Span,
+    pub value_span: Span,
+    pub value: Known<Val>,
+}
+
+impl Attr {
+    pub fn symbol(&self) -> Option<&Symbol> {
+        match &self.value {
+            Known::Given(Val::Symbol(s)) => Some(s),
+            _ => None,
+        }
+    }
+
+    pub fn integer(&self) -> Option<i64> {
+        match &self.value {
+            Known::Given(Val::Integer(n)) => Some(*n),
+            _ => None,
+        }
+    }
+
+    pub fn quantity(&self) -> Option<Quantity> {
+        match &self.value {
+            Known::Given(Val::Quantity(q)) => Some(*q),
+            _ => None,
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Val {
+    Symbol(Symbol),
+    Symbols(Vec<Symbol>),
+    Integer(i64),
+    Quantity(Quantity),
+    Text(String),
+    Position(Position),
+}
+
+/// A name from a vocabulary, as written (`clear`, `go_forward`).
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct Symbol {
+    pub name: String,
+    pub span: Span,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Quantity {
+    pub value: f64,
+    pub unit: Unit,
+}
+
+impl Quantity {
+    /// The value in SI units (m/s, m, s).
+    pub fn si(self) -> f64 {
+        self.value * self.unit.to_si()
+    }
+}
+
+/// `RELATION of REFERENCE`
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct Position {
+    pub relation: Symbol,
+    pub reference: Symbol,
+}

@@ -1,0 +1,197 @@
+//! The parser driver: lex, balance braces, run the lalrpop grammar, and turn every
+//! recovered parse error into a located diagnostic in plain words.
+//!
+//! `parse` is total: it returns a tree for any input (possibly with error nodes) and
+//! never panics. Errors caused by an earlier lexical error or by a brace this pass
+//! closed are not reported twice.
+
+use crate::cst::File;
+use crate::lexer::{self, Spanned, Token};
+use crate::suggest;
+use lalrpop_util::{ErrorRecovery, ParseError};
+use tad_diagnostics::{Code, Diagnostic, LineIndex, Span};
+
+#[allow(clippy::all, clippy::pedantic, unused_parens, unused_qualifications)]
+mod grammar {
+    include!(concat!(env!("OUT_DIR"), "/grammar.rs"));
+}
+
+/// A parsed file: its tree, its comments (for the formatter) and what went wrong.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Parsed {
+    pub file: File,
+    pub comments: Vec<Span>,
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+impl Parsed {
+    pub fn has_errors(&self) -> bool {
+        self.diagnostics.iter().any(Diagnostic::is_error)
+    }
+}
+
+pub fn parse(src: &str) -> Parsed {
+    let lexed = lexer::lex(src);
+    let mut diagnostics = lexed.diagnostics;
+    let mut tokens = lexed.tokens;
+    close_braces(src, &mut tokens, &mut diagnostics);
+
+    let mut errors = Vec::new();
+    let stream = tokens.iter().map(|&t| Ok::<Spanned, ()>(t));
+    let file = match grammar::FileParser::new().parse(src, &mut errors, stream) {
+        Ok(file) => file,
+        Err(error) => {
+            errors.push(ErrorRecovery { error, dropped_tokens: Vec::new() });
+            File::default()
+        }
+    };
+    for recovery in errors {
+        if let Some(d) = parse_error(src, &tokens, recovery.error) {
+            diagnostics.push(d);
+        }
+    }
+    Parsed { file, comments: lexed.comments, diagnostics }
+}
+
+/// Report every `{` left open at the end of the file and close it with an empty `}`
+/// token there, so the tree keeps everything that was parsed.
+fn close_braces(src: &str, tokens: &mut Vec<Spanned>, diagnostics: &mut Vec<Diagnostic>) {
+    let index = LineIndex::new(src);
+    let indent = |offset: usize| {
+        let start = index.line_start(index.line_of(offset));
+        src[start..].len() - src[start..].trim_start_matches([' ', '\t']).len()
+    };
+    let line_leading = |offset: usize| src[index.line_start(index.line_of(offset))..offset].trim().is_empty();
+    let mut open: Vec<usize> = Vec::new();
+    // A `{` that a later, less indented `}` closed: most likely the one missing its `}`.
+    let mut suspect: Option<(usize, usize)> = None;
+    for &(start, token, _) in tokens.iter() {
+        match token {
+            Token::LBrace => open.push(start),
+            Token::RBrace => {
+                if let Some(opened) = open.pop() {
+                    if suspect.is_none() && line_leading(start) && indent(opened) > indent(start) {
+                        suspect = Some((opened, start));
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    let end = src.len();
+    for (i, &opened) in open.iter().enumerate().rev() {
+        let mut d = Diagnostic::new(Code::E0102, "unclosed `{`", Span::new(opened, opened + 1), "this `{` is never closed")
+            .with_secondary(Span::new(end, end), "the file ends here");
+        if let (0, Some((likely, closer))) = (i, suspect) {
+            d = Diagnostic::new(Code::E0102, "unclosed `{`", Span::new(likely, likely + 1), "this `{` is probably missing its `}`")
+                .with_secondary(Span::new(closer, closer + 1), "this `}`, indented like an outer block, closes it instead")
+                .with_secondary(Span::new(opened, opened + 1), "so this `{` is still open at the end of the file");
+        }
+        diagnostics.push(d.with_help("add the missing `}`"));
+        tokens.push((end, Token::RBrace, end));
+    }
+}
+
+fn parse_error(src: &str, tokens: &[Spanned], error: ParseError<usize, Token, ()>) -> Option<Diagnostic> {
+    match error {
+        ParseError::UnrecognizedToken { token: (start, token, end), expected } => {
+            if token == Token::Error || (token == Token::RBrace && start == end) {
+                return None; // reported by the lexer, or by `close_braces`
+            }
+            let span = Span::new(start, end);
+            let found = describe_token(src, token, span);
+            let wanted = expected_words(&expected);
+            let previous = tokens.iter().rev().find(|t| t.2 <= start).map(|t| t.1);
+            let mut d = Diagnostic::new(
+                Code::E0100,
+                format!("expected {wanted}, found {found}"),
+                span,
+                format!("expected {wanted}"),
+            );
+            if previous == Some(Token::Number) && token == Token::Ident {
+                let word = &src[start..end];
+                d.message = format!("unknown unit `{word}`");
+                d.primary.message = "not a unit".into();
+                let guess = match word {
+                    "kmh" | "kph" | "kmph" | "km" => Some("km/h"),
+                    "ms" | "mps" => Some("m/s"),
+                    "sec" | "secs" | "seconds" => Some("s"),
+                    "meter" | "meters" | "metre" | "metres" => Some("m"),
+                    _ => suggest::closest(word, lexer::UNITS.iter().copied()),
+                };
+                d = match guess {
+                    Some(unit) => d.with_help(format!("did you mean `{unit}`?")).with_fix(span, unit),
+                    None => d.with_help("units are `km/h`, `mph`, `m/s`, `m` and `s`"),
+                };
+            } else if token == Token::Key && expected.iter().any(|e| e == "\"actor\"") {
+                d = d.with_help("fields belong inside a section, e.g. `environment { weather: clear }`");
+            } else if token == Token::Colon {
+                d = d.with_help("a field is written `name: value`, the name and `:` on the same line");
+            } else if token == Token::Ident && expected.iter().any(|e| e == "\"{\"") && previous == Some(Token::Ident) {
+                d = d.with_help("names are single words joined with `_`, e.g. `construction_vehicle`");
+            }
+            Some(d)
+        }
+        ParseError::UnrecognizedEof { location, expected } => {
+            let span = Span::new(location.min(src.len()), location.min(src.len()));
+            let wanted = expected_words(&expected);
+            Some(Diagnostic::new(Code::E0101, format!("unexpected end of file, expected {wanted}"), span, format!("expected {wanted}")))
+        }
+        ParseError::ExtraToken { token: (start, token, end) } => {
+            let span = Span::new(start, end);
+            Some(Diagnostic::new(Code::E0100, format!("unexpected {}", describe_token(src, token, span)), span, "not expected here"))
+        }
+        ParseError::InvalidToken { location } => {
+            Some(Diagnostic::new(Code::E0001, "invalid token", Span::new(location, location), "here"))
+        }
+        ParseError::User { .. } => None,
+    }
+}
+
+fn describe_token(src: &str, token: Token, span: Span) -> String {
+    let text = src.get(span.start..span.end).unwrap_or("");
+    match token {
+        Token::Key => format!("field name `{}`", text.trim_end_matches(':').trim_end()),
+        Token::Str => "a string".into(),
+        Token::TextBlock => "a text block".into(),
+        Token::Number => format!("number `{text}`"),
+        _ if span.is_empty() => "end of file".into(),
+        _ => format!("`{text}`"),
+    }
+}
+
+/// The grammar's expected terminals in plain words, most useful first.
+fn expected_words(expected: &[String]) -> String {
+    const VALUE_STARTS: &[&str] = &["Number", "String", "TextBlock", "\"[\"", "Ident", "\"unspecified\"", "Invalid"];
+    let is_value = expected.iter().any(|e| e == "Number") && expected.iter().any(|e| e == "\"[\"");
+    let mut words: Vec<(u8, String)> = Vec::new();
+    if is_value {
+        words.push((2, "a value".into()));
+    }
+    for e in expected {
+        if is_value && VALUE_STARTS.contains(&e.as_str()) {
+            continue;
+        }
+        let word = match e.as_str() {
+            "\"}\"" => (0, "`}`".to_string()),
+            "\"]\"" => (0, "`]`".to_string()),
+            "Key" => (1, "a field name".to_string()),
+            "Ident" => (3, "a name".to_string()),
+            "Number" => (4, "a number".to_string()),
+            "Unit" => (4, "a unit".to_string()),
+            "String" => (4, "a string".to_string()),
+            "TextBlock" => (4, "a text block".to_string()),
+            "Invalid" => continue,
+            quoted => (5, format!("`{}`", quoted.trim_matches('"'))),
+        };
+        words.push(word);
+    }
+    words.sort();
+    words.dedup();
+    let words: Vec<String> = words.into_iter().map(|(_, w)| w).collect();
+    match words.as_slice() {
+        [] => "something else".into(),
+        [one] => one.clone(),
+        [init @ .., last] => format!("{} or {last}", init.join(", ")),
+    }
+}

@@ -1,0 +1,192 @@
+//! The shape of a scenario: which sections exist, which fields each has, and what kind of
+//! value each field takes.
+//!
+//! This table is the single source for lowering (unknown field, wrong kind of value,
+//! "did you mean"), for the formatter's knowledge of lists, and for the field reference in
+//! `spec/language.md` (a test checks they agree). Vocabularies (which names are valid
+//! weather, behaviors, ...) are not here: they are declared in TAD in `stdlib/`.
+
+/// The kind of value a field takes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ValueType {
+    /// One name from a vocabulary: `clear`, `go_forward`.
+    Symbol,
+    /// A list of names: `[stop_sign, school_zone]`; `[]` for none.
+    SymbolList,
+    /// A whole number: `3`, `-1`.
+    Integer,
+    /// A number with a speed unit: `38 km/h`, `20 mph`, `5 m/s`.
+    Speed,
+    /// A number with a time unit: `195 s`.
+    Duration,
+    /// A number with a length unit: `4.5 m`.
+    Length,
+    /// A string or text block.
+    Text,
+    /// `RELATION of REFERENCE`: `left_front of ego`.
+    Position,
+}
+
+impl ValueType {
+    /// "a speed", "a list of names", ... for messages.
+    pub fn describe(self) -> &'static str {
+        match self {
+            ValueType::Symbol => "a name",
+            ValueType::SymbolList => "a list of names",
+            ValueType::Integer => "a whole number",
+            ValueType::Speed => "a speed",
+            ValueType::Duration => "a duration",
+            ValueType::Length => "a length",
+            ValueType::Text => "a string",
+            ValueType::Position => "a position",
+        }
+    }
+}
+
+#[derive(Debug, PartialEq, Eq, Hash)]
+pub struct FieldDef {
+    pub name: &'static str,
+    pub ty: ValueType,
+    /// A valid value, used in help messages.
+    pub example: &'static str,
+    pub doc: &'static str,
+}
+
+#[derive(Debug, PartialEq, Eq, Hash)]
+pub struct SectionDef {
+    pub name: &'static str,
+    pub doc: &'static str,
+    pub fields: &'static [FieldDef],
+}
+
+impl SectionDef {
+    pub fn field(&self, name: &str) -> Option<&'static FieldDef> {
+        self.fields.iter().find(|f| f.name == name)
+    }
+}
+
+macro_rules! field {
+    ($name:literal, $ty:ident, $example:literal, $doc:literal) => {
+        FieldDef { name: $name, ty: ValueType::$ty, example: $example, doc: $doc }
+    };
+}
+
+pub const SOURCE: SectionDef = SectionDef {
+    name: "source",
+    doc: "where the scenario comes from",
+    fields: &[
+        field!("video", Text, "\"la_014.mp4\"", "the source video file"),
+        field!("time", Duration, "195 s", "the timestamp of the frame in the video"),
+        field!("frame", Integer, "4680", "the frame number in the video, when no timestamp is known"),
+        field!("region", Symbol, "los_angeles", "the region the video was recorded in"),
+        field!("description", Text, "\"\"\" ... \"\"\"", "the natural-language description the scenario was made from"),
+    ],
+};
+
+pub const ENVIRONMENT: SectionDef = SectionDef {
+    name: "environment",
+    doc: "weather and time of day",
+    fields: &[
+        field!("weather", Symbol, "clear", "the weather"),
+        field!("time", Symbol, "daytime", "the time of day"),
+    ],
+};
+
+pub const ROAD: SectionDef = SectionDef {
+    name: "road",
+    doc: "the road network around the ego vehicle",
+    fields: &[
+        field!("type", Symbol, "straight_road", "the road type"),
+        field!("context", Symbol, "urban", "the road context"),
+        field!("lanes", Integer, "2", "lanes per direction"),
+        field!("direction", Symbol, "two_way", "`one_way` or `two_way`"),
+        field!("special_lanes", SymbolList, "[bike_lane]", "special lanes; `[]` for none"),
+        field!("signs", SymbolList, "[stop_sign]", "traffic signs; `[]` for none"),
+        field!("light", Symbol, "green", "the traffic light state facing the ego vehicle; `none` for no light"),
+        field!("traffic", Symbol, "light", "traffic density"),
+        field!("hazards", SymbolList, "[accident]", "accidents and other hazards; `[]` for none"),
+        field!("roadworks", SymbolList, "[lane_closure]", "roadworks and lane closures; `[]` for none"),
+        field!("emergency_vehicles", SymbolList, "[ambulance]", "emergency vehicles present; `[]` for none"),
+        field!("roadside", SymbolList, "[sidewalk, trees]", "what lines the road"),
+    ],
+};
+
+pub const EGO: SectionDef = SectionDef {
+    name: "ego",
+    doc: "the ego vehicle",
+    fields: &[
+        field!("behavior", Symbol, "go_forward", "what the ego vehicle does"),
+        field!("speed", Speed, "30 km/h", "its speed"),
+        field!("lane", Integer, "1", "its lane index: 1 is the leftmost lane in its direction"),
+    ],
+};
+
+/// The fields of an `actor` block (count and type are in its header).
+pub const ACTOR: SectionDef = SectionDef {
+    name: "actor",
+    doc: "a group of actors of one type that move together",
+    fields: &[
+        field!("behavior", Symbol, "go_forward", "what every actor of the group does"),
+        field!("speed", Speed, "30 km/h", "their speed"),
+        field!("position", Position, "front of ego", "where the group is, relative to a reference"),
+        field!("lane", Integer, "1", "their lane index; negative for the opposite direction"),
+    ],
+};
+
+/// The sections a scenario may contain, in canonical order.
+pub const SECTIONS: &[&SectionDef] = &[&SOURCE, &ENVIRONMENT, &ROAD, &EGO];
+
+pub fn section(name: &str) -> Option<&'static SectionDef> {
+    SECTIONS.iter().copied().find(|s| s.name == name)
+}
+
+/// Physical units, by the quantity they measure.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Unit {
+    KilometresPerHour,
+    MilesPerHour,
+    MetresPerSecond,
+    Metres,
+    Seconds,
+}
+
+impl Unit {
+    pub fn parse(text: &str) -> Option<Unit> {
+        Some(match text {
+            "km/h" => Unit::KilometresPerHour,
+            "mph" => Unit::MilesPerHour,
+            "m/s" => Unit::MetresPerSecond,
+            "m" => Unit::Metres,
+            "s" => Unit::Seconds,
+            _ => return None,
+        })
+    }
+
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Unit::KilometresPerHour => "km/h",
+            Unit::MilesPerHour => "mph",
+            Unit::MetresPerSecond => "m/s",
+            Unit::Metres => "m",
+            Unit::Seconds => "s",
+        }
+    }
+
+    /// The value type this unit measures.
+    pub fn measures(self) -> ValueType {
+        match self {
+            Unit::KilometresPerHour | Unit::MilesPerHour | Unit::MetresPerSecond => ValueType::Speed,
+            Unit::Metres => ValueType::Length,
+            Unit::Seconds => ValueType::Duration,
+        }
+    }
+
+    /// Multiply by this to get SI units (m/s, m, s).
+    pub fn to_si(self) -> f64 {
+        match self {
+            Unit::KilometresPerHour => 1000.0 / 3600.0,
+            Unit::MilesPerHour => 1609.344 / 3600.0,
+            Unit::MetresPerSecond | Unit::Metres | Unit::Seconds => 1.0,
+        }
+    }
+}
