@@ -37,9 +37,11 @@ codes! {
     E0003 => Error,
     E0004 => Error,
     E0005 => Error,
+    E0006 => Error,
     E0100 => Error,
     E0101 => Error,
     E0102 => Error,
+    E0103 => Error,
     E0200 => Error,
     E0201 => Error,
     E0202 => Error,
@@ -61,11 +63,7 @@ impl Code {
     /// Parse `E0203` (case-insensitive; `0203` and `203` mean the error code).
     pub fn parse(text: &str) -> Option<Code> {
         let text = text.trim().to_ascii_uppercase();
-        let full = if text.starts_with('E') || text.starts_with('W') {
-            text
-        } else {
-            format!("E{:0>4}", text)
-        };
+        let full = if text.starts_with('E') || text.starts_with('W') { text } else { format!("E{:0>4}", text) };
         Code::ALL.iter().copied().find(|c| c.as_str() == full)
     }
 

@@ -67,6 +67,10 @@ pub enum Token {
     Comment,
     /// Text the lexer could not match; already reported.
     Error,
+    /// A name directly followed by `{`: the head of a block (`road {`, `actor a: bus {`).
+    /// Not produced by logos: [`lex`] turns such an [`Token::Ident`] into this, so that
+    /// a stray name is never mistaken for the start of a section during error recovery.
+    Head,
 }
 
 /// Every keyword of the language, with its token. A test round-trips each one.
@@ -162,6 +166,11 @@ pub fn lex(src: &str) -> Lexed {
             }
         }
     }
+    for i in 1..out.tokens.len() {
+        if out.tokens[i].1 == Token::LBrace && out.tokens[i - 1].1 == Token::Ident {
+            out.tokens[i - 1].1 = Token::Head;
+        }
+    }
     out
 }
 
@@ -182,7 +191,9 @@ fn lex_error(src: &str, span: Span, error: LexError) -> Diagnostic {
                 "'" => d.with_help("strings use double quotes: `\"...\"`"),
                 "/" => d.with_help("units are written `km/h`, `mph`, `m/s`, `m` or `s`"),
                 "-" => d.with_help("a negative number is written with no space after `-`, e.g. `-1`"),
-                _ if !text.is_ascii() => d.with_help("names are ASCII letters, digits and `_`; other text belongs in a string"),
+                _ if !text.is_ascii() => {
+                    d.with_help("names are ASCII letters, digits and `_`; other text belongs in a string")
+                }
                 _ => d,
             };
             d
@@ -265,13 +276,10 @@ pub fn text_block_content(raw: &str) -> String {
     let inner = inner.strip_suffix("\"\"\"").unwrap_or(inner);
     let inner = inner.strip_prefix("\r\n").or_else(|| inner.strip_prefix('\n')).unwrap_or(inner);
     let lines: Vec<&str> = inner.lines().collect();
-    let indent = lines
-        .iter()
-        .filter(|l| !l.trim().is_empty())
-        .map(|l| l.len() - l.trim_start().len())
-        .min()
-        .unwrap_or(0);
-    let mut out: Vec<&str> = lines.iter().map(|l| if l.len() >= indent { &l[indent..] } else { l.trim_start() }).collect();
+    let indent =
+        lines.iter().filter(|l| !l.trim().is_empty()).map(|l| l.len() - l.trim_start().len()).min().unwrap_or(0);
+    let mut out: Vec<&str> =
+        lines.iter().map(|l| if l.len() >= indent { &l[indent..] } else { l.trim_start() }).collect();
     while out.last().is_some_and(|l| l.trim().is_empty()) {
         out.pop();
     }
@@ -306,6 +314,7 @@ mod tests {
             vec![Key, Number, Unit, Key, Number, Key, Ident]
         );
         assert_eq!(kinds("x\n: 1"), vec![Ident, Colon, Number]);
+        assert_eq!(kinds("actor a: big bus {}"), vec![Actor, Key, Ident, Head, LBrace, RBrace]);
     }
 
     #[test]

@@ -97,7 +97,8 @@ impl Lowerer<'_> {
             } else if ["actors", "actor_group", "npc", "npcs", "agents"].contains(&name.text.as_str()) {
                 d = d.with_help("declare each group as `actor NAME: COUNT TYPE { ... }`");
             } else {
-                d = d.with_note("the sections are `source`, `environment`, `road` and `ego`; groups are `actor` blocks");
+                d = d
+                    .with_note("the sections are `source`, `environment`, `road` and `ego`; groups are `actor` blocks");
             }
             self.report(d);
             return;
@@ -105,9 +106,14 @@ impl Lowerer<'_> {
         if let Some(previous) = scenario.section(def.name) {
             let first = previous.name_span;
             self.report(
-                Diagnostic::new(Code::E0204, format!("section `{}` is given twice", def.name), name.span, "given again here")
-                    .with_secondary(first, "first given here")
-                    .with_help("merge the two sections into one"),
+                Diagnostic::new(
+                    Code::E0204,
+                    format!("section `{}` is given twice", def.name),
+                    name.span,
+                    "given again here",
+                )
+                .with_secondary(first, "first given here")
+                .with_help("merge the two sections into one"),
             );
             return;
         }
@@ -126,14 +132,24 @@ impl Lowerer<'_> {
         let name = &actor.name;
         if name.text == "ego" {
             self.report(
-                Diagnostic::new(Code::E0212, "`ego` is reserved for the ego vehicle", name.span, "cannot name an actor group")
-                    .with_help("describe the ego vehicle in the `ego { ... }` section, or rename this group"),
+                Diagnostic::new(
+                    Code::E0212,
+                    "`ego` is reserved for the ego vehicle",
+                    name.span,
+                    "cannot name an actor group",
+                )
+                .with_help("describe the ego vehicle in the `ego { ... }` section, or rename this group"),
             );
         } else if let Some(previous) = scenario.actor(&name.text) {
             self.report(
-                Diagnostic::new(Code::E0209, format!("actor group `{}` is declared twice", name.text), name.span, "declared again here")
-                    .with_secondary(previous.name.span, "first declared here")
-                    .with_help("give each group its own name"),
+                Diagnostic::new(
+                    Code::E0209,
+                    format!("actor group `{}` is declared twice", name.text),
+                    name.span,
+                    "declared again here",
+                )
+                .with_secondary(previous.name.span, "first declared here")
+                .with_help("give each group its own name"),
             );
             return None;
         }
@@ -158,7 +174,9 @@ impl Lowerer<'_> {
     fn fields(&mut self, def: &'static SectionDef, entries: &[cst::Entry]) -> Vec<Attr> {
         let mut attrs: Vec<Attr> = Vec::new();
         for entry in entries {
-            let cst::Entry::Field(field) = entry else { continue };
+            let cst::Entry::Field(field) = entry else {
+                continue;
+            };
             let key = &field.key;
             let Some(field_def) = def.field(&key.text) else {
                 self.unknown_field(def, key);
@@ -167,9 +185,14 @@ impl Lowerer<'_> {
             if let Some(previous) = attrs.iter().find(|a| a.def.name == field_def.name) {
                 let first = previous.key_span;
                 self.report(
-                    Diagnostic::new(Code::E0204, format!("field `{}` is given twice", key.text), key.span, "given again here")
-                        .with_secondary(first, "first given here")
-                        .with_help("keep one of the two"),
+                    Diagnostic::new(
+                        Code::E0204,
+                        format!("field `{}` is given twice", key.text),
+                        key.span,
+                        "given again here",
+                    )
+                    .with_secondary(first, "first given here")
+                    .with_help("keep one of the two"),
                 );
                 continue;
             }
@@ -187,7 +210,11 @@ impl Lowerer<'_> {
             key.span,
             format!("`{}` has no such field", def.name),
         );
-        if let Some(guess) = suggest::closest(&key.text, def.fields.iter().map(|f| f.name)) {
+        let alias = schema::FIELD_ALIASES
+            .iter()
+            .find(|(from, to)| *from == key.text && def.field(to).is_some())
+            .map(|(_, to)| *to);
+        if let Some(guess) = alias.or_else(|| suggest::closest(&key.text, def.fields.iter().map(|f| f.name))) {
             d = d.with_help(format!("did you mean `{guess}`?")).with_fix(key.span, guess);
         } else {
             let owners: Vec<&str> = schema::SECTIONS
@@ -196,10 +223,14 @@ impl Lowerer<'_> {
                 .filter(|s| s.field(&key.text).is_some())
                 .map(|s| s.name)
                 .collect();
-            if !owners.is_empty() {
-                d = d.with_help(format!("`{}` belongs in {}", key.text, owners.iter().map(|o| format!("`{o}`")).collect::<Vec<_>>().join(" or ")));
-            } else if def.name == "actor" && ["count", "number", "type", "kind"].contains(&key.text.as_str()) {
+            if def.name == "actor" && ["count", "number", "type", "kind"].contains(&key.text.as_str()) {
                 d = d.with_help("the count and type of a group go in its header: `actor NAME: 3 sedan { ... }`");
+            } else if !owners.is_empty() {
+                d = d.with_help(format!(
+                    "`{}` belongs in {}",
+                    key.text,
+                    owners.iter().map(|o| format!("`{o}`")).collect::<Vec<_>>().join(" or ")
+                ));
             }
             let fields: Vec<String> = def.fields.iter().map(|f| format!("`{}`", f.name)).collect();
             d = d.with_note(format!("the fields of `{}` are {}", def.name, fields.join(", ")));
@@ -236,8 +267,13 @@ impl Lowerer<'_> {
             (ValueType::Integer, Value::Number { number, unit, span }) => {
                 if let Some(unit) = unit {
                     self.report(
-                        Diagnostic::new(Code::E0206, format!("`{}` takes no unit", def.name), *unit, "remove this unit")
-                            .with_fix(Span::new(number.end, span.end), ""),
+                        Diagnostic::new(
+                            Code::E0206,
+                            format!("`{}` takes no unit", def.name),
+                            *unit,
+                            "remove this unit",
+                        )
+                        .with_fix(Span::new(number.end, span.end), ""),
                     );
                 }
                 Val::Integer(self.integer(*number, def.name)?)
@@ -248,7 +284,9 @@ impl Lowerer<'_> {
             (ValueType::Text, Value::String(span)) => {
                 Val::Text(lexer::unescape(&self.src[span.start..span.end], span.start, &mut self.diagnostics))
             }
-            (ValueType::Text, Value::TextBlock(span)) => Val::Text(lexer::text_block_content(&self.src[span.start..span.end])),
+            (ValueType::Text, Value::TextBlock(span)) => {
+                Val::Text(lexer::text_block_content(&self.src[span.start..span.end]))
+            }
             (ValueType::Position, Value::Position { relation, reference, .. }) => Val::Position(Position {
                 relation: self.symbol_from_words(relation),
                 reference: self.symbol_from_words(reference),
@@ -283,9 +321,17 @@ impl Lowerer<'_> {
         let name = join(words);
         if words.len() > 1 {
             self.report(
-                Diagnostic::new(Code::E0207, format!("`{}` is several words", words.iter().map(|w| w.text.as_str()).collect::<Vec<_>>().join(" ")), span, "a name is one word")
-                    .with_help(format!("join the words with `_`: `{name}`"))
-                    .with_fix(span, name.clone()),
+                Diagnostic::new(
+                    Code::E0207,
+                    format!(
+                        "`{}` is several words",
+                        words.iter().map(|w| w.text.as_str()).collect::<Vec<_>>().join(" ")
+                    ),
+                    span,
+                    "a name is one word",
+                )
+                .with_help(format!("join the words with `_`: `{name}`"))
+                .with_fix(span, name.clone()),
             );
         }
         Symbol { name, span }
@@ -330,7 +376,12 @@ impl Lowerer<'_> {
     fn integer(&mut self, number: Span, what: &str) -> Option<i64> {
         let text = &self.src[number.start..number.end];
         if let Some((whole, fraction)) = text.split_once('.') {
-            let mut d = Diagnostic::new(Code::E0211, format!("`{what}` takes a whole number, found `{text}`"), number, "not a whole number");
+            let mut d = Diagnostic::new(
+                Code::E0211,
+                format!("`{what}` takes a whole number, found `{text}`"),
+                number,
+                "not a whole number",
+            );
             if fraction.bytes().all(|b| b == b'0') {
                 d = d.with_help(format!("write `{whole}`")).with_fix(number, whole);
             }
@@ -340,7 +391,12 @@ impl Lowerer<'_> {
         match text.parse::<i64>() {
             Ok(n) => Some(n),
             Err(_) => {
-                self.report(Diagnostic::new(Code::E0005, format!("number `{text}` is out of range"), number, "too large"));
+                self.report(Diagnostic::new(
+                    Code::E0005,
+                    format!("number `{text}` is out of range"),
+                    number,
+                    "too large",
+                ));
                 None
             }
         }
@@ -351,7 +407,12 @@ impl Lowerer<'_> {
         let value: f64 = match text.parse() {
             Ok(v) if f64::is_finite(v) => v,
             _ => {
-                self.report(Diagnostic::new(Code::E0005, format!("number `{text}` is out of range"), number, "too large"));
+                self.report(Diagnostic::new(
+                    Code::E0005,
+                    format!("number `{text}` is out of range"),
+                    number,
+                    "too large",
+                ));
                 return None;
             }
         };
@@ -362,9 +423,14 @@ impl Lowerer<'_> {
         };
         let Some(unit_span) = unit else {
             self.report(
-                Diagnostic::new(Code::E0206, format!("`{}` needs a unit", def.name), number, format!("{} without a unit", def.ty.describe()))
-                    .with_help(format!("write `{text} {default}`; the units are {units}"))
-                    .with_fix(Span::new(number.end, number.end), format!(" {default}")),
+                Diagnostic::new(
+                    Code::E0206,
+                    format!("`{}` needs a unit", def.name),
+                    number,
+                    format!("{} without a unit", def.ty.describe()),
+                )
+                .with_help(format!("write `{text} {default}`; the units are {units}"))
+                .with_fix(Span::new(number.end, number.end), format!(" {default}")),
             );
             return None;
         };
@@ -374,7 +440,12 @@ impl Lowerer<'_> {
             self.report(
                 Diagnostic::new(
                     Code::E0206,
-                    format!("`{}` takes {}, but `{unit_text}` measures {}", def.name, def.ty.describe(), unit.measures().describe().trim_start_matches("a ")),
+                    format!(
+                        "`{}` takes {}, but `{unit_text}` measures {}",
+                        def.name,
+                        def.ty.describe(),
+                        unit.measures().describe().trim_start_matches("a ")
+                    ),
                     unit_span,
                     format!("not a unit of {}", def.ty.describe().trim_start_matches("a ")),
                 )

@@ -5,7 +5,7 @@
 //! never panics. Errors caused by an earlier lexical error or by a brace this pass
 //! closed are not reported twice.
 
-use crate::cst::File;
+use crate::cst::{Entry, Field, File, Item, Member, Value};
 use crate::lexer::{self, Spanned, Token};
 use crate::suggest;
 use lalrpop_util::{ErrorRecovery, ParseError};
@@ -34,7 +34,10 @@ pub fn parse(src: &str) -> Parsed {
     let lexed = lexer::lex(src);
     let mut diagnostics = lexed.diagnostics;
     let mut tokens = lexed.tokens;
-    close_braces(src, &mut tokens, &mut diagnostics);
+    // An unterminated text block swallowed the rest of the file, closing braces included:
+    // saying so once is enough.
+    let swallowed = diagnostics.iter().any(|d| d.code == Code::E0003);
+    close_braces(src, &mut tokens, &mut diagnostics, !swallowed);
 
     let mut errors = Vec::new();
     let stream = tokens.iter().map(|&t| Ok::<Spanned, ()>(t));
@@ -45,17 +48,101 @@ pub fn parse(src: &str) -> Parsed {
             File::default()
         }
     };
-    for recovery in errors {
-        if let Some(d) = parse_error(src, &tokens, recovery.error) {
-            diagnostics.push(d);
+    let mut file = file;
+    let mut syntax: Vec<Diagnostic> = errors.into_iter().filter_map(|r| parse_error(src, &tokens, r.error)).collect();
+    let missing_colons = split_words_at_line_breaks(src, &mut file);
+    // What follows a missing `:` on its line is a consequence of it.
+    let index = LineIndex::new(src);
+    syntax.retain(|d| {
+        !missing_colons.iter().any(|m| {
+            d.primary.span.start > m.primary.span.start
+                && index.line_of(d.primary.span.start) == index.line_of(m.primary.span.start)
+        })
+    });
+    drop_values_with_unknown_units(src, &mut file, &syntax);
+    diagnostics.extend(missing_colons);
+    diagnostics.extend(syntax);
+    Parsed { file, comments: lexed.comments, diagnostics }
+}
+
+/// Words of a value that continue on the next line are almost always the next field
+/// with its `:` forgotten (`weather: clear` / `time daytime`). Report that, and cut the
+/// value at the line break, so the rest is not taken as one long name.
+fn split_words_at_line_breaks(src: &str, file: &mut File) -> Vec<Diagnostic> {
+    let mut diagnostics = Vec::new();
+    let mut split = |words: &mut Vec<crate::cst::Name>| {
+        let Some(i) = (1..words.len()).find(|&i| src[words[i - 1].span.end..words[i].span.start].contains('\n')) else {
+            return;
+        };
+        let key = &words[i];
+        diagnostics.push(
+            Diagnostic::new(
+                Code::E0103,
+                format!("missing `:` after `{}`", key.text),
+                key.span,
+                "a field name needs a `:`",
+            )
+            .with_help(format!("write `{}: ...`", key.text))
+            .with_fix(Span::new(key.span.end, key.span.end), ":"),
+        );
+        words.truncate(i);
+    };
+    for field in fields_mut(file) {
+        match &mut field.value {
+            Value::Words(words) => split(words),
+            Value::Position { reference, span, .. } => {
+                split(reference);
+                span.end = crate::cst::words_span(reference).end;
+            }
+            _ => {}
+        }
+        field.span.end = field.value.span().end;
+    }
+    diagnostics
+}
+
+/// `speed: 30 kmh` is reported as an unknown unit; the value is then an error node, so it
+/// is not reported again as a speed without a unit.
+fn drop_values_with_unknown_units(src: &str, file: &mut File, syntax: &[Diagnostic]) {
+    let units: Vec<Span> = syntax
+        .iter()
+        .filter(|d| d.message.starts_with("unknown unit") || d.message.starts_with("exponent"))
+        .map(|d| d.primary.span)
+        .collect();
+    for field in fields_mut(file) {
+        if let Value::Number { number, unit: None, .. } = field.value
+            && let Some(bad) =
+                units.iter().find(|u| u.start >= number.end && src[number.end..u.start].trim().is_empty())
+        {
+            field.value = Value::Error(number.to(*bad));
         }
     }
-    Parsed { file, comments: lexed.comments, diagnostics }
+}
+
+/// Every field of every section and actor block.
+fn fields_mut(file: &mut File) -> impl Iterator<Item = &mut Field> {
+    file.items
+        .iter_mut()
+        .filter_map(|item| match item {
+            Item::Scenario(scenario) => Some(&mut scenario.body.items),
+            _ => None,
+        })
+        .flatten()
+        .filter_map(|member| match member {
+            Member::Section(section) => Some(&mut section.body.items),
+            Member::Actor(actor) => Some(&mut actor.body.items),
+            Member::Error(_) => None,
+        })
+        .flatten()
+        .filter_map(|entry| match entry {
+            Entry::Field(field) => Some(field),
+            Entry::Error(_) => None,
+        })
 }
 
 /// Report every `{` left open at the end of the file and close it with an empty `}`
 /// token there, so the tree keeps everything that was parsed.
-fn close_braces(src: &str, tokens: &mut Vec<Spanned>, diagnostics: &mut Vec<Diagnostic>) {
+fn close_braces(src: &str, tokens: &mut Vec<Spanned>, diagnostics: &mut Vec<Diagnostic>, report: bool) {
     let index = LineIndex::new(src);
     let indent = |offset: usize| {
         let start = index.line_start(index.line_of(offset));
@@ -69,10 +156,12 @@ fn close_braces(src: &str, tokens: &mut Vec<Spanned>, diagnostics: &mut Vec<Diag
         match token {
             Token::LBrace => open.push(start),
             Token::RBrace => {
-                if let Some(opened) = open.pop() {
-                    if suspect.is_none() && line_leading(start) && indent(opened) > indent(start) {
-                        suspect = Some((opened, start));
-                    }
+                if let Some(opened) = open.pop()
+                    && suspect.is_none()
+                    && line_leading(start)
+                    && indent(opened) > indent(start)
+                {
+                    suspect = Some((opened, start));
                 }
             }
             _ => {}
@@ -80,14 +169,22 @@ fn close_braces(src: &str, tokens: &mut Vec<Spanned>, diagnostics: &mut Vec<Diag
     }
     let end = src.len();
     for (i, &opened) in open.iter().enumerate().rev() {
-        let mut d = Diagnostic::new(Code::E0102, "unclosed `{`", Span::new(opened, opened + 1), "this `{` is never closed")
-            .with_secondary(Span::new(end, end), "the file ends here");
+        let mut d =
+            Diagnostic::new(Code::E0102, "unclosed `{`", Span::new(opened, opened + 1), "this `{` is never closed")
+                .with_secondary(Span::new(end, end), "the file ends here");
         if let (0, Some((likely, closer))) = (i, suspect) {
-            d = Diagnostic::new(Code::E0102, "unclosed `{`", Span::new(likely, likely + 1), "this `{` is probably missing its `}`")
-                .with_secondary(Span::new(closer, closer + 1), "this `}`, indented like an outer block, closes it instead")
-                .with_secondary(Span::new(opened, opened + 1), "so this `{` is still open at the end of the file");
+            d = Diagnostic::new(
+                Code::E0102,
+                "unclosed `{`",
+                Span::new(likely, likely + 1),
+                "this `{` is probably missing its `}`",
+            )
+            .with_secondary(Span::new(closer, closer + 1), "this `}`, indented like an outer block, closes it instead")
+            .with_secondary(Span::new(opened, opened + 1), "so this `{` is still open at the end of the file");
         }
-        diagnostics.push(d.with_help("add the missing `}`"));
+        if report {
+            diagnostics.push(d.with_help("add the missing `}`"));
+        }
         tokens.push((end, Token::RBrace, end));
     }
 }
@@ -97,6 +194,10 @@ fn parse_error(src: &str, tokens: &[Spanned], error: ParseError<usize, Token, ()
         ParseError::UnrecognizedToken { token: (start, token, end), expected } => {
             if token == Token::Error || (token == Token::RBrace && start == end) {
                 return None; // reported by the lexer, or by `close_braces`
+            }
+            let next = tokens.iter().find(|t| t.0 >= end).map(|t| t.1);
+            if next == Some(Token::Error) {
+                return None; // `lanes = 2`: the lexer's report of `=` says what is wrong
             }
             let span = Span::new(start, end);
             let found = describe_token(src, token, span);
@@ -112,6 +213,12 @@ fn parse_error(src: &str, tokens: &[Spanned], error: ParseError<usize, Token, ()
                 let word = &src[start..end];
                 d.message = format!("unknown unit `{word}`");
                 d.primary.message = "not a unit".into();
+                if word.starts_with(['e', 'E']) && word[1..].bytes().all(|b| b.is_ascii_digit()) && word.len() > 1 {
+                    return Some(
+                        Diagnostic::new(Code::E0100, "exponent notation is not supported", span, "an exponent")
+                            .with_help("write the number in full, e.g. `1000` instead of `1e3`"),
+                    );
+                }
                 let guess = match word {
                     "kmh" | "kph" | "kmph" | "km" => Some("km/h"),
                     "ms" | "mps" => Some("m/s"),
@@ -125,21 +232,36 @@ fn parse_error(src: &str, tokens: &[Spanned], error: ParseError<usize, Token, ()
                 };
             } else if token == Token::Key && expected.iter().any(|e| e == "\"actor\"") {
                 d = d.with_help("fields belong inside a section, e.g. `environment { weather: clear }`");
+            } else if token == Token::Unit && expected.iter().any(|e| e == "Ident" || e == "Head") {
+                d = d.with_help(format!("`{}` is a unit and cannot be a name; choose another name", &src[start..end]));
+            } else if token == Token::Head && expected.iter().any(|e| e == "Key") {
+                d = d.with_help(format!(
+                    "a block cannot be inside a section; is the `}}` of the section missing before `{}`?",
+                    &src[start..end]
+                ));
             } else if token == Token::Colon {
                 d = d.with_help("a field is written `name: value`, the name and `:` on the same line");
-            } else if token == Token::Ident && expected.iter().any(|e| e == "\"{\"") && previous == Some(Token::Ident) {
-                d = d.with_help("names are single words joined with `_`, e.g. `construction_vehicle`");
             }
             Some(d)
         }
         ParseError::UnrecognizedEof { location, expected } => {
             let span = Span::new(location.min(src.len()), location.min(src.len()));
             let wanted = expected_words(&expected);
-            Some(Diagnostic::new(Code::E0101, format!("unexpected end of file, expected {wanted}"), span, format!("expected {wanted}")))
+            Some(Diagnostic::new(
+                Code::E0101,
+                format!("unexpected end of file, expected {wanted}"),
+                span,
+                format!("expected {wanted}"),
+            ))
         }
         ParseError::ExtraToken { token: (start, token, end) } => {
             let span = Span::new(start, end);
-            Some(Diagnostic::new(Code::E0100, format!("unexpected {}", describe_token(src, token, span)), span, "not expected here"))
+            Some(Diagnostic::new(
+                Code::E0100,
+                format!("unexpected {}", describe_token(src, token, span)),
+                span,
+                "not expected here",
+            ))
         }
         ParseError::InvalidToken { location } => {
             Some(Diagnostic::new(Code::E0001, "invalid token", Span::new(location, location), "here"))
@@ -177,6 +299,8 @@ fn expected_words(expected: &[String]) -> String {
             "\"]\"" => (0, "`]`".to_string()),
             "Key" => (1, "a field name".to_string()),
             "Ident" => (3, "a name".to_string()),
+            "Head" if expected.iter().any(|e| e == "\"actor\"") => (3, "a section".to_string()),
+            "Head" => (3, "a name".to_string()),
             "Number" => (4, "a number".to_string()),
             "Unit" => (4, "a unit".to_string()),
             "String" => (4, "a string".to_string()),

@@ -86,10 +86,7 @@ pub const SOURCE: SectionDef = SectionDef {
 pub const ENVIRONMENT: SectionDef = SectionDef {
     name: "environment",
     doc: "weather and time of day",
-    fields: &[
-        field!("weather", Symbol, "clear", "the weather"),
-        field!("time", Symbol, "daytime", "the time of day"),
-    ],
+    fields: &[field!("weather", Symbol, "clear", "the weather"), field!("time", Symbol, "daytime", "the time of day")],
 };
 
 pub const ROAD: SectionDef = SectionDef {
@@ -132,6 +129,31 @@ pub const ACTOR: SectionDef = SectionDef {
         field!("lane", Integer, "1", "their lane index; negative for the opposite direction"),
     ],
 };
+
+/// Field names other notations use (TrafficAlign's YAML, TrafficComposer's IR) and the
+/// TAD field each means, for suggestions.
+pub const FIELD_ALIASES: &[(&str, &str)] = &[
+    ("lane_number", "lanes"),
+    ("lane_num", "lanes"),
+    ("num_lanes", "lanes"),
+    ("road_type", "type"),
+    ("road_context", "context"),
+    ("traffic_sign", "signs"),
+    ("traffic_signs", "signs"),
+    ("traffic_light", "light"),
+    ("special_lane", "special_lanes"),
+    ("one_way_or_two_way", "direction"),
+    ("lane_index", "lane"),
+    ("lane_idx", "lane"),
+    ("position_relation", "position"),
+    ("position_target", "position"),
+    ("relation", "position"),
+    ("time_of_day", "time"),
+    ("current_behavior", "behavior"),
+    ("behaviour", "behavior"),
+    ("velocity", "speed"),
+    ("density", "traffic"),
+];
 
 /// The sections a scenario may contain, in canonical order.
 pub const SECTIONS: &[&SectionDef] = &[&SOURCE, &ENVIRONMENT, &ROAD, &EGO];

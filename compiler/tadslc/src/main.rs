@@ -1,1 +1,94 @@
-fn main() {}
+//! `tadslc`, the TADSL compiler command line.
+//!
+//! This crate owns everything the core crates must not do: reading and writing files,
+//! the terminal, exit codes. Each subcommand lives in its own module and returns an
+//! [`ExitCode`]-like status; `main` only parses arguments and dispatches.
+//!
+//! Exit codes: 0 success, 1 the input has errors (or warnings with `--deny-warnings`, or
+//! unformatted files with `fmt --check`), 2 usage or I/O failure.
+
+use clap::{Parser, Subcommand, ValueEnum};
+use std::path::PathBuf;
+use std::process::ExitCode;
+use tadslc::{Format, bench, check, explain, fmt};
+
+#[derive(Parser)]
+#[command(name = "tadslc", version, about = "The TADSL compiler: check, format and explain traffic scenarios")]
+struct Cli {
+    /// When to colour terminal output (default: on a terminal, unless NO_COLOR is set)
+    #[arg(long, value_enum, global = true, default_value_t = Color::Auto)]
+    color: Color,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Check scenario files and report every problem
+    Check {
+        /// Files or directories (searched recursively for *.tad); `-` reads standard input
+        #[arg(required = true)]
+        paths: Vec<PathBuf>,
+        /// Output format
+        #[arg(long, value_enum, default_value_t = Format::Human)]
+        format: Format,
+        /// Treat warnings as errors for the exit code
+        #[arg(long)]
+        deny_warnings: bool,
+    },
+    /// Format scenario files in place in the canonical layout
+    Fmt {
+        /// Files or directories; `-` formats standard input to standard output
+        #[arg(required = true)]
+        paths: Vec<PathBuf>,
+        /// Change nothing; exit 1 if any file is not formatted
+        #[arg(long)]
+        check: bool,
+    },
+    /// Explain a diagnostic code, e.g. `tadslc explain E0203`
+    Explain {
+        /// The code; omit it to list every code
+        code: Option<String>,
+    },
+    /// Measure check throughput on a generated corpus and on the examples
+    Bench {
+        /// Number of generated scenarios
+        #[arg(long, default_value_t = 10_000)]
+        scenarios: usize,
+        /// Seed of the corpus generator
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Directory of real scenarios to measure as well
+        #[arg(long)]
+        examples: Option<PathBuf>,
+        /// Timed repetitions of each measurement (the best is reported)
+        #[arg(long, default_value_t = 5)]
+        runs: usize,
+    },
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum Color {
+    Auto,
+    Always,
+    Never,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let color = match cli.color {
+        Color::Always => true,
+        Color::Never => false,
+        Color::Auto => {
+            use std::io::IsTerminal;
+            std::env::var_os("NO_COLOR").is_none_or(|v| v.is_empty()) && std::io::stderr().is_terminal()
+        }
+    };
+    let status = match cli.command {
+        Command::Check { paths, format, deny_warnings } => check::run(&paths, format, deny_warnings, color),
+        Command::Fmt { paths, check } => fmt::run(&paths, check, color),
+        Command::Explain { code } => explain::run(code.as_deref()),
+        Command::Bench { scenarios, seed, examples, runs } => bench::run(scenarios, seed, examples.as_deref(), runs),
+    };
+    status.into()
+}

@@ -2,7 +2,9 @@
 
 use super::FileReport;
 use crate::{Diagnostic, Severity};
-use codespan_reporting::diagnostic::{Diagnostic as CsDiagnostic, Label as CsLabel, LabelStyle, Severity as CsSeverity};
+use codespan_reporting::diagnostic::{
+    Diagnostic as CsDiagnostic, Label as CsLabel, LabelStyle, Severity as CsSeverity,
+};
 use codespan_reporting::files::SimpleFile;
 use codespan_reporting::term::{self, Config, termcolor};
 
@@ -43,9 +45,12 @@ fn convert(d: &Diagnostic, len: usize) -> CsDiagnostic<()> {
         Severity::Error => CsSeverity::Error,
         Severity::Warning => CsSeverity::Warning,
     };
-    let mut labels = vec![CsLabel::new(LabelStyle::Primary, (), clamp(d.primary.span, len)).with_message(&d.primary.message)];
+    let mut labels =
+        vec![CsLabel::new(LabelStyle::Primary, (), clamp(d.primary.span, len)).with_message(&d.primary.message)];
     labels.extend(
-        d.secondary.iter().map(|l| CsLabel::new(LabelStyle::Secondary, (), clamp(l.span, len)).with_message(&l.message)),
+        d.secondary
+            .iter()
+            .map(|l| CsLabel::new(LabelStyle::Secondary, (), clamp(l.span, len)).with_message(&l.message)),
     );
     let mut notes = d.notes.clone();
     if let Some(help) = &d.help {

@@ -1,0 +1,77 @@
+//! `tadslc fmt`: rewrite files in the canonical layout, or check that they are.
+
+use crate::Status;
+use crate::files;
+use tad_diagnostics::render::{FileReport, human};
+
+pub fn run(paths: &[std::path::PathBuf], check: bool, color: bool) -> Status {
+    let (files, io_errors) = files::collect(paths);
+    let mut status = Status::Ok;
+    for error in &io_errors {
+        eprintln!("error: {error}");
+        status = Status::Usage;
+    }
+    let mut unformatted = 0;
+    for path in &files {
+        let input = match files::read(path) {
+            Ok(input) => input,
+            Err(e) => {
+                eprintln!("error: {e}");
+                status = Status::Usage;
+                continue;
+            }
+        };
+        if input.invalid_utf8.is_some() {
+            eprintln!("error: `{}` is not valid UTF-8; not formatted", input.name);
+            status = status.max(Status::Failed);
+            continue;
+        }
+        let formatted = match tad_syntax::format::format(&input.text) {
+            Ok(formatted) => formatted,
+            Err(diagnostics) => {
+                let report = FileReport { name: &input.name, text: &input.text, diagnostics: &diagnostics };
+                eprint!("{}", human::render(&report, color));
+                eprintln!("error: `{}` has syntax errors; not formatted", input.name);
+                status = status.max(Status::Failed);
+                continue;
+            }
+        };
+        let Some(target) = &input.path else {
+            print!("{formatted}");
+            continue;
+        };
+        if formatted == input.text {
+            continue;
+        }
+        unformatted += 1;
+        if check {
+            let line = first_difference(&input.text, &formatted);
+            eprintln!("{}: not formatted (first difference at line {line})", input.name);
+            status = status.max(Status::Failed);
+        } else if let Err(e) = write_atomically(target, &formatted) {
+            eprintln!("error: cannot write `{}`: {e}", input.name);
+            status = Status::Usage;
+        } else {
+            eprintln!("formatted {}", input.name);
+        }
+    }
+    if check && unformatted > 0 {
+        eprintln!("{unformatted} of {} files would be reformatted; run `tadslc fmt` on them", files.len());
+    }
+    status
+}
+
+fn first_difference(a: &str, b: &str) -> usize {
+    a.lines().zip(b.lines()).position(|(x, y)| x != y).unwrap_or_else(|| a.lines().count().min(b.lines().count())) + 1
+}
+
+/// Write through a temporary file beside the target, so a failure never truncates it.
+fn write_atomically(path: &std::path::Path, text: &str) -> std::io::Result<()> {
+    let mut tmp = path.as_os_str().to_owned();
+    tmp.push(".tadslc-fmt.tmp");
+    let tmp = std::path::PathBuf::from(tmp);
+    std::fs::write(&tmp, text)?;
+    std::fs::rename(&tmp, path).inspect_err(|_| {
+        let _ = std::fs::remove_file(&tmp);
+    })
+}

@@ -1,0 +1,33 @@
+//! The `tadslc` library: the command line's subcommands, shared with its tests.
+//!
+//! Exit codes: 0 success, 1 the input has errors (or warnings with `--deny-warnings`, or
+//! unformatted files with `fmt --check`), 2 usage or I/O failure.
+
+pub mod bench;
+pub mod check;
+pub mod corpus;
+pub mod explain;
+pub mod files;
+pub mod fmt;
+
+/// Output format of `check`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Format {
+    Human,
+    Json,
+    Sarif,
+}
+
+/// Exit statuses, in increasing precedence.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Status {
+    Ok = 0,
+    Failed = 1,
+    Usage = 2,
+}
+
+impl From<Status> for std::process::ExitCode {
+    fn from(status: Status) -> Self {
+        std::process::ExitCode::from(status as u8)
+    }
+}
