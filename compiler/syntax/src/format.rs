@@ -37,6 +37,7 @@ pub fn format_parsed(src: &str, parsed: &Parsed) -> String {
         last_end: 0,
         line_open: false,
         block_start: true,
+        force_blank: false,
     };
     printer.file(&parsed.file);
     printer.out
@@ -55,6 +56,8 @@ struct Printer<'a> {
     line_open: bool,
     /// Nothing printed yet in the current block: no blank line before the first line.
     block_start: bool,
+    /// The next line is preceded by a blank line.
+    force_blank: bool,
 }
 
 impl Printer<'_> {
@@ -88,9 +91,10 @@ impl Printer<'_> {
             self.out.push('\n');
         }
         let gap = self.src.get(self.last_end..start).unwrap_or("");
-        if allow_blank && !self.block_start && gap.matches('\n').count() >= 2 {
+        if self.force_blank || (allow_blank && !self.block_start && gap.matches('\n').count() >= 2) {
             self.out.push('\n');
         }
+        self.force_blank = false;
         self.block_start = false;
         for _ in 0..self.depth {
             self.out.push_str(INDENT);
@@ -107,7 +111,7 @@ impl Printer<'_> {
     }
 
     fn file(&mut self, file: &cst::File) {
-        for item in &file.items {
+        for (index, item) in file.items.iter().enumerate() {
             match item {
                 Item::Use(u) => {
                     self.start(u.span, u.span.end);
@@ -117,21 +121,9 @@ impl Printer<'_> {
                     self.last_end = u.span.end;
                 }
                 Item::Scenario(s) => {
-                    self.comments_before(s.span.start);
-                    if !self.out.is_empty() && !self.out.ends_with("\n\n") {
-                        // a blank line before the scenario, whatever the source had
-                        self.out.push('\n');
-                        self.line_open = true;
-                        self.block_start = false;
-                        self.last_end = self.last_end.min(s.span.start);
-                        self.comments_before(s.body.open.end);
-                        self.out.push('\n');
-                        for _ in 0..self.depth {
-                            self.out.push_str(INDENT);
-                        }
-                    } else {
-                        self.start(s.span, s.body.open.end);
-                    }
+                    // a blank line separates the scenario from the items before it
+                    self.force_blank = index > 0;
+                    self.start(s.span, s.body.open.end);
                     self.out.push_str("scenario");
                     if let Some(name) = &s.name {
                         self.out.push(' ');
@@ -280,7 +272,7 @@ mod tests {
         let out = fmt(src);
         assert_eq!(
             out,
-            "// head\n\nscenario demo { // open\n  road {\n    lanes: 2 // two\n    // before light\n    light: green\n  }\n  // end\n} // tail\n// last\n"
+            "// head\nscenario demo { // open\n  road {\n    lanes: 2 // two\n    // before light\n    light: green\n  }\n  // end\n} // tail\n// last\n"
         );
         assert_eq!(fmt(&out), out);
     }
@@ -291,6 +283,12 @@ mod tests {
         let out = fmt(src);
         assert_eq!(out, "scenario demo {\n  road {\n    // first\n    signs: [stop_sign, yield_sign]\n  }\n}\n");
         assert_eq!(fmt(&out), out);
+    }
+
+    #[test]
+    fn a_comment_stays_attached_to_the_scenario_after_it() {
+        assert_eq!(fmt("// about\nscenario demo {\n}\n"), "// about\nscenario demo {\n}\n");
+        assert_eq!(fmt("use x\n// about\nscenario demo {}"), "use x\n\n// about\nscenario demo {\n}\n");
     }
 
     #[test]

@@ -1,0 +1,177 @@
+//! The command line as a user runs it: exit codes, output formats, files and stdin.
+
+mod common;
+use common::*;
+use serde_json::Value;
+
+const CLEAN: &str = "scenario demo {\n  ego {\n    speed: 30 km/h\n  }\n}\n";
+const WARNING_ONLY: &str = "scenario demo {\n  environment {\n  }\n}\n";
+
+#[test]
+fn three_separate_syntax_errors_give_three_located_coded_errors() {
+    let out = tadslc(&["check", "--format", "json", "tests/ui/parse/three_errors.tad"], "");
+    assert_eq!(code(&out), 1);
+    let file: Value = serde_json::from_str(stdout(&out).trim()).expect("one JSON object");
+    let diagnostics = file["diagnostics"].as_array().expect("diagnostics");
+    let lines: Vec<(u64, &str)> = diagnostics
+        .iter()
+        .map(|d| (d["span"]["start"]["line"].as_u64().unwrap(), d["code"].as_str().unwrap()))
+        .collect();
+    assert_eq!(lines, vec![(5, "E0100"), (9, "E0100"), (15, "E0100")]);
+}
+
+#[test]
+fn json_output_has_the_documented_shape() {
+    let out = tadslc(&["check", "--format", "json", "tests/ui/structure/unknown_field.tad", "-"], CLEAN);
+    assert_eq!(code(&out), 1);
+    let lines: Vec<Value> = stdout(&out).lines().map(|l| serde_json::from_str(l).expect("valid JSON line")).collect();
+    assert_eq!(lines.len(), 2, "one object per file");
+    assert_eq!(lines[1]["file"], "<stdin>");
+    assert_eq!(lines[1]["diagnostics"].as_array().map(Vec::len), Some(0));
+    let d = &lines[0]["diagnostics"][0];
+    for key in ["code", "severity", "message", "span", "label", "labels", "notes", "help", "fixes"] {
+        assert!(d.get(key).is_some(), "missing `{key}` in {d}");
+    }
+    assert_eq!(d["code"], "E0203");
+    assert_eq!(d["severity"], "error");
+    assert_eq!(d["span"]["start"], serde_json::json!({"line": 3, "column": 5}));
+    assert_eq!(d["span"]["end"], serde_json::json!({"line": 3, "column": 11}));
+    let (start, end) = (d["span"]["byte_start"].as_u64().unwrap(), d["span"]["byte_end"].as_u64().unwrap());
+    let text = std::fs::read_to_string(repo().join("tests/ui/structure/unknown_field.tad")).unwrap();
+    assert_eq!(&text[start as usize..end as usize], "wether");
+    assert_eq!(d["fixes"][0]["replacement"], "weather");
+    assert_eq!(d["help"], "did you mean `weather`?");
+}
+
+#[test]
+fn sarif_output_is_a_valid_sarif_log() {
+    let out = tadslc(&["check", "--format", "sarif", "tests/ui/structure"], "");
+    assert_eq!(code(&out), 1);
+    let log: Value = serde_json::from_str(&stdout(&out)).expect("one JSON document");
+    assert_eq!(log["version"], "2.1.0");
+    let run = &log["runs"][0];
+    assert_eq!(run["tool"]["driver"]["name"], "tadslc");
+    let rules = run["tool"]["driver"]["rules"].as_array().unwrap();
+    let results = run["results"].as_array().unwrap();
+    assert!(results.len() > 20);
+    for result in results {
+        let index = result["ruleIndex"].as_u64().unwrap() as usize;
+        assert_eq!(rules[index]["id"], result["ruleId"], "ruleIndex points at the rule");
+        assert!(matches!(result["level"].as_str(), Some("error" | "warning")));
+        let region = &result["locations"][0]["physicalLocation"]["region"];
+        assert!(region["startLine"].as_u64().unwrap() >= 1 && region["startColumn"].as_u64().unwrap() >= 1);
+        let uri = result["locations"][0]["physicalLocation"]["artifactLocation"]["uri"].as_str().unwrap();
+        assert!(uri.starts_with("tests/ui/structure/") && uri.ends_with(".tad"), "{uri}");
+    }
+    assert!(rules.iter().all(|r| !r["shortDescription"]["text"].as_str().unwrap().is_empty()));
+}
+
+#[test]
+fn exit_codes() {
+    assert_eq!(code(&tadslc(&["check", "-"], CLEAN)), 0);
+    assert_eq!(code(&tadslc(&["check", "-"], "scenario {")), 1);
+    // warnings pass unless denied
+    assert_eq!(code(&tadslc(&["check", "-"], WARNING_ONLY)), 0);
+    assert_eq!(code(&tadslc(&["check", "--deny-warnings", "-"], WARNING_ONLY)), 1);
+    // usage and I/O failures
+    assert_eq!(code(&tadslc(&[], "")), 2);
+    assert_eq!(code(&tadslc(&["check"], "")), 2);
+    assert_eq!(code(&tadslc(&["check", "--format", "xml", "-"], CLEAN)), 2);
+    let out = tadslc(&["check", "no/such/file.tad", "-"], CLEAN);
+    assert_eq!(code(&out), 2);
+    assert!(stderr(&out).contains("cannot read `no/such/file.tad`"));
+    assert!(stderr(&out).contains("checked 1 file: no problems"), "the other file is still checked");
+}
+
+#[test]
+fn human_output_is_coloured_only_when_asked_or_on_a_terminal() {
+    let plain = tadslc(&["check", "tests/ui/structure/unknown_field.tad"], "");
+    assert!(!stderr(&plain).contains('\u{1b}'), "not a terminal: no escapes");
+    assert!(stderr(&plain).contains("error[E0203]: unknown field `wether` in `environment`"));
+    assert!(stderr(&plain).contains("checked 1 file: 5 errors"));
+    let coloured = tadslc(&["check", "--color", "always", "tests/ui/structure/unknown_field.tad"], "");
+    assert!(stderr(&coloured).contains('\u{1b}'));
+}
+
+#[test]
+fn invalid_utf8_is_a_located_error() {
+    let out = tadslc(&["check", "--format", "json", "tests/ui/lex/not_utf8.tad"], "");
+    assert_eq!(code(&out), 1);
+    let file: Value = serde_json::from_str(stdout(&out).trim()).unwrap();
+    assert_eq!(file["diagnostics"][0]["code"], "E0006");
+    assert_eq!(file["diagnostics"][0]["span"]["start"]["line"], 1);
+}
+
+#[test]
+fn explain_prints_every_code_and_rejects_unknown_ones() {
+    for code_ in tad_diagnostics::Code::ALL {
+        let out = tadslc(&["explain", code_.as_str()], "");
+        assert_eq!(code(&out), 0, "{code_}");
+        let text = stdout(&out);
+        assert!(text.starts_with(&format!("{code_} {}", code_.title())), "{text}");
+        assert!(text.contains("```"), "{code_} shows examples");
+    }
+    assert!(stdout(&tadslc(&["explain", "e0203"], "")).starts_with("E0203 unknown field"));
+    let list = stdout(&tadslc(&["explain"], ""));
+    assert_eq!(list.lines().count(), tad_diagnostics::Code::ALL.len());
+    assert_eq!(code(&tadslc(&["explain", "E9999"], "")), 2);
+}
+
+#[test]
+fn fmt_rewrites_checks_and_never_touches_broken_files() {
+    let dir = scratch("fmt");
+    let messy = dir.join("messy.tad");
+    let broken = dir.join("broken.tad");
+    std::fs::write(&messy, "scenario demo { ego { speed:30 km/h } } // end\n").unwrap();
+    std::fs::write(&broken, "scenario demo { ego { speed: ] } }\n").unwrap();
+    let dir_arg = dir.to_str().unwrap();
+
+    let out = tadslc(&["fmt", "--check", dir_arg], "");
+    assert_eq!(code(&out), 1);
+    assert!(stderr(&out).contains("messy.tad: not formatted"));
+    assert_eq!(std::fs::read_to_string(&messy).unwrap(), "scenario demo { ego { speed:30 km/h } } // end\n");
+
+    let out = tadslc(&["fmt", dir_arg], "");
+    assert_eq!(code(&out), 1, "the broken file fails");
+    assert_eq!(
+        std::fs::read_to_string(&messy).unwrap(),
+        "scenario demo {\n  ego {\n    speed: 30 km/h\n  }\n} // end\n"
+    );
+    assert_eq!(std::fs::read_to_string(&broken).unwrap(), "scenario demo { ego { speed: ] } }\n");
+    assert!(stderr(&out).contains("has syntax errors; not formatted"));
+
+    std::fs::remove_file(&broken).unwrap();
+    assert_eq!(code(&tadslc(&["fmt", "--check", dir_arg], "")), 0);
+    // standard input is formatted to standard output
+    let out = tadslc(&["fmt", "-"], "scenario  demo{}");
+    assert_eq!((code(&out), stdout(&out).as_str()), (0, "scenario demo {\n}\n"));
+}
+
+#[test]
+fn directories_are_searched_recursively_for_tad_files() {
+    let dir = scratch("walk");
+    std::fs::create_dir_all(dir.join("a/b")).unwrap();
+    std::fs::create_dir_all(dir.join(".hidden")).unwrap();
+    std::fs::write(dir.join("a/b/one.tad"), CLEAN).unwrap();
+    std::fs::write(dir.join("a/two.tad"), CLEAN).unwrap();
+    std::fs::write(dir.join("a/notes.txt"), "not a scenario").unwrap();
+    std::fs::write(dir.join(".hidden/three.tad"), "broken {").unwrap();
+    let out = tadslc(&["check", "--format", "json", dir.to_str().unwrap()], "");
+    assert_eq!(code(&out), 0);
+    let files: Vec<String> = stdout(&out)
+        .lines()
+        .map(|l| serde_json::from_str::<Value>(l).unwrap()["file"].as_str().unwrap().to_string())
+        .collect();
+    assert_eq!(files.len(), 2);
+    assert!(files[0].ends_with("a/b/one.tad") && files[1].ends_with("a/two.tad"), "{files:?}");
+}
+
+#[test]
+fn bench_reports_throughput_against_the_peer() {
+    let out = tadslc(&["bench", "--scenarios", "50", "--runs", "1", "--examples", "tests/ui/fmt"], "");
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    let text = stdout(&out);
+    for row in ["peer: serde_json::Value", "lex", "check (lex+parse+lower)", "fmt (parse+print)", "check examples"] {
+        assert!(text.contains(row), "{row} missing from\n{text}");
+    }
+}
