@@ -55,6 +55,11 @@ codes! {
     E0210 => Error,
     E0211 => Error,
     E0212 => Error,
+    E0213 => Error,
+    E0214 => Error,
+    // YAML import (3xx): add codes below this line
+    // end of YAML codes
+    // names and vocabulary (4xx), semantics (5xx), completeness (6xx)
     W0200 => Warning,
     W0201 => Warning,
 }

@@ -36,6 +36,7 @@ pub struct File {
 pub enum Item {
     Use(Use),
     Scenario(Scenario),
+    Declaration(Declaration),
     Error(Span),
 }
 
@@ -44,6 +45,7 @@ impl Item {
         match self {
             Item::Use(u) => u.span,
             Item::Scenario(s) => s.span,
+            Item::Declaration(d) => d.span,
             Item::Error(span) => *span,
         }
     }
@@ -54,6 +56,16 @@ impl Item {
 pub struct Use {
     pub span: Span,
     pub path: Vec<Name>,
+}
+
+/// A vocabulary declaration: `KIND NAME` or `KIND NAME { FIELD* }`,
+/// e.g. `weather clear { aliases: [sunny] }`.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct Declaration {
+    pub span: Span,
+    pub kind: Name,
+    pub name: Name,
+    pub body: Option<Body<Entry>>,
 }
 
 /// `scenario NAME { MEMBER* }`

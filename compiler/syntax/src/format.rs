@@ -131,6 +131,16 @@ impl Printer<'_> {
                     }
                     self.body(&s.body, |p, member| p.member(member));
                 }
+                Item::Declaration(d) => {
+                    let head_end = d.body.as_ref().map_or(d.span.end, |b| b.open.end);
+                    self.start(d.span, head_end);
+                    let head = format!("{} {}", d.kind.text, d.name.text);
+                    self.out.push_str(&head);
+                    match &d.body {
+                        Some(body) => self.body(body, |p, entry| p.entry(entry)),
+                        None => self.last_end = d.span.end,
+                    }
+                }
                 Item::Error(span) => self.verbatim(*span),
             }
         }

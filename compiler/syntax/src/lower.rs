@@ -46,10 +46,15 @@ impl Lowerer<'_> {
                             .with_help("move this scenario to a file of its own"),
                     ),
                 },
+                cst::Item::Declaration(d) => {
+                    if let Some(declaration) = self.declaration(d, &module.declarations) {
+                        module.declarations.push(declaration);
+                    }
+                }
                 cst::Item::Error(_) => {}
             }
         }
-        let recovered = file.items.iter().any(|i| matches!(i, cst::Item::Error(_)));
+        let recovered = file.items.iter().any(|i| matches!(i, cst::Item::Error(_) | cst::Item::Declaration(_)));
         if first.is_none() && !recovered {
             let end = self.src.len();
             self.report(
@@ -58,6 +63,43 @@ impl Lowerer<'_> {
             );
         }
         module
+    }
+
+    fn declaration(&mut self, d: &cst::Declaration, previous: &[Declaration]) -> Option<Declaration> {
+        let Some(def) = schema::declaration(&d.kind.text) else {
+            let mut diagnostic = Diagnostic::new(
+                Code::E0213,
+                format!("unknown declaration kind `{}`", d.kind.text),
+                d.kind.span,
+                "not a kind of declaration",
+            );
+            let candidates = schema::DECLARATIONS.iter().map(|k| k.name).chain(["scenario", "use"]);
+            if let Some(guess) = suggest::closest(&d.kind.text, candidates) {
+                diagnostic = diagnostic.with_help(format!("did you mean `{guess}`?")).with_fix(d.kind.span, guess);
+            } else {
+                diagnostic = diagnostic.with_note("declarations are written `KIND NAME { ... }`; the kinds are listed in spec/vocabulary.md");
+            }
+            self.report(diagnostic);
+            return None;
+        };
+        if let Some(first) = previous.iter().find(|p| p.def.name == def.name && p.name.text == d.name.text) {
+            self.report(
+                Diagnostic::new(
+                    Code::E0214,
+                    format!("{} `{}` is declared twice", def.name, d.name.text),
+                    d.name.span,
+                    "declared again here",
+                )
+                .with_secondary(first.name.span, "first declared here")
+                .with_help("remove one of the declarations"),
+            );
+            return None;
+        }
+        let attrs = match &d.body {
+            Some(body) => self.fields(def, &body.items),
+            None => Vec::new(),
+        };
+        Some(Declaration { def, span: d.span, name: d.name.clone(), attrs })
     }
 
     fn scenario(&mut self, s: &cst::Scenario) -> Scenario {
@@ -263,6 +305,9 @@ impl Lowerer<'_> {
                         .with_fix(span, fix),
                 );
                 Val::Symbols(if none { Vec::new() } else { vec![symbol] })
+            }
+            (ValueType::Flag, Value::Words(words)) if words.len() == 1 && matches!(words[0].text.as_str(), "yes" | "no") => {
+                Val::Flag(words[0].text == "yes")
             }
             (ValueType::Integer, Value::Number { number, unit, span }) => {
                 if let Some(unit) = unit {

@@ -12,7 +12,23 @@ use tad_diagnostics::Span;
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Module {
     pub uses: Vec<crate::cst::Use>,
+    pub declarations: Vec<Declaration>,
     pub scenario: Option<Scenario>,
+}
+
+/// `KIND NAME { FIELD* }`: one name of a vocabulary.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Declaration {
+    pub def: &'static SectionDef,
+    pub span: Span,
+    pub name: Name,
+    pub attrs: Vec<Attr>,
+}
+
+impl Declaration {
+    pub fn attr(&self, name: &str) -> Option<&Attr> {
+        self.attrs.iter().find(|a| a.def.name == name)
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -123,6 +139,20 @@ impl Attr {
         }
     }
 
+    pub fn flag(&self) -> Option<bool> {
+        match &self.value {
+            Known::Given(Val::Flag(b)) => Some(*b),
+            _ => None,
+        }
+    }
+
+    pub fn symbols(&self) -> Option<&[Symbol]> {
+        match &self.value {
+            Known::Given(Val::Symbols(s)) => Some(s),
+            _ => None,
+        }
+    }
+
     pub fn quantity(&self) -> Option<Quantity> {
         match &self.value {
             Known::Given(Val::Quantity(q)) => Some(*q),
@@ -139,6 +169,7 @@ pub enum Val {
     Quantity(Quantity),
     Text(String),
     Position(Position),
+    Flag(bool),
 }
 
 /// A name from a vocabulary, as written (`clear`, `go_forward`).

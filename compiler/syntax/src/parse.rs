@@ -121,18 +121,24 @@ fn drop_values_with_unknown_units(src: &str, file: &mut File, syntax: &[Diagnost
 
 /// Every field of every section and actor block.
 fn fields_mut(file: &mut File) -> impl Iterator<Item = &mut Field> {
-    file.items
-        .iter_mut()
-        .filter_map(|item| match item {
-            Item::Scenario(scenario) => Some(&mut scenario.body.items),
-            _ => None,
-        })
-        .flatten()
-        .filter_map(|member| match member {
-            Member::Section(section) => Some(&mut section.body.items),
-            Member::Actor(actor) => Some(&mut actor.body.items),
-            Member::Error(_) => None,
-        })
+    let mut blocks: Vec<&mut Vec<Entry>> = Vec::new();
+    for item in &mut file.items {
+        match item {
+            Item::Declaration(d) => blocks.extend(d.body.as_mut().map(|b| &mut b.items)),
+            Item::Scenario(scenario) => {
+                for member in &mut scenario.body.items {
+                    match member {
+                        Member::Section(section) => blocks.push(&mut section.body.items),
+                        Member::Actor(actor) => blocks.push(&mut actor.body.items),
+                        Member::Error(_) => {}
+                    }
+                }
+            }
+            Item::Use(_) | Item::Error(_) => {}
+        }
+    }
+    blocks
+        .into_iter()
         .flatten()
         .filter_map(|entry| match entry {
             Entry::Field(field) => Some(field),

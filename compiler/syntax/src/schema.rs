@@ -25,6 +25,8 @@ pub enum ValueType {
     Text,
     /// `RELATION of REFERENCE`: `left_front of ego`.
     Position,
+    /// `yes` or `no`.
+    Flag,
 }
 
 impl ValueType {
@@ -39,6 +41,7 @@ impl ValueType {
             ValueType::Length => "a length",
             ValueType::Text => "a string",
             ValueType::Position => "a position",
+            ValueType::Flag => "`yes` or `no`",
         }
     }
 }
@@ -47,6 +50,8 @@ impl ValueType {
 pub struct FieldDef {
     pub name: &'static str,
     pub ty: ValueType,
+    /// The vocabulary (declaration kind) its names come from, for name fields.
+    pub vocabulary: Option<&'static str>,
     /// A valid value, used in help messages.
     pub example: &'static str,
     pub doc: &'static str,
@@ -67,7 +72,10 @@ impl SectionDef {
 
 macro_rules! field {
     ($name:literal, $ty:ident, $example:literal, $doc:literal) => {
-        FieldDef { name: $name, ty: ValueType::$ty, example: $example, doc: $doc }
+        FieldDef { name: $name, ty: ValueType::$ty, vocabulary: None, example: $example, doc: $doc }
+    };
+    ($name:literal, $ty:ident in $vocabulary:literal, $example:literal, $doc:literal) => {
+        FieldDef { name: $name, ty: ValueType::$ty, vocabulary: Some($vocabulary), example: $example, doc: $doc }
     };
 }
 
@@ -78,7 +86,7 @@ pub const SOURCE: SectionDef = SectionDef {
         field!("video", Text, "\"la_014.mp4\"", "the source video file"),
         field!("time", Duration, "195 s", "the timestamp of the frame in the video"),
         field!("frame", Integer, "4680", "the frame number in the video, when no timestamp is known"),
-        field!("region", Symbol, "los_angeles", "the region the video was recorded in"),
+        field!("region", Symbol in "region", "los_angeles", "the region the video was recorded in"),
         field!("description", Text, "\"\"\" ... \"\"\"", "the natural-language description the scenario was made from"),
     ],
 };
@@ -86,25 +94,25 @@ pub const SOURCE: SectionDef = SectionDef {
 pub const ENVIRONMENT: SectionDef = SectionDef {
     name: "environment",
     doc: "weather and time of day",
-    fields: &[field!("weather", Symbol, "clear", "the weather"), field!("time", Symbol, "daytime", "the time of day")],
+    fields: &[field!("weather", Symbol in "weather", "clear", "the weather"), field!("time", Symbol in "time_of_day", "daytime", "the time of day")],
 };
 
 pub const ROAD: SectionDef = SectionDef {
     name: "road",
     doc: "the road network around the ego vehicle",
     fields: &[
-        field!("type", Symbol, "straight_road", "the road type"),
-        field!("context", Symbol, "urban", "the road context"),
+        field!("type", Symbol in "road_type", "straight_road", "the road type"),
+        field!("context", Symbol in "road_context", "urban", "the road context"),
         field!("lanes", Integer, "2", "lanes per direction"),
-        field!("direction", Symbol, "two_way", "`one_way` or `two_way`"),
-        field!("special_lanes", SymbolList, "[bike_lane]", "special lanes; `[]` for none"),
-        field!("signs", SymbolList, "[stop_sign]", "traffic signs; `[]` for none"),
-        field!("light", Symbol, "green", "the traffic light state facing the ego vehicle; `none` for no light"),
-        field!("traffic", Symbol, "light", "traffic density"),
-        field!("hazards", SymbolList, "[accident]", "accidents and other hazards; `[]` for none"),
-        field!("roadworks", SymbolList, "[lane_closure]", "roadworks and lane closures; `[]` for none"),
-        field!("emergency_vehicles", SymbolList, "[ambulance]", "emergency vehicles present; `[]` for none"),
-        field!("roadside", SymbolList, "[sidewalk, trees]", "what lines the road"),
+        field!("direction", Symbol in "direction", "two_way", "`one_way` or `two_way`"),
+        field!("special_lanes", SymbolList in "special_lane", "[bike_lane]", "special lanes; `[]` for none"),
+        field!("signs", SymbolList in "traffic_sign", "[stop_sign]", "traffic signs; `[]` for none"),
+        field!("light", Symbol in "light_state", "green", "the traffic light state facing the ego vehicle; `none` for no light"),
+        field!("traffic", Symbol in "traffic_density", "light", "traffic density"),
+        field!("hazards", SymbolList in "hazard", "[accident]", "accidents and other hazards; `[]` for none"),
+        field!("roadworks", SymbolList in "roadwork", "[lane_closure]", "roadworks and lane closures; `[]` for none"),
+        field!("emergency_vehicles", SymbolList in "emergency_vehicle", "[ambulance]", "emergency vehicles present; `[]` for none"),
+        field!("roadside", SymbolList in "roadside", "[sidewalk, trees]", "what lines the road"),
     ],
 };
 
@@ -112,7 +120,7 @@ pub const EGO: SectionDef = SectionDef {
     name: "ego",
     doc: "the ego vehicle",
     fields: &[
-        field!("behavior", Symbol, "go_forward", "what the ego vehicle does"),
+        field!("behavior", Symbol in "behavior", "go_forward", "what the ego vehicle does"),
         field!("speed", Speed, "30 km/h", "its speed"),
         field!("lane", Integer, "1", "its lane index: 1 is the leftmost lane in its direction"),
     ],
@@ -123,12 +131,92 @@ pub const ACTOR: SectionDef = SectionDef {
     name: "actor",
     doc: "a group of actors of one type that move together",
     fields: &[
-        field!("behavior", Symbol, "go_forward", "what every actor of the group does"),
+        field!("behavior", Symbol in "behavior", "go_forward", "what every actor of the group does"),
         field!("speed", Speed, "30 km/h", "their speed"),
         field!("position", Position, "front of ego", "where the group is, relative to a reference"),
         field!("lane", Integer, "1", "their lane index; negative for the opposite direction"),
     ],
 };
+
+/// Fields every declaration may have.
+const ALIASES: FieldDef = field!("aliases", SymbolList, "[sunny]", "other names for the same thing; using one is a warning with a fix");
+const DOC: FieldDef = field!("description", Text, "\"...\"", "what the name means");
+
+macro_rules! declaration {
+    ($name:literal, $doc:literal $(, $field:expr)* $(,)?) => {
+        SectionDef { name: $name, doc: $doc, fields: &[ALIASES, DOC $(, $field)*] }
+    };
+}
+
+/// The kinds of vocabulary declaration (`KIND NAME { ... }`) and their fields. A scenario
+/// field with a `vocabulary` takes the names declared with that kind.
+pub const DECLARATIONS: &[&SectionDef] = &[
+    &declaration!("weather", "a weather condition"),
+    &declaration!("time_of_day", "a time of day"),
+    &declaration!(
+        "road_type",
+        "a kind of road layout",
+        field!("signalised", Flag, "no", "whether traffic lights can control it (default `yes`)"),
+        field!("junction", Flag, "yes", "whether roads meet or cross in it (default `no`)"),
+    ),
+    &declaration!(
+        "road_context",
+        "the kind of area a road runs through",
+        field!("max_speed", Speed, "60 km/h", "the highest plausible speed there"),
+        field!("signalised", Flag, "no", "whether traffic lights occur there (default `yes`)"),
+    ),
+    &declaration!(
+        "direction",
+        "one-way or two-way traffic",
+        field!("opposite_lanes", Flag, "yes", "whether the road has lanes for the opposite direction"),
+    ),
+    &declaration!("special_lane", "a lane with a special purpose"),
+    &declaration!(
+        "traffic_sign",
+        "a traffic sign",
+        field!("conflicts_with", SymbolList in "light_state", "[green]", "light states that contradict it"),
+    ),
+    &declaration!(
+        "light_state",
+        "the state of the traffic light facing the ego vehicle",
+        field!("present", Flag, "no", "whether there is a light at all (default `yes`)"),
+    ),
+    &declaration!("traffic_density", "how dense the traffic is"),
+    &declaration!("hazard", "an accident or other hazard on the road"),
+    &declaration!("roadwork", "roadworks or a lane closure"),
+    &declaration!("emergency_vehicle", "a kind of emergency vehicle"),
+    &declaration!("roadside", "something that lines the road"),
+    &declaration!("region", "a region scenarios come from", field!("style", Symbol, "metropolitan", "its kind of region")),
+    &declaration!("actor_kind", "a broad class of actors that share behaviors"),
+    &declaration!(
+        "actor_type",
+        "a type of actor with its physical attributes",
+        field!("kind", Symbol in "actor_kind", "vehicle", "its class"),
+        field!("length", Length, "4.6 m", "its length"),
+        field!("width", Length, "1.8 m", "its width"),
+        field!("height", Length, "1.5 m", "its height"),
+        field!("typical_speed", Speed, "40 km/h", "its usual speed"),
+        field!("max_speed", Speed, "180 km/h", "the highest plausible speed"),
+    ),
+    &declaration!(
+        "behavior",
+        "something an actor does",
+        field!("performers", SymbolList in "actor_kind", "[vehicle]", "the actor kinds that can do it"),
+        field!("max_speed", Speed, "0 km/h", "the highest speed compatible with it"),
+    ),
+    &declaration!(
+        "relation",
+        "where something is relative to a reference",
+        field!("lateral", Symbol, "left", "`left`, `right`, `same` or `opposite`"),
+        field!("longitudinal", Symbol, "front", "`front`, `behind` or `same`"),
+    ),
+    &declaration!("road_element", "a point of the road a position can refer to"),
+    &declaration!("reference", "a built-in reference point (`ego`)"),
+];
+
+pub fn declaration(kind: &str) -> Option<&'static SectionDef> {
+    DECLARATIONS.iter().copied().find(|d| d.name == kind)
+}
 
 /// Field names other notations use (TrafficAlign's YAML, TrafficComposer's IR) and the
 /// TAD field each means, for suggestions.
