@@ -60,8 +60,29 @@ codes! {
     // YAML import (3xx): add codes below this line
     // end of YAML codes
     // names and vocabulary (4xx), semantics (5xx), completeness (6xx)
+    E0400 => Error,
+    E0402 => Error,
+    E0403 => Error,
+    E0404 => Error,
+    E0405 => Error,
+    E0500 => Error,
+    E0501 => Error,
+    E0502 => Error,
+    E0503 => Error,
+    E0506 => Error,
+    E0509 => Error,
+    E0510 => Error,
     W0200 => Warning,
     W0201 => Warning,
+    W0401 => Warning,
+    W0402 => Warning,
+    W0403 => Warning,
+    W0504 => Warning,
+    W0505 => Warning,
+    W0507 => Warning,
+    W0508 => Warning,
+    W0600 => Warning,
+    W0601 => Warning,
 }
 
 impl Code {

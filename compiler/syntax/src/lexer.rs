@@ -71,6 +71,9 @@ pub enum Token {
     /// Not produced by logos: [`lex`] turns such an [`Token::Ident`] into this, so that
     /// a stray name is never mistaken for the start of a section during error recovery.
     Head,
+    /// The first name of a top-level item: the kind of a declaration (`weather` in
+    /// `weather clear`). Marked by [`lex`] for the same reason as [`Token::Head`].
+    DeclKind,
 }
 
 /// Every keyword of the language, with its token. A test round-trips each one.
@@ -171,7 +174,50 @@ pub fn lex(src: &str) -> Lexed {
             out.tokens[i - 1].1 = Token::Head;
         }
     }
+    mark_declaration_kinds(&mut out.tokens);
     out
+}
+
+/// Outside braces, items are flat (`use PATH`, `scenario NAME {...}`, `KIND NAME [{...}]`):
+/// follow them and mark the first name of each declaration as [`Token::DeclKind`].
+fn mark_declaration_kinds(tokens: &mut [Spanned]) {
+    #[derive(PartialEq)]
+    enum State {
+        Item,
+        UsePath,
+        AfterPathName,
+        Name,
+    }
+    let mut depth = 0usize;
+    let mut state = State::Item;
+    for token in tokens.iter_mut() {
+        match token.1 {
+            Token::LBrace => {
+                depth += 1;
+                state = State::Item;
+                continue;
+            }
+            Token::RBrace => {
+                depth = depth.saturating_sub(1);
+                state = State::Item;
+                continue;
+            }
+            _ if depth > 0 => continue,
+            _ => {}
+        }
+        state = match (state, token.1) {
+            (State::UsePath, Token::Ident) => State::AfterPathName,
+            (State::AfterPathName, Token::Dot) => State::UsePath,
+            (State::Name, Token::Ident | Token::Head) => State::Item,
+            (_, Token::Use) => State::UsePath,
+            (_, Token::Scenario) => State::Name,
+            (_, Token::Ident) => {
+                token.1 = Token::DeclKind;
+                State::Name
+            }
+            _ => State::Item,
+        };
+    }
 }
 
 fn lex_error(src: &str, span: Span, error: LexError) -> Diagnostic {
@@ -310,11 +356,18 @@ mod tests {
     fn keys_values_and_units() {
         use Token::*;
         assert_eq!(
-            kinds("speed: 38 km/h lane : -2 kind: go_forward"),
-            vec![Key, Number, Unit, Key, Number, Key, Ident]
+            kinds("{ speed: 38 km/h lane : -2 kind: go_forward }"),
+            vec![LBrace, Key, Number, Unit, Key, Number, Key, Ident, RBrace]
         );
-        assert_eq!(kinds("x\n: 1"), vec![Ident, Colon, Number]);
-        assert_eq!(kinds("actor a: big bus {}"), vec![Actor, Key, Ident, Head, LBrace, RBrace]);
+        assert_eq!(kinds("{ x\n: 1 }"), vec![LBrace, Ident, Colon, Number, RBrace]);
+        assert_eq!(kinds("{ actor a: big bus {} }"), vec![LBrace, Actor, Key, Ident, Head, LBrace, RBrace, RBrace]);
+        assert_eq!(
+            kinds("use a.b weather wet weather clear { x: y } scenario s2 { road { k: v } }"),
+            vec![
+                Use, Ident, Dot, Ident, DeclKind, Ident, DeclKind, Head, LBrace, Key, Ident, RBrace, Scenario, Head,
+                LBrace, Head, LBrace, Key, Ident, RBrace, RBrace
+            ]
+        );
     }
 
     #[test]

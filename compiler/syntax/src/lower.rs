@@ -77,7 +77,9 @@ impl Lowerer<'_> {
             if let Some(guess) = suggest::closest(&d.kind.text, candidates) {
                 diagnostic = diagnostic.with_help(format!("did you mean `{guess}`?")).with_fix(d.kind.span, guess);
             } else {
-                diagnostic = diagnostic.with_note("declarations are written `KIND NAME { ... }`; the kinds are listed in spec/vocabulary.md");
+                diagnostic = diagnostic.with_note(
+                    "declarations are written `KIND NAME { ... }`; the kinds are listed in spec/vocabulary.md",
+                );
             }
             self.report(diagnostic);
             return None;
@@ -306,7 +308,9 @@ impl Lowerer<'_> {
                 );
                 Val::Symbols(if none { Vec::new() } else { vec![symbol] })
             }
-            (ValueType::Flag, Value::Words(words)) if words.len() == 1 && matches!(words[0].text.as_str(), "yes" | "no") => {
+            (ValueType::Flag, Value::Words(words))
+                if words.len() == 1 && matches!(words[0].text.as_str(), "yes" | "no") =>
+            {
                 Val::Flag(words[0].text == "yes")
             }
             (ValueType::Integer, Value::Number { number, unit, span }) => {

@@ -137,13 +137,10 @@ fn fields_mut(file: &mut File) -> impl Iterator<Item = &mut Field> {
             Item::Use(_) | Item::Error(_) => {}
         }
     }
-    blocks
-        .into_iter()
-        .flatten()
-        .filter_map(|entry| match entry {
-            Entry::Field(field) => Some(field),
-            Entry::Error(_) => None,
-        })
+    blocks.into_iter().flatten().filter_map(|entry| match entry {
+        Entry::Field(field) => Some(field),
+        Entry::Error(_) => None,
+    })
 }
 
 /// Report every `{` left open at the end of the file and close it with an empty `}`
@@ -307,6 +304,7 @@ fn expected_words(expected: &[String]) -> String {
             "Ident" => (3, "a name".to_string()),
             "Head" if expected.iter().any(|e| e == "\"actor\"") => (3, "a section".to_string()),
             "Head" => (3, "a name".to_string()),
+            "DeclKind" => (3, "a declaration".to_string()),
             "Number" => (4, "a number".to_string()),
             "Unit" => (4, "a unit".to_string()),
             "String" => (4, "a string".to_string()),

@@ -94,7 +94,10 @@ pub const SOURCE: SectionDef = SectionDef {
 pub const ENVIRONMENT: SectionDef = SectionDef {
     name: "environment",
     doc: "weather and time of day",
-    fields: &[field!("weather", Symbol in "weather", "clear", "the weather"), field!("time", Symbol in "time_of_day", "daytime", "the time of day")],
+    fields: &[
+        field!("weather", Symbol in "weather", "clear", "the weather"),
+        field!("time", Symbol in "time_of_day", "daytime", "the time of day"),
+    ],
 };
 
 pub const ROAD: SectionDef = SectionDef {
@@ -139,7 +142,8 @@ pub const ACTOR: SectionDef = SectionDef {
 };
 
 /// Fields every declaration may have.
-const ALIASES: FieldDef = field!("aliases", SymbolList, "[sunny]", "other names for the same thing; using one is a warning with a fix");
+const ALIASES: FieldDef =
+    field!("aliases", SymbolList, "[sunny]", "other names for the same thing; using one is a warning with a fix");
 const DOC: FieldDef = field!("description", Text, "\"...\"", "what the name means");
 
 macro_rules! declaration {
@@ -186,7 +190,11 @@ pub const DECLARATIONS: &[&SectionDef] = &[
     &declaration!("roadwork", "roadworks or a lane closure"),
     &declaration!("emergency_vehicle", "a kind of emergency vehicle"),
     &declaration!("roadside", "something that lines the road"),
-    &declaration!("region", "a region scenarios come from", field!("style", Symbol, "metropolitan", "its kind of region")),
+    &declaration!(
+        "region",
+        "a region scenarios come from",
+        field!("style", Symbol, "metropolitan", "its kind of region")
+    ),
     &declaration!("actor_kind", "a broad class of actors that share behaviors"),
     &declaration!(
         "actor_type",

@@ -2,15 +2,20 @@
 
 use crate::files::{self, Input};
 use crate::{Format, Status};
+use tad_check::{Checked, Class, Options};
+use tad_db::Database;
 use tad_diagnostics::render::{FileReport, human, json, sarif};
 use tad_diagnostics::{Code, Diagnostic, Severity, Span};
 
-/// Every diagnostic of one input: a non-UTF-8 file is reported, then checked as decoded.
-pub fn diagnose(input: &Input) -> Vec<Diagnostic> {
-    let (_, mut diagnostics) = tad_syntax::analyze(&input.text);
+/// Check one input through the database: a non-UTF-8 file is reported, then checked as
+/// decoded.
+pub fn diagnose_in(db: &mut Database, input: &Input) -> Checked {
+    let path = input.path.clone().unwrap_or_else(|| std::path::PathBuf::from(&input.name));
+    let file = db.set_file(path, input.text.clone());
+    let mut checked = tad_db::check(db, file).clone();
     if let Some(at) = input.invalid_utf8 {
         // The lossy text has U+FFFD (3 bytes) where the invalid sequence was.
-        diagnostics.insert(
+        checked.diagnostics.insert(
             0,
             Diagnostic::new(
                 Code::E0006,
@@ -21,18 +26,25 @@ pub fn diagnose(input: &Input) -> Vec<Diagnostic> {
             .with_help("save the file as UTF-8"),
         );
     }
-    diagnostics
+    checked
 }
 
-pub fn run(paths: &[std::path::PathBuf], format: Format, deny_warnings: bool, color: bool) -> Status {
+/// Every diagnostic of one input, with the default options.
+pub fn diagnose(input: &Input) -> Vec<Diagnostic> {
+    diagnose_in(&mut Database::new(Options::default()), input).diagnostics
+}
+
+pub fn run(paths: &[std::path::PathBuf], format: Format, deny_warnings: bool, color: bool, options: Options) -> Status {
     let (files, io_errors) = files::collect(paths);
     let mut status = Status::Ok;
     for error in &io_errors {
         eprintln!("error: {error}");
         status = Status::Usage;
     }
-    let mut checked: Vec<(Input, Vec<Diagnostic>)> = Vec::new();
+    let mut db = Database::new(options);
+    let mut checked: Vec<(Input, Checked)> = Vec::new();
     let (mut errors, mut warnings) = (0, 0);
+    let mut classes = [0usize; 3];
     for path in &files {
         let input = match files::read(path) {
             Ok(input) => input,
@@ -42,26 +54,43 @@ pub fn run(paths: &[std::path::PathBuf], format: Format, deny_warnings: bool, co
                 continue;
             }
         };
-        let diagnostics = diagnose(&input);
-        errors += diagnostics.iter().filter(|d| d.severity == Severity::Error).count();
-        warnings += diagnostics.iter().filter(|d| d.severity == Severity::Warning).count();
-        let report = FileReport { name: &input.name, text: &input.text, diagnostics: &diagnostics };
+        let result = diagnose_in(&mut db, &input);
+        errors += result.diagnostics.iter().filter(|d| d.severity == Severity::Error).count();
+        warnings += result.diagnostics.iter().filter(|d| d.severity == Severity::Warning).count();
+        if let Some(class) = result.class {
+            classes[class as usize] += 1;
+        }
+        let report = FileReport { name: &input.name, text: &input.text, diagnostics: &result.diagnostics };
         match format {
-            Format::Human => eprint!("{}", human::render(&report, color)),
-            Format::Json => println!("{}", serde_json::Value::Object(json::file_object(&report))),
+            Format::Human => {
+                eprint!("{}", human::render(&report, color));
+                if let Some(class) = result.class.filter(|c| *c != Class::Complete) {
+                    eprintln!("{}: {}", input.name, class.as_str());
+                }
+            }
+            Format::Json => {
+                let mut object = json::file_object(&report);
+                object.insert("class".into(), result.class.map_or(serde_json::Value::Null, |c| c.as_str().into()));
+                object.insert("refinement".into(), result.refinement.clone().into());
+                println!("{}", serde_json::Value::Object(object));
+            }
             Format::Sarif => {}
         }
-        checked.push((input, diagnostics));
+        checked.push((input, result));
     }
     match format {
         Format::Sarif => {
             let reports: Vec<FileReport<'_>> = checked
                 .iter()
-                .map(|(input, diagnostics)| FileReport { name: &input.name, text: &input.text, diagnostics })
+                .map(|(input, result)| FileReport {
+                    name: &input.name,
+                    text: &input.text,
+                    diagnostics: &result.diagnostics,
+                })
                 .collect();
             println!("{}", sarif::render(&reports, env!("CARGO_PKG_VERSION")));
         }
-        Format::Human => eprintln!("{}", summary(checked.len(), errors, warnings)),
+        Format::Human => eprintln!("{}", summary(checked.len(), errors, warnings, classes)),
         Format::Json => {}
     }
     if errors > 0 || (deny_warnings && warnings > 0) {
@@ -74,12 +103,19 @@ fn plural(n: usize, word: &str) -> String {
     if n == 1 { format!("1 {word}") } else { format!("{n} {word}s") }
 }
 
-fn summary(files: usize, errors: usize, warnings: usize) -> String {
+fn summary(files: usize, errors: usize, warnings: usize, classes: [usize; 3]) -> String {
     let problems = match (errors, warnings) {
         (0, 0) => "no problems".to_string(),
         (e, 0) => plural(e, "error"),
         (0, w) => plural(w, "warning"),
         (e, w) => format!("{}, {}", plural(e, "error"), plural(w, "warning")),
     };
-    format!("checked {}: {problems}", plural(files, "file"))
+    let names = ["complete", "incomplete", "non_scenario"];
+    let classes: Vec<String> =
+        classes.iter().zip(names).filter(|(n, _)| **n > 0).map(|(n, name)| format!("{n} {name}")).collect();
+    if classes.is_empty() {
+        format!("checked {}: {problems}", plural(files, "file"))
+    } else {
+        format!("checked {}: {problems}; scenarios: {}", plural(files, "file"), classes.join(", "))
+    }
 }

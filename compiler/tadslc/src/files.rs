@@ -4,6 +4,7 @@ use std::io::Read;
 use std::path::{Path, PathBuf};
 
 /// One input: a display name and its text.
+#[derive(Clone, Debug)]
 pub struct Input {
     pub name: String,
     pub path: Option<PathBuf>,

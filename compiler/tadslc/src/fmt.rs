@@ -4,7 +4,29 @@ use crate::Status;
 use crate::files;
 use tad_diagnostics::render::{FileReport, human};
 
-pub fn run(paths: &[std::path::PathBuf], check: bool, color: bool) -> Status {
+/// The codes whose fixes `--canonicalize` applies.
+pub const CANONICAL: &[tad_diagnostics::Code] =
+    &[tad_diagnostics::Code::W0401, tad_diagnostics::Code::W0402, tad_diagnostics::Code::W0403];
+
+/// `text` with every canonical-form fix applied (repeated until none is left, since a
+/// fix can only be applied once its overlapping neighbours are).
+pub fn canonicalize(db: &mut tad_db::Database, input: &files::Input) -> String {
+    let mut text = input.text.clone();
+    for _ in 0..8 {
+        let probe = files::Input { text: text.clone(), ..input.clone() };
+        let checked = crate::check::diagnose_in(db, &probe);
+        let (fixed, applied) =
+            tad_diagnostics::apply_fixes(&text, checked.diagnostics.iter().filter(|d| CANONICAL.contains(&d.code)));
+        if applied == 0 {
+            break;
+        }
+        text = fixed;
+    }
+    text
+}
+
+pub fn run(paths: &[std::path::PathBuf], check: bool, canonical: bool, color: bool) -> Status {
+    let mut db = tad_db::Database::new(tad_check::Options::default());
     let (files, io_errors) = files::collect(paths);
     let mut status = Status::Ok;
     for error in &io_errors {
@@ -26,7 +48,8 @@ pub fn run(paths: &[std::path::PathBuf], check: bool, color: bool) -> Status {
             status = status.max(Status::Failed);
             continue;
         }
-        let formatted = match tad_syntax::format::format(&input.text) {
+        let source = if canonical { canonicalize(&mut db, &input) } else { input.text.clone() };
+        let formatted = match tad_syntax::format::format(&source) {
             Ok(formatted) => formatted,
             Err(diagnostics) => {
                 let report = FileReport { name: &input.name, text: &input.text, diagnostics: &diagnostics };

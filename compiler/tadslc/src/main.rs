@@ -35,6 +35,8 @@ enum Command {
         /// Treat warnings as errors for the exit code
         #[arg(long)]
         deny_warnings: bool,
+        #[command(flatten)]
+        rules: Rules,
     },
     /// Format scenario files in place in the canonical layout
     Fmt {
@@ -44,6 +46,10 @@ enum Command {
         /// Change nothing; exit 1 if any file is not formatted
         #[arg(long)]
         check: bool,
+        /// Also replace aliases, non-canonical units and 0-based lane indexes by their
+        /// canonical forms (the fixes of W0401, W0402 and W0403)
+        #[arg(long)]
+        canonicalize: bool,
     },
     /// Explain a diagnostic code, e.g. `tadslc explain E0203`
     Explain {
@@ -67,6 +73,55 @@ enum Command {
     },
 }
 
+/// Checking rules.
+#[derive(clap::Args)]
+struct Rules {
+    /// Extra rules: `dashcam` applies TrafficAlign's extraction rules for dash-cam frames
+    #[arg(long, value_enum, default_value_t = ProfileArg::Default)]
+    profile: ProfileArg,
+    /// The essentials whose absence together makes a non-scenario
+    #[arg(long, value_delimiter = ',', default_value = "weather,time,road")]
+    non_scenario: Vec<EssentialArg>,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum ProfileArg {
+    Default,
+    Dashcam,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum EssentialArg {
+    Weather,
+    Time,
+    Road,
+    Ego,
+    Actors,
+}
+
+impl Rules {
+    fn options(&self) -> tad_check::Options {
+        use tad_check::{Essential, Profile};
+        tad_check::Options {
+            profile: match self.profile {
+                ProfileArg::Default => Profile::Default,
+                ProfileArg::Dashcam => Profile::Dashcam,
+            },
+            non_scenario: self
+                .non_scenario
+                .iter()
+                .map(|e| match e {
+                    EssentialArg::Weather => Essential::Weather,
+                    EssentialArg::Time => Essential::Time,
+                    EssentialArg::Road => Essential::Road,
+                    EssentialArg::Ego => Essential::Ego,
+                    EssentialArg::Actors => Essential::Actors,
+                })
+                .collect(),
+        }
+    }
+}
+
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum Color {
     Auto,
@@ -85,8 +140,10 @@ fn main() -> ExitCode {
         }
     };
     let status = match cli.command {
-        Command::Check { paths, format, deny_warnings } => check::run(&paths, format, deny_warnings, color),
-        Command::Fmt { paths, check } => fmt::run(&paths, check, color),
+        Command::Check { paths, format, deny_warnings, rules } => {
+            check::run(&paths, format, deny_warnings, color, rules.options())
+        }
+        Command::Fmt { paths, check, canonicalize } => fmt::run(&paths, check, canonicalize, color),
         Command::Explain { code } => explain::run(code.as_deref()),
         Command::Bench { scenarios, seed, examples, runs } => bench::run(scenarios, seed, examples.as_deref(), runs),
     };

@@ -4,42 +4,70 @@
 mod common;
 use tad_diagnostics::{Code, Severity};
 
-fn tad_blocks(text: &str) -> Vec<String> {
-    let mut blocks = Vec::new();
-    let mut current: Option<String> = None;
+/// Fenced blocks as `(language, text)`.
+fn blocks(text: &str) -> Vec<(String, String)> {
+    let mut out = Vec::new();
+    let mut current: Option<(String, String)> = None;
     for line in text.lines() {
         match (&mut current, line.trim_end()) {
-            (None, "```tad") => current = Some(String::new()),
-            (Some(block), "```") => {
-                blocks.push(std::mem::take(block));
-                current = None;
-            }
-            (Some(block), line) => {
+            (None, fence) if fence.starts_with("```") => current = Some((fence[3..].to_string(), String::new())),
+            (Some(_), "```") => out.extend(current.take()),
+            (Some((_, block)), line) => {
                 block.push_str(line);
                 block.push('\n');
             }
             _ => {}
         }
     }
-    blocks
+    out
+}
+
+fn tad_blocks(text: &str) -> Vec<String> {
+    blocks(text).into_iter().filter(|(lang, _)| lang == "tad").map(|(_, b)| b).collect()
+}
+
+/// Check `text` as a file of its own, with the standard library.
+fn check(text: &str, options: tad_check::Options) -> Vec<tad_diagnostics::Diagnostic> {
+    let input = tadslc::files::Input {
+        name: "example.tad".into(),
+        path: Some(std::env::temp_dir().join("tadsl-spec-example.tad")),
+        text: text.to_string(),
+        invalid_utf8: None,
+    };
+    tadslc::check::diagnose_in(&mut tad_db::Database::new(options), &input).diagnostics
 }
 
 #[test]
 fn every_code_has_an_erroneous_and_a_corrected_example() {
     for code in Code::ALL {
-        let blocks = tad_blocks(code.explanation());
-        assert_eq!(blocks.len(), if *code == Code::E0006 { 1 } else { 2 }, "{code}: examples");
-        if *code != Code::E0006 {
-            let (_, diagnostics) = tad_syntax::analyze(&blocks[0]);
-            assert!(diagnostics.iter().any(|d| d.code == *code), "{code}: the erroneous example gives {diagnostics:?}");
+        let options = tad_check::Options {
+            profile: if *code == Code::E0510 { tad_check::Profile::Dashcam } else { tad_check::Profile::Default },
+            ..Default::default()
+        };
+        let examples: Vec<(String, String)> =
+            blocks(code.explanation()).into_iter().filter(|(l, _)| l != "json").collect();
+        assert_eq!(examples.len(), 2, "{code}: an erroneous and a corrected example");
+        let (language, erroneous) = &examples[0];
+        if language == "tad" {
+            let diagnostics = check(erroneous, options.clone());
+            assert!(
+                diagnostics.iter().any(|d| d.code == *code),
+                "{code}: the erroneous example gives {diagnostics:#?}"
+            );
         }
-        let corrected = blocks.last().unwrap();
-        let (_, diagnostics) = tad_syntax::analyze(corrected);
-        assert!(
-            diagnostics.iter().all(|d| d.severity != Severity::Error && d.code != *code),
-            "{code}: the corrected example gives {diagnostics:?}"
-        );
-        assert_eq!(tad_syntax::format::format(corrected).as_deref(), Ok(corrected.as_str()), "{code}: not formatted");
+        let (language, corrected) = &examples[1];
+        if language == "tad" {
+            let diagnostics = check(corrected, options.clone());
+            assert!(
+                diagnostics.iter().all(|d| d.severity != Severity::Error && d.code != *code),
+                "{code}: the corrected example gives {diagnostics:#?}"
+            );
+            assert_eq!(
+                tad_syntax::format::format(corrected).as_deref(),
+                Ok(corrected.as_str()),
+                "{code}: not formatted"
+            );
+        }
     }
 }
 

@@ -1,0 +1,72 @@
+//! The TADSL checker: what a structurally valid scenario means, and whether it holds up.
+//!
+//! Input is the lowered [`Module`] and the [`Vocabulary`] its file sees; output is a
+//! [`Checked`]: diagnostics, the completeness [`Class`] of the scenario and the refinement
+//! requests a scenario extractor can act on. Four passes, each reporting and going on:
+//!
+//! 1. names: every name resolves in the vocabulary of its field (or is reported with the
+//!    closest name); aliases and non-canonical units are warnings with fixes;
+//! 2. declarations: the names a declaration refers to resolve too;
+//! 3. semantics: lanes, behaviors per actor kind, speeds, relations against lanes,
+//!    reference cycles, lights and signs;
+//! 4. completeness: missing essential attributes, and the class they add up to.
+//!
+//! The checker knows no vocabulary lists: every name comes from declarations.
+
+mod completeness;
+mod names;
+mod semantics;
+pub mod vocab;
+
+pub use completeness::{Class, Essential};
+pub use vocab::{Conflict, Entry, Lookup, Vocabulary};
+
+use tad_diagnostics::Diagnostic;
+use tad_syntax::model::Module;
+
+/// Rules that can be switched per run.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct Options {
+    pub profile: Profile,
+    /// A scenario missing all of these is not a scenario.
+    pub non_scenario: Vec<Essential>,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options { profile: Profile::Default, non_scenario: vec![Essential::Weather, Essential::Time, Essential::Road] }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Profile {
+    Default,
+    /// TrafficAlign's extraction rules for forward-facing dash-cam frames: nothing is
+    /// described behind the ego vehicle.
+    Dashcam,
+}
+
+/// The result of checking one module.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Checked {
+    pub diagnostics: Vec<Diagnostic>,
+    /// `None` for a module without a scenario.
+    pub class: Option<Class>,
+    /// Requests for what the scenario should state, ready for an extraction prompt.
+    pub refinement: Vec<String>,
+}
+
+/// Check `module` against `vocabulary`. Diagnostics are sorted by position.
+pub fn check(module: &Module, vocabulary: &Vocabulary, options: &Options) -> Checked {
+    let mut out = Checked::default();
+    names::declarations(module, vocabulary, &mut out.diagnostics);
+    if let Some(scenario) = &module.scenario {
+        let resolved = names::scenario(scenario, vocabulary, &mut out.diagnostics);
+        semantics::check(scenario, vocabulary, &resolved, options, &mut out.diagnostics);
+        let (class, refinement) = completeness::classify(scenario, vocabulary, options, &mut out.diagnostics);
+        out.class = Some(class);
+        out.refinement = refinement;
+    }
+    tad_diagnostics::sort(&mut out.diagnostics);
+    out
+}

@@ -1,0 +1,196 @@
+//! Name resolution: every name in its field's vocabulary, references to groups and road
+//! elements, aliases and units brought to their canonical form.
+
+use crate::vocab::{Lookup, Vocabulary};
+use std::collections::HashMap;
+use tad_diagnostics::{Code, Diagnostic};
+use tad_syntax::model::{Attr, Known, Scenario, Symbol, Val};
+use tad_syntax::schema::{FieldDef, Unit};
+
+/// What a group's position refers to.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Target {
+    Ego,
+    Group(usize),
+    RoadElement(String),
+}
+
+/// Resolution results the later passes use, by actor group index.
+#[derive(Debug, Default)]
+pub struct Resolved {
+    pub targets: HashMap<usize, Target>,
+}
+
+fn kind_label(kind: &str) -> String {
+    kind.replace('_', " ")
+}
+
+/// Resolve `symbol` in `kind`: an unknown name is an error, an alias a warning with a fix.
+pub fn resolve_symbol(vocabulary: &Vocabulary, kind: &str, field: &str, symbol: &Symbol, out: &mut Vec<Diagnostic>) {
+    match vocabulary.lookup(kind, &symbol.name) {
+        Lookup::Exact(_) => {}
+        Lookup::Alias(entry) => out.push(
+            Diagnostic::new(
+                Code::W0401,
+                format!("`{}` is another name for the {} `{}`", symbol.name, kind_label(kind), entry.name),
+                symbol.span,
+                "an alias",
+            )
+            .with_help(format!("write `{}`", entry.name))
+            .with_fix(symbol.span, entry.name.clone()),
+        ),
+        Lookup::Unknown => {
+            let mut d = Diagnostic::new(
+                Code::E0400,
+                format!("unknown {} `{}`", kind_label(kind), symbol.name),
+                symbol.span,
+                format!("not a {} `{field}` can take", kind_label(kind)),
+            );
+            if let Some(guess) = vocabulary.suggest(kind, &symbol.name) {
+                d = d.with_help(format!("did you mean `{guess}`?")).with_fix(symbol.span, guess.to_string());
+            }
+            let names = vocabulary.names(kind);
+            d = if names.is_empty() {
+                d.with_note(format!("no {} is declared; is a `use` missing?", kind_label(kind)))
+            } else if names.len() <= 12 {
+                d.with_note(format!("the {} names are {}", kind_label(kind), quoted(&names)))
+            } else {
+                d.with_note(format!("declare it with `{kind} {} {{ ... }}` if it is new", symbol.name))
+            };
+            out.push(d);
+        }
+    }
+}
+
+pub fn quoted(names: &[&str]) -> String {
+    names.iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
+}
+
+/// Names in one attribute, by its field's vocabulary.
+fn attr(vocabulary: &Vocabulary, attr: &Attr, out: &mut Vec<Diagnostic>) {
+    let Known::Given(value) = &attr.value else { return };
+    let def: &FieldDef = attr.def;
+    match (value, def.vocabulary) {
+        (Val::Symbol(symbol), Some(kind)) => resolve_symbol(vocabulary, kind, def.name, symbol, out),
+        (Val::Symbols(symbols), Some(kind)) => {
+            for symbol in symbols {
+                resolve_symbol(vocabulary, kind, def.name, symbol, out);
+            }
+        }
+        (Val::Quantity(q), _) if matches!(q.unit, Unit::MilesPerHour | Unit::MetresPerSecond) => {
+            let kmh = q.si() * 3.6;
+            let text = format_number(kmh);
+            out.push(
+                Diagnostic::new(
+                    Code::W0402,
+                    format!(
+                        "speeds are written in km/h: {} {} is {text} km/h",
+                        format_number(q.value),
+                        q.unit.as_str()
+                    ),
+                    attr.value_span,
+                    "not in km/h",
+                )
+                .with_help(format!("write `{text} km/h`"))
+                .with_fix(attr.value_span, format!("{text} km/h")),
+            );
+        }
+        _ => {}
+    }
+}
+
+/// A number to one decimal, without a trailing `.0`.
+pub fn format_number(value: f64) -> String {
+    let rounded = (value * 10.0).round() / 10.0;
+    if rounded.fract() == 0.0 { format!("{}", rounded as i64) } else { format!("{rounded:.1}") }
+}
+
+/// The relation names of declarations, which use the small fixed sets the checker reads.
+const LATERAL: &[&str] = &["left", "right", "same", "opposite"];
+const LONGITUDINAL: &[&str] = &["front", "behind", "same"];
+
+/// Names inside the file's own declarations.
+pub fn declarations(module: &tad_syntax::model::Module, vocabulary: &Vocabulary, out: &mut Vec<Diagnostic>) {
+    for declaration in &module.declarations {
+        for a in &declaration.attrs {
+            if a.def.name == "aliases" {
+                continue;
+            }
+            attr(vocabulary, a, out);
+            if declaration.def.name == "relation" && matches!(a.def.name, "lateral" | "longitudinal") {
+                let allowed = if a.def.name == "lateral" { LATERAL } else { LONGITUDINAL };
+                if let Some(symbol) = a.symbol().filter(|s| !allowed.contains(&s.name.as_str())) {
+                    out.push(
+                        Diagnostic::new(
+                            Code::E0400,
+                            format!("unknown {} direction `{}`", a.def.name, symbol.name),
+                            symbol.span,
+                            format!("`{}` is one of {}", a.def.name, quoted(allowed)),
+                        )
+                        .with_note(format!("`{}` takes {}", a.def.name, quoted(allowed))),
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// Names in the scenario; returns what positions refer to.
+pub fn scenario(scenario: &Scenario, vocabulary: &Vocabulary, out: &mut Vec<Diagnostic>) -> Resolved {
+    let mut resolved = Resolved::default();
+    for section in &scenario.sections {
+        for a in &section.attrs {
+            attr(vocabulary, a, out);
+        }
+    }
+    for (index, group) in scenario.actors.iter().enumerate() {
+        if let Known::Given(kind) = &group.kind.value {
+            resolve_symbol(vocabulary, "actor_type", "type", kind, out);
+        }
+        for a in &group.attrs {
+            attr(vocabulary, a, out);
+            let Known::Given(Val::Position(position)) = &a.value else { continue };
+            resolve_symbol(vocabulary, "relation", "position", &position.relation, out);
+            if let Some(target) = reference(scenario, vocabulary, &position.reference, out) {
+                resolved.targets.insert(index, target);
+            }
+        }
+    }
+    resolved
+}
+
+/// A position's reference: a group of this scenario, `ego`, or a road element.
+fn reference(
+    scenario: &Scenario,
+    vocabulary: &Vocabulary,
+    symbol: &Symbol,
+    out: &mut Vec<Diagnostic>,
+) -> Option<Target> {
+    if let Some(i) = scenario.actors.iter().position(|g| g.name.text == symbol.name) {
+        return Some(Target::Group(i));
+    }
+    for (kind, is_ego) in [("reference", true), ("road_element", false)] {
+        if let Some(entry) = vocabulary.get(kind, &symbol.name) {
+            resolve_symbol(vocabulary, kind, "position", symbol, out);
+            return Some(if is_ego { Target::Ego } else { Target::RoadElement(entry.name.clone()) });
+        }
+    }
+    let groups: Vec<&str> = scenario.actors.iter().map(|g| g.name.text.as_str()).collect();
+    let mut candidates: Vec<&str> = groups.clone();
+    candidates.extend(vocabulary.names("reference"));
+    candidates.extend(vocabulary.names("road_element"));
+    let mut d = Diagnostic::new(
+        Code::E0402,
+        format!("unknown reference `{}`", symbol.name),
+        symbol.span,
+        "not `ego`, an actor group or a road element",
+    );
+    if let Some(guess) = tad_syntax::suggest::closest(&symbol.name, candidates.iter().copied()) {
+        d = d.with_help(format!("did you mean `{guess}`?")).with_fix(symbol.span, guess.to_string());
+    }
+    if !groups.is_empty() {
+        d = d.with_note(format!("the actor groups are {}", quoted(&groups)));
+    }
+    out.push(d);
+    None
+}

@@ -1,0 +1,420 @@
+//! Scenario semantics: what the vocabulary's attributes say about a scenario.
+//!
+//! Lanes against the road (TrafficAlign's convention: 1..n in the ego's direction, -1..-n
+//! opposite), behaviors against the kinds that can perform them, speeds against behavior,
+//! actor type and road context, relations against lane indexes, position reference cycles,
+//! lights against the road and signs against lights, counts, and the dash-cam profile.
+
+use crate::names::{Resolved, Target, format_number, quoted};
+use crate::vocab::{Entry, Vocabulary};
+use crate::{Options, Profile};
+use tad_diagnostics::{Code, Diagnostic, Span};
+use tad_syntax::model::{Attr, Known, Scenario, Val};
+
+/// The ego vehicle's actor kind.
+const EGO_KIND: &str = "vehicle";
+
+fn entry<'v>(vocabulary: &'v Vocabulary, kind: &str, attr: Option<&Attr>) -> Option<&'v Entry> {
+    vocabulary.get(kind, &attr?.symbol()?.name)
+}
+
+fn speed_text(si: f64) -> String {
+    format!("{} km/h", format_number(si * 3.6))
+}
+
+pub fn check(
+    scenario: &Scenario,
+    vocabulary: &Vocabulary,
+    resolved: &Resolved,
+    options: &Options,
+    out: &mut Vec<Diagnostic>,
+) {
+    let road = scenario.section("road");
+    let road_attr = |name: &str| road.and_then(|r| r.attr(name));
+    let lanes = road_attr("lanes").and_then(Attr::integer);
+    let direction = entry(vocabulary, "direction", road_attr("direction"));
+    let opposite_lanes = direction.and_then(|d| d.flag("opposite_lanes"));
+    let context = entry(vocabulary, "road_context", road_attr("context"));
+    let road_type = entry(vocabulary, "road_type", road_attr("type"));
+
+    lanes_check(scenario, road_attr("lanes"), lanes, opposite_lanes, direction, out);
+    lights_and_signs(vocabulary, road_attr("light"), road_attr("signs"), road_type, context, out);
+
+    // the ego vehicle
+    let ego = scenario.section("ego");
+    let ego_lane = ego.and_then(|e| e.attr("lane")).and_then(Attr::integer);
+    if let Some(ego) = ego {
+        let behavior = entry(vocabulary, "behavior", ego.attr("behavior"));
+        performers(behavior, ego.attr("behavior"), EGO_KIND, "the ego vehicle", out);
+        speeds(ego.attr("speed"), behavior, None, context, "the ego vehicle", out);
+    }
+
+    for (index, group) in scenario.actors.iter().enumerate() {
+        let what = format!("group `{}`", group.name.text);
+        if let Some(count) = &group.count
+            && let Known::Given(n) = count.value
+            && n < 1
+        {
+            out.push(
+                Diagnostic::new(
+                    Code::E0509,
+                    format!("{what} has {n} actors"),
+                    count.span,
+                    "a group has at least one actor",
+                )
+                .with_help("remove the group if nothing is there"),
+            );
+        }
+        let actor_type = match &group.kind.value {
+            Known::Given(kind) => vocabulary.get("actor_type", &kind.name),
+            Known::Unspecified => None,
+        };
+        let actor_kind = actor_type.and_then(|t| t.symbol("kind"));
+        let behavior_attr = group.attr("behavior");
+        let behavior = entry(vocabulary, "behavior", behavior_attr);
+        if let Some(kind) = actor_kind {
+            performers(behavior, behavior_attr, kind, &what, out);
+        }
+        speeds(group.attr("speed"), behavior, actor_type, context, &what, out);
+
+        let Some(position_attr) = group.attr("position") else { continue };
+        let Known::Given(Val::Position(position)) = &position_attr.value else { continue };
+        let relation = vocabulary.get("relation", &position.relation.name);
+        if resolved.targets.get(&index) == Some(&Target::Ego)
+            && let Some(relation) = relation
+        {
+            if options.profile == Profile::Dashcam && relation.symbol("longitudinal") == Some("behind") {
+                out.push(
+                        Diagnostic::new(
+                            Code::E0510,
+                            format!("{what} is `{}` the ego vehicle, which a dash-cam cannot see", relation.name),
+                            position.relation.span,
+                            "behind the camera",
+                        )
+                        .with_note("the `dashcam` profile describes forward-facing camera frames: only what is ahead or beside the ego vehicle"),
+                    );
+            }
+            let lane = group.attr("lane").and_then(Attr::integer);
+            if let (Some(lane), Some(ego_lane)) = (lane, ego_lane) {
+                relation_vs_lanes(vocabulary, relation, position.relation.span, lane, ego_lane, &what, out);
+            }
+        }
+    }
+    cycles(scenario, resolved, out);
+}
+
+fn lanes_check(
+    scenario: &Scenario,
+    lanes_attr: Option<&Attr>,
+    lanes: Option<i64>,
+    opposite_lanes: Option<bool>,
+    direction: Option<&Entry>,
+    out: &mut Vec<Diagnostic>,
+) {
+    let mut indexed: Vec<(&Attr, i64, String)> = Vec::new();
+    if let Some(a) = scenario.section("ego").and_then(|e| e.attr("lane")) {
+        indexed.extend(a.integer().map(|n| (a, n, "the ego vehicle".to_string())));
+    }
+    for group in &scenario.actors {
+        if let Some(a) = group.attr("lane") {
+            indexed.extend(a.integer().map(|n| (a, n, format!("group `{}`", group.name.text))));
+        }
+    }
+    if let Some(n) = lanes.filter(|n| *n < 1) {
+        if let Some(a) = lanes_attr {
+            out.push(Diagnostic::new(
+                Code::E0500,
+                format!("a road has at least one lane, not {n}"),
+                a.value_span,
+                "not a lane count",
+            ));
+        }
+        return;
+    }
+    // Lane indexes counted from 0 (another tool's convention) are shifted, not rejected.
+    let zero_based = indexed.iter().any(|(_, n, _)| *n == 0)
+        && indexed.iter().all(|(_, n, _)| *n >= 0)
+        && lanes.is_none_or(|l| indexed.iter().all(|(_, n, _)| *n < l));
+    if zero_based {
+        let first = indexed.iter().find(|(_, n, _)| *n == 0).map(|(a, ..)| a.value_span).unwrap_or_default();
+        let mut d =
+            Diagnostic::new(Code::W0403, "lane indexes look counted from 0", first, "lane 0 does not exist in TAD")
+                .with_help(
+                    "TAD counts lanes from 1 (the leftmost lane in the ego's direction); add 1 to every lane index",
+                );
+        for (a, n, _) in &indexed {
+            d = d.with_fix(a.value_span, (n + 1).to_string());
+        }
+        out.push(d);
+        return;
+    }
+    for (a, n, who) in &indexed {
+        let n = *n;
+        if n == 0 {
+            out.push(
+                Diagnostic::new(
+                    Code::E0500,
+                    format!("{who} is in lane 0, which does not exist"),
+                    a.value_span,
+                    "lanes are numbered from 1",
+                )
+                .with_help(
+                    "1 is the leftmost lane in the ego's direction; -1 the leftmost lane of the opposite direction",
+                ),
+            );
+        } else if let Some(lanes) = lanes.filter(|l| n.abs() > *l) {
+            let mut d = Diagnostic::new(
+                Code::E0500,
+                format!(
+                    "{who} is in lane {n}, but the road has {lanes} lane{} per direction",
+                    if lanes == 1 { "" } else { "s" }
+                ),
+                a.value_span,
+                "beyond the road",
+            )
+            .with_help(if n > 0 {
+                format!("use a lane from 1 to {lanes}")
+            } else {
+                format!("use a lane from -1 to -{lanes}")
+            });
+            if let Some(l) = lanes_attr {
+                d = d.with_secondary(l.value_span, "lanes per direction");
+            }
+            out.push(d);
+        } else if n < 0 && opposite_lanes == Some(false) {
+            let mut d = Diagnostic::new(
+                Code::E0501,
+                format!(
+                    "{who} is in lane {n} of the opposite direction, but the road is {}",
+                    direction.map_or("one-way", |d| d.name.as_str())
+                ),
+                a.value_span,
+                "no opposite direction",
+            )
+            .with_help("negative lane indexes are the opposite direction's lanes; a one-way road has none");
+            if let Some(d_attr) = scenario.section("road").and_then(|r| r.attr("direction")) {
+                d = d.with_secondary(d_attr.value_span, "the road's direction");
+            }
+            out.push(d);
+        }
+    }
+}
+
+fn performers(behavior: Option<&Entry>, attr: Option<&Attr>, kind: &str, what: &str, out: &mut Vec<Diagnostic>) {
+    let (Some(behavior), Some(attr)) = (behavior, attr) else { return };
+    let Some(performers) = behavior.symbols("performers") else { return };
+    if !performers.contains(&kind) {
+        out.push(
+            Diagnostic::new(
+                Code::E0502,
+                format!("{what} cannot `{}`: it is a {kind}", behavior.name),
+                attr.value_span,
+                format!("not something a {kind} does"),
+            )
+            .with_note(format!("`{}` is done by {}", behavior.name, quoted(&performers))),
+        );
+    }
+}
+
+fn speeds(
+    attr: Option<&Attr>,
+    behavior: Option<&Entry>,
+    actor_type: Option<&Entry>,
+    context: Option<&Entry>,
+    what: &str,
+    out: &mut Vec<Diagnostic>,
+) {
+    let Some(attr) = attr else { return };
+    let Some(speed) = attr.quantity().map(|q| q.si()) else { return };
+    const EPSILON: f64 = 1e-9;
+    if let Some((behavior, max)) = behavior.and_then(|b| b.speed("max_speed").map(|m| (b, m)))
+        && speed > max + EPSILON
+    {
+        out.push(
+            Diagnostic::new(
+                Code::E0503,
+                format!("{what} is `{}` but moves at {}", behavior.name, speed_text(speed)),
+                attr.value_span,
+                format!("`{}` allows at most {}", behavior.name, speed_text(max)),
+            )
+            .with_help(format!("write `{}`, or a behavior that moves", speed_text(max)))
+            .with_fix(attr.value_span, speed_text(max)),
+        );
+        return;
+    }
+    if speed < 0.0 {
+        out.push(Diagnostic::new(
+            Code::E0503,
+            format!("{what} has a negative speed"),
+            attr.value_span,
+            "speeds are not negative",
+        ));
+        return;
+    }
+    if let Some((t, max)) = actor_type.and_then(|t| t.speed("max_speed").map(|m| (t, m)))
+        && speed > max + EPSILON
+    {
+        out.push(Diagnostic::new(
+            Code::W0504,
+            format!("{what} moves at {}, implausibly fast for a {}", speed_text(speed), t.name),
+            attr.value_span,
+            format!("a {} reaches about {}", t.name, speed_text(max)),
+        ));
+        return;
+    }
+    if let Some((c, max)) = context.and_then(|c| c.speed("max_speed").map(|m| (c, m)))
+        && speed > max + EPSILON
+    {
+        out.push(Diagnostic::new(
+            Code::W0504,
+            format!("{what} moves at {}, implausibly fast on a {} road", speed_text(speed), c.name.replace('_', " ")),
+            attr.value_span,
+            format!("more than {} there", speed_text(max)),
+        ));
+    }
+}
+
+/// `front of ego` in another lane, `left` in a lane to the right, ...: same direction only
+/// (the paper writes oncoming traffic as `front`).
+fn relation_vs_lanes(
+    vocabulary: &Vocabulary,
+    relation: &Entry,
+    span: Span,
+    lane: i64,
+    ego_lane: i64,
+    what: &str,
+    out: &mut Vec<Diagnostic>,
+) {
+    if lane < 0 || ego_lane < 0 {
+        return;
+    }
+    let lateral = relation.symbol("lateral").unwrap_or("same");
+    let actual = match lane.cmp(&ego_lane) {
+        std::cmp::Ordering::Less => "left",
+        std::cmp::Ordering::Greater => "right",
+        std::cmp::Ordering::Equal => "same",
+    };
+    let consistent = match lateral {
+        "same" => actual == "same",
+        "left" | "right" => actual == lateral || actual == "same",
+        _ => true,
+    };
+    if consistent {
+        return;
+    }
+    let longitudinal = relation.symbol("longitudinal").unwrap_or("same");
+    let better = vocabulary
+        .entries("relation")
+        .iter()
+        .find(|r| r.symbol("lateral") == Some(actual) && r.symbol("longitudinal").unwrap_or("same") == longitudinal);
+    let mut d = Diagnostic::new(
+        Code::W0505,
+        format!(
+            "{what} is `{}` the ego vehicle, but its lane {lane} is {} of the ego's lane {ego_lane}",
+            relation.name,
+            match actual {
+                "left" => "to the left",
+                "right" => "to the right",
+                _ => "the same as",
+            }
+        ),
+        span,
+        "disagrees with the lanes",
+    );
+    if let Some(better) = better {
+        d = d.with_help(format!("write `{}`, or correct the lane", better.name)).with_fix(span, better.name.clone());
+    }
+    out.push(d);
+}
+
+fn lights_and_signs(
+    vocabulary: &Vocabulary,
+    light_attr: Option<&Attr>,
+    signs: Option<&Attr>,
+    road_type: Option<&Entry>,
+    context: Option<&Entry>,
+    out: &mut Vec<Diagnostic>,
+) {
+    let light_entry = entry(vocabulary, "light_state", light_attr);
+    if let (Some(light), Some(light_attr)) = (light_entry, light_attr)
+        && light.flag("present") != Some(false)
+    {
+        let unsignalised = [road_type, context].into_iter().flatten().find(|e| e.flag("signalised") == Some(false));
+        if let Some(place) = unsignalised {
+            out.push(
+                Diagnostic::new(
+                    Code::W0507,
+                    format!("a `{}` traffic light on a {}", light.name, place.name.replace('_', " ")),
+                    light_attr.value_span,
+                    format!("a {} has no traffic lights", place.name.replace('_', " ")),
+                )
+                .with_help("write `light: none`, or correct the road"),
+            );
+        }
+    }
+    let (Some(signs), Some(light)) = (signs, light_entry) else { return };
+    for sign in signs.symbols().unwrap_or(&[]) {
+        let Some(sign_entry) = vocabulary.get("traffic_sign", &sign.name) else { continue };
+        if sign_entry.symbols("conflicts_with").is_some_and(|c| c.contains(&light.name.as_str())) {
+            let mut d = Diagnostic::new(
+                Code::W0508,
+                format!("a {} together with a {} light", sign_entry.name.replace('_', " "), light.name),
+                sign.span,
+                format!("contradicts the `{}` light", light.name),
+            );
+            if let Some(l) = light_attr {
+                d = d.with_secondary(l.value_span, "the light");
+            }
+            out.push(d.with_help("a scenario states what governs the ego vehicle: keep the sign or the light"));
+        }
+    }
+}
+
+/// Groups positioned relative to each other in a circle have no anchor.
+fn cycles(scenario: &Scenario, resolved: &Resolved, out: &mut Vec<Diagnostic>) {
+    let next = |i: usize| match resolved.targets.get(&i) {
+        Some(Target::Group(j)) => Some(*j),
+        _ => None,
+    };
+    let mut reported = vec![false; scenario.actors.len()];
+    for start in 0..scenario.actors.len() {
+        // walk at most n steps; a revisit of `start` is a cycle through it
+        let mut path = vec![start];
+        let mut current = start;
+        while let Some(j) = next(current) {
+            if j == start {
+                if path.iter().any(|&p| reported[p]) {
+                    break;
+                }
+                for &p in &path {
+                    reported[p] = true;
+                }
+                let position_span = |i: usize| {
+                    scenario.actors[i].attr("position").map_or(scenario.actors[i].name.span, |a| a.value_span)
+                };
+                let names: Vec<&str> = path.iter().map(|&p| scenario.actors[p].name.text.as_str()).collect();
+                let mut d = Diagnostic::new(
+                    Code::E0506,
+                    if path.len() == 1 {
+                        format!("group `{}` is positioned relative to itself", names[0])
+                    } else {
+                        format!("groups {} are positioned relative to each other in a cycle", quoted(&names))
+                    },
+                    position_span(start),
+                    "this position",
+                )
+                .with_help("place one of them relative to `ego` or a road element");
+                for &p in &path[1..] {
+                    d = d.with_secondary(position_span(p), "relative to the next");
+                }
+                out.push(d);
+                break;
+            }
+            if path.contains(&j) || path.len() > scenario.actors.len() {
+                break;
+            }
+            path.push(j);
+            current = j;
+        }
+    }
+}
