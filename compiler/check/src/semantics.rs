@@ -87,7 +87,7 @@ pub fn check(
                 out.push(
                         Diagnostic::new(
                             Code::E0510,
-                            format!("{what} is `{}` the ego vehicle, which a dash-cam cannot see", relation.name),
+                            format!("{what} is `{} of ego`, where a dash-cam cannot see", relation.name),
                             position.relation.span,
                             "behind the camera",
                         )
@@ -310,11 +310,11 @@ fn relation_vs_lanes(
     let mut d = Diagnostic::new(
         Code::W0505,
         format!(
-            "{what} is `{}` the ego vehicle, but its lane {lane} is {} of the ego's lane {ego_lane}",
+            "{what} is `{} of ego`, but its lane {lane} is {} the ego's lane {ego_lane}",
             relation.name,
             match actual {
-                "left" => "to the left",
-                "right" => "to the right",
+                "left" => "to the left of",
+                "right" => "to the right of",
                 _ => "the same as",
             }
         ),

@@ -17,14 +17,23 @@ fn every_example_checks_and_is_formatted() {
         let relative = path.strip_prefix(&root).unwrap().to_str().unwrap().to_string();
         let input = tadslc::files::read(path).unwrap();
         let checked = tadslc::check::diagnose_in(&mut db, &input);
-        let unexpected: Vec<_> = checked.diagnostics.iter().filter(|d| d.code != tad_diagnostics::Code::W0600).collect();
+        let unexpected: Vec<_> =
+            checked.diagnostics.iter().filter(|d| d.code != tad_diagnostics::Code::W0600).collect();
         assert!(unexpected.is_empty(), "{relative}: {unexpected:#?}");
-        let expected = if INCOMPLETE.contains(&relative.as_str()) { tad_check::Class::Incomplete } else { tad_check::Class::Complete };
+        let expected = if INCOMPLETE.contains(&relative.as_str()) {
+            tad_check::Class::Incomplete
+        } else {
+            tad_check::Class::Complete
+        };
         assert_eq!(checked.class, Some(expected), "{relative}");
         let (module, _) = tad_syntax::analyze(&input.text);
         let stem = path.file_stem().unwrap().to_str().unwrap();
         assert_eq!(module.scenario.and_then(|s| s.name).map(|n| n.text).as_deref(), Some(stem), "named after its file");
-        assert_eq!(tad_syntax::format::format(&input.text).as_deref(), Ok(input.text.as_str()), "{relative} is not formatted");
+        assert_eq!(
+            tad_syntax::format::format(&input.text).as_deref(),
+            Ok(input.text.as_str()),
+            "{relative} is not formatted"
+        );
     }
 }
 

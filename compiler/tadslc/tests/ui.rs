@@ -4,7 +4,8 @@
 //! `// error[E0203]: 4:5-4:11` (severity, code, 1-based start and end line:column). The
 //! harness compares that set exactly with what the checker reports, then compares the
 //! rendered human output (no colour) with the `.stderr` file beside the fixture. Fixtures
-//! under `tests/ui/fmt/` are also formatted and compared with `NAME.formatted`.
+//! under `tests/ui/fmt/` are also formatted and compared with `NAME.formatted`. A line
+//! `// profile: dashcam` checks the fixture with that profile.
 //!
 //! `TAD_BLESS=1 cargo test --test ui` rewrites `.stderr` and `.formatted` files; it never
 //! writes when `CI` is set. Expected files without a fixture fail the run.
@@ -14,8 +15,12 @@ use std::path::{Path, PathBuf};
 use tad_diagnostics::LineIndex;
 use tad_diagnostics::render::{FileReport, human};
 
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").canonicalize().expect("the repository")
+}
+
 fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/ui")
+    repo().join("tests/ui")
 }
 
 fn fixtures(dir: &Path, out: &mut Vec<PathBuf>) {
@@ -67,7 +72,11 @@ fn run_fixture(path: &Path) -> Result<(), Failed> {
     let input = tadslc::files::read(path).map_err(|e| format!("cannot read fixture: {e}"))?;
     let text = input.text.clone();
     let name = format!("tests/ui/{}", path.strip_prefix(root()).unwrap_or(path).display());
-    let diagnostics = tadslc::check::diagnose(&input);
+    let mut options = tad_check::Options::default();
+    if text.lines().any(|l| l.trim() == "// profile: dashcam") {
+        options.profile = tad_check::Profile::Dashcam;
+    }
+    let diagnostics = tadslc::check::diagnose_in(&mut tad_db::Database::new(options), &input).diagnostics;
 
     let index = LineIndex::new(&text);
     let mut actual: Vec<(String, String, String)> = diagnostics
@@ -91,7 +100,9 @@ fn run_fixture(path: &Path) -> Result<(), Failed> {
         problems.push(format!("diagnostics differ\n--- expected\n{}\n--- actual\n{}", show(&wanted), show(&actual)));
     }
 
-    let rendered = human::render(&FileReport { name: &name, text: &text, diagnostics: &diagnostics }, false);
+    // paths inside messages are shown relative to the repository
+    let rendered = human::render(&FileReport { name: &name, text: &text, diagnostics: &diagnostics }, false)
+        .replace(&format!("{}/", repo().display()), "");
     compare(&path.with_extension("stderr"), &rendered, &mut problems);
 
     if path.components().any(|c| c.as_os_str() == "fmt") {
