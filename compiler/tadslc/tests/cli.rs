@@ -178,3 +178,66 @@ fn bench_reports_throughput_against_the_peer() {
         assert!(text.contains(row), "{row} missing from\n{text}");
     }
 }
+
+#[test]
+fn fmt_canonicalize_applies_canonical_forms_and_then_checks_clean() {
+    let dir = scratch("canonical");
+    let path = dir.join("aliases.tad");
+    std::fs::copy(repo().join("tests/ui/check/aliases_and_units.tad"), &path).unwrap();
+    let before = std::fs::read_to_string(&path).unwrap();
+    let out = tadslc(&["fmt", "--canonicalize", path.to_str().unwrap()], "");
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    let after = std::fs::read_to_string(&path).unwrap();
+    assert_ne!(before, after);
+    for (old, new) in [
+        ("sunny", "clear"),
+        ("30 mph", "48.3 km/h"),
+        ("12.5 m/s", "45 km/h"),
+        ("front_right of ego_vehicle", "right_front of ego"),
+    ] {
+        assert!(!after.contains(&format!(": {old}")) && after.contains(new), "{old} -> {new}\n{after}");
+    }
+    // nothing canonical is left to fix, and a second run changes nothing
+    let checked = tadslc(&["check", "--format", "json", path.to_str().unwrap()], "");
+    let file: Value = serde_json::from_str(stdout(&checked).trim()).unwrap();
+    assert!(file["diagnostics"].as_array().unwrap().iter().all(|d| !d["code"].as_str().unwrap().starts_with("W04")));
+    assert_eq!(file["class"], "complete");
+    assert_eq!(code(&tadslc(&["fmt", "--check", "--canonicalize", path.to_str().unwrap()], "")), 0);
+}
+
+#[test]
+fn profile_and_non_scenario_options() {
+    let follower = "scenario s2 {\n  actor f: car {\n    position: behind of ego\n  }\n}\n";
+    let codes = |args: &[&str], input: &str| -> Vec<String> {
+        let mut all = vec!["check", "--format", "json"];
+        all.extend_from_slice(args);
+        all.push("-");
+        let out = tadslc(&all, input);
+        let file: Value = serde_json::from_str(stdout(&out).trim()).unwrap();
+        file["diagnostics"].as_array().unwrap().iter().map(|d| d["code"].as_str().unwrap().to_string()).collect()
+    };
+    assert!(!codes(&[], follower).contains(&"E0510".to_string()));
+    assert!(codes(&["--profile", "dashcam"], follower).contains(&"E0510".to_string()));
+    // by default weather, time and road all missing make a non-scenario; with `weather` alone, so does this
+    let no_weather = CLEAN.replace("    weather: clear\n", "");
+    assert!(!codes(&[], &no_weather).contains(&"W0601".to_string()));
+    assert!(codes(&["--non-scenario", "weather"], &no_weather).contains(&"W0601".to_string()));
+    assert_eq!(code(&tadslc(&["check", "--non-scenario", "colour", "-"], CLEAN)), 2);
+}
+
+#[test]
+fn json_carries_class_and_refinement() {
+    let out =
+        tadslc(&["check", "--format", "json", "tests/ui/check/incomplete.tad", "tests/ui/check/non_scenario.tad"], "");
+    let files: Vec<Value> = stdout(&out).lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert_eq!(files[0]["class"], "incomplete");
+    let refinement: Vec<&str> =
+        files[0]["refinement"].as_array().unwrap().iter().map(|r| r.as_str().unwrap()).collect();
+    assert!(refinement.iter().any(|r| r.contains("lane index of group `parked_right`")), "{refinement:?}");
+    assert!(refinement.iter().any(|r| r.contains("how many actors group `crowd`")), "{refinement:?}");
+    assert!(refinement.iter().any(|r| r.starts_with("State the number of lanes per direction")), "{refinement:?}");
+    assert_eq!(files[1]["class"], "non_scenario");
+    assert_eq!(files[1]["refinement"], serde_json::json!([]));
+    let human = stderr(&tadslc(&["check", "tests/ui/check/incomplete.tad"], ""));
+    assert!(human.contains("tests/ui/check/incomplete.tad: incomplete"), "{human}");
+}

@@ -106,10 +106,18 @@ fn codes(text: &str) -> Vec<String> {
     codes
 }
 
-fn exercise(input: &str, what: &str, iteration: usize) {
-    let result = std::panic::catch_unwind(|| {
-        let (_, diagnostics) = tad_syntax::analyze(input);
-        for d in &diagnostics {
+fn exercise(db: &mut tad_db::Database, input: &str, what: &str, iteration: usize) {
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        // the whole checker, with the standard library, through the database
+        let file = tadslc::files::Input {
+            name: "mutated.tad".into(),
+            path: Some(std::env::temp_dir().join("tadsl-mutated.tad")),
+            text: input.to_string(),
+            invalid_utf8: None,
+        };
+        // one database for the whole run: each input replaces the last, as edits would
+        let checked = tadslc::check::diagnose_in(db, &file);
+        for d in &checked.diagnostics {
             assert!(
                 d.primary.span.start <= d.primary.span.end && d.primary.span.end <= input.len(),
                 "span out of range"
@@ -125,7 +133,7 @@ fn exercise(input: &str, what: &str, iteration: usize) {
             );
             assert_eq!(codes(input), codes(&formatted), "formatting keeps the meaning");
         }
-    });
+    }));
     if result.is_err() {
         let path = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("robustness-{what}-{iteration}.tad"));
         let _ = std::fs::write(&path, input);
@@ -137,9 +145,10 @@ fn exercise(input: &str, what: &str, iteration: usize) {
 fn byte_mutations_never_panic() {
     let corpus = corpus();
     let mut rng = Rng::new(SEED);
+    let mut db = tad_db::Database::new(tad_check::Options::default());
     for i in 0..BYTE_MUTATIONS {
         let source = rng.pick(&corpus).clone();
-        exercise(&mutate_bytes(&mut rng, &source), "byte", i);
+        exercise(&mut db, &mutate_bytes(&mut rng, &source), "byte", i);
     }
 }
 
@@ -147,14 +156,16 @@ fn byte_mutations_never_panic() {
 fn token_mutations_never_panic() {
     let corpus = corpus();
     let mut rng = Rng::new(SEED ^ 1);
+    let mut db = tad_db::Database::new(tad_check::Options::default());
     for i in 0..TOKEN_MUTATIONS {
         let source = rng.pick(&corpus).clone();
-        exercise(&mutate_tokens(&mut rng, &source), "token", i);
+        exercise(&mut db, &mutate_tokens(&mut rng, &source), "token", i);
     }
 }
 
 #[test]
 fn pathological_inputs() {
+    let mut db = tad_db::Database::new(tad_check::Options::default());
     for input in [
         String::new(),
         "{".repeat(10_000),
@@ -167,6 +178,6 @@ fn pathological_inputs() {
         "a ".repeat(20_000),
         "\u{0}\u{FFFD}\u{FEFF}".repeat(100),
     ] {
-        exercise(&input, "pathological", input.len());
+        exercise(&mut db, &input, "pathological", input.len());
     }
 }
