@@ -103,3 +103,24 @@ fn field_tables_match_the_schema() {
         assert_eq!(listed, fields, "spec/language.md table for `{}`", section.name);
     }
 }
+
+#[test]
+fn vocabulary_spec_lists_every_declaration_kind_and_field() {
+    let text = std::fs::read_to_string(common::repo().join("spec/vocabulary.md")).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    let kinds: Vec<&str> = lines.iter().filter_map(|l| l.strip_prefix("### `")).filter_map(|l| l.split('`').next()).collect();
+    let declared: Vec<&str> = tad_syntax::schema::DECLARATIONS.iter().map(|d| d.name).collect();
+    assert_eq!(kinds, declared);
+    for kind in tad_syntax::schema::DECLARATIONS {
+        let heading = lines.iter().position(|l| *l == format!("### `{}`", kind.name)).unwrap();
+        let listed: Vec<&str> = lines[heading + 1..]
+            .iter()
+            .take_while(|l| !l.starts_with('#'))
+            .filter_map(|l| l.strip_prefix("| `"))
+            .filter_map(|l| l.split('`').next())
+            .collect();
+        let fields: Vec<&str> =
+            kind.fields.iter().map(|f| f.name).filter(|f| !matches!(*f, "aliases" | "description")).collect();
+        assert_eq!(listed, fields, "spec/vocabulary.md for `{}`", kind.name);
+    }
+}
