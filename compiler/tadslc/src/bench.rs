@@ -66,6 +66,18 @@ pub fn run(n: usize, seed: u64, examples: Option<&Path>, runs: usize) -> Status 
             black_box(tad_syntax::analyze(text));
         }
     });
+    // the whole checker: structure, names against the standard vocabulary, semantics and
+    // completeness (the vocabulary is built once, as the database does)
+    let prelude = tad_db::stdlib::source(tad_db::PRELUDE).unwrap_or_default();
+    let (core, _) = tad_syntax::analyze(prelude);
+    let (vocabulary, _) = tad_check::Vocabulary::build([(tad_db::PRELUDE, &core)]);
+    let options = tad_check::Options::default();
+    let full = best_of(runs, || {
+        for text in &tad {
+            let (module, _) = tad_syntax::analyze(text);
+            black_box(tad_check::check(&module, &vocabulary, &options));
+        }
+    });
     let format = best_of(runs, || {
         for text in &tad {
             black_box(tad_syntax::format::format(text).ok());
@@ -79,7 +91,8 @@ pub fn run(n: usize, seed: u64, examples: Option<&Path>, runs: usize) -> Status 
     );
     Row { what: "peer: serde_json::Value (JSON)".into(), items: n, bytes: json_bytes, time: peer }.print(None);
     Row { what: "lex".into(), items: n, bytes: tad_bytes, time: lex }.print(Some(peer));
-    Row { what: "check (lex+parse+lower)".into(), items: n, bytes: tad_bytes, time: check }.print(Some(peer));
+    Row { what: "parse (lex+parse+lower)".into(), items: n, bytes: tad_bytes, time: check }.print(Some(peer));
+    Row { what: "check (parse+names+semantics)".into(), items: n, bytes: tad_bytes, time: full }.print(Some(peer));
     Row { what: "fmt (parse+print)".into(), items: n, bytes: tad_bytes, time: format }.print(Some(peer));
 
     if let Some(dir) = examples {

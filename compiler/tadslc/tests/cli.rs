@@ -174,7 +174,14 @@ fn bench_reports_throughput_against_the_peer() {
     let out = tadslc(&["bench", "--scenarios", "50", "--runs", "1", "--examples", "tests/ui/fmt"], "");
     assert_eq!(code(&out), 0, "{}", stderr(&out));
     let text = stdout(&out);
-    for row in ["peer: serde_json::Value", "lex", "check (lex+parse+lower)", "fmt (parse+print)", "check examples"] {
+    for row in [
+        "peer: serde_json::Value",
+        "lex",
+        "parse (lex+parse+lower)",
+        "check (parse+names+semantics)",
+        "fmt (parse+print)",
+        "check examples",
+    ] {
         assert!(text.contains(row), "{row} missing from\n{text}");
     }
 }

@@ -108,7 +108,8 @@ fn field_tables_match_the_schema() {
 fn vocabulary_spec_lists_every_declaration_kind_and_field() {
     let text = std::fs::read_to_string(common::repo().join("spec/vocabulary.md")).unwrap();
     let lines: Vec<&str> = text.lines().collect();
-    let kinds: Vec<&str> = lines.iter().filter_map(|l| l.strip_prefix("### `")).filter_map(|l| l.split('`').next()).collect();
+    let kinds: Vec<&str> =
+        lines.iter().filter_map(|l| l.strip_prefix("### `")).filter_map(|l| l.split('`').next()).collect();
     let declared: Vec<&str> = tad_syntax::schema::DECLARATIONS.iter().map(|d| d.name).collect();
     assert_eq!(kinds, declared);
     for kind in tad_syntax::schema::DECLARATIONS {
