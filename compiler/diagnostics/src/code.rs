@@ -83,6 +83,8 @@ codes! {
     W0508 => Warning,
     W0600 => Warning,
     W0601 => Warning,
+    // Scenic backend (7xx): add codes below this line
+    // end of Scenic codes
 }
 
 impl Code {
