@@ -102,7 +102,8 @@ impl Code {
             return "";
         };
         let rest = &REFERENCE[start..];
-        let end = rest[heading.len()..].find("\n## ").map_or(rest.len(), |i| i + heading.len() + 1);
+        let body = &rest[heading.len()..];
+        let end = ["\n## ", "\n<!--"].iter().filter_map(|m| body.find(m)).min().map_or(rest.len(), |i| i + heading.len() + 1);
         rest[..end].trim_end()
     }
 
