@@ -52,12 +52,11 @@ pub fn parse(src: &str) -> Parsed {
     let mut syntax: Vec<Diagnostic> = errors.into_iter().filter_map(|r| parse_error(src, &tokens, r.error)).collect();
     let missing_colons = split_words_at_line_breaks(src, &mut file);
     // What follows a missing `:` on its line is a consequence of it.
-    let index = LineIndex::new(src);
+    let same_line = |a: usize, b: usize| !src[a.min(b)..a.max(b)].contains('\n');
     syntax.retain(|d| {
-        !missing_colons.iter().any(|m| {
-            d.primary.span.start > m.primary.span.start
-                && index.line_of(d.primary.span.start) == index.line_of(m.primary.span.start)
-        })
+        !missing_colons
+            .iter()
+            .any(|m| d.primary.span.start > m.primary.span.start && same_line(d.primary.span.start, m.primary.span.start))
     });
     drop_values_with_unknown_units(src, &mut file, &syntax);
     diagnostics.extend(missing_colons);
@@ -146,30 +145,26 @@ fn fields_mut(file: &mut File) -> impl Iterator<Item = &mut Field> {
 /// Report every `{` left open at the end of the file and close it with an empty `}`
 /// token there, so the tree keeps everything that was parsed.
 fn close_braces(src: &str, tokens: &mut Vec<Spanned>, diagnostics: &mut Vec<Diagnostic>, report: bool) {
+    let mut open: Vec<usize> = Vec::new();
+    let mut pairs: Vec<(usize, usize)> = Vec::new();
+    for &(start, token, _) in tokens.iter() {
+        match token {
+            Token::LBrace => open.push(start),
+            Token::RBrace => pairs.extend(open.pop().map(|opened| (opened, start))),
+            _ => {}
+        }
+    }
+    if open.is_empty() {
+        return;
+    }
     let index = LineIndex::new(src);
     let indent = |offset: usize| {
         let start = index.line_start(index.line_of(offset));
         src[start..].len() - src[start..].trim_start_matches([' ', '\t']).len()
     };
     let line_leading = |offset: usize| src[index.line_start(index.line_of(offset))..offset].trim().is_empty();
-    let mut open: Vec<usize> = Vec::new();
     // A `{` that a later, less indented `}` closed: most likely the one missing its `}`.
-    let mut suspect: Option<(usize, usize)> = None;
-    for &(start, token, _) in tokens.iter() {
-        match token {
-            Token::LBrace => open.push(start),
-            Token::RBrace => {
-                if let Some(opened) = open.pop()
-                    && suspect.is_none()
-                    && line_leading(start)
-                    && indent(opened) > indent(start)
-                {
-                    suspect = Some((opened, start));
-                }
-            }
-            _ => {}
-        }
-    }
+    let suspect = pairs.iter().copied().find(|&(opened, closed)| line_leading(closed) && indent(opened) > indent(closed));
     let end = src.len();
     for (i, &opened) in open.iter().enumerate().rev() {
         let mut d =
