@@ -8,6 +8,9 @@
 //! The command line builds a database per run; the language server keeps one and sets
 //! file texts as the editor changes them.
 //!
+//! A `.yaml`/`.yml` file is read by `tad-yaml` into the same model, so YAML answers are
+//! checked by the same code and reported at their own lines.
+//!
 //! Module resolution: `use a.b` is `a/b.tad` in the using file's directory, else the
 //! standard module `a.b` embedded from `stdlib/` at build time. Every file sees the
 //! prelude `core` unless it is the prelude.
@@ -74,10 +77,18 @@ fn is_stdlib(path: &Path) -> bool {
     path.starts_with(STDLIB_PREFIX)
 }
 
-/// Parse and lower one file.
+/// Whether a path is read as YAML (TrafficAlign's or TrafficComposer's form, possibly a
+/// whole LLM answer) rather than TAD.
+pub fn is_yaml(path: &Path) -> bool {
+    path.extension().is_some_and(|e| e.eq_ignore_ascii_case("yaml") || e.eq_ignore_ascii_case("yml"))
+}
+
+/// Parse and lower one file: TAD, or YAML by its extension. Either way the result is the
+/// same model, with spans into the file's own text.
 #[salsa::tracked(returns(ref))]
 pub fn analyze(db: &dyn Db, file: SourceFile) -> Analysis {
-    let (module, diagnostics) = tad_syntax::analyze(file.text(db));
+    let (module, diagnostics) =
+        if is_yaml(file.path(db)) { tad_yaml::lower(file.text(db)) } else { tad_syntax::analyze(file.text(db)) };
     Analysis { module, diagnostics }
 }
 

@@ -58,6 +58,15 @@ codes! {
     E0213 => Error,
     E0214 => Error,
     // YAML import (3xx): add codes below this line
+    E0300 => Error,
+    E0301 => Error,
+    E0302 => Error,
+    E0303 => Error,
+    E0304 => Error,
+    W0300 => Warning,
+    W0301 => Warning,
+    W0302 => Warning,
+    W0303 => Warning,
     // end of YAML codes
     // names and vocabulary (4xx), semantics (5xx), completeness (6xx)
     E0400 => Error,

@@ -315,6 +315,12 @@ pub fn unescape(raw: &str, offset: usize, diagnostics: &mut Vec<Diagnostic>) -> 
     out
 }
 
+/// Bytes of leading spaces and tabs: indentation is ASCII, so cutting it off is always
+/// on a character boundary (other whitespace, such as U+3000, is content).
+fn indentation(line: &str) -> usize {
+    line.len() - line.trim_start_matches([' ', '\t']).len()
+}
+
 /// The content of a `"""` text block: the line break after the opening quotes and the
 /// indentation common to all non-blank lines are removed, as are trailing blank lines.
 pub fn text_block_content(raw: &str) -> String {
@@ -323,9 +329,9 @@ pub fn text_block_content(raw: &str) -> String {
     let inner = inner.strip_prefix("\r\n").or_else(|| inner.strip_prefix('\n')).unwrap_or(inner);
     let lines: Vec<&str> = inner.lines().collect();
     let indent =
-        lines.iter().filter(|l| !l.trim().is_empty()).map(|l| l.len() - l.trim_start().len()).min().unwrap_or(0);
+        lines.iter().filter(|l| !l.trim().is_empty()).map(|l| indentation(l)).min().unwrap_or(0);
     let mut out: Vec<&str> =
-        lines.iter().map(|l| if l.len() >= indent { &l[indent..] } else { l.trim_start() }).collect();
+        lines.iter().map(|l| if indentation(l) >= indent { &l[indent..] } else { l.trim_start() }).collect();
     while out.last().is_some_and(|l| l.trim().is_empty()) {
         out.pop();
     }
@@ -406,6 +412,15 @@ mod tests {
         unescape(r#""bad \q""#, 10, &mut d);
         assert_eq!(d[0].code, Code::E0004);
         assert_eq!(d[0].primary.span, Span::new(15, 17));
+    }
+
+    #[test]
+    fn text_block_indentation_is_ascii() {
+        // U+3000 is whitespace but not indentation: it stays, and nothing is cut mid-character
+        let raw = "\"\"\"\n  x\n\u{3000}y\n\"\"\"";
+        assert_eq!(text_block_content(raw), "  x\n\u{3000}y");
+        let raw = "\"\"\"\n \u{3000}x\n  y\n\"\"\"";
+        assert_eq!(text_block_content(raw), "\u{3000}x\n y");
     }
 
     #[test]

@@ -9,6 +9,7 @@ pub mod corpus;
 pub mod explain;
 pub mod files;
 pub mod fmt;
+pub mod interchange;
 
 /// Output format of `check`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]

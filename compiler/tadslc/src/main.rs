@@ -51,6 +51,26 @@ enum Command {
         #[arg(long)]
         canonicalize: bool,
     },
+    /// Convert a YAML scenario (TrafficAlign's form, TrafficComposer's IR, or a whole LLM
+    /// answer around one) to canonical TAD
+    Import {
+        /// The YAML file or answer
+        path: PathBuf,
+        /// Where to write the TAD (default: standard output)
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
+    /// Print a scenario in another form
+    Export {
+        /// TrafficAlign's YAML form (with extra keys for everything TAD adds)
+        #[arg(long, required = true)]
+        yaml: bool,
+        /// The TAD file
+        path: PathBuf,
+        /// Where to write (default: standard output)
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
     /// Explain a diagnostic code, e.g. `tadslc explain E0203`
     Explain {
         /// The code; omit it to list every code
@@ -144,6 +164,8 @@ fn main() -> ExitCode {
             check::run(&paths, format, deny_warnings, color, rules.options())
         }
         Command::Fmt { paths, check, canonicalize } => fmt::run(&paths, check, canonicalize, color),
+        Command::Import { path, output } => tadslc::interchange::run_import(&path, output.as_deref(), color),
+        Command::Export { yaml: _, path, output } => tadslc::interchange::run_export(&path, output.as_deref(), color),
         Command::Explain { code } => explain::run(code.as_deref()),
         Command::Bench { scenarios, seed, examples, runs } => bench::run(scenarios, seed, examples.as_deref(), runs),
     };

@@ -248,3 +248,67 @@ fn json_carries_class_and_refinement() {
     let human = stderr(&tadslc(&["check", "tests/ui/check/incomplete.tad"], ""));
     assert!(human.contains("tests/ui/check/incomplete.tad: incomplete"), "{human}");
 }
+
+#[test]
+fn yaml_answers_are_checked_at_their_own_lines() {
+    let out = tadslc(
+        &["check", "--format", "json", "tests/yaml/paper/nl_to_dsl_example_1.yaml", "tests/yaml/paper/nl_to_dsl_example_2.yaml"],
+        "",
+    );
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    for line in stdout(&out).lines() {
+        let file: Value = serde_json::from_str(line).unwrap();
+        assert_eq!(file["class"], "complete", "{file}");
+    }
+
+    let out = tadslc(&["check", "--format", "json", "tests/yaml/cli/non_scenario.yaml"], "");
+    let file: Value = serde_json::from_str(stdout(&out).trim()).unwrap();
+    assert_eq!(file["class"], "non_scenario");
+
+    let out = tadslc(&["check", "--format", "json", "tests/yaml/cli/missing_lane.yaml"], "");
+    let file: Value = serde_json::from_str(stdout(&out).trim()).unwrap();
+    assert_eq!(file["class"], "incomplete");
+    let refinement = file["refinement"].as_array().unwrap();
+    assert_eq!(refinement.len(), 1, "{refinement:?}");
+    assert!(refinement[0].as_str().unwrap().contains("lane index of group `parked_right`"));
+    // the W0600 for the group points at its key, the aliases at their YAML values
+    let at = |code: &str| -> Vec<u64> {
+        file["diagnostics"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|d| d["code"] == code)
+            .map(|d| d["span"]["start"]["line"].as_u64().unwrap())
+            .collect()
+    };
+    assert_eq!(at("W0600"), vec![22]);
+    assert_eq!(at("W0401"), vec![5, 17, 28]);
+}
+
+#[test]
+fn import_writes_canonical_tad_and_export_round_trips() {
+    let dir = scratch("interchange");
+    let tad = dir.join("missing_lane.tad");
+    let out = tadslc(&["import", "tests/yaml/cli/missing_lane.yaml", "-o", tad.to_str().unwrap()], "");
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    let text = std::fs::read_to_string(&tad).unwrap();
+    for expected in ["scenario missing_lane {", "weather: clear", "behavior: go_forward", "position: right_front of ego", "lane: unspecified"] {
+        assert!(text.contains(expected), "{expected} missing from\n{text}");
+    }
+    assert_eq!(code(&tadslc(&["fmt", "--check", tad.to_str().unwrap()], "")), 0, "imported TAD is formatted");
+
+    // export then import gives back the example
+    for example in ["examples/paper/nl_to_dsl_example_2.tad", "examples/regions/switzerland_tram_street.tad"] {
+        let yaml = dir.join("exported.yaml");
+        let out = tadslc(&["export", "--yaml", example, "-o", yaml.to_str().unwrap()], "");
+        assert_eq!(code(&out), 0, "{}", stderr(&out));
+        let back = tadslc(&["import", yaml.to_str().unwrap()], "");
+        assert_eq!(code(&back), 0, "{}", stderr(&back));
+        let original = std::fs::read_to_string(repo().join(example)).unwrap();
+        let without_comments: String =
+            original.lines().filter(|l| !l.starts_with("//")).collect::<Vec<_>>().join("\n").trim_start().to_string() + "\n";
+        assert_eq!(stdout(&back), without_comments, "{example}");
+    }
+    // a file with errors is not exported
+    assert_eq!(code(&tadslc(&["export", "--yaml", "tests/ui/structure/unknown_field.tad"], "")), 1);
+}

@@ -165,12 +165,16 @@ fn main() {
             _ => {}
         }
     }
-    // every diagnostic code is expected by at least one fixture
+    // every diagnostic code is expected by at least one fixture: these, or the YAML answer
+    // fixtures of `tests/yaml/answers` (annotated `# error[CODE]: ...`, run by tad-yaml)
+    let mut yaml = Vec::new();
+    fixtures(&repo().join("tests/yaml/answers"), &mut yaml);
     let all: Vec<String> = files
         .iter()
         .filter(|p| p.extension().is_some_and(|e| e == "tad"))
+        .chain(yaml.iter().filter(|p| p.extension().is_some_and(|e| e == "yaml")))
         .filter_map(|p| std::fs::read(p).ok())
-        .map(|bytes| String::from_utf8_lossy(&bytes).into_owned())
+        .map(|bytes| String::from_utf8_lossy(&bytes).replace("\n# error[", "\n// error[").replace("\n# warning[", "\n// warning["))
         .flat_map(|t| expected(&t).into_iter().map(|(_, c, _)| c))
         .collect();
     trials.push(Trial::test("every code has a fixture", move || {

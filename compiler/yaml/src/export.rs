@@ -1,0 +1,382 @@
+//! A model written in TrafficAlign's YAML form, with extra keys for what that form lacks.
+
+use crate::norm::{self, normalize};
+use serde_norway::Value;
+use tad_syntax::model::*;
+use tad_syntax::schema::Unit;
+
+const IN: &str = "    ";
+
+/// Write the scenario of `module` in the paper's YAML form: `environment`,
+/// `road_network` and `actors` (with `ego_vehicle` and one key per actor group), values in
+/// the paper's spelling (`straight road`, `two-way`, `left front`, `30 km/h`). Everything
+/// TAD has and that form lacks goes in extra keys, so [`crate::lower`] reads back the same
+/// scenario: `scenario` (the name), `use`, a `source` block, and in `road_network`
+/// `special_lanes`, `signs` (the full list when there is more than one sign; the paper's
+/// `traffic_sign` holds one), `traffic`, `hazards`, `roadworks`, `emergency_vehicles` and
+/// `roadside`. Absent fields are left out; `unspecified` is written `unspecified`.
+///
+/// `src` is the TAD text the model was lowered from: its leading comments become YAML
+/// comments, and quantities keep their written form. Declarations are not exported.
+pub fn export(module: &Module, src: &str) -> String {
+    let mut out = String::new();
+    for line in src.lines() {
+        let t = line.trim();
+        if let Some(comment) = t.strip_prefix("//") {
+            if comment.chars().all(|c| printable(c) || c == '\t') {
+                out.push_str(&format!("#{}\n", comment.trim_end()));
+            }
+        } else if !t.is_empty() {
+            break;
+        }
+    }
+    if !out.is_empty() {
+        out.push('\n');
+    }
+    let Some(s) = &module.scenario else {
+        out.push_str("{}\n");
+        return out;
+    };
+    let w = Writer { src };
+    if let Some(name) = &s.name {
+        out.push_str(&format!("scenario: {}\n", scalar(&name.text)));
+    }
+    if !module.uses.is_empty() {
+        let paths: Vec<String> = module
+            .uses
+            .iter()
+            .map(|u| flow_item(&u.path.iter().map(|n| n.text.as_str()).collect::<Vec<_>>().join(".")))
+            .collect();
+        out.push_str(&format!("use: [{}]\n", paths.join(", ")));
+    }
+    if let Some(source) = s.section("source") {
+        out.push_str("source:");
+        let mut body = String::new();
+        for a in &source.attrs {
+            let value = match a.def.name {
+                "video" | "description" => w.text(&a.value, 1),
+                "time" => w.quantity(a),
+                "frame" => w.integer(&a.value),
+                _ => w.symbol(Field::Plain, &a.value),
+            };
+            body.push_str(&format!("{IN}{}: {value}\n", a.def.name));
+        }
+        block(&mut out, &body);
+    }
+    if let Some(env) = s.section("environment") {
+        out.push_str("environment:");
+        let mut body = String::new();
+        for a in &env.attrs {
+            body.push_str(&format!("{IN}{}: {}\n", a.def.name, w.symbol(Field::Plain, &a.value)));
+        }
+        block(&mut out, &body);
+    }
+    if let Some(road) = s.section("road") {
+        out.push_str("road_network:");
+        let mut body = String::new();
+        let mut line = |key: &str, value: String| body.push_str(&format!("{IN}{key}: {value}\n"));
+        if let Some(a) = road.attr("type") {
+            line("road_type", w.symbol(Field::RoadType, &a.value));
+        }
+        if let Some(a) = road.attr("context") {
+            line("road_context", w.symbol(Field::Plain, &a.value));
+        }
+        if let Some(a) = road.attr("signs") {
+            let (single, full) = match &a.value {
+                Known::Unspecified => ("unspecified".to_string(), None),
+                Known::Given(Val::Symbols(list)) => match list.as_slice() {
+                    [] => ("none".to_string(), None),
+                    [one] if one.name != "none" => (w.name(Field::Plain, &one.name), None),
+                    [first, ..] => (w.name(Field::Plain, &first.name), Some(w.symbols(&a.value))),
+                },
+                other => (w.symbol(Field::Plain, other), None),
+            };
+            line("traffic_sign", single);
+            if let Some(full) = full {
+                line("signs", full);
+            }
+        }
+        if let Some(a) = road.attr("light") {
+            line("traffic_light", w.symbol(Field::Plain, &a.value));
+        }
+        if let Some(a) = road.attr("lanes") {
+            line("lane_number", w.integer(&a.value));
+        }
+        if let Some(a) = road.attr("direction") {
+            line("one-way_or_two-way", w.symbol(Field::Direction, &a.value));
+        }
+        for field in ["special_lanes", "traffic", "hazards", "roadworks", "emergency_vehicles", "roadside"] {
+            if let Some(a) = road.attr(field) {
+                let value = if field == "traffic" { w.symbol(Field::Plain, &a.value) } else { w.symbols(&a.value) };
+                line(field, value);
+            }
+        }
+        block(&mut out, &body);
+    }
+    let ego = s.section("ego");
+    if ego.is_none() && s.actors.is_empty() {
+        // the paper's form always has `actors`; it also makes an empty scenario a scenario
+        out.push_str("actors: {}\n");
+    } else {
+        out.push_str("actors:\n");
+        if let Some(ego) = ego {
+            out.push_str(&format!("{IN}ego_vehicle:\n"));
+            let mut line = |key: &str, value: String| out.push_str(&format!("{IN}{IN}{key}: {value}\n"));
+            line("type", "none".into());
+            if let Some(a) = ego.attr("behavior") {
+                line("behavior", w.symbol(Field::Plain, &a.value));
+            }
+            if let Some(a) = ego.attr("speed") {
+                line("speed", w.quantity(a));
+            }
+            line("position_target", "unspecified".into());
+            line("position_relation", "unspecified".into());
+            if let Some(a) = ego.attr("lane") {
+                line("lane_index", w.integer(&a.value));
+            }
+        }
+        for actor in &s.actors {
+            out.push_str(&format!("{IN}{}:\n", scalar(&actor.name.text)));
+            let mut line = |key: &str, value: String| out.push_str(&format!("{IN}{IN}{key}: {value}\n"));
+            let kind = match &actor.kind.value {
+                Known::Given(kind) => w.name(Field::Plain, &kind.name),
+                Known::Unspecified => "unspecified".into(),
+            };
+            line("type", kind);
+            match &actor.count {
+                Some(Spanned { value: Known::Given(n), .. }) => line("number", n.to_string()),
+                Some(Spanned { value: Known::Unspecified, .. }) => line("number", "unspecified".into()),
+                None => {}
+            }
+            if let Some(a) = actor.attr("behavior") {
+                line("behavior", w.symbol(Field::Plain, &a.value));
+            }
+            if let Some(a) = actor.attr("speed") {
+                line("speed", w.quantity(a));
+            }
+            if let Some(a) = actor.attr("position") {
+                let (target, relation) = match &a.value {
+                    Known::Given(Val::Position(p)) => {
+                        let target = if p.reference.name == "ego" {
+                            "ego_vehicle".to_string()
+                        } else if s.actor(&p.reference.name).is_some() {
+                            scalar(&p.reference.name)
+                        } else {
+                            w.name(Field::Plain, &p.reference.name)
+                        };
+                        (target, w.name(Field::Plain, &p.relation.name))
+                    }
+                    _ => ("unspecified".to_string(), "unspecified".to_string()),
+                };
+                line("position_target", target);
+                line("position_relation", relation);
+            }
+            if let Some(a) = actor.attr("lane") {
+                line("lane_index", w.integer(&a.value));
+            }
+        }
+    }
+    out
+}
+
+/// Append `: {}` for an empty mapping, else a line break and the body.
+fn block(out: &mut String, body: &str) {
+    if body.is_empty() {
+        out.push_str(" {}\n");
+    } else {
+        out.push('\n');
+        out.push_str(body);
+    }
+}
+
+#[derive(Clone, Copy, PartialEq)]
+enum Field {
+    Plain,
+    RoadType,
+    Direction,
+}
+
+struct Writer<'a> {
+    src: &'a str,
+}
+
+impl Writer<'_> {
+    /// A name in the paper's spelling when that reads back as the same name, else as is.
+    fn name(&self, field: Field, name: &str) -> String {
+        let spaced = match (field, name) {
+            (_, "t_intersection") => "t-intersection".to_string(),
+            (_, "y_intersection") => "y-intersection".to_string(),
+            (Field::Direction, _) => name.replace('_', "-"),
+            _ => name.replace('_', " "),
+        };
+        let reads_back = normalize(&spaced) == name
+            && !norm::is_unspecified(&spaced)
+            && !norm::is_none_word(&spaced)
+            && match field {
+                Field::RoadType => {
+                    norm::split_road_type(&spaced)
+                        == norm::RoadTypeParts { road_type: Some(spaced.clone()), ..Default::default() }
+                }
+                _ => true,
+            };
+        if reads_back || name == "none" { flow_item(&spaced) } else { flow_item(name) }
+    }
+
+    fn symbol(&self, field: Field, v: &Known<Val>) -> String {
+        match v {
+            Known::Given(Val::Symbol(s)) => self.name(field, &s.name),
+            other => self.other(other),
+        }
+    }
+
+    fn symbols(&self, v: &Known<Val>) -> String {
+        match v {
+            Known::Given(Val::Symbols(list)) => {
+                let items: Vec<String> = list.iter().map(|s| self.name(Field::Plain, &s.name)).collect();
+                format!("[{}]", items.join(", "))
+            }
+            other => self.other(other),
+        }
+    }
+
+    fn integer(&self, v: &Known<Val>) -> String {
+        match v {
+            Known::Given(Val::Integer(n)) => n.to_string(),
+            other => self.other(other),
+        }
+    }
+
+    fn quantity(&self, a: &Attr) -> String {
+        let Known::Given(Val::Quantity(q)) = &a.value else { return self.other(&a.value) };
+        let default = if q.unit == Unit::Seconds { Unit::Seconds } else { Unit::KilometresPerHour };
+        if let Some(written) = self.src.get(a.value_span.start..a.value_span.end) {
+            let written = written.split_whitespace().collect::<Vec<_>>().join(" ");
+            if norm::parse_quantity(&written, default) == Some((q.value, q.unit)) && !written.contains(['#', ':']) {
+                return written;
+            }
+        }
+        format!("{} {}", crate::tad::number(q.value), q.unit.as_str())
+    }
+
+    fn text(&self, v: &Known<Val>, depth: usize) -> String {
+        match v {
+            Known::Given(Val::Text(t)) => text(t, depth),
+            other => self.other(other),
+        }
+    }
+
+    /// A value of an unexpected kind for its field: written as TAD would.
+    fn other(&self, v: &Known<Val>) -> String {
+        match v {
+            Known::Unspecified => "unspecified".into(),
+            Known::Given(Val::Text(t)) => quoted(t),
+            Known::Given(Val::Symbol(s)) => flow_item(&s.name),
+            other => quoted(&crate::tad::value(other, 0)),
+        }
+    }
+}
+
+/// A plain scalar when YAML (1.2, and 1.1 as Python's `yaml.safe_load` reads it) reads it
+/// back as the same string, else a double-quoted one.
+pub fn scalar(s: &str) -> String {
+    const SPECIAL: &[&str] = &["y", "yes", "n", "no", "on", "off", "true", "false", "null", "~", "none"];
+    let plain = !s.is_empty()
+        && s.trim() == s
+        && !SPECIAL.contains(&s.to_ascii_lowercase().as_str())
+        && s.chars().all(|c| c.is_ascii_graphic() || c == ' ')
+        && matches!(
+            serde_norway::from_str::<Value>(&format!("k: {s}")),
+            Ok(Value::Mapping(m)) if m.get("k").and_then(Value::as_str) == Some(s)
+        );
+    if plain { s.to_string() } else { quoted(s) }
+}
+
+/// A scalar that is also safe inside a flow list `[...]`.
+fn flow_item(s: &str) -> String {
+    if s.contains([',', '[', ']', '{', '}', '#', ':', '&', '*', '!', '|', '>', '\'', '"', '%', '@', '`']) {
+        quoted(s)
+    } else if s == "none" {
+        s.to_string()
+    } else {
+        scalar(s)
+    }
+}
+
+/// `s` as a YAML double-quoted scalar.
+pub fn quoted(s: &str) -> String {
+    let mut out = String::with_capacity(s.len() + 2);
+    out.push('"');
+    for c in s.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            '\n' => out.push_str("\\n"),
+            '\t' => out.push_str("\\t"),
+            '\r' => out.push_str("\\r"),
+            '\0' => out.push_str("\\0"),
+            c if printable(c) && !matches!(c, '\u{85}' | '\u{2028}' | '\u{2029}' | '\u{feff}') => out.push(c),
+            c if (c as u32) <= 0xffff => out.push_str(&format!("\\u{:04X}", c as u32)),
+            c => out.push_str(&format!("\\U{:08X}", c as u32)),
+        }
+    }
+    out.push('"');
+    out
+}
+
+/// YAML's printable characters.
+fn printable(c: char) -> bool {
+    matches!(c as u32, 0x20..=0x7e | 0x85 | 0xa0..=0xd7ff | 0xe000..=0xfffd | 0x10000..=0x10ffff)
+}
+
+/// Text: a literal block (`|-`) when one reads back exactly, else a quoted string.
+fn text(t: &str, depth: usize) -> String {
+    let indent = IN.repeat(depth + 1);
+    let simple = t.contains('\n')
+        && !t.starts_with([' ', '\n', '\t'])
+        && !t.ends_with('\n')
+        && t.chars()
+            .all(|c| c == '\n' || (printable(c) && !matches!(c, '\u{85}' | '\u{2028}' | '\u{2029}' | '\u{feff}')))
+        && t.lines().all(|l| l.trim_end() == l);
+    if simple {
+        let mut block = String::from("|-");
+        for line in t.split('\n') {
+            block.push('\n');
+            if !line.is_empty() {
+                block.push_str(&indent);
+                block.push_str(line);
+            }
+        }
+        let check = format!("k: {block}\n");
+        if matches!(
+            serde_norway::from_str::<Value>(&check),
+            Ok(Value::Mapping(m)) if m.get("k").and_then(Value::as_str) == Some(t)
+        ) {
+            return block;
+        }
+    }
+    quoted(t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scalars_are_quoted_when_yaml_would_misread_them() {
+        assert_eq!(scalar("straight road"), "straight road");
+        assert_eq!(scalar("yes"), "\"yes\"");
+        assert_eq!(scalar("null"), "\"null\"");
+        assert_eq!(scalar("a: b"), "\"a: b\"");
+        assert_eq!(scalar("#x"), "\"#x\"");
+        assert_eq!(quoted("say \"hi\"\n\u{1}\u{2028}"), "\"say \\\"hi\\\"\\n\\u0001\\u2028\"");
+    }
+
+    #[test]
+    fn text_reads_back() {
+        for t in ["one\ntwo", "a: b\n  c # d\n\nlast", "  leading", "trailing\n", "x\r\ny", "\"\"\"", "tab\there"] {
+            let yaml = format!("k: {}\n", text(t, 0));
+            let v: Value = serde_norway::from_str(&yaml).unwrap();
+            assert_eq!(v["k"].as_str(), Some(t), "{yaml}");
+        }
+    }
+}

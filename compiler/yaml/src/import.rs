@@ -1,0 +1,1368 @@
+//! YAML (TrafficAlign or TrafficComposer form) to the scenario model.
+
+use crate::norm::{self, normalize};
+use crate::scan::{self, Tree};
+use crate::{extract, parse};
+use serde_norway::Value;
+use tad_diagnostics::{Code, Diagnostic, Span};
+use tad_syntax::cst::{Name, Use};
+use tad_syntax::model::*;
+use tad_syntax::schema::{self, FieldDef, SectionDef, Unit};
+use tad_syntax::suggest;
+
+/// Which notation a YAML answer is written in, detected from its keys.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Dialect {
+    /// TrafficAlign's translation prompt: `environment`, `road_network` (a mapping),
+    /// `actors`. Also what [`crate::export`] writes.
+    TrafficAlign,
+    /// TrafficComposer's IR: `participant`, and in its older form a top-level `weather`,
+    /// `lane_num`, `traffic_signal` and `road_network` as a list of strings.
+    TrafficComposer,
+}
+
+/// How strongly a key states a field, when several keys state the same one.
+const DERIVED: u8 = 0; // read out of another value's text (`two-way straight road`)
+const PAPER: u8 = 1; // the paper's or TrafficComposer's key for the field
+const EXTRA: u8 = 2; // the TAD-named key `export` adds (`signs`, `special_lanes`)
+
+pub fn lower(text: &str) -> (Module, Vec<Diagnostic>) {
+    let mut diagnostics = Vec::new();
+    let Some(range) = extract::extract(text) else {
+        let first = text.lines().find(|l| !l.trim().is_empty()).unwrap_or("");
+        let start = text.find(first).unwrap_or(0);
+        let span = Span::new(start, start + first.trim_end().len());
+        diagnostics.push(
+            Diagnostic::new(Code::E0300, "no YAML scenario found in this answer", span, "expected YAML here")
+                .with_help("put the scenario between `<YAML>` and `</YAML>`, or in a ```yaml code fence")
+                .with_note("a plain YAML file must be a mapping with `environment`, `road_network` and `actors`"),
+        );
+        return (Module::default(), diagnostics);
+    };
+    let slice = &text[range.clone()];
+    let whole = Span::new(range.start, range.end);
+    if slice.trim().is_empty() {
+        diagnostics.push(
+            Diagnostic::new(Code::E0300, "the YAML block is empty", whole, "nothing here")
+                .with_help("the block must hold the scenario: `environment`, `road_network` and `actors`"),
+        );
+        return (Module::default(), diagnostics);
+    }
+    let (work, value) = parse::parse(slice, range.start, &mut diagnostics);
+    let Some(value) = value else {
+        tad_diagnostics::sort(&mut diagnostics);
+        return (Module::default(), diagnostics);
+    };
+    let tree = scan::scan(&work, range.start);
+    let mut importer = Importer {
+        text,
+        tree,
+        dialect: Dialect::TrafficAlign,
+        diagnostics,
+        sections: Vec::new(),
+        actors: Vec::new(),
+        pending: Vec::new(),
+        name: None,
+        uses: Vec::new(),
+        whole,
+    };
+    let module = importer.module(&value);
+    let mut diagnostics = importer.diagnostics;
+    tad_diagnostics::sort(&mut diagnostics);
+    (module, diagnostics)
+}
+
+/// The dialect of a top-level mapping.
+pub fn detect(map: &serde_norway::Mapping) -> Dialect {
+    let composer = map.iter().any(|(k, v)| {
+        let key = normalize(&key_text(k));
+        matches!(key.as_str(), "participant" | "participants" | "lane_num" | "traffic_signal" | "weather")
+            || (key == "road_network" && matches!(untag(v), Value::Sequence(_)))
+    });
+    if composer { Dialect::TrafficComposer } else { Dialect::TrafficAlign }
+}
+
+fn untag(v: &Value) -> &Value {
+    match v {
+        Value::Tagged(t) => untag(&t.value),
+        other => other,
+    }
+}
+
+fn key_text(k: &Value) -> String {
+    match untag(k) {
+        Value::String(s) => s.clone(),
+        Value::Number(n) => n.to_string(),
+        Value::Bool(b) => b.to_string(),
+        Value::Null => "null".into(),
+        _ => "?".into(),
+    }
+}
+
+fn describe(v: &Value) -> &'static str {
+    match untag(v) {
+        Value::Null => "nothing",
+        Value::Bool(_) => "`true`/`false`",
+        Value::Number(_) => "a number",
+        Value::String(_) => "text",
+        Value::Sequence(_) => "a list",
+        Value::Mapping(_) => "a mapping",
+        Value::Tagged(_) => "a tagged value",
+    }
+}
+
+/// One statement of a field by some key.
+#[derive(Clone, Debug)]
+struct Prop {
+    def: &'static FieldDef,
+    key: String,
+    key_span: Span,
+    value_span: Span,
+    value: Known<Val>,
+    rank: u8,
+    /// A one-name summary of a list (`traffic_sign: stop sign` next to `signs: [...]`).
+    summary: bool,
+}
+
+struct SectionBuild {
+    def: &'static SectionDef,
+    span: Span,
+    name_span: Span,
+    props: Vec<Prop>,
+}
+
+struct ActorBuild {
+    key: String,
+    name: Name,
+    span: Span,
+    count: Option<Spanned<Known<i64>>>,
+    kind: Option<Spanned<Known<Symbol>>>,
+    props: Vec<Prop>,
+}
+
+/// `position_relation` or `position_target` as written.
+#[derive(Clone)]
+struct Part {
+    key_span: Span,
+    value_span: Span,
+    word: Option<String>,
+}
+
+/// An actor's position, resolved once every actor key is known.
+struct PendingPosition {
+    actor: usize,
+    relation: Option<Part>,
+    target: Option<Part>,
+}
+
+struct Importer<'a> {
+    text: &'a str,
+    tree: Tree,
+    dialect: Dialect,
+    diagnostics: Vec<Diagnostic>,
+    sections: Vec<SectionBuild>,
+    actors: Vec<ActorBuild>,
+    pending: Vec<PendingPosition>,
+    name: Option<Name>,
+    uses: Vec<Use>,
+    whole: Span,
+}
+
+/// Where a value is: its key's node in the scanned tree, with fallbacks.
+#[derive(Clone, Copy)]
+struct At {
+    node: Option<usize>,
+    key_span: Span,
+    value_span: Span,
+}
+
+const TOP_KEYS: &[&str] = &[
+    "environment",
+    "road_network",
+    "actors",
+    "source",
+    "scenario",
+    "use",
+    "participant",
+    "weather",
+    "time",
+    "lane_num",
+    "traffic_signal",
+    "traffic_light",
+    "traffic_sign",
+];
+const ENVIRONMENT_KEYS: &[&str] = &["weather", "time"];
+const ROAD_KEYS: &[&str] = &[
+    "road_type",
+    "road_context",
+    "traffic_sign",
+    "traffic_light",
+    "lane_number",
+    "one-way_or_two-way",
+    "special_lane",
+    "special_lanes",
+    "signs",
+    "traffic",
+    "hazards",
+    "roadworks",
+    "emergency_vehicles",
+    "roadside",
+];
+const EGO_KEYS: &[&str] = &[
+    "type",
+    "behavior",
+    "current_behavior",
+    "speed",
+    "position_target",
+    "position_relation",
+    "lane_index",
+    "lane_idx",
+];
+const ACTOR_KEYS: &[&str] = &[
+    "type",
+    "number",
+    "behavior",
+    "current_behavior",
+    "speed",
+    "position_target",
+    "position_relation",
+    "lane_index",
+    "lane_idx",
+];
+const SOURCE_KEYS: &[&str] = &["video", "time", "frame", "region", "description"];
+
+/// TAD field names and other common spellings, and the YAML key to use instead.
+const KEY_HINTS: &[(&str, &str)] = &[
+    ("lanes", "lane_number"),
+    ("num_lanes", "lane_number"),
+    ("number_of_lanes", "lane_number"),
+    ("type", "road_type"),
+    ("context", "road_context"),
+    ("direction", "one-way_or_two-way"),
+    ("one_way_or_two_way", "one-way_or_two-way"),
+    ("light", "traffic_light"),
+    ("traffic_lights", "traffic_light"),
+    ("traffic_signs", "traffic_sign"),
+    ("time_of_day", "time"),
+    ("behaviour", "behavior"),
+    ("current_behaviour", "current_behavior"),
+    ("action", "behavior"),
+    ("lane", "lane_index"),
+    ("position", "position_relation"),
+    ("relation", "position_relation"),
+    ("target", "position_target"),
+    ("count", "number"),
+    ("kind", "type"),
+    ("velocity", "speed"),
+    ("road", "road_network"),
+    ("ego", "actors"),
+    ("npcs", "actors"),
+    ("participants", "participant"),
+];
+
+fn same_val(a: &Known<Val>, b: &Known<Val>) -> bool {
+    fn names(s: &[Symbol]) -> Vec<&str> {
+        let mut v: Vec<&str> = s.iter().map(|s| s.name.as_str()).collect();
+        v.sort_unstable();
+        v
+    }
+    match (a, b) {
+        (Known::Unspecified, Known::Unspecified) => true,
+        (Known::Given(a), Known::Given(b)) => match (a, b) {
+            (Val::Symbol(a), Val::Symbol(b)) => a.name == b.name,
+            (Val::Symbols(a), Val::Symbols(b)) => names(a) == names(b),
+            (Val::Integer(a), Val::Integer(b)) => a == b,
+            (Val::Quantity(a), Val::Quantity(b)) => a == b,
+            (Val::Text(a), Val::Text(b)) => a == b,
+            (Val::Position(a), Val::Position(b)) => {
+                a.relation.name == b.relation.name && a.reference.name == b.reference.name
+            }
+            (Val::Flag(a), Val::Flag(b)) => a == b,
+            _ => false,
+        },
+        _ => false,
+    }
+}
+
+/// Whether two statements of one field agree, a list summary agreeing with any list that
+/// contains its name.
+fn agree(a: &Prop, b: &Prop) -> bool {
+    if same_val(&a.value, &b.value) {
+        return true;
+    }
+    let summary_of = |s: &Prop, list: &Prop| match (&s.value, &list.value) {
+        (Known::Given(Val::Symbols(one)), Known::Given(Val::Symbols(all))) if s.summary => {
+            one.iter().all(|o| all.iter().any(|a| a.name == o.name)) && (one.is_empty() == all.is_empty())
+        }
+        _ => false,
+    };
+    summary_of(a, b) || summary_of(b, a)
+}
+
+impl Importer<'_> {
+    fn report(&mut self, d: Diagnostic) {
+        self.diagnostics.push(d);
+    }
+
+    fn at(&self, node: Option<usize>, fallback: Span) -> At {
+        match node {
+            Some(n) => At { node, key_span: self.tree.node(n).key_span, value_span: self.tree.value_span(n) },
+            None => At { node: None, key_span: fallback, value_span: fallback },
+        }
+    }
+
+    /// The entries of a mapping value, each with where it is; E0304 for anything else.
+    fn entries<'v>(&mut self, v: &'v Value, at: At, what: &str) -> Vec<(String, &'v Value, At)> {
+        match untag(v) {
+            Value::Mapping(map) => map
+                .iter()
+                .enumerate()
+                .map(|(i, (k, v))| {
+                    let key = key_text(k);
+                    let node = self.tree.child(at.node, &key, i);
+                    (key, v, self.at(node, at.key_span))
+                })
+                .collect(),
+            Value::Null => Vec::new(),
+            other => {
+                self.report(
+                    Diagnostic::new(
+                        Code::E0304,
+                        format!("`{what}` takes a mapping of keys, found {}", describe(other)),
+                        at.value_span,
+                        "expected `key: value` lines",
+                    )
+                    .with_help(format!("write the keys of `{what}` on their own lines, indented under it")),
+                );
+                Vec::new()
+            }
+        }
+    }
+
+    fn unknown_key(&mut self, key: &str, at: At, context: &str, known: &[&str]) {
+        let mut d = Diagnostic::new(
+            Code::E0302,
+            format!("unknown key `{key}` in {context}"),
+            at.key_span,
+            "not a key of this form",
+        );
+        let normalized = normalize(key);
+        let hint = KEY_HINTS.iter().find(|(from, to)| *from == normalized && known.contains(to)).map(|(_, to)| *to);
+        if let Some(guess) = hint.or_else(|| suggest::closest(key, known.iter().copied())) {
+            d = d.with_help(format!("did you mean `{guess}`?")).with_fix(at.key_span, guess);
+        } else {
+            let list: Vec<String> = known.iter().map(|k| format!("`{k}`")).collect();
+            d = d.with_note(format!("the keys of {context} are {}", list.join(", ")));
+        }
+        d = d.with_note("the value of this key is ignored");
+        self.report(d);
+    }
+
+    fn malformed(&mut self, key: &str, found: &str, span: Span, expected: &str, example: &str) {
+        self.report(
+            Diagnostic::new(
+                Code::E0303,
+                format!("`{key}` takes {expected}, found `{found}`"),
+                span,
+                format!("not {expected}"),
+            )
+            .with_help(format!(
+                "write {expected} such as `{example}`, or `unspecified` if the description does not say"
+            ))
+            .with_fix(span, "unspecified"),
+        );
+    }
+
+    fn wrong_shape(&mut self, key: &str, v: &Value, span: Span, expected: &str) {
+        self.report(
+            Diagnostic::new(
+                Code::E0304,
+                format!("`{key}` takes {expected}, found {}", describe(v)),
+                span,
+                format!("expected {expected}"),
+            )
+            .with_help(format!("write one value after `{key}:`")),
+        );
+    }
+
+    fn ignored(&mut self, span: Span, message: String, help: &str) {
+        self.report(Diagnostic::new(Code::W0302, message, span, "ignored").with_help(help.to_string()));
+    }
+
+    // ---- values ------------------------------------------------------------------------
+
+    /// `None` (TrafficComposer's missing value) or null: read as `unspecified`.
+    fn missing(&self, v: &Value, none_is_a_value: bool) -> bool {
+        match untag(v) {
+            Value::Null => true,
+            Value::String(s) => {
+                norm::is_unspecified(s)
+                    || (norm::is_none_word(s) && (!none_is_a_value || self.dialect == Dialect::TrafficComposer))
+            }
+            _ => false,
+        }
+    }
+
+    fn symbol_from(&mut self, key: &str, text: &str, span: Span, example: &str) -> Option<Symbol> {
+        let name = normalize(text);
+        if norm::is_identifier(&name) {
+            Some(Symbol { name, span })
+        } else {
+            self.malformed(key, text.trim(), span, "a name", example);
+            None
+        }
+    }
+
+    fn symbol(&mut self, key: &str, v: &Value, at: At, example: &str) -> Option<Known<Symbol>> {
+        if self.missing(v, true) {
+            return Some(Known::Unspecified);
+        }
+        match untag(v) {
+            Value::String(s) => self.symbol_from(key, s, at.value_span, example).map(Known::Given),
+            Value::Number(n) => {
+                self.malformed(key, &n.to_string(), at.value_span, "a name", example);
+                None
+            }
+            Value::Bool(b) => {
+                self.malformed(key, &b.to_string(), at.value_span, "a name", example);
+                None
+            }
+            other => {
+                self.wrong_shape(key, other, at.value_span, "one name");
+                None
+            }
+        }
+    }
+
+    /// A list of names: a YAML list, a single name, a comma-separated string; `none` is
+    /// the empty list in the paper's form.
+    fn symbols(&mut self, key: &str, v: &Value, at: At, example: &str) -> Option<Known<Vec<Symbol>>> {
+        if self.missing(v, true) {
+            return Some(Known::Unspecified);
+        }
+        let mut out: Vec<Symbol> = Vec::new();
+        let mut duplicate = None;
+        let mut push = |s: Symbol, out: &mut Vec<Symbol>| {
+            if out.iter().any(|o| o.name == s.name) {
+                duplicate.get_or_insert(s.span);
+            } else {
+                out.push(s);
+            }
+        };
+        match untag(v) {
+            Value::String(s) => {
+                if norm::is_none_word(s) {
+                    return Some(Known::Given(Vec::new()));
+                }
+                let source = self.text.get(at.value_span.start..at.value_span.end).unwrap_or("");
+                let mut cursor = 0;
+                for piece in s.split(',') {
+                    let piece = piece.trim();
+                    if piece.is_empty() {
+                        continue;
+                    }
+                    let span = match source.get(cursor..).and_then(|rest| rest.find(piece)) {
+                        Some(i) => {
+                            let start = at.value_span.start + cursor + i;
+                            cursor += i + piece.len();
+                            Span::new(start, start + piece.len())
+                        }
+                        None => at.value_span,
+                    };
+                    if let Some(sym) = self.symbol_from(key, piece, span, example) {
+                        push(sym, &mut out);
+                    }
+                }
+            }
+            Value::Sequence(items) => {
+                for (i, item) in items.iter().enumerate() {
+                    let node = self.tree.item(at.node, i);
+                    let span = node.map_or(at.value_span, |n| self.tree.value_span(n));
+                    match untag(item) {
+                        Value::Null => {}
+                        // `[none]` is the paper's `none`; in a longer list `none` is a name
+                        Value::String(s) if norm::is_none_word(s) && items.len() == 1 => {}
+                        Value::String(s) if norm::is_unspecified(s) && items.len() == 1 => {
+                            return Some(Known::Unspecified);
+                        }
+                        Value::String(s) => {
+                            if let Some(sym) = self.symbol_from(key, s, span, example) {
+                                push(sym, &mut out);
+                            }
+                        }
+                        Value::Number(n) => self.malformed(key, &n.to_string(), span, "a name", example),
+                        Value::Bool(b) => self.malformed(key, &b.to_string(), span, "a name", example),
+                        other => self.wrong_shape(key, other, span, "a list of names"),
+                    }
+                }
+            }
+            Value::Number(n) => {
+                self.malformed(key, &n.to_string(), at.value_span, "a list of names", example);
+                return None;
+            }
+            Value::Bool(b) => {
+                self.malformed(key, &b.to_string(), at.value_span, "a list of names", example);
+                return None;
+            }
+            other => {
+                self.wrong_shape(key, other, at.value_span, "a list of names");
+                return None;
+            }
+        }
+        if let Some(span) = duplicate {
+            self.report(
+                Diagnostic::new(Code::W0201, format!("`{key}` lists a name twice"), span, "already listed")
+                    .with_help("list each name once"),
+            );
+        }
+        Some(Known::Given(out))
+    }
+
+    fn integer(&mut self, key: &str, v: &Value, at: At, example: &str) -> Option<Known<i64>> {
+        if self.missing(v, false) {
+            return Some(Known::Unspecified);
+        }
+        let span = at.value_span;
+        let whole = |f: f64| (f.fract() == 0.0 && f.abs() < 9.0e15).then_some(f as i64);
+        match untag(v) {
+            Value::Number(n) => {
+                if let Some(i) = n.as_i64() {
+                    return Some(Known::Given(i));
+                }
+                let text = n.to_string();
+                let mut d = Diagnostic::new(
+                    Code::E0303,
+                    format!("`{key}` takes a whole number, found `{text}`"),
+                    span,
+                    "not a whole number",
+                );
+                if let Some(i) = n.as_f64().and_then(whole) {
+                    d = d.with_help(format!("write `{i}`")).with_fix(span, i.to_string());
+                }
+                self.report(d);
+                None
+            }
+            Value::String(s) => {
+                if let Some(i) = norm::parse_integer(s) {
+                    return Some(Known::Given(i));
+                }
+                if let Some(i) = norm::number_word(s) {
+                    self.report(
+                        Diagnostic::new(
+                            Code::E0303,
+                            format!("`{key}` takes a whole number, found `{}`", s.trim()),
+                            span,
+                            "a number in words",
+                        )
+                        .with_help(format!("write `{i}`"))
+                        .with_fix(span, i.to_string()),
+                    );
+                    return None;
+                }
+                self.malformed(key, s, span, "a whole number", example);
+                None
+            }
+            Value::Bool(b) => {
+                self.malformed(key, &b.to_string(), span, "a whole number", example);
+                None
+            }
+            other => {
+                self.wrong_shape(key, other, span, "a whole number");
+                None
+            }
+        }
+    }
+
+    fn quantity(&mut self, key: &str, v: &Value, at: At, default: Unit, example: &str) -> Option<Known<Quantity>> {
+        if self.missing(v, false) {
+            return Some(Known::Unspecified);
+        }
+        let span = at.value_span;
+        let what = if default == Unit::Seconds { "a duration" } else { "a speed" };
+        match untag(v) {
+            Value::Number(n) => match n.as_f64().filter(|f| f.is_finite()) {
+                Some(value) => Some(Known::Given(Quantity { value, unit: default })),
+                None => {
+                    self.malformed(key, &n.to_string(), span, what, example);
+                    None
+                }
+            },
+            Value::String(s) => match norm::parse_quantity(s, default) {
+                Some((value, unit)) => Some(Known::Given(Quantity { value, unit })),
+                None => {
+                    self.malformed(key, s.trim(), span, what, example);
+                    None
+                }
+            },
+            Value::Bool(b) => {
+                self.malformed(key, &b.to_string(), span, what, example);
+                None
+            }
+            other => {
+                self.wrong_shape(key, other, span, what);
+                None
+            }
+        }
+    }
+
+    fn text_value(&mut self, key: &str, v: &Value, at: At) -> Option<Known<String>> {
+        match untag(v) {
+            Value::Null => Some(Known::Unspecified),
+            Value::String(s) if norm::is_unspecified(s) => Some(Known::Unspecified),
+            Value::String(s) => Some(Known::Given(s.clone())),
+            Value::Number(n) => Some(Known::Given(n.to_string())),
+            Value::Bool(b) => Some(Known::Given(b.to_string())),
+            other => {
+                self.wrong_shape(key, other, at.value_span, "text");
+                None
+            }
+        }
+    }
+
+    fn part(&mut self, key: &str, v: &Value, at: At) -> Option<Part> {
+        let mut part = Part { key_span: at.key_span, value_span: at.value_span, word: None };
+        match untag(v) {
+            Value::Null => {}
+            Value::String(s) if norm::is_unspecified(s) || norm::is_none_word(s) => {}
+            Value::String(s) => part.word = Some(s.clone()),
+            Value::Number(n) => part.word = Some(n.to_string()),
+            Value::Bool(b) => part.word = Some(b.to_string()),
+            other => {
+                self.wrong_shape(key, other, at.value_span, "one name");
+                return None;
+            }
+        }
+        Some(part)
+    }
+
+    // ---- collecting ----------------------------------------------------------------------
+
+    fn section(&mut self, name: &str, span: Span, name_span: Span) -> usize {
+        if let Some(i) = self.sections.iter().position(|s| s.def.name == name) {
+            return i;
+        }
+        let def = schema::section(name).unwrap_or(&schema::EGO);
+        self.sections.push(SectionBuild { def, span, name_span, props: Vec::new() });
+        self.sections.len() - 1
+    }
+
+    /// The section `name`, created at `at` (its key) when it does not exist yet.
+    fn section_at(&mut self, name: &str, at: At) -> usize {
+        let block = at.node.map_or(at.key_span, |n| self.tree.block(n));
+        self.section(name, block, at.key_span)
+    }
+
+    fn propose(&mut self, target: Target, prop: Prop) {
+        let props = match target {
+            Target::Section(i) => &mut self.sections[i].props,
+            Target::Actor(i) => &mut self.actors[i].props,
+        };
+        let Some(i) = props.iter().position(|p| p.def.name == prop.def.name) else {
+            props.push(prop);
+            return;
+        };
+        let old = &props[i];
+        let unspecified = |p: &Prop| matches!(p.value, Known::Unspecified);
+        if agree(old, &prop) {
+            let replace = prop.rank > old.rank || (old.summary && !prop.summary);
+            if replace {
+                props[i] = prop;
+            }
+            return;
+        }
+        match (unspecified(old), unspecified(&prop)) {
+            (true, false) => {
+                props[i] = prop;
+                return;
+            }
+            (false, true) => return,
+            _ => {}
+        }
+        let new_wins = prop.rank > old.rank;
+        let (winner, loser) = if new_wins { (prop.clone(), old.clone()) } else { (old.clone(), prop.clone()) };
+        if new_wins {
+            props[i] = prop;
+        }
+        let message = if winner.key == loser.key {
+            format!("`{}` is given twice with different values", loser.key)
+        } else {
+            format!("`{}` disagrees with `{}`", loser.key, winner.key)
+        };
+        self.report(
+            Diagnostic::new(Code::W0301, message, loser.value_span, "this value is ignored")
+                .with_secondary(winner.value_span, "this one is used")
+                .with_help("make the two agree, or remove one"),
+        );
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn set(&mut self, target: Target, field: &str, key: &str, at: At, value: Known<Val>, rank: u8, summary: bool) {
+        let def = match target {
+            Target::Section(i) => self.sections[i].def.field(field),
+            Target::Actor(_) => schema::ACTOR.field(field),
+        };
+        let Some(def) = def else { return };
+        let prop =
+            Prop { def, key: key.to_string(), key_span: at.key_span, value_span: at.value_span, value, rank, summary };
+        self.propose(target, prop);
+    }
+
+    fn set_symbol(&mut self, target: Target, field: &str, key: &str, v: &Value, at: At, rank: u8) {
+        let example = field_example(target, field);
+        if let Some(s) = self.symbol(key, v, at, example) {
+            self.set(target, field, key, at, known_map(s, Val::Symbol), rank, false);
+        }
+    }
+
+    fn set_symbols(&mut self, target: Target, field: &str, key: &str, v: &Value, at: At, rank: u8) {
+        let example = field_example(target, field);
+        if let Some(s) = self.symbols(key, v, at, example) {
+            self.set(target, field, key, at, known_map(s, Val::Symbols), rank, false);
+        }
+    }
+
+    /// The paper's `traffic_sign`: one sign (or `none`), which a `signs` list may extend.
+    fn set_traffic_sign(&mut self, road: Target, key: &str, v: &Value, at: At) {
+        if let Some(s) = self.symbols(key, v, at, "stop sign") {
+            let summary = matches!(&s, Known::Given(list) if list.len() <= 1);
+            self.set(road, "signs", key, at, known_map(s, Val::Symbols), PAPER, summary);
+        }
+    }
+
+    fn set_integer(&mut self, target: Target, field: &str, key: &str, v: &Value, at: At, rank: u8) {
+        if let Some(n) = self.integer(key, v, at, "1") {
+            self.set(target, field, key, at, known_map(n, Val::Integer), rank, false);
+        }
+    }
+
+    fn set_quantity(&mut self, target: Target, field: &str, key: &str, v: &Value, at: At, unit: Unit) {
+        let example = if unit == Unit::Seconds { "195 s" } else { "30 km/h" };
+        if let Some(q) = self.quantity(key, v, at, unit, example) {
+            self.set(target, field, key, at, known_map(q, Val::Quantity), PAPER, false);
+        }
+    }
+
+    // ---- the forms -------------------------------------------------------------------------
+
+    fn module(&mut self, value: &Value) -> Module {
+        let root = self.at(Some(scan::ROOT), self.whole);
+        let root = At { key_span: Span::new(self.whole.start, self.whole.start), value_span: self.whole, ..root };
+        let value = match untag(value) {
+            Value::Mapping(_) => value,
+            Value::Null => {
+                self.report(
+                    Diagnostic::new(Code::E0300, "the YAML block holds no scenario", self.whole, "only comments here")
+                        .with_help("the block must hold the scenario: `environment`, `road_network` and `actors`"),
+                );
+                return Module::default();
+            }
+            other => {
+                self.report(
+                    Diagnostic::new(
+                        Code::E0304,
+                        format!("a scenario is a YAML mapping, found {}", describe(other)),
+                        self.whole,
+                        "expected `environment:`, `road_network:` and `actors:`",
+                    )
+                    .with_help("write the scenario as `key: value` lines, starting with `environment:`"),
+                );
+                return Module::default();
+            }
+        };
+        let (value, root) = self.unwrap(value, root);
+        if let Value::Mapping(map) = untag(value) {
+            self.dialect = detect(map);
+        }
+        for (key, v, at) in self.entries(value, root, "the scenario") {
+            match normalize(&key).as_str() {
+                "environment" => self.environment(v, at),
+                "road_network" => self.road_network(v, at),
+                "actors" | "participant" | "participants" => self.actors(&key, v, at),
+                "source" => self.source(v, at),
+                "scenario" => self.scenario_name(&key, v, at),
+                "use" => self.uses(&key, v, at),
+                "weather" => {
+                    let env = Target::Section(self.section_at("environment", at));
+                    self.weather(env, &key, v, at);
+                }
+                "time" => {
+                    let env = Target::Section(self.section_at("environment", at));
+                    self.set_symbol(env, "time", &key, v, at, PAPER);
+                }
+                "lane_num" => {
+                    let road = Target::Section(self.section_at("road", at));
+                    self.set_integer(road, "lanes", &key, v, at, PAPER);
+                }
+                "traffic_signal" | "traffic_light" => {
+                    let road = Target::Section(self.section_at("road", at));
+                    self.set_symbol(road, "light", &key, v, at, PAPER);
+                }
+                "traffic_sign" => {
+                    let road = Target::Section(self.section_at("road", at));
+                    self.set_traffic_sign(road, &key, v, at);
+                }
+                _ => self.unknown_key(&key, at, "the scenario", TOP_KEYS),
+            }
+        }
+        self.resolve_positions();
+        self.finish()
+    }
+
+    /// `scenario: { environment: ..., ... }` or any single wrapper key around the form.
+    fn unwrap<'v>(&mut self, value: &'v Value, at: At) -> (&'v Value, At) {
+        let Value::Mapping(map) = untag(value) else { return (value, at) };
+        let known = |k: &Value| extract::TOP_LEVEL_KEYS.contains(&normalize(&key_text(k)).as_str());
+        if map.len() != 1 {
+            return (value, at);
+        }
+        let Some((k, v)) = map.iter().next() else { return (value, at) };
+        let wrapper = !known(k) || normalize(&key_text(k)) == "scenario";
+        if wrapper && matches!(untag(v), Value::Mapping(m) if m.keys().any(known)) {
+            let key = key_text(k);
+            let node = self.tree.child(at.node, &key, 0);
+            return (v, self.at(node, at.key_span));
+        }
+        (value, at)
+    }
+
+    fn scenario_name(&mut self, key: &str, v: &Value, at: At) {
+        match untag(v) {
+            Value::String(s) if !s.trim().is_empty() => {
+                self.name = Some(Name { text: norm::identifier(s), span: at.value_span });
+            }
+            Value::Null => {}
+            other => self.wrong_shape(key, other, at.value_span, "a name"),
+        }
+    }
+
+    fn uses(&mut self, key: &str, v: &Value, at: At) {
+        let items: Vec<(String, Span)> = match untag(v) {
+            Value::String(s) => vec![(s.clone(), at.value_span)],
+            Value::Sequence(items) => items
+                .iter()
+                .enumerate()
+                .filter_map(|(i, item)| {
+                    let span = self.tree.item(at.node, i).map_or(at.value_span, |n| self.tree.value_span(n));
+                    match untag(item) {
+                        Value::String(s) => Some((s.clone(), span)),
+                        _ => None,
+                    }
+                })
+                .collect(),
+            Value::Null => Vec::new(),
+            other => {
+                self.wrong_shape(key, other, at.value_span, "a module name or a list of them");
+                return;
+            }
+        };
+        for (path, span) in items {
+            let source = self.text.get(span.start..span.end).unwrap_or("");
+            let located = source == path;
+            let mut names = Vec::new();
+            let mut offset = span.start;
+            for segment in path.split('.') {
+                let seg_span = if located { Span::new(offset, offset + segment.len()) } else { span };
+                offset += segment.len() + 1;
+                if !norm::is_identifier(segment.trim()) {
+                    self.malformed(key, &path, span, "a module name", "national_park");
+                    names.clear();
+                    break;
+                }
+                names.push(Name { text: segment.trim().to_string(), span: seg_span });
+            }
+            if !names.is_empty() {
+                self.uses.push(Use { span, path: names });
+            }
+        }
+    }
+
+    /// Whether `v` can be a block of keys; when not, E0304 is reported.
+    fn keyed(&mut self, v: &Value, at: At, what: &str) -> bool {
+        let ok = matches!(untag(v), Value::Mapping(_) | Value::Null);
+        if !ok {
+            self.entries(v, at, what);
+        }
+        ok
+    }
+
+    fn environment(&mut self, v: &Value, at: At) {
+        if !self.keyed(v, at, "environment") {
+            return;
+        }
+        let env = Target::Section(self.section_at("environment", at));
+        for (key, v, at) in self.entries(v, at, "environment") {
+            match normalize(&key).as_str() {
+                "weather" => self.weather(env, &key, v, at),
+                "time" => self.set_symbol(env, "time", &key, v, at, PAPER),
+                _ => self.unknown_key(&key, at, "`environment`", ENVIRONMENT_KEYS),
+            }
+        }
+    }
+
+    /// `weather`, which TrafficComposer also uses for the time of day (`night`).
+    fn weather(&mut self, env: Target, key: &str, v: &Value, at: At) {
+        let text = match untag(v) {
+            Value::String(s) if self.dialect == Dialect::TrafficComposer && !self.missing(v, true) => s.clone(),
+            _ => return self.set_symbol(env, "weather", key, v, at, PAPER),
+        };
+        let (weather, time) = norm::split_weather(&text);
+        if let Some(time) = time {
+            let span = self.sub_span(at.value_span, &time);
+            if let Some(sym) = self.symbol_from(key, &time, span, "daytime") {
+                let at = At { value_span: span, ..at };
+                self.set(env, "time", key, at, Known::Given(Val::Symbol(sym)), DERIVED, false);
+            }
+        }
+        if let Some(weather) = weather {
+            let span = self.sub_span(at.value_span, &weather);
+            if let Some(sym) = self.symbol_from(key, &weather, span, "clear") {
+                let at = At { value_span: span, ..at };
+                self.set(env, "weather", key, at, Known::Given(Val::Symbol(sym)), PAPER, false);
+            }
+        }
+    }
+
+    /// Where `part` is inside the value at `span`, else `span`.
+    fn sub_span(&self, span: Span, part: &str) -> Span {
+        let source = self.text.get(span.start..span.end).unwrap_or("");
+        let first = part.split_whitespace().next().unwrap_or(part);
+        let last = part.split_whitespace().last().unwrap_or(part);
+        match (source.find(first), source.rfind(last)) {
+            (Some(a), Some(b)) if b + last.len() >= a => Span::new(span.start + a, span.start + b + last.len()),
+            _ => span,
+        }
+    }
+
+    fn road_network(&mut self, v: &Value, at: At) {
+        let composer_item = self.dialect == Dialect::TrafficComposer && matches!(untag(v), Value::String(_));
+        if !matches!(untag(v), Value::Sequence(_)) && !composer_item && !self.keyed(v, at, "road_network") {
+            return;
+        }
+        let road = Target::Section(self.section_at("road", at));
+        match untag(v) {
+            Value::Sequence(items) => {
+                for (i, item) in items.iter().enumerate() {
+                    let node = self.tree.item(at.node, i);
+                    let item_at = match node {
+                        Some(n) => At { node, key_span: self.tree.value_span(n), value_span: self.tree.value_span(n) },
+                        None => at,
+                    };
+                    match untag(item) {
+                        Value::String(s) => self.road_item(road, s, item_at),
+                        Value::Null => {}
+                        other => self.wrong_shape("road_network", other, item_at.value_span, "a road element"),
+                    }
+                }
+                return;
+            }
+            Value::String(s) if self.dialect == Dialect::TrafficComposer && !self.missing(v, true) => {
+                let s = s.clone();
+                return self.road_item(road, &s, at);
+            }
+            _ => {}
+        }
+        for (key, v, at) in self.entries(v, at, "road_network") {
+            match normalize(&key).as_str() {
+                "road_type" => self.road_type(road, &key, v, at),
+                "road_context" => self.set_symbol(road, "context", &key, v, at, PAPER),
+                "traffic_sign" => self.set_traffic_sign(road, &key, v, at),
+                "traffic_light" => self.set_symbol(road, "light", &key, v, at, PAPER),
+                "lane_number" | "lane_num" => self.set_integer(road, "lanes", &key, v, at, PAPER),
+                "one_way_or_two_way" => self.set_symbol(road, "direction", &key, v, at, PAPER),
+                "special_lane" => self.set_symbols(road, "special_lanes", &key, v, at, PAPER),
+                "special_lanes" | "signs" | "hazards" | "roadworks" | "emergency_vehicles" | "roadside" => {
+                    let field = normalize(&key);
+                    self.set_symbols(road, &field, &key, v, at, EXTRA)
+                }
+                "traffic" => self.set_symbol(road, "traffic", &key, v, at, EXTRA),
+                _ => self.unknown_key(&key, at, "`road_network`", ROAD_KEYS),
+            }
+        }
+    }
+
+    /// `road_type`: its text may also say the direction and special lanes.
+    fn road_type(&mut self, road: Target, key: &str, v: &Value, at: At) {
+        let text = match untag(v) {
+            Value::String(s) if !self.missing(v, true) => s.clone(),
+            _ => return self.set_symbol(road, "type", key, v, at, PAPER),
+        };
+        let parts = norm::split_road_type(&text);
+        match &parts.road_type {
+            Some(t) => {
+                let span = self.sub_span(at.value_span, t);
+                if let Some(sym) = self.symbol_from(key, t, span, "straight road") {
+                    self.set(
+                        road,
+                        "type",
+                        key,
+                        At { value_span: span, ..at },
+                        Known::Given(Val::Symbol(sym)),
+                        PAPER,
+                        false,
+                    );
+                }
+            }
+            None => self.set(road, "type", key, at, Known::Unspecified, PAPER, false),
+        }
+        if let Some(direction) = parts.direction {
+            let sym = Symbol { name: direction.to_string(), span: at.value_span };
+            self.set(road, "direction", key, at, Known::Given(Val::Symbol(sym)), DERIVED, false);
+        }
+        if !parts.special_lanes.is_empty() {
+            let mut lanes = Vec::new();
+            for lane in &parts.special_lanes {
+                let span = self.sub_span(at.value_span, lane);
+                if let Some(sym) = self.symbol_from(key, lane, span, "bike lane") {
+                    lanes.push(sym);
+                }
+            }
+            self.set(road, "special_lanes", key, at, Known::Given(Val::Symbols(lanes)), DERIVED, false);
+        }
+    }
+
+    /// One string of TrafficComposer's `road_network` list.
+    fn road_item(&mut self, road: Target, text: &str, at: At) {
+        let lower = text.trim().to_lowercase();
+        let words: Vec<&str> = lower.split_whitespace().collect();
+        let key = "road_network";
+        if matches!(
+            lower.as_str(),
+            "traffic light" | "traffic lights" | "traffic signal" | "traffic signals" | "traffic_light"
+        ) {
+            // a light is there; its state is not said
+            self.set(road, "light", key, at, Known::Unspecified, DERIVED, false);
+            return;
+        }
+        if words.last().is_some_and(|w| *w == "sign" || *w == "signs") {
+            if let Some(sym) = self.symbol_from(key, text, at.value_span, "stop sign") {
+                let mut list = match self.road_prop(road, "signs").map(|p| p.value.clone()) {
+                    Some(Known::Given(Val::Symbols(list))) => list,
+                    _ => Vec::new(),
+                };
+                list.push(sym);
+                self.replace(road, "signs", key, at, Known::Given(Val::Symbols(list)));
+            }
+            return;
+        }
+        let count = words.first().and_then(|w| norm::parse_integer(w).or_else(|| norm::number_word(w)));
+        if let (Some(n), true) = (count, words.len() >= 2 && words[1].starts_with("lane")) {
+            self.set(road, "lanes", key, at, Known::Given(Val::Integer(n)), DERIVED, false);
+            return;
+        }
+        if let Some(n) = words
+            .first()
+            .and_then(|w| w.strip_suffix("-lane"))
+            .and_then(|w| norm::parse_integer(w).or_else(|| norm::number_word(w)))
+        {
+            self.set(road, "lanes", key, at, Known::Given(Val::Integer(n)), DERIVED, false);
+            return;
+        }
+        let parts = norm::split_road_type(text);
+        if let Some(direction) = parts.direction {
+            let sym = Symbol { name: direction.to_string(), span: at.value_span };
+            self.set(road, "direction", key, at, Known::Given(Val::Symbol(sym)), DERIVED, false);
+        }
+        let Some(road_type) = parts.road_type else { return };
+        if let Some(existing) = self.road_prop(road, "type").and_then(|p| match &p.value {
+            Known::Given(Val::Symbol(s)) => Some(s.name.clone()),
+            _ => None,
+        }) {
+            self.ignored(
+                at.value_span,
+                format!("`{}` is a second road type", text.trim()),
+                &format!("TAD gives a road one type; `{existing}` is used"),
+            );
+            return;
+        }
+        if let Some(sym) = self.symbol_from(key, &road_type, at.value_span, "intersection") {
+            self.set(road, "type", key, at, Known::Given(Val::Symbol(sym)), PAPER, false);
+        }
+    }
+
+    fn road_prop(&self, road: Target, field: &str) -> Option<&Prop> {
+        match road {
+            Target::Section(i) => self.sections[i].props.iter().find(|p| p.def.name == field),
+            Target::Actor(_) => None,
+        }
+    }
+
+    /// Set a field, replacing what is there without comparing (lists built item by item).
+    fn replace(&mut self, road: Target, field: &str, key: &str, at: At, value: Known<Val>) {
+        if let Target::Section(i) = road
+            && let Some(p) = self.sections[i].props.iter_mut().find(|p| p.def.name == field)
+        {
+            p.value = value;
+            p.value_span = p.value_span.to(at.value_span);
+            return;
+        }
+        self.set(road, field, key, at, value, DERIVED, false);
+    }
+
+    fn source(&mut self, v: &Value, at: At) {
+        if !self.keyed(v, at, "source") {
+            return;
+        }
+        let source = Target::Section(self.section_at("source", at));
+        for (key, v, at) in self.entries(v, at, "source") {
+            match normalize(&key).as_str() {
+                "video" | "description" => {
+                    if let Some(t) = self.text_value(&key, v, at) {
+                        let field = normalize(&key);
+                        self.set(source, &field, &key, at, known_map(t, Val::Text), PAPER, false);
+                    }
+                }
+                "time" => self.set_quantity(source, "time", &key, v, at, Unit::Seconds),
+                "frame" => self.set_integer(source, "frame", &key, v, at, PAPER),
+                "region" => self.set_symbol(source, "region", &key, v, at, PAPER),
+                _ => self.unknown_key(&key, at, "`source`", SOURCE_KEYS),
+            }
+        }
+    }
+
+    fn actors(&mut self, what: &str, v: &Value, at: At) {
+        let what = what.to_string();
+        for (key, v, at) in self.entries(v, at, &what) {
+            if norm::is_ego(&normalize(&key)) {
+                self.ego(&key, v, at);
+            } else {
+                self.actor(&key, v, at);
+            }
+        }
+    }
+
+    fn ego(&mut self, ego_key: &str, v: &Value, at: At) {
+        if !self.keyed(v, at, ego_key) {
+            return;
+        }
+        let ego = Target::Section(self.section_at("ego", at));
+        let mut position: Option<Span> = None;
+        for (key, v, at) in self.entries(v, at, ego_key) {
+            match normalize(&key).as_str() {
+                "type" => {
+                    let fine =
+                        self.missing(v, false) || matches!(untag(v), Value::String(s) if norm::is_ego(&normalize(s)));
+                    if !fine {
+                        self.ignored(
+                            at.value_span,
+                            "TAD gives the ego vehicle no type".to_string(),
+                            "the paper's form writes `type: none` for the ego vehicle",
+                        );
+                    }
+                }
+                "number" => {
+                    let fine = self.missing(v, false) || untag(v).as_i64() == Some(1);
+                    if !fine {
+                        self.ignored(at.value_span, "there is one ego vehicle".to_string(), "remove `number`");
+                    }
+                }
+                "behavior" | "current_behavior" => self.set_symbol(ego, "behavior", &key, v, at, PAPER),
+                "speed" => self.set_quantity(ego, "speed", &key, v, at, Unit::KilometresPerHour),
+                "lane_index" | "lane_idx" => self.set_integer(ego, "lane", &key, v, at, PAPER),
+                "position_target" | "position_relation" => {
+                    if !self.missing(v, false) {
+                        position = Some(position.map_or(at.value_span, |p: Span| p.to(at.value_span)));
+                    }
+                }
+                _ => self.unknown_key(&key, at, &format!("`{ego_key}`"), EGO_KEYS),
+            }
+        }
+        if let Some(span) = position {
+            self.ignored(
+                span,
+                "TAD gives the ego vehicle no position".to_string(),
+                "other actors are placed relative to the ego vehicle; write `unspecified` for the ego's",
+            );
+        }
+    }
+
+    fn actor(&mut self, actor_key: &str, v: &Value, at: At) {
+        if !self.keyed(v, at, actor_key) {
+            return;
+        }
+        let base = norm::identifier(actor_key);
+        let mut name = base.clone();
+        let mut n = 2;
+        while self.actors.iter().any(|a| a.name.text == name) {
+            name = format!("{base}_{n}");
+            n += 1;
+        }
+        if name != base {
+            self.report(
+                Diagnostic::new(
+                    Code::W0303,
+                    format!("actor `{actor_key}` is renamed `{name}`"),
+                    at.key_span,
+                    format!("`{base}` is taken"),
+                )
+                .with_help("give each actor group a key of its own"),
+            );
+        }
+        let span = at.node.map_or(at.key_span, |n| self.tree.block(n));
+        let index = self.actors.len();
+        self.actors.push(ActorBuild {
+            key: actor_key.to_string(),
+            name: Name { text: name, span: at.key_span },
+            span,
+            count: None,
+            kind: None,
+            props: Vec::new(),
+        });
+        let me = Target::Actor(index);
+        let mut relation = None;
+        let mut target = None;
+        for (key, v, at) in self.entries(v, at, actor_key) {
+            match normalize(&key).as_str() {
+                "type" => {
+                    if let Some(kind) = self.symbol(&key, v, at, "sedan") {
+                        self.actors[index].kind = Some(Spanned { value: kind, span: at.value_span });
+                    }
+                }
+                "number" => {
+                    if let Some(count) = self.integer(&key, v, at, "1") {
+                        self.actors[index].count = Some(Spanned { value: count, span: at.value_span });
+                    }
+                }
+                "behavior" | "current_behavior" => self.set_symbol(me, "behavior", &key, v, at, PAPER),
+                "speed" => self.set_quantity(me, "speed", &key, v, at, Unit::KilometresPerHour),
+                "lane_index" | "lane_idx" => self.set_integer(me, "lane", &key, v, at, PAPER),
+                "position_relation" => relation = self.part(&key, v, at),
+                "position_target" => target = self.part(&key, v, at),
+                _ => self.unknown_key(&key, at, &format!("actor `{actor_key}`"), ACTOR_KEYS),
+            }
+        }
+        self.pending.push(PendingPosition { actor: index, relation, target });
+    }
+
+    /// The reference a `position_target` names: `ego`, an actor group, or a road element.
+    fn reference(&mut self, part: &Part) -> Option<Symbol> {
+        let word = part.word.as_deref().unwrap_or("");
+        let normalized = normalize(word);
+        if norm::is_ego(&normalized) {
+            return Some(Symbol { name: "ego".into(), span: part.value_span });
+        }
+        let as_key = norm::identifier(word);
+        let exact = self.actors.iter().find(|a| a.key == word.trim());
+        let close = || self.actors.iter().find(|a| normalize(&a.key) == normalized || a.name.text == as_key);
+        if let Some(actor) = exact.or_else(close) {
+            return Some(Symbol { name: actor.name.text.clone(), span: part.value_span });
+        }
+        self.symbol_from("position_target", word, part.value_span, "ego_vehicle")
+    }
+
+    fn resolve_positions(&mut self) {
+        for pending in std::mem::take(&mut self.pending) {
+            let me = Target::Actor(pending.actor);
+            let (relation, target) = (pending.relation, pending.target);
+            let Some(first) = relation.clone().or(target.clone()) else { continue };
+            let relation_word = relation.as_ref().and_then(|r| r.word.clone());
+            let value = match relation_word {
+                Some(word) => {
+                    let relation_part = relation.clone().unwrap_or(first.clone());
+                    let Some(rel) = self.symbol_from("position_relation", &word, relation_part.value_span, "front")
+                    else {
+                        continue;
+                    };
+                    let reference = match &target {
+                        Some(t) if t.word.is_some() => match self.reference(t) {
+                            Some(r) => r,
+                            None => continue,
+                        },
+                        // the paper's actors are placed relative to the ego vehicle
+                        _ => {
+                            let end = relation_part.value_span.end;
+                            Symbol { name: "ego".into(), span: Span::new(end, end) }
+                        }
+                    };
+                    Known::Given(Val::Position(Position { relation: rel, reference }))
+                }
+                None => Known::Unspecified,
+            };
+            let key_span = first.key_span;
+            let mut value_span = relation.as_ref().map_or(first.value_span, |r| r.value_span);
+            if let Some(t) = &target
+                && t.word.is_some()
+                && relation.as_ref().is_some_and(|r| r.word.is_some())
+            {
+                value_span = value_span.to(t.value_span);
+            }
+            let key = if relation.is_some() { "position_relation" } else { "position_target" };
+            let at = At { node: None, key_span, value_span };
+            self.set(me, "position", key, at, value, PAPER, false);
+        }
+    }
+
+    fn finish(&mut self) -> Module {
+        let mut sections: Vec<Section> = std::mem::take(&mut self.sections)
+            .into_iter()
+            .map(|s| {
+                let mut props = s.props;
+                props.sort_by_key(|p| s.def.fields.iter().position(|f| f.name == p.def.name));
+                Section {
+                    def: s.def,
+                    span: s.span,
+                    name_span: s.name_span,
+                    attrs: props.into_iter().map(attr).collect(),
+                }
+            })
+            .collect();
+        sections.sort_by_key(|s| schema::SECTIONS.iter().position(|d| d.name == s.def.name));
+        let actors = std::mem::take(&mut self.actors)
+            .into_iter()
+            .map(|a| {
+                let mut props = a.props;
+                props.sort_by_key(|p| schema::ACTOR.fields.iter().position(|f| f.name == p.def.name));
+                ActorGroup {
+                    span: a.span,
+                    kind: a.kind.unwrap_or(Spanned { value: Known::Unspecified, span: a.name.span }),
+                    name: a.name,
+                    count: a.count,
+                    attrs: props.into_iter().map(attr).collect(),
+                }
+            })
+            .collect();
+        Module {
+            uses: std::mem::take(&mut self.uses),
+            declarations: Vec::new(),
+            scenario: Some(Scenario { span: self.whole, name: self.name.take(), sections, actors }),
+        }
+    }
+}
+
+#[derive(Clone, Copy)]
+enum Target {
+    Section(usize),
+    Actor(usize),
+}
+
+fn attr(p: Prop) -> Attr {
+    Attr { def: p.def, key_span: p.key_span, value_span: p.value_span, value: p.value }
+}
+
+fn known_map<T>(k: Known<T>, f: impl FnOnce(T) -> Val) -> Known<Val> {
+    match k {
+        Known::Given(v) => Known::Given(f(v)),
+        Known::Unspecified => Known::Unspecified,
+    }
+}
+
+/// An example value of a field, in the paper's spelling, for help messages.
+fn field_example(target: Target, field: &str) -> &'static str {
+    match (target, field) {
+        (_, "weather") => "clear",
+        (_, "time") => "daytime",
+        (_, "type") => "straight road",
+        (_, "context") => "urban",
+        (_, "direction") => "two-way",
+        (_, "light") => "green",
+        (_, "signs") => "stop sign",
+        (_, "special_lanes") => "bike lane",
+        (_, "traffic") => "light",
+        (_, "behavior") => "move forward",
+        (_, "region") => "los angeles",
+        (_, "hazards") => "accident",
+        (_, "roadworks") => "lane closure",
+        (_, "emergency_vehicles") => "ambulance",
+        (_, "roadside") => "sidewalk",
+        _ => "unspecified",
+    }
+}

@@ -1,0 +1,41 @@
+//! YAML interchange for TADSL: the YAML scenarios LLMs answer with (TrafficAlign's
+//! translation prompt, TrafficComposer's IR) to the scenario model, and back.
+//!
+//! ```text
+//! raw answer ──extract──▶ YAML text ──serde_norway──▶ values ──┐
+//!                              └──scan (spans by line)──────────┴──lower──▶ model::Module
+//! model::Module ──export──▶ TrafficAlign YAML (with extra keys)
+//! model::Module ──to_tad──▶ canonical TAD source
+//! ```
+//!
+//! Pure (no I/O) and total: every function returns a result for any input and never
+//! panics; problems are diagnostics (codes `E03xx`/`W03xx`) whose spans are byte ranges
+//! of the text given to [`lower`], so they point at the YAML lines.
+//!
+//! The two dialects and how their values map to TAD are described in `spec/yaml.md`.
+
+mod export;
+mod extract;
+mod import;
+pub mod norm;
+mod parse;
+mod scan;
+mod tad;
+
+pub use export::export;
+pub use extract::extract;
+pub use import::{Dialect, lower};
+pub use tad::to_tad;
+
+/// The dialect of the YAML in `answer`, if there is a YAML mapping to judge.
+pub fn dialect(answer: &str) -> Option<Dialect> {
+    let range = extract(answer)?;
+    let text = &answer[range];
+    if parse::too_deep(text).is_some() {
+        return None;
+    }
+    match serde_norway::from_str::<serde_norway::Value>(text).ok()? {
+        serde_norway::Value::Mapping(map) => Some(import::detect(&map)),
+        _ => None,
+    }
+}
