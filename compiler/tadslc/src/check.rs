@@ -35,25 +35,12 @@ pub fn diagnose(input: &Input) -> Vec<Diagnostic> {
 }
 
 pub fn run(paths: &[std::path::PathBuf], format: Format, deny_warnings: bool, color: bool, options: Options) -> Status {
-    let (files, io_errors) = files::collect(paths);
-    let mut status = Status::Ok;
-    for error in &io_errors {
-        eprintln!("error: {error}");
-        status = Status::Usage;
-    }
+    let (inputs, mut status) = files::load(paths);
     let mut db = Database::new(options);
     let mut checked: Vec<(Input, Checked)> = Vec::new();
     let (mut errors, mut warnings) = (0, 0);
     let mut classes = [0usize; 3];
-    for path in &files {
-        let input = match files::read(path) {
-            Ok(input) => input,
-            Err(e) => {
-                eprintln!("error: {e}");
-                status = Status::Usage;
-                continue;
-            }
-        };
+    for input in inputs {
         let result = diagnose_in(&mut db, &input);
         errors += result.diagnostics.iter().filter(|d| d.severity == Severity::Error).count();
         warnings += result.diagnostics.iter().filter(|d| d.severity == Severity::Warning).count();

@@ -82,3 +82,26 @@ pub fn read(path: &Path) -> Result<Input, String> {
     let path = (path.as_os_str() != "-").then(|| path.to_path_buf());
     Ok(Input { name, path, text, invalid_utf8 })
 }
+
+/// Every input `paths` name (see [`collect`]), in order. Paths that cannot be read are
+/// reported on standard error; the status is then [`Status::Usage`](crate::Status), and
+/// the other inputs are still returned.
+pub fn load(paths: &[PathBuf]) -> (Vec<Input>, crate::Status) {
+    let (files, errors) = collect(paths);
+    let mut status = crate::Status::Ok;
+    for error in &errors {
+        eprintln!("error: {error}");
+        status = crate::Status::Usage;
+    }
+    let mut inputs = Vec::with_capacity(files.len());
+    for path in &files {
+        match read(path) {
+            Ok(input) => inputs.push(input),
+            Err(e) => {
+                eprintln!("error: {e}");
+                status = crate::Status::Usage;
+            }
+        }
+    }
+    (inputs, status)
+}

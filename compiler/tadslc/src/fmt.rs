@@ -27,28 +27,15 @@ pub fn canonicalize(db: &mut tad_db::Database, input: &files::Input) -> String {
 
 pub fn run(paths: &[std::path::PathBuf], check: bool, canonical: bool, color: bool) -> Status {
     let mut db = tad_db::Database::new(tad_check::Options::default());
-    let (files, io_errors) = files::collect(paths);
-    let mut status = Status::Ok;
-    for error in &io_errors {
-        eprintln!("error: {error}");
-        status = Status::Usage;
-    }
+    let (inputs, mut status) = files::load(paths);
     let mut unformatted = 0;
-    for path in &files {
-        let input = match files::read(path) {
-            Ok(input) => input,
-            Err(e) => {
-                eprintln!("error: {e}");
-                status = Status::Usage;
-                continue;
-            }
-        };
+    for input in &inputs {
         if input.invalid_utf8.is_some() {
             eprintln!("error: `{}` is not valid UTF-8; not formatted", input.name);
             status = status.max(Status::Failed);
             continue;
         }
-        let source = if canonical { canonicalize(&mut db, &input) } else { input.text.clone() };
+        let source = if canonical { canonicalize(&mut db, input) } else { input.text.clone() };
         let formatted = match tad_syntax::format::format(&source) {
             Ok(formatted) => formatted,
             Err(diagnostics) => {
@@ -79,7 +66,7 @@ pub fn run(paths: &[std::path::PathBuf], check: bool, canonical: bool, color: bo
         }
     }
     if check && unformatted > 0 {
-        eprintln!("{unformatted} of {} files would be reformatted; run `tadslc fmt` on them", files.len());
+        eprintln!("{unformatted} of {} files would be reformatted; run `tadslc fmt` on them", inputs.len());
     }
     status
 }

@@ -55,38 +55,45 @@ pub fn import(db: &mut Database, input: &Input) -> (String, Vec<Diagnostic>) {
     }
     let tad = tad_yaml::to_tad(&module);
     // canonical names, units and lanes, checked as a TAD file beside the original
-    let tad_input = Input { name: input.name.clone(), path: Some(path.with_extension("tad")), text: tad, invalid_utf8: None };
+    let tad_input =
+        Input { name: input.name.clone(), path: Some(path.with_extension("tad")), text: tad, invalid_utf8: None };
     let canonical = crate::fmt::canonicalize(db, &tad_input);
     let text = tad_syntax::format::format(&canonical).unwrap_or(canonical);
     (text, diagnostics)
 }
 
+/// Read one input, or say why not.
+fn read(path: &Path) -> Result<Input, Status> {
+    files::read(path).map_err(|e| {
+        eprintln!("error: {e}");
+        Status::Usage
+    })
+}
+
 pub fn run_import(path: &Path, out: Option<&Path>, color: bool) -> Status {
-    let input = match files::read(path) {
+    let input = match read(path) {
         Ok(input) => input,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return Status::Usage;
-        }
+        Err(status) => return status,
     };
     let mut db = Database::new(Options::default());
     let (text, diagnostics) = import(&mut db, &input);
     let errors = report(&input, &diagnostics, color);
     let status = write_output(out, &text);
     if errors > 0 {
-        eprintln!("imported `{}` with {errors} error{}: the output lacks what they name", input.name, if errors == 1 { "" } else { "s" });
+        eprintln!(
+            "imported `{}` with {errors} error{}: the output lacks what they name",
+            input.name,
+            if errors == 1 { "" } else { "s" }
+        );
         return status.max(Status::Failed);
     }
     status
 }
 
 pub fn run_export(path: &Path, out: Option<&Path>, color: bool) -> Status {
-    let input = match files::read(path) {
+    let input = match read(path) {
         Ok(input) => input,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return Status::Usage;
-        }
+        Err(status) => return status,
     };
     let mut db = Database::new(Options::default());
     let checked = crate::check::diagnose_in(&mut db, &input);
