@@ -252,7 +252,13 @@ fn json_carries_class_and_refinement() {
 #[test]
 fn yaml_answers_are_checked_at_their_own_lines() {
     let out = tadslc(
-        &["check", "--format", "json", "tests/yaml/paper/nl_to_dsl_example_1.yaml", "tests/yaml/paper/nl_to_dsl_example_2.yaml"],
+        &[
+            "check",
+            "--format",
+            "json",
+            "tests/yaml/paper/nl_to_dsl_example_1.yaml",
+            "tests/yaml/paper/nl_to_dsl_example_2.yaml",
+        ],
         "",
     );
     assert_eq!(code(&out), 0, "{}", stderr(&out));
@@ -292,7 +298,13 @@ fn import_writes_canonical_tad_and_export_round_trips() {
     let out = tadslc(&["import", "tests/yaml/cli/missing_lane.yaml", "-o", tad.to_str().unwrap()], "");
     assert_eq!(code(&out), 0, "{}", stderr(&out));
     let text = std::fs::read_to_string(&tad).unwrap();
-    for expected in ["scenario missing_lane {", "weather: clear", "behavior: go_forward", "position: right_front of ego", "lane: unspecified"] {
+    for expected in [
+        "scenario missing_lane {",
+        "weather: clear",
+        "behavior: go_forward",
+        "position: right_front of ego",
+        "lane: unspecified",
+    ] {
         assert!(text.contains(expected), "{expected} missing from\n{text}");
     }
     assert_eq!(code(&tadslc(&["fmt", "--check", tad.to_str().unwrap()], "")), 0, "imported TAD is formatted");
@@ -306,7 +318,8 @@ fn import_writes_canonical_tad_and_export_round_trips() {
         assert_eq!(code(&back), 0, "{}", stderr(&back));
         let original = std::fs::read_to_string(repo().join(example)).unwrap();
         let without_comments: String =
-            original.lines().filter(|l| !l.starts_with("//")).collect::<Vec<_>>().join("\n").trim_start().to_string() + "\n";
+            original.lines().filter(|l| !l.starts_with("//")).collect::<Vec<_>>().join("\n").trim_start().to_string()
+                + "\n";
         assert_eq!(stdout(&back), without_comments, "{example}");
     }
     // a file with errors is not exported

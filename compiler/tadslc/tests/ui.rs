@@ -174,7 +174,11 @@ fn main() {
         .filter(|p| p.extension().is_some_and(|e| e == "tad"))
         .chain(yaml.iter().filter(|p| p.extension().is_some_and(|e| e == "yaml")))
         .filter_map(|p| std::fs::read(p).ok())
-        .map(|bytes| String::from_utf8_lossy(&bytes).replace("\n# error[", "\n// error[").replace("\n# warning[", "\n// warning["))
+        .map(|bytes| {
+            String::from_utf8_lossy(&bytes)
+                .replace("\n# error[", "\n// error[")
+                .replace("\n# warning[", "\n// warning[")
+        })
         .flat_map(|t| expected(&t).into_iter().map(|(_, c, _)| c))
         .collect();
     trials.push(Trial::test("every code has a fixture", move || {
