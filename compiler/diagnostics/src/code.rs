@@ -93,6 +93,14 @@ codes! {
     W0600 => Warning,
     W0601 => Warning,
     // Scenic backend (7xx): add codes below this line
+    E0700 => Error,
+    W0700 => Warning,
+    W0701 => Warning,
+    W0702 => Warning,
+    W0703 => Warning,
+    W0704 => Warning,
+    W0705 => Warning,
+    W0706 => Warning,
     // end of Scenic codes
 }
 
@@ -112,7 +120,8 @@ impl Code {
         };
         let rest = &REFERENCE[start..];
         let body = &rest[heading.len()..];
-        let end = ["\n## ", "\n<!--"].iter().filter_map(|m| body.find(m)).min().map_or(rest.len(), |i| i + heading.len() + 1);
+        let end =
+            ["\n## ", "\n<!--"].iter().filter_map(|m| body.find(m)).min().map_or(rest.len(), |i| i + heading.len() + 1);
         rest[..end].trim_end()
     }
 

@@ -328,8 +328,7 @@ pub fn text_block_content(raw: &str) -> String {
     let inner = inner.strip_suffix("\"\"\"").unwrap_or(inner);
     let inner = inner.strip_prefix("\r\n").or_else(|| inner.strip_prefix('\n')).unwrap_or(inner);
     let lines: Vec<&str> = inner.lines().collect();
-    let indent =
-        lines.iter().filter(|l| !l.trim().is_empty()).map(|l| indentation(l)).min().unwrap_or(0);
+    let indent = lines.iter().filter(|l| !l.trim().is_empty()).map(|l| indentation(l)).min().unwrap_or(0);
     let mut out: Vec<&str> =
         lines.iter().map(|l| if indentation(l) >= indent { &l[indent..] } else { l.trim_start() }).collect();
     while out.last().is_some_and(|l| l.trim().is_empty()) {

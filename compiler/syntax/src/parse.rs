@@ -54,9 +54,9 @@ pub fn parse(src: &str) -> Parsed {
     // What follows a missing `:` on its line is a consequence of it.
     let same_line = |a: usize, b: usize| !src[a.min(b)..a.max(b)].contains('\n');
     syntax.retain(|d| {
-        !missing_colons
-            .iter()
-            .any(|m| d.primary.span.start > m.primary.span.start && same_line(d.primary.span.start, m.primary.span.start))
+        !missing_colons.iter().any(|m| {
+            d.primary.span.start > m.primary.span.start && same_line(d.primary.span.start, m.primary.span.start)
+        })
     });
     drop_values_with_unknown_units(src, &mut file, &syntax);
     diagnostics.extend(missing_colons);
@@ -164,7 +164,8 @@ fn close_braces(src: &str, tokens: &mut Vec<Spanned>, diagnostics: &mut Vec<Diag
     };
     let line_leading = |offset: usize| src[index.line_start(index.line_of(offset))..offset].trim().is_empty();
     // A `{` that a later, less indented `}` closed: most likely the one missing its `}`.
-    let suspect = pairs.iter().copied().find(|&(opened, closed)| line_leading(closed) && indent(opened) > indent(closed));
+    let suspect =
+        pairs.iter().copied().find(|&(opened, closed)| line_leading(closed) && indent(opened) > indent(closed));
     let end = src.len();
     for (i, &opened) in open.iter().enumerate().rev() {
         let mut d =

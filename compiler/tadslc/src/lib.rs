@@ -4,6 +4,7 @@
 //! unformatted files with `fmt --check`), 2 usage or I/O failure.
 
 pub mod bench;
+pub mod build;
 pub mod check;
 pub mod corpus;
 pub mod explain;

@@ -51,6 +51,27 @@ enum Command {
         #[arg(long)]
         canonicalize: bool,
     },
+    /// Compile checked scenarios for a simulator
+    Build {
+        /// Scenario files or directories
+        #[arg(required = true)]
+        paths: Vec<PathBuf>,
+        /// The target language
+        #[arg(long, value_enum, default_value_t = Target::Scenic)]
+        target: Target,
+        /// Output directory (default: standard output for a single file)
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// Directory of the CARLA OpenDRIVE maps (`TownNN.xodr`)
+        #[arg(long)]
+        map_dir: Option<PathBuf>,
+        /// The town to use, e.g. `Town10HD` (default: the first map with the road's features)
+        #[arg(long)]
+        map: Option<String>,
+        /// Which simulator the behaviors are written for
+        #[arg(long, value_enum, default_value_t = Simulator::Carla)]
+        simulator: Simulator,
+    },
     /// Convert a YAML scenario (TrafficAlign's form, TrafficComposer's IR, or a whole LLM
     /// answer around one) to canonical TAD
     Import {
@@ -143,6 +164,17 @@ impl Rules {
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum Target {
+    Scenic,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum Simulator {
+    Carla,
+    Newtonian,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum Color {
     Auto,
     Always,
@@ -164,6 +196,18 @@ fn main() -> ExitCode {
             check::run(&paths, format, deny_warnings, color, rules.options())
         }
         Command::Fmt { paths, check, canonicalize } => fmt::run(&paths, check, canonicalize, color),
+        Command::Build { paths, target: Target::Scenic, output, map_dir, map, simulator } => tadslc::build::run(
+            &paths,
+            "scenic",
+            output.as_deref(),
+            map_dir.as_deref(),
+            map.as_deref(),
+            match simulator {
+                Simulator::Carla => "carla",
+                Simulator::Newtonian => "newtonian",
+            },
+            color,
+        ),
         Command::Import { path, output } => tadslc::interchange::run_import(&path, output.as_deref(), color),
         Command::Export { yaml: _, path, output } => tadslc::interchange::run_export(&path, output.as_deref(), color),
         Command::Explain { code } => explain::run(code.as_deref()),

@@ -167,12 +167,16 @@ fn main() {
     }
     // every diagnostic code is expected by at least one fixture: these, or the YAML answer
     // fixtures of `tests/yaml/answers` (annotated `# error[CODE]: ...`, run by tad-yaml)
+    // and the Scenic backend's fixtures (`tests/scenic/fixtures`, run by tad-scenic)
     let mut yaml = Vec::new();
     fixtures(&repo().join("tests/yaml/answers"), &mut yaml);
+    let mut scenic = Vec::new();
+    fixtures(&repo().join("tests/scenic/fixtures"), &mut scenic);
     let all: Vec<String> = files
         .iter()
         .filter(|p| p.extension().is_some_and(|e| e == "tad"))
         .chain(yaml.iter().filter(|p| p.extension().is_some_and(|e| e == "yaml")))
+        .chain(scenic.iter().filter(|p| p.extension().is_some_and(|e| e == "tad")))
         .filter_map(|p| std::fs::read(p).ok())
         .map(|bytes| {
             String::from_utf8_lossy(&bytes)
