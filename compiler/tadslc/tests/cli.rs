@@ -325,3 +325,20 @@ fn import_writes_canonical_tad_and_export_round_trips() {
     // a file with errors is not exported
     assert_eq!(code(&tadslc(&["export", "--yaml", "tests/ui/structure/unknown_field.tad"], "")), 1);
 }
+
+#[test]
+fn build_writes_scenic_programs_and_refuses_broken_files() {
+    let dir = scratch("build");
+    let out = tadslc(&["build", "--target", "scenic", "examples/safety", "-o", dir.to_str().unwrap()], "");
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    let programs = std::fs::read_dir(&dir).unwrap().count();
+    assert_eq!(programs, 8, "one program per example");
+    let text = std::fs::read_to_string(dir.join("red_light_running.scenic")).unwrap();
+    assert!(text.contains("model scenic.simulators.carla.model") && text.contains("param carla_map"));
+    let newtonian = tadslc(&["build", "--simulator", "newtonian", "examples/safety/right_turn.tad"], "");
+    assert_eq!(code(&newtonian), 0, "{}", stderr(&newtonian));
+    assert!(stdout(&newtonian).contains("model scenic.simulators.newtonian.driving_model"));
+    let broken = tadslc(&["build", "tests/ui/structure/unknown_field.tad"], "");
+    assert_eq!(code(&broken), 1);
+    assert!(stdout(&broken).is_empty(), "nothing is emitted for a file with errors");
+}
