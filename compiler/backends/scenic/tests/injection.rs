@@ -232,15 +232,6 @@ fn adversarial_programs_run_in_scenic() {
     };
     let files = emit_all(&dir, &options);
     let records = common::run_oracle(&python, &check, &["--sim", "100", "--max-iters", "500"], &files);
-    let failures: Vec<String> = records
-        .iter()
-        .filter(|r| {
-            !(r["compiled"] == true
-                && r["sampled"] == true
-                && r["error"].is_null()
-                && r["sim_steps"].as_u64().is_some_and(|s| s >= 100))
-        })
-        .map(|r| r.to_string())
-        .collect();
+    let failures = common::failures(&records, 100);
     assert!(failures.is_empty(), "{} of {} failed:\n{}", failures.len(), records.len(), failures.join("\n"));
 }

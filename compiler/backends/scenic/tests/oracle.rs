@@ -74,16 +74,7 @@ fn every_example_compiles_samples_and_simulates_in_scenic() {
     let steps = STEPS.to_string();
     let records = common::run_oracle(&python, &check, &["--sim", &steps, "--max-iters", "500"], &files);
     figures(&files, &times, &records);
-    let failures: Vec<String> = records
-        .iter()
-        .filter(|r| {
-            !(r["compiled"] == true
-                && r["sampled"] == true
-                && r["error"].is_null()
-                && r["sim_steps"].as_u64().is_some_and(|s| s >= STEPS))
-        })
-        .map(|r| r.to_string())
-        .collect();
+    let failures = common::failures(&records, STEPS);
     assert!(failures.is_empty(), "{} of {} examples failed:\n{}", failures.len(), records.len(), failures.join("\n"));
 }
 

@@ -184,15 +184,6 @@ fn the_standard_vocabulary_builds_to_scenic_that_runs() {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("scenic-sweep");
     let files = emit_all(Simulator::Newtonian, &dir, &maps);
     let records = common::run_oracle(&python, &check, &["--sim", "100", "--max-iters", "500"], &files);
-    let failures: Vec<String> = records
-        .iter()
-        .filter(|r| {
-            !(r["compiled"] == true
-                && r["sampled"] == true
-                && r["error"].is_null()
-                && r["sim_steps"].as_u64().is_some_and(|s| s >= 100))
-        })
-        .map(|r| r.to_string())
-        .collect();
+    let failures = common::failures(&records, 100);
     assert!(failures.is_empty(), "{} of {} failed:\n{}", failures.len(), records.len(), failures.join("\n"));
 }

@@ -158,3 +158,18 @@ pub fn run_oracle(python: &Path, check: &Path, args: &[&str], files: &[PathBuf])
     }
     records
 }
+
+/// The oracle records of programs that did not compile, sample, or simulate at least
+/// `steps` steps without an error, as JSON lines.
+pub fn failures(records: &[serde_json::Value], steps: u64) -> Vec<String> {
+    records
+        .iter()
+        .filter(|r| {
+            !(r["compiled"] == true
+                && r["sampled"] == true
+                && r["error"].is_null()
+                && r["sim_steps"].as_u64().is_some_and(|s| s >= steps))
+        })
+        .map(|r| r.to_string())
+        .collect()
+}
