@@ -1,17 +1,21 @@
 //! Completeness: TrafficAlign's semantic validation.
 //!
-//! Essential attributes: the environment's weather and time; the road's type, lanes and
-//! direction; the ego's behavior, speed and lane; every group's type, count, behavior,
-//! position and lane. An attribute is missing when absent or `unspecified`. A scenario
-//! missing every essential group of `Options::non_scenario` (by default weather, time and
-//! the road) is a non-scenario — a title card or a dashboard frame — to be discarded;
-//! otherwise one missing anything is incomplete, to be refined; else complete. Each
-//! missing attribute yields a concrete request for the extractor.
+//! The essential attributes are the schema's (`FieldDef::essential`: the environment's
+//! weather and time; the road's type, lanes and direction; the ego's behavior, speed and
+//! lane; every group's behavior, position and lane) plus a group's type and count when
+//! its header says `unspecified`. An attribute is missing when absent or `unspecified`. A
+//! scenario missing every essential group of `Options::non_scenario` (by default weather,
+//! time and the road) is a non-scenario — a title card or a dashboard frame — to be
+//! discarded; otherwise one missing anything is incomplete, to be refined; else complete.
+//!
+//! The checker states facts only: each missing element is a W0600 whose payload names the
+//! element and its fields. The words of a refinement request are rendered from those
+//! payloads elsewhere (`tad-feedback`), for whoever asks the extractor.
 
 use crate::Options;
-use crate::vocab::Vocabulary;
-use tad_diagnostics::{Code, Diagnostic, Span};
-use tad_syntax::model::{Attr, Known, Scenario};
+use tad_diagnostics::{Code, Diagnostic, Element, Payload, Span};
+use tad_syntax::model::{Attr, Known, Scenario, Section};
+use tad_syntax::schema::{self, SectionDef};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Class {
@@ -35,9 +39,9 @@ impl Class {
 pub enum Essential {
     Weather,
     Time,
-    /// The road's type, lanes and direction, all of them.
+    /// The road's essential fields, all of them.
     Road,
-    /// The ego's behavior, speed and lane, all of them.
+    /// The ego's essential fields, all of them.
     Ego,
     /// Any actor group.
     Actors,
@@ -66,120 +70,44 @@ fn present(attr: Option<&Attr>) -> bool {
     matches!(attr, Some(Attr { value: Known::Given(_), .. }))
 }
 
-fn one_of(vocabulary: &Vocabulary, kind: &str) -> String {
-    let names = vocabulary.names(kind);
-    if names.is_empty() { String::new() } else { format!(" (one of: {})", names.join(", ")) }
+/// The essential fields of `def` that `section` does not state.
+fn absent(def: &SectionDef, section: Option<&Section>) -> Vec<String> {
+    def.essential().filter(|f| !present(section.and_then(|s| s.attr(f.name)))).map(|f| f.name.to_string()).collect()
 }
 
-struct Missing {
-    /// Where to report: the section or group name, or the scenario's name.
-    span: Span,
-    element: String,
-    attributes: Vec<&'static str>,
-}
-
-pub fn classify(
-    scenario: &Scenario,
-    vocabulary: &Vocabulary,
-    options: &Options,
-    out: &mut Vec<Diagnostic>,
-) -> (Class, Vec<String>) {
+pub fn classify(scenario: &Scenario, options: &Options, out: &mut Vec<Diagnostic>) -> Class {
     let anchor = scenario.name.as_ref().map_or(Span::new(scenario.span.start, scenario.span.start + 8), |n| n.span);
-    let mut missing: Vec<Missing> = Vec::new();
-    let mut requests: Vec<String> = Vec::new();
-
-    let mut section = |name: &str, fields: &[(&'static str, String)], element: &str, requests: &mut Vec<String>| {
-        let s = scenario.section(name);
-        let absent: Vec<&'static str> =
-            fields.iter().filter(|(f, _)| !present(s.and_then(|s| s.attr(f)))).map(|(f, _)| *f).collect();
-        for (f, request) in fields {
-            if absent.contains(f) {
-                requests.push(request.clone());
-            }
+    // (where to report, element, missing fields)
+    let mut missing: Vec<(Span, Element, Vec<String>)> = Vec::new();
+    for (def, element) in
+        [(&schema::ENVIRONMENT, Element::Environment), (&schema::ROAD, Element::Road), (&schema::EGO, Element::Ego)]
+    {
+        let section = scenario.section(def.name);
+        let fields = absent(def, section);
+        if !fields.is_empty() {
+            missing.push((section.map_or(anchor, |s| s.name_span), element, fields));
         }
-        if !absent.is_empty() {
-            missing.push(Missing {
-                span: s.map_or(anchor, |s| s.name_span),
-                element: element.to_string(),
-                attributes: absent,
-            });
-        }
-    };
-    section(
-        "environment",
-        &[
-            ("weather", format!("State the weather{}.", one_of(vocabulary, "weather"))),
-            ("time", format!("State the time of day{}.", one_of(vocabulary, "time_of_day"))),
-        ],
-        "the environment",
-        &mut requests,
-    );
-    section(
-        "road",
-        &[
-            ("type", format!("State the road type{}.", one_of(vocabulary, "road_type"))),
-            ("lanes", "State the number of lanes per direction.".to_string()),
-            ("direction", format!("State whether the road is one-way or two-way{}.", one_of(vocabulary, "direction"))),
-        ],
-        "the road",
-        &mut requests,
-    );
-    section(
-        "ego",
-        &[
-            (
-                "behavior",
-                "State what the ego vehicle is doing (for example go_forward, turn_left, stopped).".to_string(),
-            ),
-            ("speed", "State the ego vehicle's speed in km/h.".to_string()),
-            ("lane", "State the ego vehicle's lane index (1 is the leftmost lane in its direction).".to_string()),
-        ],
-        "the ego vehicle",
-        &mut requests,
-    );
+    }
     for group in &scenario.actors {
-        let name = &group.name.text;
-        let mut absent = Vec::new();
+        let mut fields = Vec::new();
         if matches!(group.kind.value, Known::Unspecified) {
-            absent.push("type");
-            requests.push(format!("State the type of actor group `{name}` (for example sedan, pedestrian, bus)."));
+            fields.push("type".to_string());
         }
         if matches!(group.count.as_ref().map(|c| &c.value), Some(Known::Unspecified)) {
-            absent.push("count");
-            requests.push(format!("State how many actors group `{name}` has."));
+            fields.push("count".to_string());
         }
-        for (field, request) in [
-            ("behavior", format!("State what actor group `{name}` is doing.")),
-            (
-                "position",
-                format!(
-                    "State where actor group `{name}` is relative to the ego vehicle (for example front, left_front, right)."
-                ),
-            ),
-            (
-                "lane",
-                format!(
-                    "State the lane index of group `{name}` (1 is the leftmost lane in the ego's direction, -1 the leftmost of the opposite direction)."
-                ),
-            ),
-        ] {
-            if !present(group.attr(field)) {
-                absent.push(field);
-                requests.push(request);
-            }
-        }
-        if !absent.is_empty() {
-            missing.push(Missing { span: group.name.span, element: format!("group `{name}`"), attributes: absent });
+        fields.extend(schema::ACTOR.essential().filter(|f| !present(group.attr(f.name))).map(|f| f.name.to_string()));
+        if !fields.is_empty() {
+            missing.push((group.name.span, Element::Group { name: group.name.text.clone() }, fields));
         }
     }
 
-    let road = scenario.section("road");
-    let ego = scenario.section("ego");
+    let none_of = |def: &SectionDef| def.essential().all(|f| !present(scenario.attr(def.name, f.name)));
     let gone = |essential: Essential| match essential {
         Essential::Weather => !present(scenario.attr("environment", "weather")),
         Essential::Time => !present(scenario.attr("environment", "time")),
-        Essential::Road => ["type", "lanes", "direction"].iter().all(|f| !present(road.and_then(|r| r.attr(f)))),
-        Essential::Ego => ["behavior", "speed", "lane"].iter().all(|f| !present(ego.and_then(|e| e.attr(f)))),
+        Essential::Road => none_of(&schema::ROAD),
+        Essential::Ego => none_of(&schema::EGO),
         Essential::Actors => scenario.actors.is_empty(),
     };
     if !options.non_scenario.is_empty() && options.non_scenario.iter().all(|e| gone(*e)) {
@@ -191,28 +119,33 @@ pub fn classify(
                 anchor,
                 format!("no {}", parts.join(", no ")),
             )
+            .with_payload(Payload::NonScenario { absent: parts.iter().map(|p| p.to_string()).collect() })
             .with_note(
                 "a frame without these is usually a title card, a map or a dashboard; it is classed `non_scenario`",
             ),
         );
-        return (Class::NonScenario, Vec::new());
+        return Class::NonScenario;
     }
     if missing.is_empty() {
-        return (Class::Complete, Vec::new());
+        return Class::Complete;
     }
-    for m in &missing {
-        let list: Vec<String> = m.attributes.iter().map(|a| format!("`{a}`")).collect();
+    for (span, element, fields) in missing {
+        let list: Vec<String> = fields.iter().map(|a| format!("`{a}`")).collect();
+        let what = match &element {
+            Element::Environment => "the environment".to_string(),
+            Element::Road => "the road".to_string(),
+            Element::Ego => "the ego vehicle".to_string(),
+            Element::Group { name } => format!("group `{name}`"),
+        };
         out.push(
-            Diagnostic::new(
-                Code::W0600,
-                format!("{} does not state its {}", m.element, join_and(&list)),
-                m.span,
-                "incomplete",
-            )
-            .with_help("state them, or write `unspecified` when the source does not say (it still counts as missing)"),
+            Diagnostic::new(Code::W0600, format!("{what} does not state its {}", join_and(&list)), span, "incomplete")
+                .with_payload(Payload::Missing { element, fields })
+                .with_help(
+                    "state them, or write `unspecified` when the source does not say (it still counts as missing)",
+                ),
         );
     }
-    (Class::Incomplete, requests)
+    Class::Incomplete
 }
 
 fn join_and(items: &[String]) -> String {

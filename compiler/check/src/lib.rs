@@ -1,8 +1,8 @@
 //! The TADSL checker: what a structurally valid scenario means, and whether it holds up.
 //!
 //! Input is the lowered [`Module`] and the [`Vocabulary`] its file sees; output is a
-//! [`Checked`]: diagnostics, the completeness [`Class`] of the scenario and the refinement
-//! requests a scenario extractor can act on. Four passes, each reporting and going on:
+//! [`Checked`]: diagnostics (each with its typed payload) and the completeness [`Class`] of
+//! the scenario. Four passes, each reporting and going on:
 //!
 //! 1. names: every name resolves in the vocabulary of its field (or is reported with the
 //!    closest name); aliases and non-canonical units are warnings with fixes;
@@ -10,6 +10,9 @@
 //! 3. semantics: lanes, behaviors per actor kind, speeds, relations against lanes,
 //!    reference cycles, lights and signs;
 //! 4. completeness: missing essential attributes, and the class they add up to.
+//!
+//! The checker states facts; requests in words for an extractor or a language model are
+//! rendered from the payloads by `tad-feedback`.
 //!
 //! The checker knows no vocabulary lists: every name comes from declarations.
 
@@ -19,7 +22,7 @@ mod semantics;
 pub mod vocab;
 
 pub use completeness::{Class, Essential};
-pub use vocab::{Conflict, Entry, Lookup, Vocabulary};
+pub use vocab::{Conflict, Entry, Layer, Lookup, Vocabulary};
 
 use tad_diagnostics::Diagnostic;
 use tad_syntax::model::Module;
@@ -52,8 +55,6 @@ pub struct Checked {
     pub diagnostics: Vec<Diagnostic>,
     /// `None` for a module without a scenario.
     pub class: Option<Class>,
-    /// Requests for what the scenario should state, ready for an extraction prompt.
-    pub refinement: Vec<String>,
 }
 
 /// Check `module` against `vocabulary`. Diagnostics are sorted by position.
@@ -63,9 +64,7 @@ pub fn check(module: &Module, vocabulary: &Vocabulary, options: &Options) -> Che
     if let Some(scenario) = &module.scenario {
         let resolved = names::scenario(scenario, vocabulary, &mut out.diagnostics);
         semantics::check(scenario, vocabulary, &resolved, options, &mut out.diagnostics);
-        let (class, refinement) = completeness::classify(scenario, vocabulary, options, &mut out.diagnostics);
-        out.class = Some(class);
-        out.refinement = refinement;
+        out.class = Some(completeness::classify(scenario, options, &mut out.diagnostics));
     }
     tad_diagnostics::sort(&mut out.diagnostics);
     out

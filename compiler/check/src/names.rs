@@ -3,7 +3,7 @@
 
 use crate::vocab::{Lookup, Vocabulary};
 use std::collections::HashMap;
-use tad_diagnostics::{Code, Diagnostic};
+use tad_diagnostics::{Applicability, Code, Diagnostic, Payload};
 use tad_syntax::model::{Attr, Known, Scenario, Symbol, Val};
 use tad_syntax::schema::{FieldDef, Unit};
 
@@ -36,8 +36,13 @@ pub fn resolve_symbol(vocabulary: &Vocabulary, kind: &str, field: &str, symbol: 
                 symbol.span,
                 "an alias",
             )
+            .with_payload(Payload::Alias {
+                namespace: kind.to_string(),
+                written: symbol.name.clone(),
+                canonical: entry.name.clone(),
+            })
             .with_help(format!("write `{}`", entry.name))
-            .with_fix(symbol.span, entry.name.clone()),
+            .with_fix(symbol.span, entry.name.clone(), Applicability::MachineApplicable),
         ),
         Lookup::Unknown => {
             let mut d = Diagnostic::new(
@@ -46,9 +51,20 @@ pub fn resolve_symbol(vocabulary: &Vocabulary, kind: &str, field: &str, symbol: 
                 symbol.span,
                 format!("not a {} `{field}` can take", kind_label(kind)),
             );
-            if let Some(guess) = vocabulary.suggest(kind, &symbol.name) {
-                d = d.with_help(format!("did you mean `{guess}`?")).with_fix(symbol.span, guess.to_string());
+            let candidates = vocabulary.candidates(kind, &symbol.name, 5);
+            if let Some(guess) = candidates.first() {
+                d = d.with_help(format!("did you mean `{guess}`?")).with_fix(
+                    symbol.span,
+                    guess.to_string(),
+                    Applicability::MaybeIncorrect,
+                );
             }
+            d = d.with_payload(Payload::Unknown {
+                namespace: kind.to_string(),
+                name: symbol.name.clone(),
+                candidates: candidates.iter().map(|c| c.to_string()).collect(),
+                module: None,
+            });
             let names = vocabulary.names(kind);
             d = if names.is_empty() {
                 d.with_note(format!("no {} is declared; is a `use` missing?", kind_label(kind)))
@@ -91,8 +107,13 @@ fn attr(vocabulary: &Vocabulary, attr: &Attr, out: &mut Vec<Diagnostic>) {
                     attr.value_span,
                     "not in km/h",
                 )
+                .with_payload(Payload::Alias {
+                    namespace: "unit".into(),
+                    written: format!("{} {}", format_number(q.value), q.unit.as_str()),
+                    canonical: format!("{text} km/h"),
+                })
                 .with_help(format!("write `{text} km/h`"))
-                .with_fix(attr.value_span, format!("{text} km/h")),
+                .with_fix(attr.value_span, format!("{text} km/h"), Applicability::MachineApplicable),
             );
         }
         _ => {}
@@ -179,15 +200,13 @@ fn reference(
     let mut candidates: Vec<&str> = groups.clone();
     candidates.extend(vocabulary.names("reference"));
     candidates.extend(vocabulary.names("road_element"));
-    let mut d = Diagnostic::new(
+    let d = Diagnostic::new(
         Code::E0402,
         format!("unknown reference `{}`", symbol.name),
         symbol.span,
         "not `ego`, an actor group or a road element",
     );
-    if let Some(guess) = tad_syntax::suggest::closest(&symbol.name, candidates.iter().copied()) {
-        d = d.with_help(format!("did you mean `{guess}`?")).with_fix(symbol.span, guess.to_string());
-    }
+    let (mut d, _) = tad_syntax::suggest::unknown(d, "reference", &symbol.name, symbol.span, candidates);
     if !groups.is_empty() {
         d = d.with_note(format!("the actor groups are {}", quoted(&groups)));
     }

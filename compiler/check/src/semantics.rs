@@ -8,7 +8,7 @@
 use crate::names::{Resolved, Target, format_number, quoted};
 use crate::vocab::{Entry, Vocabulary};
 use crate::{Options, Profile};
-use tad_diagnostics::{Code, Diagnostic, Span};
+use tad_diagnostics::{Applicability, Code, Diagnostic, Payload, Span};
 use tad_syntax::model::{Attr, Known, Scenario, Val};
 
 /// The ego vehicle's actor kind.
@@ -62,6 +62,7 @@ pub fn check(
                     count.span,
                     "a group has at least one actor",
                 )
+                .with_payload(range("count", n as f64, Some(1.0), None, None))
                 .with_help("remove the group if nothing is there"),
             );
         }
@@ -91,6 +92,11 @@ pub fn check(
                             position.relation.span,
                             "behind the camera",
                         )
+                        .with_payload(Payload::Incompatible {
+                            subject: "dashcam".into(),
+                            value: relation.name.clone(),
+                            allowed: Vec::new(),
+                        })
                         .with_note("the `dashcam` profile describes forward-facing camera frames: only what is ahead or beside the ego vehicle"),
                     );
             }
@@ -122,12 +128,15 @@ fn lanes_check(
     }
     if let Some(n) = lanes.filter(|n| *n < 1) {
         if let Some(a) = lanes_attr {
-            out.push(Diagnostic::new(
-                Code::E0500,
-                format!("a road has at least one lane, not {n}"),
-                a.value_span,
-                "not a lane count",
-            ));
+            out.push(
+                Diagnostic::new(
+                    Code::E0500,
+                    format!("a road has at least one lane, not {n}"),
+                    a.value_span,
+                    "not a lane count",
+                )
+                .with_payload(range("lanes", n as f64, Some(1.0), None, None)),
+            );
         }
         return;
     }
@@ -141,9 +150,14 @@ fn lanes_check(
             Diagnostic::new(Code::W0403, "lane indexes look counted from 0", first, "lane 0 does not exist in TAD")
                 .with_help(
                     "TAD counts lanes from 1 (the leftmost lane in the ego's direction); add 1 to every lane index",
-                );
+                )
+                .with_payload(Payload::WrongValue {
+                    field: "lane".into(),
+                    expected: "lane indexes counted from 1".into(),
+                    found: "0".into(),
+                });
         for (a, n, _) in &indexed {
-            d = d.with_fix(a.value_span, (n + 1).to_string());
+            d = d.with_fix(a.value_span, (n + 1).to_string(), Applicability::MachineApplicable);
         }
         out.push(d);
         return;
@@ -158,6 +172,7 @@ fn lanes_check(
                     a.value_span,
                     "lanes are numbered from 1",
                 )
+                .with_payload(range("lane", 0.0, lanes.map(|l| -(l as f64)), lanes.map(|l| l as f64), None))
                 .with_help(
                     "1 is the leftmost lane in the ego's direction; -1 the leftmost lane of the opposite direction",
                 ),
@@ -172,6 +187,7 @@ fn lanes_check(
                 a.value_span,
                 "beyond the road",
             )
+            .with_payload(range("lane", n as f64, Some(-(lanes as f64)), Some(lanes as f64), None))
             .with_help(if n > 0 {
                 format!("use a lane from 1 to {lanes}")
             } else {
@@ -191,6 +207,11 @@ fn lanes_check(
                 a.value_span,
                 "no opposite direction",
             )
+            .with_payload(Payload::Incompatible {
+                subject: direction.map_or("one_way", |d| d.name.as_str()).to_string(),
+                value: format!("lane {n}"),
+                allowed: Vec::new(),
+            })
             .with_help("negative lane indexes are the opposite direction's lanes; a one-way road has none");
             if let Some(d_attr) = scenario.section("road").and_then(|r| r.attr("direction")) {
                 d = d.with_secondary(d_attr.value_span, "the road's direction");
@@ -211,6 +232,11 @@ fn performers(behavior: Option<&Entry>, attr: Option<&Attr>, kind: &str, what: &
                 attr.value_span,
                 format!("not something a {kind} does"),
             )
+            .with_payload(Payload::Incompatible {
+                subject: kind.to_string(),
+                value: behavior.name.clone(),
+                allowed: performers.iter().map(|p| p.to_string()).collect(),
+            })
             .with_note(format!("`{}` is done by {}", behavior.name, quoted(&performers))),
         );
     }
@@ -237,40 +263,54 @@ fn speeds(
                 attr.value_span,
                 format!("`{}` allows at most {}", behavior.name, speed_text(max)),
             )
+            .with_payload(speed_range(speed, None, Some(max)))
             .with_help(format!("write `{}`, or a behavior that moves", speed_text(max)))
-            .with_fix(attr.value_span, speed_text(max)),
+            .with_fix(attr.value_span, speed_text(max), Applicability::MaybeIncorrect),
         );
         return;
     }
     if speed < 0.0 {
-        out.push(Diagnostic::new(
-            Code::E0503,
-            format!("{what} has a negative speed"),
-            attr.value_span,
-            "speeds are not negative",
-        ));
+        out.push(
+            Diagnostic::new(
+                Code::E0503,
+                format!("{what} has a negative speed"),
+                attr.value_span,
+                "speeds are not negative",
+            )
+            .with_payload(speed_range(speed, Some(0.0), None)),
+        );
         return;
     }
     if let Some((t, max)) = actor_type.and_then(|t| t.speed("max_speed").map(|m| (t, m)))
         && speed > max + EPSILON
     {
-        out.push(Diagnostic::new(
-            Code::W0504,
-            format!("{what} moves at {}, implausibly fast for a {}", speed_text(speed), t.name),
-            attr.value_span,
-            format!("a {} reaches about {}", t.name, speed_text(max)),
-        ));
+        out.push(
+            Diagnostic::new(
+                Code::W0504,
+                format!("{what} moves at {}, implausibly fast for a {}", speed_text(speed), t.name),
+                attr.value_span,
+                format!("a {} reaches about {}", t.name, speed_text(max)),
+            )
+            .with_payload(speed_range(speed, None, Some(max))),
+        );
         return;
     }
     if let Some((c, max)) = context.and_then(|c| c.speed("max_speed").map(|m| (c, m)))
         && speed > max + EPSILON
     {
-        out.push(Diagnostic::new(
-            Code::W0504,
-            format!("{what} moves at {}, implausibly fast on a {} road", speed_text(speed), c.name.replace('_', " ")),
-            attr.value_span,
-            format!("more than {} there", speed_text(max)),
-        ));
+        out.push(
+            Diagnostic::new(
+                Code::W0504,
+                format!(
+                    "{what} moves at {}, implausibly fast on a {} road",
+                    speed_text(speed),
+                    c.name.replace('_', " ")
+                ),
+                attr.value_span,
+                format!("more than {} there", speed_text(max)),
+            )
+            .with_payload(speed_range(speed, None, Some(max))),
+        );
     }
 }
 
@@ -305,7 +345,7 @@ fn relation_vs_lanes(
     let longitudinal = relation.symbol("longitudinal").unwrap_or("same");
     let better = vocabulary
         .entries("relation")
-        .iter()
+        .into_iter()
         .find(|r| r.symbol("lateral") == Some(actual) && r.symbol("longitudinal").unwrap_or("same") == longitudinal);
     let mut d = Diagnostic::new(
         Code::W0505,
@@ -320,9 +360,18 @@ fn relation_vs_lanes(
         ),
         span,
         "disagrees with the lanes",
-    );
+    )
+    .with_payload(Payload::Incompatible {
+        subject: format!("lane {lane} beside ego lane {ego_lane}"),
+        value: relation.name.clone(),
+        allowed: better.iter().map(|b| b.name.clone()).collect(),
+    });
     if let Some(better) = better {
-        d = d.with_help(format!("write `{}`, or correct the lane", better.name)).with_fix(span, better.name.clone());
+        d = d.with_help(format!("write `{}`, or correct the lane", better.name)).with_fix(
+            span,
+            better.name.clone(),
+            Applicability::MaybeIncorrect,
+        );
     }
     out.push(d);
 }
@@ -348,6 +397,11 @@ fn lights_and_signs(
                     light_attr.value_span,
                     format!("a {} has no traffic lights", place.name.replace('_', " ")),
                 )
+                .with_payload(Payload::Incompatible {
+                    subject: place.name.clone(),
+                    value: light.name.clone(),
+                    allowed: vec!["none".into()],
+                })
                 .with_help("write `light: none`, or correct the road"),
             );
         }
@@ -361,13 +415,29 @@ fn lights_and_signs(
                 format!("a {} together with a {} light", sign_entry.name.replace('_', " "), light.name),
                 sign.span,
                 format!("contradicts the `{}` light", light.name),
-            );
+            )
+            .with_payload(Payload::Incompatible {
+                subject: sign_entry.name.clone(),
+                value: light.name.clone(),
+                allowed: Vec::new(),
+            });
             if let Some(l) = light_attr {
                 d = d.with_secondary(l.value_span, "the light");
             }
             out.push(d.with_help("a scenario states what governs the ego vehicle: keep the sign or the light"));
         }
     }
+}
+
+/// A quantity outside its bounds.
+fn range(quantity: &str, value: f64, min: Option<f64>, max: Option<f64>, unit: Option<&str>) -> Payload {
+    Payload::OutOfRange { quantity: quantity.into(), value, min, max, unit: unit.map(str::to_string) }
+}
+
+/// A speed outside its bounds, in km/h (rounded like the messages).
+fn speed_range(speed: f64, min: Option<f64>, max: Option<f64>) -> Payload {
+    let kmh = |v: f64| (v * 36.0).round() / 10.0;
+    range("speed", kmh(speed), min.map(kmh), max.map(kmh), Some("km/h"))
 }
 
 /// Groups positioned relative to each other in a circle have no anchor.
@@ -403,6 +473,7 @@ fn cycles(scenario: &Scenario, resolved: &Resolved, out: &mut Vec<Diagnostic>) {
                     position_span(start),
                     "this position",
                 )
+                .with_payload(Payload::Cycle { groups: names.iter().map(|n| n.to_string()).collect() })
                 .with_help("place one of them relative to `ego` or a road element");
                 for &p in &path[1..] {
                     d = d.with_secondary(position_span(p), "relative to the next");

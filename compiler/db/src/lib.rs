@@ -1,26 +1,43 @@
 //! The TADSL query database: the one place that turns files into checked results.
 //!
-//! Built on salsa 0.28 and the only crate that depends on it. Inputs are [`SourceFile`]s
-//! (a path and a text) and the run's [`Settings`]; tracked queries parse and lower a file
-//! ([`analyze`]), gather the vocabulary it sees through the prelude and its `use`s
-//! ([`vocabulary`]), and check it ([`check`]). Results are plain values with diagnostics
-//! inside them (no accumulators), so they are reused whenever their inputs are unchanged.
-//! The command line builds a database per run; the language server keeps one and sets
-//! file texts as the editor changes them.
+//! Built on salsa 0.28 and the only crate that depends on it. No query touches the disk:
+//! everything a query reads is an input the host (the CLI, the language server) sets.
 //!
-//! A `.yaml`/`.yml` file is read by `tad-yaml` into the same model, so YAML answers are
-//! checked by the same code and reported at their own lines.
+//! Inputs:
+//! - [`SourceFile`]: a file's [`FileId`], path (its name in messages), text, [`Language`]
+//!   (TAD, or a YAML answer read by `tad-yaml`: chosen by the host, not guessed from the
+//!   path by a query) and [`Imports`] (the prelude it sees and the file each of its `use`s
+//!   resolved to);
+//! - [`Settings`]: the run's checker options.
 //!
-//! Module resolution: `use a.b` is `a/b.tad` in the using file's directory, else the
-//! standard module `a.b` embedded from `stdlib/` at build time. Every file sees the
-//! prelude `core` unless it is the prelude.
+//! Queries, each reused until what it read changes:
+//!
+//! ```text
+//! analyze(file) ──▶ declarations(file) ──▶ layer(file)          one module's vocabulary
+//!     │                                        │
+//!     │             scope(file): prelude + used modules (from Imports inputs only)
+//!     │                                        ▼
+//!     │                      vocabulary(file) = layers of scope(file) + layer(file)
+//!     ▼                                        │
+//!  check(file) ◀───────────────────────────────┘   + settings
+//! ```
+//!
+//! So an edit that changes no declaration (a comment, a value in the scenario) re-runs
+//! `analyze`, `declarations` and `check` of that file only; every module's layer and the
+//! file's vocabulary are reused. Results are plain values with diagnostics inside (no
+//! accumulators); every diagnostic carries the [`FileId`] of its file.
+//!
+//! Module resolution (done by the host, [`Database::set_source`]): `use a.b` is `a/b.tad`
+//! in the using file's directory, read through a [`FileSystem`], else the standard module
+//! `a.b` embedded from `stdlib/` at build time. Every file sees the prelude `core` unless
+//! it is the prelude.
 
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
-use tad_check::{Checked, Options, Vocabulary};
-use tad_diagnostics::{Code, Diagnostic};
+use tad_check::{Checked, Layer, Options, Vocabulary};
+use tad_diagnostics::{Code, Diagnostic, FileId, FileSpan, Payload};
 use tad_syntax::model::Module;
 
 /// The standard modules, embedded at build time.
@@ -37,12 +54,43 @@ pub const STDLIB_PREFIX: &str = "<stdlib>";
 /// The module every file sees.
 pub const PRELUDE: &str = "core";
 
+/// The notation of a source text.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Language {
+    Tad,
+    /// A YAML scenario in TrafficAlign's or TrafficComposer's form, possibly a whole LLM
+    /// answer around one.
+    Yaml,
+}
+
+impl Language {
+    /// The language a host assumes for a path: YAML for `.yaml`/`.yml`, else TAD.
+    pub fn of_path(path: &Path) -> Language {
+        let yaml = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("yaml") || e.eq_ignore_ascii_case("yml"));
+        if yaml { Language::Yaml } else { Language::Tad }
+    }
+}
+
+/// What a file's names refer to: the prelude it sees (none for the prelude itself) and
+/// the file of each `use` that resolved.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Imports {
+    pub prelude: Option<SourceFile>,
+    pub modules: BTreeMap<String, SourceFile>,
+}
+
 #[salsa::input(debug)]
 pub struct SourceFile {
+    #[returns(copy)]
+    pub id: FileId,
     #[returns(ref)]
     pub path: PathBuf,
     #[returns(ref)]
     pub text: String,
+    #[returns(copy)]
+    pub language: Language,
+    #[returns(ref)]
+    pub imports: Imports,
 }
 
 /// Options of a run, as an input so changing them re-checks exactly what depends on them.
@@ -54,8 +102,6 @@ pub struct Settings {
 
 #[salsa::db]
 pub trait Db: salsa::Database {
-    /// The file of module `name` (`a.b`) as `from` sees it, if there is one.
-    fn module(&self, name: &str, from: SourceFile) -> Option<SourceFile>;
     fn settings(&self) -> Settings;
 }
 
@@ -73,132 +119,193 @@ pub struct Scope {
     pub diagnostics: Vec<Diagnostic>,
 }
 
-fn is_stdlib(path: &Path) -> bool {
-    path.starts_with(STDLIB_PREFIX)
+fn stamp(diagnostics: impl IntoIterator<Item = Diagnostic>, file: FileId) -> Vec<Diagnostic> {
+    diagnostics.into_iter().map(|d| d.in_file(file)).collect()
 }
 
-/// Whether a path is read as YAML (TrafficAlign's or TrafficComposer's form, possibly a
-/// whole LLM answer) rather than TAD.
-pub fn is_yaml(path: &Path) -> bool {
-    path.extension().is_some_and(|e| e.eq_ignore_ascii_case("yaml") || e.eq_ignore_ascii_case("yml"))
-}
-
-/// Parse and lower one file: TAD, or YAML by its extension. Either way the result is the
-/// same model, with spans into the file's own text.
+/// Parse and lower one file in its language. Either way the result is the same model,
+/// with spans into the file's own text.
 #[salsa::tracked(returns(ref))]
 pub fn analyze(db: &dyn Db, file: SourceFile) -> Analysis {
-    let (module, diagnostics) =
-        if is_yaml(file.path(db)) { tad_yaml::lower(file.text(db)) } else { tad_syntax::analyze(file.text(db)) };
-    Analysis { module, diagnostics }
+    let (module, diagnostics) = match file.language(db) {
+        Language::Tad => tad_syntax::analyze(file.text(db)),
+        Language::Yaml => tad_yaml::lower(file.text(db)),
+    };
+    Analysis { module, diagnostics: stamp(diagnostics, file.id(db)) }
 }
 
 /// The module name a file is known by.
-fn module_name(path: &Path) -> String {
+pub fn module_name(path: &Path) -> String {
     path.file_stem().map_or_else(|| "<file>".to_string(), |s| s.to_string_lossy().into_owned())
 }
 
-/// Whether `file` is the prelude itself (embedded, or the source it was embedded from).
-fn is_prelude(db: &dyn Db, file: SourceFile) -> bool {
-    let path = file.path(db);
-    if is_stdlib(path) {
-        return module_name(path) == PRELUDE;
-    }
-    let on_disk = Path::new(stdlib::STDLIB_DIR).join(format!("{PRELUDE}.tad"));
-    path.canonicalize().is_ok_and(|p| p == on_disk) || stdlib::source(PRELUDE) == Some(file.text(db).as_str())
+/// The file's own declarations: unchanged by edits elsewhere in the file.
+#[salsa::tracked(returns(ref))]
+pub fn declarations(db: &dyn Db, file: SourceFile) -> Module {
+    Module { declarations: analyze(db, file).module.declarations.clone(), ..Module::default() }
 }
 
-/// The vocabulary `file` sees: the prelude, every module it uses (transitively, each
-/// once), then its own declarations.
+/// One module's vocabulary, built once and shared by every file that sees the module.
+#[salsa::tracked(returns(clone))]
+pub fn layer(db: &dyn Db, file: SourceFile) -> Arc<Layer> {
+    Arc::new(Layer::build(&module_name(file.path(db)), file.id(db), declarations(db, file)))
+}
+
+/// The modules `file` sees, in order: the prelude, then every module it uses,
+/// transitively, each once. Reads only [`Imports`] inputs.
 #[salsa::tracked(returns(ref))]
-pub fn vocabulary(db: &dyn Db, file: SourceFile) -> Scope {
-    let mut diagnostics = Vec::new();
-    let mut order: Vec<(String, SourceFile)> = Vec::new();
-    if !is_prelude(db, file)
-        && let Some(prelude) = db.module(PRELUDE, file)
-    {
-        order.push((PRELUDE.to_string(), prelude));
-    }
-    // breadth-first through `use`, reporting only the file's own unresolved uses
-    let mut queue: Vec<SourceFile> = vec![file];
+pub fn scope(db: &dyn Db, file: SourceFile) -> Vec<SourceFile> {
+    let mut order: Vec<SourceFile> = Vec::new();
+    let prelude = file.imports(db).prelude;
+    order.extend(prelude);
     let mut seen: Vec<SourceFile> = vec![file];
-    while let Some(current) = queue.pop() {
-        for u in &analyze(db, current).module.uses {
-            let name: String = u.path.iter().map(|n| n.text.as_str()).collect::<Vec<_>>().join(".");
-            match db.module(&name, current) {
-                Some(used) if !seen.contains(&used) => {
-                    seen.push(used);
-                    if !is_prelude(db, used) {
-                        order.push((name.clone(), used));
-                    }
-                    queue.push(used);
-                    let errors = analyze(db, used).diagnostics.iter().filter(|d| d.is_error()).count();
-                    if current == file && errors > 0 {
-                        diagnostics.push(
-                            Diagnostic::new(
-                                Code::E0404,
-                                format!("module `{name}` has {errors} error{}", if errors == 1 { "" } else { "s" }),
-                                u.span,
-                                "used here",
-                            )
-                            .with_note(format!("its file is {}; check it to see them", used.path(db).display())),
-                        );
-                    }
-                }
-                Some(_) => {}
-                None if current == file => {
-                    let span = u.path.first().map_or(u.span, |f| f.span.to(u.path.last().map_or(f.span, |l| l.span)));
-                    let mut d = Diagnostic::new(Code::E0403, format!("no module `{name}`"), span, "not found");
-                    let known = stdlib::MODULES.iter().map(|(n, _)| *n);
-                    if let Some(guess) = tad_syntax::suggest::closest(&name, known) {
-                        d = d.with_help(format!("did you mean `{guess}`?")).with_fix(span, guess.to_string());
-                    }
-                    let dir = file.path(db).parent().map(|p| p.display().to_string()).unwrap_or_default();
-                    let standard: Vec<&str> = stdlib::MODULES.iter().map(|(n, _)| *n).collect();
-                    diagnostics.push(d.with_note(format!(
-                        "modules are `NAME.tad` beside the file{}, or standard: {}",
-                        if dir.is_empty() { String::new() } else { format!(" (in {dir})") },
-                        standard.iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
-                    )));
-                }
-                None => {}
+    seen.extend(prelude);
+    let mut queue: Vec<SourceFile> = vec![file];
+    let mut at = 0;
+    while at < queue.len() {
+        let current = queue[at];
+        at += 1;
+        for used in current.imports(db).modules.values() {
+            if !seen.contains(used) {
+                seen.push(*used);
+                order.push(*used);
+                queue.push(*used);
             }
         }
     }
-    let analyses: Vec<(String, &Module)> =
-        order.iter().map(|(name, f)| (name.clone(), &analyze(db, *f).module)).collect();
-    let own_name = module_name(file.path(db));
-    let own = &analyze(db, file).module;
-    let modules = analyses.iter().map(|(n, m)| (n.as_str(), *m)).chain([(own_name.as_str(), own)]);
-    let (vocabulary, conflicts) = Vocabulary::build(modules);
-    for conflict in conflicts.into_iter().filter(|c| c.module == own_name) {
-        diagnostics.push(
-            Diagnostic::new(Code::E0405, conflict.message, conflict.span, "conflicts with an earlier declaration")
-                .with_note(format!("the earlier one is in module `{}`", conflict.earlier))
-                .with_help("use the existing name, or choose another"),
-        );
-    }
+    order
+}
+
+/// The vocabulary `file` sees: the layers of its scope, then its own.
+#[salsa::tracked(returns(ref))]
+pub fn vocabulary(db: &dyn Db, file: SourceFile) -> Scope {
+    let own = layer(db, file);
+    let mut layers: Vec<Arc<Layer>> = scope(db, file).iter().map(|m| layer(db, *m)).collect();
+    layers.push(own.clone());
+    let (vocabulary, between) = Vocabulary::layered(layers);
+    let id = file.id(db);
+    let diagnostics = own
+        .conflicts()
+        .iter()
+        .chain(between.iter().filter(|c| c.at.file == id))
+        .map(|conflict| {
+            Diagnostic::new(
+                Code::E0405,
+                conflict.message.clone(),
+                conflict.span(),
+                "conflicts with an earlier declaration",
+            )
+            .in_file(id)
+            .with_payload(Payload::Duplicate {
+                namespace: conflict.kind.to_string(),
+                name: conflict.name.clone(),
+                earlier_module: Some(conflict.earlier.clone()),
+            })
+            .with_secondary_in(
+                conflict.earlier_at,
+                format!("the earlier declaration, in module `{}`", conflict.earlier),
+            )
+            .with_help("use the existing name, or choose another")
+        })
+        .collect();
     Scope { vocabulary, diagnostics }
 }
 
-/// Every diagnostic of `file`, its completeness class and refinement requests.
+/// The problems of `file`'s `use`s: unresolved modules, and used modules with errors.
+fn uses(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
+    let mut out = Vec::new();
+    let id = file.id(db);
+    let imports = file.imports(db);
+    for u in &analyze(db, file).module.uses {
+        let name: String = u.path.iter().map(|n| n.text.as_str()).collect::<Vec<_>>().join(".");
+        match imports.modules.get(&name) {
+            Some(used) => {
+                let errors: Vec<&Diagnostic> = analyze(db, *used).diagnostics.iter().filter(|d| d.is_error()).collect();
+                if let Some(first) = errors.first() {
+                    let n = errors.len();
+                    out.push(
+                        Diagnostic::new(
+                            Code::E0404,
+                            format!("module `{name}` has {n} error{}", if n == 1 { "" } else { "s" }),
+                            u.span,
+                            "used here",
+                        )
+                        .in_file(id)
+                        .with_payload(Payload::ModuleErrors { module: name.clone(), errors: n })
+                        .with_secondary_in(
+                            FileSpan { file: used.id(db), span: first.primary.span },
+                            format!("the first: {}", first.message),
+                        )
+                        .with_note(format!("its file is {}; its errors are reported there", used.path(db).display())),
+                    );
+                }
+            }
+            None => {
+                let span = u.path.first().map_or(u.span, |f| f.span.to(u.path.last().map_or(f.span, |l| l.span)));
+                let d = Diagnostic::new(Code::E0403, format!("no module `{name}`"), span, "not found").in_file(id);
+                let known = stdlib::MODULES.iter().map(|(n, _)| *n);
+                let (d, _) = tad_syntax::suggest::unknown(d, "module", &name, span, known);
+                let dir = file.path(db).parent().map(|p| p.display().to_string()).unwrap_or_default();
+                let standard: Vec<String> = stdlib::MODULES.iter().map(|(n, _)| format!("`{n}`")).collect();
+                out.push(d.with_note(format!(
+                    "modules are `NAME.tad` beside the file{}, or standard: {}",
+                    if dir.is_empty() { String::new() } else { format!(" (in {dir})") },
+                    standard.join(", ")
+                )));
+            }
+        }
+    }
+    out
+}
+
+/// Every diagnostic of `file`, and its completeness class.
 #[salsa::tracked(returns(ref))]
 pub fn check(db: &dyn Db, file: SourceFile) -> Checked {
     let analysis = analyze(db, file);
     let scope = vocabulary(db, file);
     let options = db.settings().options(db);
     let mut checked = tad_check::check(&analysis.module, &scope.vocabulary, options);
+    checked.diagnostics = stamp(std::mem::take(&mut checked.diagnostics), file.id(db));
     checked.diagnostics.extend(analysis.diagnostics.iter().cloned());
     checked.diagnostics.extend(scope.diagnostics.iter().cloned());
+    checked.diagnostics.extend(uses(db, file));
     tad_diagnostics::sort(&mut checked.diagnostics);
     checked
 }
 
-/// The database of one process: files are loaded on first use and kept.
+/// Where the host reads modules from.
+pub trait FileSystem {
+    /// The text of the file at `path`, if it is a readable file.
+    fn read(&self, path: &Path) -> Option<String>;
+}
+
+/// The machine's file system.
+pub struct RealFs;
+
+impl FileSystem for RealFs {
+    fn read(&self, path: &Path) -> Option<String> {
+        if path.is_file() { std::fs::read_to_string(path).ok() } else { None }
+    }
+}
+
+/// No file system: only the standard modules resolve.
+pub struct NoFs;
+
+impl FileSystem for NoFs {
+    fn read(&self, _: &Path) -> Option<String> {
+        None
+    }
+}
+
+/// The database of one process: the host side registers files, resolves their `use`s
+/// and sets the inputs; queries read only those.
 #[salsa::db]
 #[derive(Clone)]
 pub struct Database {
     storage: salsa::Storage<Self>,
-    files: Arc<Mutex<HashMap<PathBuf, SourceFile>>>,
+    files: HashMap<PathBuf, SourceFile>,
+    by_id: Vec<SourceFile>,
+    stdlib: BTreeMap<String, SourceFile>,
     settings: Option<Settings>,
     log: Option<Arc<Mutex<Vec<String>>>>,
 }
@@ -226,8 +333,23 @@ impl Database {
     }
 
     fn with_storage(storage: salsa::Storage<Self>, options: Options, log: Option<Arc<Mutex<Vec<String>>>>) -> Self {
-        let mut db = Database { storage, files: Arc::default(), settings: None, log };
+        let mut db = Database {
+            storage,
+            files: HashMap::new(),
+            by_id: Vec::new(),
+            stdlib: BTreeMap::new(),
+            settings: None,
+            log,
+        };
         db.settings = Some(Settings::new(&db, options));
+        for (name, text) in stdlib::MODULES {
+            let path = Path::new(STDLIB_PREFIX).join(name.split('.').collect::<PathBuf>().with_extension("tad"));
+            let file = db.register(path, text.to_string(), Language::Tad);
+            db.stdlib.insert(name.to_string(), file);
+        }
+        for file in db.stdlib.values().copied().collect::<Vec<_>>() {
+            db.resolve_imports(file, &NoFs, &mut Vec::new());
+        }
         db
     }
 
@@ -236,25 +358,88 @@ impl Database {
         self.log.as_ref().map(|l| l.lock().map(|mut l| std::mem::take(&mut *l)).unwrap_or_default()).unwrap_or_default()
     }
 
-    /// Register (or replace the text of) the file at `path`.
+    /// Register (or replace the text of) the file at `path`, in the language its extension
+    /// suggests, resolving its modules on the machine's file system.
     pub fn set_file(&mut self, path: PathBuf, text: String) -> SourceFile {
+        let language = Language::of_path(&path);
+        self.set_source(path, text, language, &RealFs)
+    }
+
+    /// Register (or replace) a source: its text and language, and the files its `use`s
+    /// resolve to through `fs` (each registered too, with its own modules).
+    pub fn set_source(&mut self, path: PathBuf, text: String, language: Language, fs: &dyn FileSystem) -> SourceFile {
         use salsa::Setter;
-        let existing = self.files.lock().ok().and_then(|files| files.get(&path).copied());
-        match existing {
+        let file = match self.files.get(&path).copied() {
             Some(file) => {
                 if file.text(self) != &text {
                     file.set_text(self).to(text);
                 }
-                file
-            }
-            None => {
-                let file = SourceFile::new(self, path.clone(), text);
-                if let Ok(mut files) = self.files.lock() {
-                    files.insert(path, file);
+                if file.language(self) != language {
+                    file.set_language(self).to(language);
                 }
                 file
             }
+            None => self.register(path, text, language),
+        };
+        self.resolve_imports(file, fs, &mut Vec::new());
+        file
+    }
+
+    fn register(&mut self, path: PathBuf, text: String, language: Language) -> SourceFile {
+        let id = FileId(self.by_id.len() as u32);
+        let file = SourceFile::new(self, id, path.clone(), text, language, Imports::default());
+        self.files.insert(path, file);
+        self.by_id.push(file);
+        file
+    }
+
+    /// Set the imports of `file` from its `use`s, registering the modules they name.
+    fn resolve_imports(&mut self, file: SourceFile, fs: &dyn FileSystem, visiting: &mut Vec<SourceFile>) {
+        use salsa::Setter;
+        if visiting.contains(&file) {
+            return;
         }
+        visiting.push(file);
+        let path = file.path(self).clone();
+        let is_stdlib = path.starts_with(STDLIB_PREFIX);
+        let prelude = self.stdlib.get(PRELUDE).copied().filter(|p| *p != file && !self.is_prelude_copy(file));
+        let names: Vec<String> = analyze(self, file)
+            .module
+            .uses
+            .iter()
+            .map(|u| u.path.iter().map(|n| n.text.as_str()).collect::<Vec<_>>().join("."))
+            .collect();
+        let mut modules = BTreeMap::new();
+        for name in names {
+            let relative: PathBuf = name.split('.').collect::<PathBuf>().with_extension("tad");
+            let local = if is_stdlib { None } else { path.parent().map(|dir| dir.join(&relative)) };
+            let found = match local.as_ref().and_then(|candidate| fs.read(candidate).map(|t| (candidate.clone(), t))) {
+                Some((candidate, text)) => Some(match self.files.get(&candidate).copied() {
+                    Some(known) => {
+                        if known.text(self) != &text {
+                            known.set_text(self).to(text);
+                        }
+                        known
+                    }
+                    None => self.register(candidate, text, Language::Tad),
+                }),
+                None => self.stdlib.get(&name).copied(),
+            };
+            if let Some(used) = found {
+                modules.insert(name, used);
+                self.resolve_imports(used, fs, visiting);
+            }
+        }
+        let imports = Imports { prelude, modules };
+        if file.imports(self) != &imports {
+            file.set_imports(self).to(imports);
+        }
+    }
+
+    /// Whether `file` is a copy of the prelude's source (`stdlib/core.tad` checked from
+    /// disk), which must not see the prelude a second time.
+    fn is_prelude_copy(&self, file: SourceFile) -> bool {
+        module_name(file.path(self)) == PRELUDE && stdlib::source(PRELUDE) == Some(file.text(self).as_str())
     }
 
     pub fn set_options(&mut self, options: Options) {
@@ -264,34 +449,29 @@ impl Database {
         }
     }
 
-    fn load(&self, path: PathBuf, text: impl FnOnce() -> Option<String>) -> Option<SourceFile> {
-        let mut files = self.files.lock().ok()?;
-        if let Some(file) = files.get(&path) {
-            return Some(*file);
-        }
-        let file = SourceFile::new(self, path.clone(), text()?);
-        files.insert(path, file);
-        Some(file)
+    /// The file with `id`.
+    pub fn file(&self, id: FileId) -> Option<SourceFile> {
+        self.by_id.get(id.0 as usize).copied()
+    }
+
+    /// The file registered at `path`.
+    pub fn file_at(&self, path: &Path) -> Option<SourceFile> {
+        self.files.get(path).copied()
+    }
+
+    /// The embedded standard module `name`.
+    pub fn standard_module(&self, name: &str) -> Option<SourceFile> {
+        self.stdlib.get(name).copied()
+    }
+
+    /// The local (not standard) modules `file` sees, in scope order.
+    pub fn local_modules(&self, file: SourceFile) -> Vec<SourceFile> {
+        scope(self, file).iter().copied().filter(|m| !m.path(self).starts_with(STDLIB_PREFIX)).collect()
     }
 }
 
 #[salsa::db]
 impl Db for Database {
-    fn module(&self, name: &str, from: SourceFile) -> Option<SourceFile> {
-        let relative: PathBuf = name.split('.').collect::<PathBuf>().with_extension("tad");
-        let from_path = from.path(self);
-        if !is_stdlib(from_path)
-            && let Some(dir) = from_path.parent()
-        {
-            let candidate = dir.join(&relative);
-            if candidate.is_file() {
-                return self.load(candidate.clone(), || std::fs::read_to_string(&candidate).ok());
-            }
-        }
-        let source = stdlib::source(name)?;
-        self.load(Path::new(STDLIB_PREFIX).join(&relative), || Some(source.to_string()))
-    }
-
     fn settings(&self) -> Settings {
         self.settings.expect("set in Database::with_storage")
     }

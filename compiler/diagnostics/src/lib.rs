@@ -5,13 +5,46 @@
 //! ([`render`]). Every diagnostic carries a stable [`Code`]; codes are never renumbered or
 //! reused, and each one is documented in `spec/diagnostics.md`, which is compiled into
 //! this crate so `tadslc explain` and the documentation cannot drift apart.
+//!
+//! A diagnostic states a fact twice: in words for people (message, labels, help) and as a
+//! typed [`Payload`] for programs (the LLM front-end, the language server, JSON and SARIF
+//! consumers), so nothing downstream ever parses a message. Fixes carry an
+//! [`Applicability`] in rustc's sense, so a tool applies only the certain ones.
+//!
+//! Every diagnostic belongs to one file ([`FileId`]); a label may point into another file
+//! (a conflicting declaration in a used module). Pure phases analyse one text and leave the
+//! file [`FileId::UNSET`]; the database stamps the file it analysed ([`Diagnostic::in_file`]).
 
 mod code;
 mod line_index;
+mod payload;
 pub mod render;
 
 pub use code::Code;
 pub use line_index::{LineCol, LineIndex};
+pub use payload::{Element, Payload};
+
+/// A source file of one run or session, numbered by the database that registered it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+pub struct FileId(pub u32);
+
+impl FileId {
+    /// The file being analysed, before the database says which one it is.
+    pub const UNSET: FileId = FileId(u32::MAX);
+}
+
+impl Default for FileId {
+    fn default() -> Self {
+        FileId::UNSET
+    }
+}
+
+/// A span in a known file.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+pub struct FileSpan {
+    pub file: FileId,
+    pub span: Span,
+}
 
 use serde::Serialize;
 
@@ -67,24 +100,49 @@ impl Severity {
     }
 }
 
-/// A span with a short message shown under it.
+/// A span with a short message shown under it. `file` is `None` for the diagnostic's own
+/// file.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct Label {
+    pub file: Option<FileId>,
     pub span: Span,
     pub message: String,
 }
 
 impl Label {
     pub fn new(span: Span, message: impl Into<String>) -> Self {
-        Label { span, message: message.into() }
+        Label { file: None, span, message: message.into() }
     }
 }
 
-/// A machine-applicable edit: replace the text at `span` with `replacement`.
+/// How sure a fix is, as rustc says it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Applicability {
+    /// Certainly what was meant: a tool may apply it without asking (an alias, a unit).
+    MachineApplicable,
+    /// Probably what was meant, to be confirmed by a person (a "did you mean" guess).
+    MaybeIncorrect,
+    /// The replacement has parts a person must fill in.
+    HasPlaceholders,
+}
+
+impl Applicability {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Applicability::MachineApplicable => "machine-applicable",
+            Applicability::MaybeIncorrect => "maybe-incorrect",
+            Applicability::HasPlaceholders => "has-placeholders",
+        }
+    }
+}
+
+/// An edit to the diagnostic's file: replace the text at `span` with `replacement`.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct Fix {
     pub span: Span,
     pub replacement: String,
+    pub applicability: Applicability,
 }
 
 /// One problem found in one source text.
@@ -92,11 +150,15 @@ pub struct Fix {
 /// The message is lowercase without a final period and states the problem; the primary
 /// label points at the offending text; `help` gives a concrete fix in words and `fixes`
 /// the same fix as edits a tool can apply.
-#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Diagnostic {
     pub severity: Severity,
     pub code: Code,
+    /// The file the primary label and the fixes are in.
+    pub file: FileId,
     pub message: String,
+    /// The fact, typed.
+    pub payload: Payload,
     pub primary: Label,
     pub secondary: Vec<Label>,
     pub notes: Vec<String>,
@@ -110,7 +172,9 @@ impl Diagnostic {
         Diagnostic {
             severity: code.severity(),
             code,
+            file: FileId::UNSET,
             message: message.into(),
+            payload: Payload::None,
             primary: Label::new(span, label),
             secondary: Vec::new(),
             notes: Vec::new(),
@@ -124,6 +188,31 @@ impl Diagnostic {
         self
     }
 
+    /// A secondary label in another file.
+    pub fn with_secondary_in(mut self, at: FileSpan, message: impl Into<String>) -> Self {
+        self.secondary.push(Label { file: Some(at.file), span: at.span, message: message.into() });
+        self
+    }
+
+    pub fn with_payload(mut self, payload: Payload) -> Self {
+        self.payload = payload;
+        self
+    }
+
+    /// Place the diagnostic in `file`, if no file is set yet; labels in the same file
+    /// stay relative to it.
+    pub fn in_file(mut self, file: FileId) -> Self {
+        if self.file == FileId::UNSET {
+            self.file = file;
+        }
+        self
+    }
+
+    /// Every file a label of this diagnostic is in.
+    pub fn files(&self) -> impl Iterator<Item = FileId> + '_ {
+        std::iter::once(self.file).chain(self.secondary.iter().filter_map(|l| l.file))
+    }
+
     pub fn with_note(mut self, note: impl Into<String>) -> Self {
         self.notes.push(note.into());
         self
@@ -134,8 +223,8 @@ impl Diagnostic {
         self
     }
 
-    pub fn with_fix(mut self, span: Span, replacement: impl Into<String>) -> Self {
-        self.fixes.push(Fix { span, replacement: replacement.into() });
+    pub fn with_fix(mut self, span: Span, replacement: impl Into<String>, applicability: Applicability) -> Self {
+        self.fixes.push(Fix { span, replacement: replacement.into(), applicability });
         self
     }
 
@@ -151,14 +240,23 @@ impl Diagnostic {
 /// Sort diagnostics by position, then code, so output and snapshots are stable.
 pub fn sort(diagnostics: &mut [Diagnostic]) {
     diagnostics.sort_by(|a, b| {
-        (a.primary.span.start, a.primary.span.end, a.code).cmp(&(b.primary.span.start, b.primary.span.end, b.code))
+        (a.file, a.primary.span.start, a.primary.span.end, a.code).cmp(&(
+            b.file,
+            b.primary.span.start,
+            b.primary.span.end,
+            b.code,
+        ))
     });
 }
 
-/// Apply every fix of `diagnostics` to `text`, skipping fixes that overlap an earlier one.
-/// Returns the new text and how many fixes were applied.
+/// Apply every machine-applicable fix of `diagnostics` to `text`, skipping fixes that
+/// overlap an earlier one. Returns the new text and how many fixes were applied.
 pub fn apply_fixes<'a>(text: &str, diagnostics: impl IntoIterator<Item = &'a Diagnostic>) -> (String, usize) {
-    let mut fixes: Vec<&Fix> = diagnostics.into_iter().flat_map(|d| &d.fixes).collect();
+    let mut fixes: Vec<&Fix> = diagnostics
+        .into_iter()
+        .flat_map(|d| &d.fixes)
+        .filter(|f| f.applicability == Applicability::MachineApplicable)
+        .collect();
     fixes.sort_by_key(|f| (f.span.start, f.span.end));
     let mut out = String::with_capacity(text.len());
     let mut cursor = 0;

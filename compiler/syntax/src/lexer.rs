@@ -8,7 +8,7 @@
 //! the grammar LR(1) while values stay free of separators (`speed: 38 km/h lane: 2`).
 
 use logos::Logos;
-use tad_diagnostics::{Code, Diagnostic, Span};
+use tad_diagnostics::{Applicability, Code, Diagnostic, Payload, Span};
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum LexError {
@@ -133,7 +133,7 @@ fn lex_text_block(lex: &mut logos::Lexer<'_, Token>) -> Result<(), LexError> {
 pub type Spanned = (usize, Token, usize);
 
 /// The result of lexing one text.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Lexed {
     /// Tokens without comments; lexical errors appear as [`Token::Error`].
     pub tokens: Vec<Spanned>,
@@ -229,11 +229,20 @@ fn lex_error(src: &str, span: Span, error: LexError) -> Diagnostic {
                 format!("unexpected character `{}`", text.escape_debug()),
                 span,
                 "not part of the language",
-            );
+            )
+            .with_payload(Payload::Syntax { expected: Vec::new(), found: Some(text.to_string()) });
             d = match text {
                 "#" => d.with_help("comments start with `//`"),
-                "=" => d.with_help("fields are written `name: value`").with_fix(span, ":"),
-                ";" => d.with_help("fields need no separator; remove the `;`").with_fix(span, ""),
+                "=" => d.with_help("fields are written `name: value`").with_fix(
+                    span,
+                    ":",
+                    Applicability::MachineApplicable,
+                ),
+                ";" => d.with_help("fields need no separator; remove the `;`").with_fix(
+                    span,
+                    "",
+                    Applicability::MachineApplicable,
+                ),
                 "'" => d.with_help("strings use double quotes: `\"...\"`"),
                 "/" => d.with_help("units are written `km/h`, `mph`, `m/s`, `m` or `s`"),
                 "-" => d.with_help("a negative number is written with no space after `-`, e.g. `-1`"),
@@ -246,6 +255,7 @@ fn lex_error(src: &str, span: Span, error: LexError) -> Diagnostic {
         }
         LexError::UnterminatedString => {
             Diagnostic::new(Code::E0002, "unterminated string", span, "this string has no closing `\"`")
+                .with_payload(Payload::Syntax { expected: vec!["`\"`".into()], found: None })
                 .with_help("close the string on the same line; use a `\"\"\"` text block for text over several lines")
         }
         LexError::UnterminatedTextBlock => Diagnostic::new(
@@ -254,8 +264,14 @@ fn lex_error(src: &str, span: Span, error: LexError) -> Diagnostic {
             Span::new(span.start, span.start + 3),
             "this text block is never closed",
         )
+        .with_payload(Payload::Syntax { expected: vec!["`\"\"\"`".into()], found: None })
         .with_help("end the text block with `\"\"\"`"),
     }
+}
+
+fn escape_payload(found: &str) -> Payload {
+    let expected = ["\\\"", "\\\\", "\\n", "\\t", "\\r", "\\u{...}"];
+    Payload::Syntax { expected: expected.iter().map(|e| format!("`{e}`")).collect(), found: Some(found.to_string()) }
 }
 
 /// Decode the escapes of a string token (quotes included in `raw`). `offset` is the byte
@@ -297,7 +313,8 @@ pub fn unescape(raw: &str, offset: usize, diagnostics: &mut Vec<Diagnostic>) -> 
                         }
                     }
                     None => diagnostics.push(
-                        Diagnostic::new(Code::E0004, "invalid unicode escape", Span::new(base + i, base + j + 1), "expected `\\u{...}` with 1 to 6 hex digits of a valid character"),
+                        Diagnostic::new(Code::E0004, "invalid unicode escape", Span::new(base + i, base + j + 1), "expected `\\u{...}` with 1 to 6 hex digits of a valid character")
+                            .with_payload(escape_payload("\\u")),
                     ),
                 }
             }
@@ -308,6 +325,7 @@ pub fn unescape(raw: &str, offset: usize, diagnostics: &mut Vec<Diagnostic>) -> 
                     Span::new(base + i, base + j + other.len_utf8()),
                     "unknown escape",
                 )
+                .with_payload(escape_payload(&format!("\\{other}")))
                 .with_help("valid escapes are `\\\"`, `\\\\`, `\\n`, `\\t`, `\\r` and `\\u{...}`; write `\\\\` for a backslash"),
             ),
         }

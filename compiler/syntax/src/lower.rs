@@ -11,7 +11,7 @@ use crate::lexer;
 use crate::model::*;
 use crate::schema::{self, FieldDef, SectionDef, Unit, ValueType};
 use crate::suggest;
-use tad_diagnostics::{Code, Diagnostic, Span};
+use tad_diagnostics::{Applicability, Code, Diagnostic, Payload, Span};
 
 pub fn lower(src: &str, file: &cst::File) -> (Module, Vec<Diagnostic>) {
     let mut lowerer = Lowerer { src, diagnostics: Vec::new() };
@@ -42,6 +42,11 @@ impl Lowerer<'_> {
                     }
                     Some(first) => self.report(
                         Diagnostic::new(Code::E0201, "a file holds one scenario", s.keyword, "a second scenario")
+                            .with_payload(Payload::Duplicate {
+                                namespace: "scenario".into(),
+                                name: s.name.as_ref().map_or_else(String::new, |n| n.text.clone()),
+                                earlier_module: None,
+                            })
                             .with_secondary(first, "the file's scenario")
                             .with_help("move this scenario to a file of its own"),
                     ),
@@ -59,7 +64,8 @@ impl Lowerer<'_> {
             let end = self.src.len();
             self.report(
                 Diagnostic::new(Code::E0200, "no scenario in this file", Span::new(end, end), "the file ends here")
-                    .with_help("a file holds one `scenario NAME { ... }`"),
+                    .with_help("a file holds one `scenario NAME { ... }`")
+                    .with_payload(Payload::Syntax { expected: vec!["`scenario NAME { ... }`".into()], found: None }),
             );
         }
         module
@@ -67,16 +73,16 @@ impl Lowerer<'_> {
 
     fn declaration(&mut self, d: &cst::Declaration, previous: &[Declaration]) -> Option<Declaration> {
         let Some(def) = schema::declaration(&d.kind.text) else {
-            let mut diagnostic = Diagnostic::new(
+            let diagnostic = Diagnostic::new(
                 Code::E0213,
                 format!("unknown declaration kind `{}`", d.kind.text),
                 d.kind.span,
                 "not a kind of declaration",
             );
             let candidates = schema::DECLARATIONS.iter().map(|k| k.name).chain(["scenario", "use"]);
-            if let Some(guess) = suggest::closest(&d.kind.text, candidates) {
-                diagnostic = diagnostic.with_help(format!("did you mean `{guess}`?")).with_fix(d.kind.span, guess);
-            } else {
+            let (mut diagnostic, guessed) =
+                suggest::unknown(diagnostic, "declaration_kind", &d.kind.text, d.kind.span, candidates);
+            if !guessed {
                 diagnostic = diagnostic.with_note(
                     "declarations are written `KIND NAME { ... }`; the kinds are listed in spec/vocabulary.md",
                 );
@@ -92,6 +98,11 @@ impl Lowerer<'_> {
                     d.name.span,
                     "declared again here",
                 )
+                .with_payload(Payload::Duplicate {
+                    namespace: def.name.into(),
+                    name: d.name.text.clone(),
+                    earlier_module: None,
+                })
                 .with_secondary(first.name.span, "first declared here")
                 .with_help("remove one of the declarations"),
             );
@@ -109,7 +120,8 @@ impl Lowerer<'_> {
             self.report(
                 Diagnostic::new(Code::E0210, "this scenario has no name", s.keyword, "a name goes after `scenario`")
                     .with_help("write `scenario my_scenario { ... }`")
-                    .with_fix(Span::new(s.keyword.end, s.keyword.end), " unnamed"),
+                    .with_payload(Payload::Syntax { expected: vec!["a name".into()], found: None })
+                    .with_fix(Span::new(s.keyword.end, s.keyword.end), " unnamed", Applicability::HasPlaceholders),
             );
         }
         let mut scenario = Scenario { span: s.span, name: s.name.clone(), sections: Vec::new(), actors: Vec::new() };
@@ -130,17 +142,17 @@ impl Lowerer<'_> {
     fn section(&mut self, section: &cst::Section, scenario: &mut Scenario) {
         let name = &section.name;
         let Some(def) = schema::section(&name.text) else {
-            let mut d = Diagnostic::new(
+            let d = Diagnostic::new(
                 Code::E0202,
                 format!("unknown section `{}`", name.text),
                 name.span,
                 "not a section of a scenario",
             );
-            if let Some(guess) = suggest::closest(&name.text, schema::SECTIONS.iter().map(|s| s.name)) {
-                d = d.with_help(format!("did you mean `{guess}`?")).with_fix(name.span, guess);
-            } else if ["actors", "actor_group", "npc", "npcs", "agents"].contains(&name.text.as_str()) {
+            let (mut d, guessed) =
+                suggest::unknown(d, "section", &name.text, name.span, schema::SECTIONS.iter().map(|s| s.name));
+            if !guessed && ["actors", "actor_group", "npc", "npcs", "agents"].contains(&name.text.as_str()) {
                 d = d.with_help("declare each group as `actor NAME: COUNT TYPE { ... }`");
-            } else {
+            } else if !guessed {
                 d = d
                     .with_note("the sections are `source`, `environment`, `road` and `ego`; groups are `actor` blocks");
             }
@@ -156,6 +168,11 @@ impl Lowerer<'_> {
                     name.span,
                     "given again here",
                 )
+                .with_payload(Payload::Duplicate {
+                    namespace: "section".into(),
+                    name: def.name.into(),
+                    earlier_module: None,
+                })
                 .with_secondary(first, "first given here")
                 .with_help("merge the two sections into one"),
             );
@@ -165,7 +182,8 @@ impl Lowerer<'_> {
             self.report(
                 Diagnostic::new(Code::W0200, format!("section `{}` is empty", def.name), name.span, "has no fields")
                     .with_help("remove it, or add its fields")
-                    .with_fix(section.span, ""),
+                    .with_payload(Payload::Empty { section: def.name.into() })
+                    .with_fix(section.span, "", Applicability::MachineApplicable),
             );
         }
         let attrs = self.fields(def, &section.body.items);
@@ -182,6 +200,7 @@ impl Lowerer<'_> {
                     name.span,
                     "cannot name an actor group",
                 )
+                .with_payload(Payload::Reserved { name: "ego".into() })
                 .with_help("describe the ego vehicle in the `ego { ... }` section, or rename this group"),
             );
         } else if let Some(previous) = scenario.actor(&name.text) {
@@ -192,6 +211,11 @@ impl Lowerer<'_> {
                     name.span,
                     "declared again here",
                 )
+                .with_payload(Payload::Duplicate {
+                    namespace: "actor_group".into(),
+                    name: name.text.clone(),
+                    earlier_module: None,
+                })
                 .with_secondary(previous.name.span, "first declared here")
                 .with_help("give each group its own name"),
             );
@@ -235,6 +259,11 @@ impl Lowerer<'_> {
                         key.span,
                         "given again here",
                     )
+                    .with_payload(Payload::Duplicate {
+                        namespace: "field".into(),
+                        name: field_def.name.into(),
+                        earlier_module: None,
+                    })
                     .with_secondary(first, "first given here")
                     .with_help("keep one of the two"),
                 );
@@ -248,7 +277,7 @@ impl Lowerer<'_> {
     }
 
     fn unknown_field(&mut self, def: &SectionDef, key: &Name) {
-        let mut d = Diagnostic::new(
+        let d = Diagnostic::new(
             Code::E0203,
             format!("unknown field `{}` in `{}`", key.text, def.name),
             key.span,
@@ -258,9 +287,21 @@ impl Lowerer<'_> {
             .iter()
             .find(|(from, to)| *from == key.text && def.field(to).is_some())
             .map(|(_, to)| *to);
-        if let Some(guess) = alias.or_else(|| suggest::closest(&key.text, def.fields.iter().map(|f| f.name))) {
-            d = d.with_help(format!("did you mean `{guess}`?")).with_fix(key.span, guess);
-        } else {
+        let (mut d, guessed) = match alias {
+            // another notation's name for the field: certain
+            Some(field) => (
+                d.with_payload(Payload::Alias {
+                    namespace: "field".into(),
+                    written: key.text.clone(),
+                    canonical: field.into(),
+                })
+                .with_help(format!("did you mean `{field}`?"))
+                .with_fix(key.span, field, Applicability::MachineApplicable),
+                true,
+            ),
+            None => suggest::unknown(d, "field", &key.text, key.span, def.fields.iter().map(|f| f.name)),
+        };
+        if !guessed {
             let owners: Vec<&str> = schema::SECTIONS
                 .iter()
                 .chain([&&schema::ACTOR])
@@ -304,7 +345,8 @@ impl Lowerer<'_> {
                 self.report(
                     Diagnostic::new(Code::E0208, format!("`{}` takes a list", def.name), span, "a single name")
                         .with_help(help)
-                        .with_fix(span, fix),
+                        .with_payload(wrong(def.name, "a list of names", &symbol.name))
+                        .with_fix(span, fix, Applicability::MachineApplicable),
                 );
                 Val::Symbols(if none { Vec::new() } else { vec![symbol] })
             }
@@ -322,7 +364,12 @@ impl Lowerer<'_> {
                             *unit,
                             "remove this unit",
                         )
-                        .with_fix(Span::new(number.end, span.end), ""),
+                        .with_payload(wrong(def.name, "a whole number", &self.src[unit.start..unit.end]))
+                        .with_fix(
+                            Span::new(number.end, span.end),
+                            "",
+                            Applicability::MachineApplicable,
+                        ),
                     );
                 }
                 Val::Integer(self.integer(*number, def.name)?)
@@ -345,7 +392,8 @@ impl Lowerer<'_> {
                 self.report(
                     Diagnostic::new(Code::E0205, "a position needs a reference", span, "a relation alone")
                         .with_help(format!("say what it is relative to, e.g. `{} of ego`", join(words)))
-                        .with_fix(Span::new(span.end, span.end), " of ego"),
+                        .with_payload(wrong(def.name, "a position", &join(words)))
+                        .with_fix(Span::new(span.end, span.end), " of ego", Applicability::MaybeIncorrect),
                 );
                 return None;
             }
@@ -357,6 +405,7 @@ impl Lowerer<'_> {
                         found.span(),
                         format!("expected {}", expected.describe()),
                     )
+                    .with_payload(wrong(def.name, expected.describe(), found.describe()))
                     .with_help(format!("for example `{}: {}`", def.name, def.example)),
                 );
                 return None;
@@ -380,7 +429,8 @@ impl Lowerer<'_> {
                     "a name is one word",
                 )
                 .with_help(format!("join the words with `_`: `{name}`"))
-                .with_fix(span, name.clone()),
+                .with_payload(wrong("name", "one word", &self.src[span.start..span.end]))
+                .with_fix(span, name.clone(), Applicability::MachineApplicable),
             );
         }
         Symbol { name, span }
@@ -407,6 +457,7 @@ impl Lowerer<'_> {
                         other.span(),
                         "expected a name",
                     )
+                    .with_payload(wrong(def.name, "a name", other.describe()))
                     .with_help(format!("for example `{}: {}`", def.name, def.example)),
                 ),
             }
@@ -416,7 +467,12 @@ impl Lowerer<'_> {
             self.report(
                 Diagnostic::new(Code::W0201, format!("`{}` lists a name twice", def.name), at, "already listed")
                     .with_help(format!("write `{deduped}`"))
-                    .with_fix(span, deduped),
+                    .with_payload(Payload::Duplicate {
+                        namespace: def.name.into(),
+                        name: self.src[at.start..at.end].to_string(),
+                        earlier_module: None,
+                    })
+                    .with_fix(span, deduped, Applicability::MachineApplicable),
             );
         }
         Some(symbols)
@@ -430,9 +486,10 @@ impl Lowerer<'_> {
                 format!("`{what}` takes a whole number, found `{text}`"),
                 number,
                 "not a whole number",
-            );
+            )
+            .with_payload(wrong(what, "a whole number", text));
             if fraction.bytes().all(|b| b == b'0') {
-                d = d.with_help(format!("write `{whole}`")).with_fix(number, whole);
+                d = d.with_help(format!("write `{whole}`")).with_fix(number, whole, Applicability::MachineApplicable);
             }
             self.report(d);
             return None;
@@ -440,12 +497,10 @@ impl Lowerer<'_> {
         match text.parse::<i64>() {
             Ok(n) => Some(n),
             Err(_) => {
-                self.report(Diagnostic::new(
-                    Code::E0005,
-                    format!("number `{text}` is out of range"),
-                    number,
-                    "too large",
-                ));
+                self.report(
+                    Diagnostic::new(Code::E0005, format!("number `{text}` is out of range"), number, "too large")
+                        .with_payload(wrong(what, "a number that fits in 64 bits", text)),
+                );
                 None
             }
         }
@@ -456,12 +511,10 @@ impl Lowerer<'_> {
         let value: f64 = match text.parse() {
             Ok(v) if f64::is_finite(v) => v,
             _ => {
-                self.report(Diagnostic::new(
-                    Code::E0005,
-                    format!("number `{text}` is out of range"),
-                    number,
-                    "too large",
-                ));
+                self.report(
+                    Diagnostic::new(Code::E0005, format!("number `{text}` is out of range"), number, "too large")
+                        .with_payload(wrong(def.name, "a finite number", text)),
+                );
                 return None;
             }
         };
@@ -479,7 +532,12 @@ impl Lowerer<'_> {
                     format!("{} without a unit", def.ty.describe()),
                 )
                 .with_help(format!("write `{text} {default}`; the units are {units}"))
-                .with_fix(Span::new(number.end, number.end), format!(" {default}")),
+                .with_payload(wrong(def.name, def.ty.describe(), text))
+                .with_fix(
+                    Span::new(number.end, number.end),
+                    format!(" {default}"),
+                    Applicability::MaybeIncorrect,
+                ),
             );
             return None;
         };
@@ -498,12 +556,17 @@ impl Lowerer<'_> {
                     unit_span,
                     format!("not a unit of {}", def.ty.describe().trim_start_matches("a ")),
                 )
+                .with_payload(wrong(def.name, def.ty.describe(), unit_text))
                 .with_help(format!("the units of {} are {units}", def.ty.describe().trim_start_matches("a "))),
             );
             return None;
         }
         Some(Quantity { value, unit })
     }
+}
+
+fn wrong(field: &str, expected: &str, found: &str) -> Payload {
+    Payload::WrongValue { field: field.into(), expected: expected.into(), found: found.into() }
 }
 
 fn join(words: &[Name]) -> String {

@@ -9,7 +9,7 @@ use crate::cst::{Entry, Field, File, Item, Member, Value};
 use crate::lexer::{self, Spanned, Token};
 use crate::suggest;
 use lalrpop_util::{ErrorRecovery, ParseError};
-use tad_diagnostics::{Code, Diagnostic, LineIndex, Span};
+use tad_diagnostics::{Applicability, Code, Diagnostic, LineIndex, Payload, Span};
 
 #[allow(clippy::all, clippy::pedantic, unused_parens, unused_qualifications)]
 mod grammar {
@@ -17,7 +17,7 @@ mod grammar {
 }
 
 /// A parsed file: its tree, its comments (for the formatter) and what went wrong.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Parsed {
     pub file: File,
     pub comments: Vec<Span>,
@@ -82,7 +82,8 @@ fn split_words_at_line_breaks(src: &str, file: &mut File) -> Vec<Diagnostic> {
                 "a field name needs a `:`",
             )
             .with_help(format!("write `{}: ...`", key.text))
-            .with_fix(Span::new(key.span.end, key.span.end), ":"),
+            .with_payload(Payload::Syntax { expected: vec!["`:`".into()], found: Some(key.text.clone()) })
+            .with_fix(Span::new(key.span.end, key.span.end), ":", Applicability::MachineApplicable),
         );
         words.truncate(i);
     };
@@ -105,7 +106,11 @@ fn split_words_at_line_breaks(src: &str, file: &mut File) -> Vec<Diagnostic> {
 fn drop_values_with_unknown_units(src: &str, file: &mut File, syntax: &[Diagnostic]) {
     let units: Vec<Span> = syntax
         .iter()
-        .filter(|d| d.message.starts_with("unknown unit") || d.message.starts_with("exponent"))
+        .filter(|d| match &d.payload {
+            Payload::Unknown { namespace, .. } => namespace == "unit",
+            Payload::WrongValue { field, .. } => field == "number",
+            _ => false,
+        })
         .map(|d| d.primary.span)
         .collect();
     for field in fields_mut(file) {
@@ -182,7 +187,10 @@ fn close_braces(src: &str, tokens: &mut Vec<Spanned>, diagnostics: &mut Vec<Diag
             .with_secondary(Span::new(opened, opened + 1), "so this `{` is still open at the end of the file");
         }
         if report {
-            diagnostics.push(d.with_help("add the missing `}`"));
+            diagnostics.push(
+                d.with_help("add the missing `}`")
+                    .with_payload(Payload::Syntax { expected: vec!["`}`".into()], found: None }),
+            );
         }
         tokens.push((end, Token::RBrace, end));
     }
@@ -200,14 +208,16 @@ fn parse_error(src: &str, tokens: &[Spanned], error: ParseError<usize, Token, ()
             }
             let span = Span::new(start, end);
             let found = describe_token(src, token, span);
-            let wanted = expected_words(&expected);
+            let words = expected_list(&expected);
+            let wanted = join_or(&words);
             let previous = tokens.iter().rev().find(|t| t.2 <= start).map(|t| t.1);
             let mut d = Diagnostic::new(
                 Code::E0100,
                 format!("expected {wanted}, found {found}"),
                 span,
                 format!("expected {wanted}"),
-            );
+            )
+            .with_payload(Payload::Syntax { expected: words, found: Some(found.clone()) });
             if previous == Some(Token::Number) && token == Token::Ident {
                 let word = &src[start..end];
                 d.message = format!("unknown unit `{word}`");
@@ -215,7 +225,12 @@ fn parse_error(src: &str, tokens: &[Spanned], error: ParseError<usize, Token, ()
                 if word.starts_with(['e', 'E']) && word[1..].bytes().all(|b| b.is_ascii_digit()) && word.len() > 1 {
                     return Some(
                         Diagnostic::new(Code::E0100, "exponent notation is not supported", span, "an exponent")
-                            .with_help("write the number in full, e.g. `1000` instead of `1e3`"),
+                            .with_help("write the number in full, e.g. `1000` instead of `1e3`")
+                            .with_payload(Payload::WrongValue {
+                                field: "number".into(),
+                                expected: "a number written in full".into(),
+                                found: word.to_string(),
+                            }),
                     );
                 }
                 let guess = match word {
@@ -225,8 +240,19 @@ fn parse_error(src: &str, tokens: &[Spanned], error: ParseError<usize, Token, ()
                     "meter" | "meters" | "metre" | "metres" => Some("m"),
                     _ => suggest::closest(word, lexer::UNITS.iter().copied()),
                 };
+                let candidates = guess.map(|g| vec![g.to_string()]).unwrap_or_default();
+                d = d.with_payload(Payload::Unknown {
+                    namespace: "unit".into(),
+                    name: word.to_string(),
+                    candidates,
+                    module: None,
+                });
                 d = match guess {
-                    Some(unit) => d.with_help(format!("did you mean `{unit}`?")).with_fix(span, unit),
+                    Some(unit) => d.with_help(format!("did you mean `{unit}`?")).with_fix(
+                        span,
+                        unit,
+                        Applicability::MaybeIncorrect,
+                    ),
                     None => d.with_help("units are `km/h`, `mph`, `m/s`, `m` and `s`"),
                 };
             } else if token == Token::Key && expected.iter().any(|e| e == "\"actor\"") {
@@ -245,26 +271,30 @@ fn parse_error(src: &str, tokens: &[Spanned], error: ParseError<usize, Token, ()
         }
         ParseError::UnrecognizedEof { location, expected } => {
             let span = Span::new(location.min(src.len()), location.min(src.len()));
-            let wanted = expected_words(&expected);
-            Some(Diagnostic::new(
-                Code::E0101,
-                format!("unexpected end of file, expected {wanted}"),
-                span,
-                format!("expected {wanted}"),
-            ))
+            let words = expected_list(&expected);
+            let wanted = join_or(&words);
+            Some(
+                Diagnostic::new(
+                    Code::E0101,
+                    format!("unexpected end of file, expected {wanted}"),
+                    span,
+                    format!("expected {wanted}"),
+                )
+                .with_payload(Payload::Syntax { expected: words, found: None }),
+            )
         }
         ParseError::ExtraToken { token: (start, token, end) } => {
             let span = Span::new(start, end);
-            Some(Diagnostic::new(
-                Code::E0100,
-                format!("unexpected {}", describe_token(src, token, span)),
-                span,
-                "not expected here",
-            ))
+            let found = describe_token(src, token, span);
+            Some(
+                Diagnostic::new(Code::E0100, format!("unexpected {found}"), span, "not expected here")
+                    .with_payload(Payload::Syntax { expected: Vec::new(), found: Some(found) }),
+            )
         }
-        ParseError::InvalidToken { location } => {
-            Some(Diagnostic::new(Code::E0001, "invalid token", Span::new(location, location), "here"))
-        }
+        ParseError::InvalidToken { location } => Some(
+            Diagnostic::new(Code::E0001, "invalid token", Span::new(location, location), "here")
+                .with_payload(Payload::Syntax { expected: Vec::new(), found: None }),
+        ),
         ParseError::User { .. } => None,
     }
 }
@@ -282,7 +312,7 @@ fn describe_token(src: &str, token: Token, span: Span) -> String {
 }
 
 /// The grammar's expected terminals in plain words, most useful first.
-fn expected_words(expected: &[String]) -> String {
+fn expected_list(expected: &[String]) -> Vec<String> {
     const VALUE_STARTS: &[&str] = &["Number", "String", "TextBlock", "\"[\"", "Ident", "\"unspecified\"", "Invalid"];
     let is_value = expected.iter().any(|e| e == "Number") && expected.iter().any(|e| e == "\"[\"");
     let mut words: Vec<(u8, String)> = Vec::new();
@@ -312,8 +342,12 @@ fn expected_words(expected: &[String]) -> String {
     }
     words.sort();
     words.dedup();
-    let words: Vec<String> = words.into_iter().map(|(_, w)| w).collect();
-    match words.as_slice() {
+    words.into_iter().map(|(_, w)| w).collect()
+}
+
+/// The expected things in words: "`}` or a field name".
+fn join_or(words: &[String]) -> String {
+    match words {
         [] => "something else".into(),
         [one] => one.clone(),
         [init @ .., last] => format!("{} or {last}", init.join(", ")),

@@ -55,6 +55,8 @@ pub struct FieldDef {
     /// A valid value, used in help messages.
     pub example: &'static str,
     pub doc: &'static str,
+    /// Whether a complete scenario states it (TrafficAlign's semantic validation).
+    pub essential: bool,
 }
 
 #[derive(Debug, PartialEq, Eq, Hash)]
@@ -68,14 +70,29 @@ impl SectionDef {
     pub fn field(&self, name: &str) -> Option<&'static FieldDef> {
         self.fields.iter().find(|f| f.name == name)
     }
+
+    /// The fields a complete scenario states, in order.
+    pub fn essential(&self) -> impl Iterator<Item = &'static FieldDef> + '_ {
+        self.fields.iter().filter(|f| f.essential)
+    }
 }
 
 macro_rules! field {
     ($name:literal, $ty:ident, $example:literal, $doc:literal) => {
-        FieldDef { name: $name, ty: ValueType::$ty, vocabulary: None, example: $example, doc: $doc }
+        FieldDef { name: $name, ty: ValueType::$ty, vocabulary: None, example: $example, doc: $doc, essential: false }
     };
     ($name:literal, $ty:ident in $vocabulary:literal, $example:literal, $doc:literal) => {
-        FieldDef { name: $name, ty: ValueType::$ty, vocabulary: Some($vocabulary), example: $example, doc: $doc }
+        FieldDef {
+            name: $name,
+            ty: ValueType::$ty,
+            vocabulary: Some($vocabulary),
+            example: $example,
+            doc: $doc,
+            essential: false,
+        }
+    };
+    (essential $name:literal, $($rest:tt)*) => {
+        FieldDef { essential: true, ..field!($name, $($rest)*) }
     };
 }
 
@@ -95,8 +112,8 @@ pub const ENVIRONMENT: SectionDef = SectionDef {
     name: "environment",
     doc: "weather and time of day",
     fields: &[
-        field!("weather", Symbol in "weather", "clear", "the weather"),
-        field!("time", Symbol in "time_of_day", "daytime", "the time of day"),
+        field!(essential "weather", Symbol in "weather", "clear", "the weather"),
+        field!(essential "time", Symbol in "time_of_day", "daytime", "the time of day"),
     ],
 };
 
@@ -104,10 +121,10 @@ pub const ROAD: SectionDef = SectionDef {
     name: "road",
     doc: "the road network around the ego vehicle",
     fields: &[
-        field!("type", Symbol in "road_type", "straight_road", "the road type"),
+        field!(essential "type", Symbol in "road_type", "straight_road", "the road type"),
         field!("context", Symbol in "road_context", "urban", "the road context"),
-        field!("lanes", Integer, "2", "lanes per direction"),
-        field!("direction", Symbol in "direction", "two_way", "`one_way` or `two_way`"),
+        field!(essential "lanes", Integer, "2", "lanes per direction"),
+        field!(essential "direction", Symbol in "direction", "two_way", "`one_way` or `two_way`"),
         field!("special_lanes", SymbolList in "special_lane", "[bike_lane]", "special lanes; `[]` for none"),
         field!("signs", SymbolList in "traffic_sign", "[stop_sign]", "traffic signs; `[]` for none"),
         field!("light", Symbol in "light_state", "green", "the traffic light state facing the ego vehicle; `none` for no light"),
@@ -123,9 +140,9 @@ pub const EGO: SectionDef = SectionDef {
     name: "ego",
     doc: "the ego vehicle",
     fields: &[
-        field!("behavior", Symbol in "behavior", "go_forward", "what the ego vehicle does"),
-        field!("speed", Speed, "30 km/h", "its speed"),
-        field!("lane", Integer, "1", "its lane index: 1 is the leftmost lane in its direction"),
+        field!(essential "behavior", Symbol in "behavior", "go_forward", "what the ego vehicle does"),
+        field!(essential "speed", Speed, "30 km/h", "its speed"),
+        field!(essential "lane", Integer, "1", "its lane index: 1 is the leftmost lane in its direction"),
     ],
 };
 
@@ -134,10 +151,10 @@ pub const ACTOR: SectionDef = SectionDef {
     name: "actor",
     doc: "a group of actors of one type that move together",
     fields: &[
-        field!("behavior", Symbol in "behavior", "go_forward", "what every actor of the group does"),
+        field!(essential "behavior", Symbol in "behavior", "go_forward", "what every actor of the group does"),
         field!("speed", Speed, "30 km/h", "their speed"),
-        field!("position", Position, "front of ego", "where the group is, relative to a reference"),
-        field!("lane", Integer, "1", "their lane index; negative for the opposite direction"),
+        field!(essential "position", Position, "front of ego", "where the group is, relative to a reference"),
+        field!(essential "lane", Integer, "1", "their lane index; negative for the opposite direction"),
     ],
 };
 

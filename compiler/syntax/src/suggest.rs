@@ -1,5 +1,7 @@
 //! "Did you mean" suggestions by edit distance.
 
+use tad_diagnostics::{Applicability, Diagnostic, Payload, Span};
+
 /// Optimal-string-alignment distance (Levenshtein plus adjacent transpositions),
 /// case-insensitive.
 pub fn distance(a: &str, b: &str) -> usize {
@@ -37,6 +39,46 @@ pub fn closest<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) ->
     best.map(|(_, c)| c)
 }
 
+/// The candidates within the typo limit of `word`, closest first (ties in the given
+/// order), at most `n`.
+pub fn ranked<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>, n: usize) -> Vec<&'a str> {
+    let limit = (word.chars().count() / 3).max(1);
+    let mut close: Vec<(usize, usize, &str)> = candidates
+        .into_iter()
+        .enumerate()
+        .map(|(i, c)| (distance(word, c), i, c))
+        .filter(|(d, ..)| *d <= limit)
+        .collect();
+    close.sort();
+    close.dedup_by(|a, b| a.2 == b.2);
+    close.into_iter().take(n).map(|(.., c)| c).collect()
+}
+
+/// Give `d` an [`Payload::Unknown`] for `name` in `namespace`, and when a candidate is
+/// close, a "did you mean" help and a maybe-incorrect fix at `span`. Returns whether a
+/// guess was made.
+pub fn unknown<'a>(
+    d: Diagnostic,
+    namespace: &str,
+    name: &str,
+    span: Span,
+    candidates: impl IntoIterator<Item = &'a str>,
+) -> (Diagnostic, bool) {
+    let close: Vec<String> = ranked(name, candidates, 5).into_iter().map(str::to_string).collect();
+    let guess = close.first().cloned();
+    let mut d = d.with_payload(Payload::Unknown {
+        namespace: namespace.to_string(),
+        name: name.to_string(),
+        candidates: close,
+        module: None,
+    });
+    let guessed = guess.is_some();
+    if let Some(guess) = guess {
+        d = d.with_help(format!("did you mean `{guess}`?")).with_fix(span, guess, Applicability::MaybeIncorrect);
+    }
+    (d, guessed)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -55,5 +97,11 @@ mod tests {
         assert_eq!(closest("wether", fields), Some("weather"));
         assert_eq!(closest("tiem", fields), Some("time"));
         assert_eq!(closest("colour", fields), None);
+    }
+
+    #[test]
+    fn ranked_orders_by_distance() {
+        assert_eq!(ranked("tme", ["type", "time", "tame"], 5), vec!["time", "tame"]);
+        assert!(ranked("colour", ["weather"], 5).is_empty());
     }
 }

@@ -54,14 +54,13 @@ pub fn run(
         let checked = crate::check::diagnose_in(&mut db, input);
         if checked.diagnostics.iter().any(|d| d.is_error()) {
             let errors: Vec<_> = checked.diagnostics.iter().filter(|d| d.is_error()).cloned().collect();
-            let report = FileReport { name: &input.name, text: &input.text, diagnostics: &errors };
+            let report = FileReport::new(&input.name, &input.text, &errors);
             eprint!("{}", human::render(&report, color));
             eprintln!("{}: not built: it has errors", input.name);
             status = status.max(Status::Failed);
             continue;
         }
-        let path = input.path.clone().unwrap_or_else(|| PathBuf::from(&input.name));
-        let file = db.set_file(path, input.text.clone());
+        let file = crate::check::register(&mut db, input);
         let module = &tad_db::analyze(&db, file).module;
         let vocabulary = &tad_db::vocabulary(&db, file).vocabulary;
         let options = EmitOptions {
@@ -71,7 +70,7 @@ pub fn run(
             source: Some(input.name.clone()),
         };
         let emitted = tad_scenic::emit(module, vocabulary, &options);
-        let report = FileReport { name: &input.name, text: &input.text, diagnostics: &emitted.diagnostics };
+        let report = FileReport::new(&input.name, &input.text, &emitted.diagnostics);
         eprint!("{}", human::render(&report, color));
         if emitted.diagnostics.iter().any(|d| d.is_error()) {
             eprintln!("{}: not built", input.name);

@@ -1,17 +1,31 @@
 //! `tadslc check`: report every problem of every file, in the chosen format.
+//!
+//! Each input is set in one database; a diagnostic whose label points into another file
+//! (a used module, the prelude) is rendered with that file's text. A local module used by
+//! an input and having errors is reported once, in its own file, after the inputs.
 
 use crate::files::{self, Input};
 use crate::{Format, Status};
 use tad_check::{Checked, Class, Options};
-use tad_db::Database;
-use tad_diagnostics::render::{FileReport, human, json, sarif};
-use tad_diagnostics::{Code, Diagnostic, Severity, Span};
+use tad_db::{Database, Language, RealFs, SourceFile};
+use tad_diagnostics::render::{FileReport, Source, human, json, sarif};
+use tad_diagnostics::{Code, Diagnostic, Payload, Severity, Span};
+
+/// Register one input in the database, in the language its path suggests.
+pub fn register(db: &mut Database, input: &Input) -> SourceFile {
+    let path = input.path.clone().unwrap_or_else(|| std::path::PathBuf::from(&input.name));
+    let language = Language::of_path(&path);
+    db.set_source(path, input.text.clone(), language, &RealFs)
+}
 
 /// Check one input through the database: a non-UTF-8 file is reported, then checked as
 /// decoded.
 pub fn diagnose_in(db: &mut Database, input: &Input) -> Checked {
-    let path = input.path.clone().unwrap_or_else(|| std::path::PathBuf::from(&input.name));
-    let file = db.set_file(path, input.text.clone());
+    let file = register(db, input);
+    checked(db, file, input)
+}
+
+fn checked(db: &Database, file: SourceFile, input: &Input) -> Checked {
     let mut checked = tad_db::check(db, file).clone();
     if let Some(at) = input.invalid_utf8 {
         // The lossy text has U+FFFD (3 bytes) where the invalid sequence was.
@@ -23,6 +37,12 @@ pub fn diagnose_in(db: &mut Database, input: &Input) -> Checked {
                 Span::new(at, at + 3),
                 "invalid bytes start here",
             )
+            .in_file(file.id(db))
+            .with_payload(Payload::WrongValue {
+                field: "encoding".into(),
+                expected: "UTF-8".into(),
+                found: "invalid bytes".into(),
+            })
             .with_help("save the file as UTF-8"),
         );
     }
@@ -34,50 +54,120 @@ pub fn diagnose(input: &Input) -> Vec<Diagnostic> {
     diagnose_in(&mut Database::new(Options::default()), input).diagnostics
 }
 
+/// The files other than `own` that the labels of `diagnostics` point into.
+pub fn related<'a>(
+    db: &'a Database,
+    own: SourceFile,
+    diagnostics: &[Diagnostic],
+) -> Vec<(String, &'a str, tad_diagnostics::FileId)> {
+    let mut out: Vec<(String, &str, tad_diagnostics::FileId)> = Vec::new();
+    for id in diagnostics.iter().flat_map(|d| d.files()) {
+        if id == own.id(db) || out.iter().any(|(_, _, known)| *known == id) {
+            continue;
+        }
+        if let Some(file) = db.file(id) {
+            out.push((file.path(db).display().to_string(), file.text(db).as_str(), id));
+        }
+    }
+    out
+}
+
+/// The report of one file, with the files its labels point into.
+pub fn report<'a>(
+    name: &'a str,
+    text: &'a str,
+    diagnostics: &'a [Diagnostic],
+    related: &'a [(String, &'a str, tad_diagnostics::FileId)],
+) -> FileReport<'a> {
+    FileReport::new(name, text, diagnostics)
+        .with_related(related.iter().map(|(name, text, file)| Source { file: *file, name, text }).collect())
+}
+
+/// One checked file, ready to render.
+struct Checked1 {
+    name: String,
+    text: String,
+    file: SourceFile,
+    result: Checked,
+}
+
 pub fn run(paths: &[std::path::PathBuf], format: Format, deny_warnings: bool, color: bool, options: Options) -> Status {
     let (inputs, mut status) = files::load(paths);
     let mut db = Database::new(options);
-    let mut checked: Vec<(Input, Checked)> = Vec::new();
+    let mut done: Vec<Checked1> = Vec::new();
+    for input in &inputs {
+        let file = register(&mut db, input);
+        let result = checked(&db, file, input);
+        done.push(Checked1 { name: input.name.clone(), text: input.text.clone(), file, result });
+    }
+    // local modules with errors of their own, each once, in their own file
+    let inputs_files: Vec<SourceFile> = done.iter().map(|c| c.file).collect();
+    let mut modules: Vec<SourceFile> = Vec::new();
+    for c in &done {
+        for m in db.local_modules(c.file) {
+            if !inputs_files.contains(&m)
+                && !modules.contains(&m)
+                && tad_db::check(&db, m).diagnostics.iter().any(Diagnostic::is_error)
+            {
+                modules.push(m);
+            }
+        }
+    }
+    for m in modules {
+        done.push(Checked1 {
+            name: m.path(&db).display().to_string(),
+            text: m.text(&db).clone(),
+            file: m,
+            result: tad_db::check(&db, m).clone(),
+        });
+    }
+
     let (mut errors, mut warnings) = (0, 0);
     let mut classes = [0usize; 3];
-    for input in inputs {
-        let result = diagnose_in(&mut db, &input);
-        errors += result.diagnostics.iter().filter(|d| d.severity == Severity::Error).count();
-        warnings += result.diagnostics.iter().filter(|d| d.severity == Severity::Warning).count();
-        if let Some(class) = result.class {
+    let mut sarif_reports = Vec::new();
+    for c in &done {
+        errors += c.result.diagnostics.iter().filter(|d| d.severity == Severity::Error).count();
+        warnings += c.result.diagnostics.iter().filter(|d| d.severity == Severity::Warning).count();
+        if let Some(class) = c.result.class {
             classes[class as usize] += 1;
         }
-        let report = FileReport { name: &input.name, text: &input.text, diagnostics: &result.diagnostics };
+        let related = related(&db, c.file, &c.result.diagnostics);
+        let report = report(&c.name, &c.text, &c.result.diagnostics, &related);
         match format {
             Format::Human => {
                 eprint!("{}", human::render(&report, color));
-                if let Some(class) = result.class.filter(|c| *c != Class::Complete) {
-                    eprintln!("{}: {}", input.name, class.as_str());
+                if let Some(class) = c.result.class.filter(|c| *c != Class::Complete) {
+                    eprintln!("{}: {}", c.name, class.as_str());
                 }
             }
             Format::Json => {
                 let mut object = json::file_object(&report);
-                object.insert("class".into(), result.class.map_or(serde_json::Value::Null, |c| c.as_str().into()));
-                object.insert("refinement".into(), result.refinement.clone().into());
+                object.insert("class".into(), c.result.class.map_or(serde_json::Value::Null, |c| c.as_str().into()));
+                let vocabulary = &tad_db::vocabulary(&db, c.file).vocabulary;
+                let refinement = tad_feedback::refinement(&c.result.diagnostics, vocabulary);
+                object.insert("refinement".into(), refinement.into());
                 println!("{}", serde_json::Value::Object(object));
             }
-            Format::Sarif => {}
+            Format::Sarif => sarif_reports.push((
+                c.name.clone(),
+                c.text.clone(),
+                c.result.diagnostics.clone(),
+                related.iter().map(|(n, t, f)| (n.clone(), t.to_string(), *f)).collect::<Vec<_>>(),
+            )),
         }
-        checked.push((input, result));
     }
     match format {
         Format::Sarif => {
-            let reports: Vec<FileReport<'_>> = checked
+            let reports: Vec<FileReport<'_>> = sarif_reports
                 .iter()
-                .map(|(input, result)| FileReport {
-                    name: &input.name,
-                    text: &input.text,
-                    diagnostics: &result.diagnostics,
+                .map(|(name, text, diagnostics, related)| {
+                    FileReport::new(name, text, diagnostics)
+                        .with_related(related.iter().map(|(n, t, f)| Source { file: *f, name: n, text: t }).collect())
                 })
                 .collect();
             println!("{}", sarif::render(&reports, env!("CARGO_PKG_VERSION")));
         }
-        Format::Human => eprintln!("{}", summary(checked.len(), errors, warnings, classes)),
+        Format::Human => eprintln!("{}", summary(inputs.len(), errors, warnings, classes)),
         Format::Json => {}
     }
     if errors > 0 || (deny_warnings && warnings > 0) {

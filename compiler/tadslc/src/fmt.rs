@@ -4,7 +4,7 @@ use crate::Status;
 use crate::files;
 use tad_diagnostics::render::{FileReport, human};
 
-/// The codes whose fixes `--canonicalize` applies.
+/// The codes whose fixes `--canonicalize` applies (their machine-applicable ones).
 pub const CANONICAL: &[tad_diagnostics::Code] =
     &[tad_diagnostics::Code::W0401, tad_diagnostics::Code::W0402, tad_diagnostics::Code::W0403];
 
@@ -39,7 +39,7 @@ pub fn run(paths: &[std::path::PathBuf], check: bool, canonical: bool, color: bo
         let formatted = match tad_syntax::format::format(&source) {
             Ok(formatted) => formatted,
             Err(diagnostics) => {
-                let report = FileReport { name: &input.name, text: &input.text, diagnostics: &diagnostics };
+                let report = FileReport::new(&input.name, &input.text, &diagnostics);
                 eprint!("{}", human::render(&report, color));
                 eprintln!("error: `{}` has syntax errors; not formatted", input.name);
                 status = status.max(Status::Failed);

@@ -11,12 +11,12 @@ use crate::Status;
 use crate::files::{self, Input};
 use std::path::{Path, PathBuf};
 use tad_check::Options;
-use tad_db::Database;
+use tad_db::{Database, Language, RealFs};
 use tad_diagnostics::render::{FileReport, human};
 use tad_diagnostics::{Diagnostic, Severity};
 
 fn report(input: &Input, diagnostics: &[Diagnostic], color: bool) -> usize {
-    eprint!("{}", human::render(&FileReport { name: &input.name, text: &input.text, diagnostics }, color));
+    eprint!("{}", human::render(&FileReport::new(&input.name, &input.text, diagnostics), color));
     diagnostics.iter().filter(|d| d.severity == Severity::Error).count()
 }
 
@@ -43,8 +43,7 @@ fn write_output(out: Option<&Path>, text: &str) -> Status {
 pub fn import(db: &mut Database, input: &Input) -> (String, Vec<Diagnostic>) {
     // read as YAML whatever the extension (answers are often `.txt` or `.md`)
     let path = input.path.clone().unwrap_or_else(|| PathBuf::from(&input.name));
-    let yaml_path = if tad_db::is_yaml(&path) { path.clone() } else { path.with_extension("answer.yaml") };
-    let file = db.set_file(yaml_path, input.text.clone());
+    let file = db.set_source(path.clone(), input.text.clone(), Language::Yaml, &RealFs);
     let diagnostics = tad_db::check(db, file).diagnostics.clone();
     let mut module = tad_db::analyze(db, file).module.clone();
     if let Some(scenario) = module.scenario.as_mut().filter(|s| s.name.is_none()) {
@@ -101,7 +100,7 @@ pub fn run_export(path: &Path, out: Option<&Path>, color: bool) -> Status {
         eprintln!("error: `{}` has errors; not exported", input.name);
         return Status::Failed;
     }
-    let file = db.set_file(input.path.clone().unwrap_or_else(|| PathBuf::from(&input.name)), input.text.clone());
+    let file = crate::check::register(&mut db, &input);
     let module = &tad_db::analyze(&db, file).module;
     write_output(out, &tad_yaml::export(module, &input.text))
 }

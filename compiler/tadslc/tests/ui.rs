@@ -13,7 +13,7 @@
 use libtest_mimic::{Arguments, Failed, Trial};
 use std::path::{Path, PathBuf};
 use tad_diagnostics::LineIndex;
-use tad_diagnostics::render::{FileReport, human};
+use tad_diagnostics::render::human;
 
 fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").canonicalize().expect("the repository")
@@ -76,7 +76,10 @@ fn run_fixture(path: &Path) -> Result<(), Failed> {
     if text.lines().any(|l| l.trim() == "// profile: dashcam") {
         options.profile = tad_check::Profile::Dashcam;
     }
-    let diagnostics = tadslc::check::diagnose_in(&mut tad_db::Database::new(options), &input).diagnostics;
+    let mut db = tad_db::Database::new(options);
+    let file = tadslc::check::register(&mut db, &input);
+    let diagnostics = tadslc::check::diagnose_in(&mut db, &input).diagnostics;
+    let related = tadslc::check::related(&db, file, &diagnostics);
 
     let index = LineIndex::new(&text);
     let mut actual: Vec<(String, String, String)> = diagnostics
@@ -101,7 +104,7 @@ fn run_fixture(path: &Path) -> Result<(), Failed> {
     }
 
     // paths inside messages are shown relative to the repository
-    let rendered = human::render(&FileReport { name: &name, text: &text, diagnostics: &diagnostics }, false)
+    let rendered = human::render(&tadslc::check::report(&name, &text, &diagnostics, &related), false)
         .replace(&format!("{}/", repo().display()), "");
     compare(&path.with_extension("stderr"), &rendered, &mut problems);
 

@@ -4,7 +4,7 @@ use crate::norm::{self, normalize};
 use crate::scan::{self, Tree};
 use crate::{extract, parse};
 use serde_norway::Value;
-use tad_diagnostics::{Code, Diagnostic, Span};
+use tad_diagnostics::{Applicability, Code, Diagnostic, Payload, Span};
 use tad_syntax::cst::{Name, Use};
 use tad_syntax::model::*;
 use tad_syntax::schema::{self, FieldDef, SectionDef, Unit};
@@ -26,6 +26,14 @@ const DERIVED: u8 = 0; // read out of another value's text (`two-way straight ro
 const PAPER: u8 = 1; // the paper's or TrafficComposer's key for the field
 const EXTRA: u8 = 2; // the TAD-named key `export` adds (`signs`, `special_lanes`)
 
+fn no_yaml() -> Payload {
+    Payload::Syntax { expected: vec!["a YAML mapping with the scenario".into()], found: None }
+}
+
+fn shape(key: &str, expected: &str, found: &str) -> Payload {
+    Payload::WrongValue { field: key.into(), expected: expected.into(), found: found.into() }
+}
+
 pub fn lower(text: &str) -> (Module, Vec<Diagnostic>) {
     let mut diagnostics = Vec::new();
     let Some(range) = extract::extract(text) else {
@@ -34,6 +42,7 @@ pub fn lower(text: &str) -> (Module, Vec<Diagnostic>) {
         let span = Span::new(start, start + first.trim_end().len());
         diagnostics.push(
             Diagnostic::new(Code::E0300, "no YAML scenario found in this answer", span, "expected YAML here")
+                .with_payload(no_yaml())
                 .with_help("put the scenario between `<YAML>` and `</YAML>`, or in a ```yaml code fence")
                 .with_note("a plain YAML file must be a mapping with `environment`, `road_network` and `actors`"),
         );
@@ -44,6 +53,7 @@ pub fn lower(text: &str) -> (Module, Vec<Diagnostic>) {
     if slice.trim().is_empty() {
         diagnostics.push(
             Diagnostic::new(Code::E0300, "the YAML block is empty", whole, "nothing here")
+                .with_payload(no_yaml())
                 .with_help("the block must hold the scenario: `environment`, `road_network` and `actors`"),
         );
         return (Module::default(), diagnostics);
@@ -332,6 +342,7 @@ impl Importer<'_> {
                         at.value_span,
                         "expected `key: value` lines",
                     )
+                    .with_payload(shape(what, "a mapping", describe(other)))
                     .with_help(format!("write the keys of `{what}` on their own lines, indented under it")),
                 );
                 Vec::new()
@@ -349,12 +360,26 @@ impl Importer<'_> {
         let normalized = normalize(key);
         let hint = KEY_HINTS.iter().find(|(from, to)| *from == normalized && known.contains(to)).map(|(_, to)| *to);
         if let Some(guess) = hint.or_else(|| suggest::closest(key, known.iter().copied())) {
-            d = d.with_help(format!("did you mean `{guess}`?")).with_fix(at.key_span, guess);
+            let sure = if hint.is_some() { Applicability::MachineApplicable } else { Applicability::MaybeIncorrect };
+            d = d.with_help(format!("did you mean `{guess}`?")).with_fix(at.key_span, guess, sure);
         } else {
             let list: Vec<String> = known.iter().map(|k| format!("`{k}`")).collect();
             d = d.with_note(format!("the keys of {context} are {}", list.join(", ")));
         }
-        d = d.with_note("the value of this key is ignored");
+        d = d.with_note("the value of this key is ignored").with_payload(Payload::Unknown {
+            namespace: "key".into(),
+            name: key.to_string(),
+            candidates: hint.into_iter().chain(suggest::ranked(key, known.iter().copied(), 5)).fold(
+                Vec::new(),
+                |mut all, k| {
+                    if !all.contains(&k.to_string()) {
+                        all.push(k.to_string());
+                    }
+                    all
+                },
+            ),
+            module: None,
+        });
         self.report(d);
     }
 
@@ -369,7 +394,8 @@ impl Importer<'_> {
             .with_help(format!(
                 "write {expected} such as `{example}`, or `unspecified` if the description does not say"
             ))
-            .with_fix(span, "unspecified"),
+            .with_payload(shape(key, expected, found))
+            .with_fix(span, "unspecified", Applicability::MaybeIncorrect),
         );
     }
 
@@ -381,12 +407,17 @@ impl Importer<'_> {
                 span,
                 format!("expected {expected}"),
             )
+            .with_payload(shape(key, expected, describe(v)))
             .with_help(format!("write one value after `{key}:`")),
         );
     }
 
     fn ignored(&mut self, span: Span, message: String, help: &str) {
-        self.report(Diagnostic::new(Code::W0302, message, span, "ignored").with_help(help.to_string()));
+        self.report(
+            Diagnostic::new(Code::W0302, message, span, "ignored").with_help(help.to_string()).with_payload(
+                Payload::Unsupported { backend: "tad".into(), construct: help.to_string(), instead: None },
+            ),
+        );
     }
 
     // ---- values ------------------------------------------------------------------------
@@ -512,6 +543,11 @@ impl Importer<'_> {
         if let Some(span) = duplicate {
             self.report(
                 Diagnostic::new(Code::W0201, format!("`{key}` lists a name twice"), span, "already listed")
+                    .with_payload(Payload::Duplicate {
+                        namespace: key.to_string(),
+                        name: String::new(),
+                        earlier_module: None,
+                    })
                     .with_help("list each name once"),
             );
         }
@@ -535,9 +571,14 @@ impl Importer<'_> {
                     format!("`{key}` takes a whole number, found `{text}`"),
                     span,
                     "not a whole number",
-                );
+                )
+                .with_payload(shape(key, "a whole number", &text));
                 if let Some(i) = n.as_f64().and_then(whole) {
-                    d = d.with_help(format!("write `{i}`")).with_fix(span, i.to_string());
+                    d = d.with_help(format!("write `{i}`")).with_fix(
+                        span,
+                        i.to_string(),
+                        Applicability::MachineApplicable,
+                    );
                 }
                 self.report(d);
                 None
@@ -554,8 +595,9 @@ impl Importer<'_> {
                             span,
                             "a number in words",
                         )
+                        .with_payload(shape(key, "a whole number", s.trim()))
                         .with_help(format!("write `{i}`"))
-                        .with_fix(span, i.to_string()),
+                        .with_fix(span, i.to_string(), Applicability::MachineApplicable),
                     );
                     return None;
                 }
@@ -690,6 +732,11 @@ impl Importer<'_> {
         };
         self.report(
             Diagnostic::new(Code::W0301, message, loser.value_span, "this value is ignored")
+                .with_payload(Payload::Duplicate {
+                    namespace: "key".into(),
+                    name: loser.key.clone(),
+                    earlier_module: None,
+                })
                 .with_secondary(winner.value_span, "this one is used")
                 .with_help("make the two agree, or remove one"),
         );
@@ -752,6 +799,7 @@ impl Importer<'_> {
             Value::Null => {
                 self.report(
                     Diagnostic::new(Code::E0300, "the YAML block holds no scenario", self.whole, "only comments here")
+                        .with_payload(no_yaml())
                         .with_help("the block must hold the scenario: `environment`, `road_network` and `actors`"),
                 );
                 return Module::default();
@@ -764,6 +812,7 @@ impl Importer<'_> {
                         self.whole,
                         "expected `environment:`, `road_network:` and `actors:`",
                     )
+                    .with_payload(shape("scenario", "a mapping", describe(other)))
                     .with_help("write the scenario as `key: value` lines, starting with `environment:`"),
                 );
                 return Module::default();
@@ -1194,6 +1243,11 @@ impl Importer<'_> {
                     at.key_span,
                     format!("`{base}` is taken"),
                 )
+                .with_payload(Payload::Duplicate {
+                    namespace: "actor_group".into(),
+                    name: base.clone(),
+                    earlier_module: None,
+                })
                 .with_help("give each actor group a key of its own"),
             );
         }

@@ -9,7 +9,7 @@
 
 use crate::scan;
 use serde_norway::Value;
-use tad_diagnostics::{Code, Diagnostic, Span};
+use tad_diagnostics::{Code, Diagnostic, Payload, Span};
 
 const MAX_ATTEMPTS: usize = 24;
 
@@ -29,7 +29,8 @@ pub fn parse(text: &str, base: usize, diagnostics: &mut Vec<Diagnostic>) -> (Str
                     Span::new(base + span.start, base + span.end),
                     format!("more than {MAX_DEPTH} levels"),
                 )
-                .with_help("a scenario needs two or three levels of nesting; remove the extra brackets"),
+                .with_help("a scenario needs two or three levels of nesting; remove the extra brackets")
+                .with_payload(invalid("brackets nested too deeply")),
                 text,
                 base,
             ));
@@ -54,6 +55,11 @@ pub fn parse(text: &str, base: usize, diagnostics: &mut Vec<Diagnostic>) -> (Str
                         "a tab",
                     )
                     .with_help("YAML indents with spaces only; each tab was read as one space")
+                    .with_payload(Payload::WrongValue {
+                        field: "indentation".into(),
+                        expected: "spaces".into(),
+                        found: "a tab".into(),
+                    })
                     .with_note("most YAML readers, including the one TrafficAlign's pipeline uses, reject this file"),
                 );
                 continue;
@@ -165,6 +171,11 @@ fn offset_of(text: &str, line: usize, column: usize) -> usize {
     offset
 }
 
+/// What the YAML reader found wrong.
+fn invalid(problem: &str) -> Payload {
+    Payload::Syntax { expected: vec!["valid YAML".into()], found: Some(problem.to_string()) }
+}
+
 /// The primary position of an error: the reader's byte index when it is a character
 /// boundary of the text, else its line and column.
 fn error_offset(text: &str, error: &serde_norway::Error) -> Option<usize> {
@@ -264,7 +275,12 @@ fn describe(work: &str, base: usize, error: &serde_norway::Error) -> (Diagnostic
                 Span::new(base + tree.node(first).key_span.start, base + tree.node(first).key_span.end),
                 "first given here",
             )
-            .with_help("a mapping has each key once: keep one of the two");
+            .with_help("a mapping has each key once: keep one of the two")
+            .with_payload(Payload::Duplicate {
+                namespace: "key".into(),
+                name: key.to_string(),
+                earlier_module: None,
+            });
             let lines = (line_of(block.start)..=line_of(block.end.saturating_sub(1).max(block.start))).collect();
             return (diagnostic, lines);
         }
@@ -290,7 +306,8 @@ fn describe(work: &str, base: usize, error: &serde_norway::Error) -> (Diagnostic
             Span::new(base + at, base + at + 3.min(work.len() - at)),
             "a second document starts here",
         )
-        .with_help("give the whole scenario as one YAML document: remove the `---` separators");
+        .with_help("give the whole scenario as one YAML document: remove the `---` separators")
+        .with_payload(invalid("more than one document"));
         return (diagnostic, markers);
     }
 
@@ -338,7 +355,8 @@ fn describe(work: &str, base: usize, error: &serde_norway::Error) -> (Diagnostic
         format!("invalid YAML: {problem}"),
         Span::new(base + span.start, base + span.end),
         label,
-    );
+    )
+    .with_payload(invalid(&problem));
     if let Some((at, message)) = secondary {
         diagnostic = diagnostic.with_secondary(Span::new(base + at, base + at), message);
     }

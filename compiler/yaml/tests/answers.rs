@@ -72,7 +72,7 @@ fn answers() {
                 actual.join("\n")
             ));
         }
-        let rendered = human::render(&FileReport { name: &name, text: &text, diagnostics: &diagnostics }, false);
+        let rendered = human::render(&FileReport::new(&name, &text, &diagnostics), false);
         compare(&path.with_extension("stderr"), &rendered, &mut problems);
         let tad = if model.scenario.is_some() { tad_yaml::to_tad(&model) } else { "(no scenario)\n".to_string() };
         if model.scenario.is_some() {

@@ -70,7 +70,7 @@ fn run(path: &Path) -> Result<(), String> {
         .collect();
     actual.sort();
     let name = path.file_name().unwrap().to_string_lossy().into_owned();
-    let report = FileReport { name: &name, text: &text, diagnostics: &emitted.diagnostics };
+    let report = FileReport::new(&name, &text, &emitted.diagnostics);
     let rendered = human::render(&report, false);
     let stderr = path.with_extension("stderr");
     if bless() {

@@ -5,17 +5,20 @@ use crate::{Diagnostic, Severity};
 use codespan_reporting::diagnostic::{
     Diagnostic as CsDiagnostic, Label as CsLabel, LabelStyle, Severity as CsSeverity,
 };
-use codespan_reporting::files::SimpleFile;
+use codespan_reporting::files::SimpleFiles;
 use codespan_reporting::term::{self, Config, termcolor};
 
 /// Render every diagnostic of one file. `color` chooses ANSI escapes.
 pub fn render(report: &FileReport<'_>, color: bool) -> String {
-    let file = SimpleFile::new(report.name, report.text);
+    let mut files = SimpleFiles::new();
+    let own = files.add(report.name, report.text);
+    let related: Vec<(crate::FileId, usize, usize)> =
+        report.related.iter().map(|s| (s.file, files.add(s.name, s.text), s.text.len())).collect();
     let config = Config::default();
     let mut buffer = if color { termcolor::Buffer::ansi() } else { termcolor::Buffer::no_color() };
     for diagnostic in report.diagnostics {
-        let converted = convert(diagnostic, report.text.len());
-        if term::emit_to_write_style(&mut buffer, &config, &file, &converted).is_err() {
+        let converted = convert(diagnostic, report, own, &related);
+        if term::emit_to_write_style(&mut buffer, &config, &files, &converted).is_err() {
             // A span outside the text would be a bug upstream; fall back to a plain line.
             let line = format!("{}[{}]: {}\n", diagnostic.severity.as_str(), diagnostic.code, diagnostic.message);
             buffer.as_mut_slice_fallback(line.as_bytes());
@@ -40,19 +43,34 @@ fn clamp(span: crate::Span, len: usize) -> std::ops::Range<usize> {
     span.start.min(end)..end
 }
 
-fn convert(d: &Diagnostic, len: usize) -> CsDiagnostic<()> {
+fn convert(
+    d: &Diagnostic,
+    report: &FileReport<'_>,
+    own: usize,
+    related: &[(crate::FileId, usize, usize)],
+) -> CsDiagnostic<usize> {
     let severity = match d.severity {
         Severity::Error => CsSeverity::Error,
         Severity::Warning => CsSeverity::Warning,
     };
+    let len = report.text.len();
     let mut labels =
-        vec![CsLabel::new(LabelStyle::Primary, (), clamp(d.primary.span, len)).with_message(&d.primary.message)];
-    labels.extend(
-        d.secondary
-            .iter()
-            .map(|l| CsLabel::new(LabelStyle::Secondary, (), clamp(l.span, len)).with_message(&l.message)),
-    );
-    let mut notes = d.notes.clone();
+        vec![CsLabel::new(LabelStyle::Primary, own, clamp(d.primary.span, len)).with_message(&d.primary.message)];
+    let mut notes = Vec::new();
+    for l in &d.secondary {
+        let place = match l.file {
+            None => Some((own, len)),
+            Some(f) if f == report.file => Some((own, len)),
+            Some(f) => related.iter().find(|(id, ..)| *id == f).map(|(_, index, len)| (*index, *len)),
+        };
+        match place {
+            Some((file, len)) => {
+                labels.push(CsLabel::new(LabelStyle::Secondary, file, clamp(l.span, len)).with_message(&l.message))
+            }
+            None => notes.push(l.message.clone()),
+        }
+    }
+    notes.extend(d.notes.iter().cloned());
     if let Some(help) = &d.help {
         notes.push(format!("help: {help}"));
     }

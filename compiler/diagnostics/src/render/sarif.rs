@@ -17,7 +17,7 @@ pub fn render(reports: &[FileReport<'_>], tool_version: &str) -> Value {
     let mut results = Vec::new();
     for report in reports {
         let index = LineIndex::new(report.text);
-        let location = |span: Span| physical_location(report, &index, span);
+        let location = |span: Span| physical_location(report.name, report.text, &index, span);
         for d in report.diagnostics {
             results.push(json!({
                 "ruleId": d.code.as_str(),
@@ -26,13 +26,19 @@ pub fn render(reports: &[FileReport<'_>], tool_version: &str) -> Value {
                 "message": { "text": message_text(d) },
                 "locations": [{ "physicalLocation": location(d.primary.span),
                                 "message": { "text": d.primary.message } }],
-                "relatedLocations": d.secondary.iter().enumerate().map(|(i, l)| json!({
-                    "id": i,
-                    "physicalLocation": location(l.span),
-                    "message": { "text": l.message },
-                })).collect::<Vec<_>>(),
+                "relatedLocations": d.secondary.iter().enumerate().filter_map(|(i, l)| {
+                    let source = report.source_of(l)?;
+                    let at = if source.file == report.file {
+                        location(l.span)
+                    } else {
+                        physical_location(source.name, source.text, &LineIndex::new(source.text), l.span)
+                    };
+                    Some(json!({ "id": i, "physicalLocation": at, "message": { "text": l.message } }))
+                }).collect::<Vec<_>>(),
+                "properties": { "payload": d.payload },
                 "fixes": d.fixes.iter().map(|f| json!({
                     "description": { "text": d.help.clone().unwrap_or_else(|| "apply the suggested replacement".into()) },
+                    "properties": { "applicability": f.applicability },
                     "artifactChanges": [{
                         "artifactLocation": { "uri": uri(report.name) },
                         "replacements": [{
@@ -107,9 +113,9 @@ fn region(text: &str, index: &LineIndex, span: Span) -> Value {
     })
 }
 
-fn physical_location(report: &FileReport<'_>, index: &LineIndex, span: Span) -> Value {
+fn physical_location(name: &str, text: &str, index: &LineIndex, span: Span) -> Value {
     json!({
-        "artifactLocation": { "uri": uri(report.name) },
-        "region": region(report.text, index, span),
+        "artifactLocation": { "uri": uri(name) },
+        "region": region(text, index, span),
     })
 }
