@@ -22,6 +22,8 @@ mod semantics;
 pub mod vocab;
 
 pub use completeness::{Class, Essential};
+pub use names::{Target, target};
+pub use semantics::lanes_counted_from_zero;
 pub use vocab::{Conflict, Entry, Layer, Lookup, Vocabulary};
 
 use tad_diagnostics::Diagnostic;

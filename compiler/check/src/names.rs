@@ -126,32 +126,11 @@ pub fn format_number(value: f64) -> String {
     if rounded.fract() == 0.0 { format!("{}", rounded as i64) } else { format!("{rounded:.1}") }
 }
 
-/// The relation names of declarations, which use the small fixed sets the checker reads.
-const LATERAL: &[&str] = &["left", "right", "same", "opposite"];
-const LONGITUDINAL: &[&str] = &["front", "behind", "same"];
-
 /// Names inside the file's own declarations.
 pub fn declarations(module: &tad_syntax::model::Module, vocabulary: &Vocabulary, out: &mut Vec<Diagnostic>) {
     for declaration in &module.declarations {
-        for a in &declaration.attrs {
-            if a.def.name == "aliases" {
-                continue;
-            }
+        for a in declaration.attrs.iter().filter(|a| a.def.name != "aliases") {
             attr(vocabulary, a, out);
-            if declaration.def.name == "relation" && matches!(a.def.name, "lateral" | "longitudinal") {
-                let allowed = if a.def.name == "lateral" { LATERAL } else { LONGITUDINAL };
-                if let Some(symbol) = a.symbol().filter(|s| !allowed.contains(&s.name.as_str())) {
-                    out.push(
-                        Diagnostic::new(
-                            Code::E0400,
-                            format!("unknown {} direction `{}`", a.def.name, symbol.name),
-                            symbol.span,
-                            format!("`{}` is one of {}", a.def.name, quoted(allowed)),
-                        )
-                        .with_note(format!("`{}` takes {}", a.def.name, quoted(allowed))),
-                    );
-                }
-            }
         }
     }
 }
@@ -180,21 +159,32 @@ pub fn scenario(scenario: &Scenario, vocabulary: &Vocabulary, out: &mut Vec<Diag
     resolved
 }
 
-/// A position's reference: a group of this scenario, `ego`, or a road element.
+/// What a position's reference names, in this order: an actor group of the scenario, a
+/// `reference` (`ego`) or a `road_element` (by name or alias); `None` for anything else.
+pub fn target(scenario: &Scenario, vocabulary: &Vocabulary, name: &str) -> Option<Target> {
+    if let Some(i) = scenario.actors.iter().position(|g| g.name.text == name) {
+        return Some(Target::Group(i));
+    }
+    if vocabulary.get("reference", name).is_some() {
+        return Some(Target::Ego);
+    }
+    vocabulary.get("road_element", name).map(|entry| Target::RoadElement(entry.name.clone()))
+}
+
+/// A position's reference, reported when it names nothing and when written as an alias.
 fn reference(
     scenario: &Scenario,
     vocabulary: &Vocabulary,
     symbol: &Symbol,
     out: &mut Vec<Diagnostic>,
 ) -> Option<Target> {
-    if let Some(i) = scenario.actors.iter().position(|g| g.name.text == symbol.name) {
-        return Some(Target::Group(i));
-    }
-    for (kind, is_ego) in [("reference", true), ("road_element", false)] {
-        if let Some(entry) = vocabulary.get(kind, &symbol.name) {
-            resolve_symbol(vocabulary, kind, "position", symbol, out);
-            return Some(if is_ego { Target::Ego } else { Target::RoadElement(entry.name.clone()) });
+    if let Some(target) = target(scenario, vocabulary, &symbol.name) {
+        match target {
+            Target::Group(_) => {}
+            Target::Ego => resolve_symbol(vocabulary, "reference", "position", symbol, out),
+            Target::RoadElement(_) => resolve_symbol(vocabulary, "road_element", "position", symbol, out),
         }
+        return Some(target);
     }
     let groups: Vec<&str> = scenario.actors.iter().map(|g| g.name.text.as_str()).collect();
     let mut candidates: Vec<&str> = groups.clone();

@@ -109,6 +109,13 @@ pub fn check(
     cycles(scenario, resolved, out);
 }
 
+/// Whether a scenario's lane indexes (the ego's and every group's) are counted from 0:
+/// one is 0, none is negative and all are below the road's `lanes`. They then mean one
+/// more each (W0403).
+pub fn lanes_counted_from_zero(indexes: &[i64], lanes: Option<i64>) -> bool {
+    indexes.contains(&0) && indexes.iter().all(|n| *n >= 0) && lanes.is_none_or(|l| indexes.iter().all(|n| *n < l))
+}
+
 fn lanes_check(
     scenario: &Scenario,
     lanes_attr: Option<&Attr>,
@@ -141,10 +148,8 @@ fn lanes_check(
         return;
     }
     // Lane indexes counted from 0 (another tool's convention) are shifted, not rejected.
-    let zero_based = indexed.iter().any(|(_, n, _)| *n == 0)
-        && indexed.iter().all(|(_, n, _)| *n >= 0)
-        && lanes.is_none_or(|l| indexed.iter().all(|(_, n, _)| *n < l));
-    if zero_based {
+    let indexes: Vec<i64> = indexed.iter().map(|(_, n, _)| *n).collect();
+    if lanes_counted_from_zero(&indexes, lanes) {
         let first = indexed.iter().find(|(_, n, _)| *n == 0).map(|(a, ..)| a.value_span).unwrap_or_default();
         let mut d =
             Diagnostic::new(Code::W0403, "lane indexes look counted from 0", first, "lane 0 does not exist in TAD")

@@ -1,7 +1,8 @@
 //! Lowering: the concrete tree to the scenario model, checking structure on the way.
 //!
 //! Structure means what the schema ([`crate::schema`]) says: one scenario per file, known
-//! sections and fields, each once, each value of the kind its field takes, units that fit.
+//! sections and fields, each once, each value of the kind its field takes (a word of its
+//! closed set, for a [`ValueType::Choice`] field), units that fit.
 //! Every problem is a coded diagnostic, and lowering always goes on: a bad field is left
 //! out of the model, a multi-word name is reported and then used joined, so one mistake
 //! does not hide the next.
@@ -350,6 +351,9 @@ impl Lowerer<'_> {
                 );
                 Val::Symbols(if none { Vec::new() } else { vec![symbol] })
             }
+            (ValueType::Choice(words_of_set), Value::Words(words)) => {
+                Val::Symbol(self.choice(def, words_of_set, words)?)
+            }
             (ValueType::Flag, Value::Words(words))
                 if words.len() == 1 && matches!(words[0].text.as_str(), "yes" | "no") =>
             {
@@ -434,6 +438,25 @@ impl Lowerer<'_> {
             );
         }
         Symbol { name, span }
+    }
+
+    /// A word of a closed set; another word is reported with the closest of the set.
+    fn choice(&mut self, def: &FieldDef, set: &'static [&'static str], words: &[Name]) -> Option<Symbol> {
+        let symbol = self.symbol_from_words(words);
+        if set.contains(&symbol.name.as_str()) {
+            return Some(symbol);
+        }
+        let listed = set.iter().map(|w| format!("`{w}`")).collect::<Vec<_>>().join(", ");
+        let d = Diagnostic::new(
+            Code::E0205,
+            format!("`{}` does not take `{}`", def.name, symbol.name),
+            symbol.span,
+            "not one of its words",
+        )
+        .with_note(format!("`{}` takes {listed}", def.name));
+        let (d, _) = suggest::unknown(d, def.name, &symbol.name, symbol.span, set.iter().copied());
+        self.report(d);
+        None
     }
 
     fn symbol_list(&mut self, def: &FieldDef, items: &[Value], span: Span) -> Option<Vec<Symbol>> {

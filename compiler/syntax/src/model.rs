@@ -153,6 +153,11 @@ impl Attr {
         }
     }
 
+    /// The word of a [`crate::schema::ValueType::Choice`] field as its enum.
+    pub fn choice<T: crate::schema::ClosedSet>(&self) -> Option<T> {
+        self.symbol().and_then(|s| T::parse(&s.name))
+    }
+
     pub fn quantity(&self) -> Option<Quantity> {
         match &self.value {
             Known::Given(Val::Quantity(q)) => Some(*q),
@@ -163,6 +168,7 @@ impl Attr {
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Val {
+    /// A name, or a word of a field's closed set (lowering checked it is one).
     Symbol(Symbol),
     Symbols(Vec<Symbol>),
     Integer(i64),

@@ -5,6 +5,11 @@
 //! "did you mean"), for the formatter's knowledge of lists, and for the field reference in
 //! `spec/language.md` (a test checks they agree). Vocabularies (which names are valid
 //! weather, behaviors, ...) are not here: they are declared in TAD in `stdlib/`.
+//!
+//! The few sets of words the compiler itself gives meaning to (a relation's [`Lateral`]
+//! and [`Longitudinal`] parts, a behavior's [`Motion`]) are closed sets: each is one Rust
+//! enum declared here with its words, a field takes it as [`ValueType::Choice`], lowering
+//! rejects any other word, and later stages (the IR) use the enum.
 
 /// The kind of value a field takes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -27,6 +32,8 @@ pub enum ValueType {
     Position,
     /// `yes` or `no`.
     Flag,
+    /// One word of a closed set ([`ClosedSet::NAMES`]): `left`, `turn_left`.
+    Choice(&'static [&'static str]),
 }
 
 impl ValueType {
@@ -42,7 +49,100 @@ impl ValueType {
             ValueType::Text => "a string",
             ValueType::Position => "a position",
             ValueType::Flag => "`yes` or `no`",
+            ValueType::Choice(_) => "a name",
         }
+    }
+}
+
+/// A closed set of words the compiler gives meaning to, as an enum.
+pub trait ClosedSet: Sized + Copy + 'static {
+    /// The words of the set, as written in TAD.
+    const NAMES: &'static [&'static str];
+    fn parse(word: &str) -> Option<Self>;
+    fn as_str(self) -> &'static str;
+}
+
+/// Declares an enum and its [`ClosedSet`] words.
+macro_rules! closed_set {
+    ($(#[$meta:meta])* $set:ident { $($(#[$vmeta:meta])* $variant:ident = $word:literal),+ $(,)? }) => {
+        $(#[$meta])*
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+        pub enum $set {
+            $($(#[$vmeta])* $variant),+
+        }
+
+        impl $set {
+            /// Every member, in the order of [`ClosedSet::NAMES`].
+            pub const ALL: &'static [$set] = &[$($set::$variant),+];
+        }
+
+        impl ClosedSet for $set {
+            const NAMES: &'static [&'static str] = &[$($word),+];
+
+            fn parse(word: &str) -> Option<$set> {
+                match word {
+                    $($word => Some($set::$variant),)+
+                    _ => None,
+                }
+            }
+
+            fn as_str(self) -> &'static str {
+                match self {
+                    $($set::$variant => $word),+
+                }
+            }
+        }
+    };
+}
+
+closed_set! {
+    /// Where a relation is across the road from its reference.
+    Lateral {
+        Left = "left",
+        Right = "right",
+        /// In the reference's lane.
+        Same = "same",
+        /// In the opposite direction's lanes.
+        Opposite = "opposite",
+    }
+}
+
+closed_set! {
+    /// Where a relation is along the road from its reference.
+    Longitudinal {
+        Front = "front",
+        Behind = "behind",
+        /// Beside it.
+        Same = "same",
+    }
+}
+
+closed_set! {
+    /// What a behavior does as motion, independent of who performs it: the class a
+    /// simulator backend maps to a driving or walking behavior.
+    Motion {
+        /// Keep moving along the lane.
+        Follow = "follow",
+        /// Halted for the moment in traffic.
+        Stop = "stop",
+        /// Standing at the curb or in a parking space.
+        Parked = "parked",
+        /// Standing still (a pedestrian or an animal).
+        Stand = "stand",
+        /// Walking along the road.
+        Walk = "walk",
+        /// Crossing the road.
+        Cross = "cross",
+        /// Grazing, barely moving.
+        Graze = "graze",
+        TurnLeft = "turn_left",
+        TurnRight = "turn_right",
+        UTurn = "u_turn",
+        ChangeLaneLeft = "change_lane_left",
+        ChangeLaneRight = "change_lane_right",
+        Overtake = "overtake",
+        Yield = "yield",
+        Reverse = "reverse",
     }
 }
 
@@ -93,6 +193,16 @@ macro_rules! field {
     };
     (essential $name:literal, $($rest:tt)*) => {
         FieldDef { essential: true, ..field!($name, $($rest)*) }
+    };
+    ($name:literal, one of $set:ident, $example:literal, $doc:literal) => {
+        FieldDef {
+            name: $name,
+            ty: ValueType::Choice(<$set as ClosedSet>::NAMES),
+            vocabulary: None,
+            example: $example,
+            doc: $doc,
+            essential: false,
+        }
     };
 }
 
@@ -228,12 +338,13 @@ pub const DECLARATIONS: &[&SectionDef] = &[
         "something an actor does",
         field!("performers", SymbolList in "actor_kind", "[vehicle]", "the actor kinds that can do it"),
         field!("max_speed", Speed, "0 km/h", "the highest speed compatible with it"),
+        field!("motion", one of Motion, "follow", "its class of motion, for simulators"),
     ),
     &declaration!(
         "relation",
         "where something is relative to a reference",
-        field!("lateral", Symbol, "left", "`left`, `right`, `same` or `opposite`"),
-        field!("longitudinal", Symbol, "front", "`front`, `behind` or `same`"),
+        field!("lateral", one of Lateral, "left", "across the road: `left`, `right`, `same` or `opposite`"),
+        field!("longitudinal", one of Longitudinal, "front", "along the road: `front`, `behind` or `same`"),
     ),
     &declaration!("road_element", "a point of the road a position can refer to"),
     &declaration!("reference", "a built-in reference point (`ego`)"),

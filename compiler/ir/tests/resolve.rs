@@ -1,0 +1,344 @@
+//! The IR of the examples and of small scenarios: concrete facts, and totality on mutated
+//! inputs. Files are loaded through `tad_db` as the command line does (prelude, `use`).
+
+use std::path::{Path, PathBuf};
+use tad_ir::*;
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn resolve_text(db: &mut tad_db::Database, path: &Path, text: &str) -> Option<Scenario> {
+    let file = db.set_file(path.to_path_buf(), text.to_string());
+    let module = &tad_db::analyze(db, file).module;
+    let vocabulary = &tad_db::vocabulary(db, file).vocabulary;
+    tad_ir::resolve(module, vocabulary)
+}
+
+fn example(relative: &str) -> Scenario {
+    let path = repo().join("examples").join(relative);
+    let text = std::fs::read_to_string(&path).unwrap();
+    resolve_text(&mut tad_db::Database::new(Default::default()), &path, &text).expect("a scenario")
+}
+
+/// A scenario file of its own, seeing the standard library only.
+fn inline(text: &str) -> Scenario {
+    let path = std::env::temp_dir().join("tadsl-ir-test").join("inline.tad");
+    resolve_text(&mut tad_db::Database::new(Default::default()), &path, text).expect("a scenario")
+}
+
+fn tad_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().path()).collect();
+    entries.sort();
+    for path in entries {
+        if path.is_dir() {
+            tad_files(&path, out);
+        } else if path.extension().is_some_and(|e| e == "tad") {
+            out.push(path);
+        }
+    }
+}
+
+fn examples() -> Vec<PathBuf> {
+    let mut files = Vec::new();
+    tad_files(&repo().join("examples"), &mut files);
+    assert!(files.len() >= 15, "the examples");
+    files
+}
+
+/// Every id in the IR indexes its table, and the placement order is a permutation of the
+/// groups with every group after the group it refers to (unless in a cycle).
+fn assert_consistent(s: &Scenario) {
+    let mut order: Vec<usize> = s.placement_order.iter().map(|id| id.index()).collect();
+    order.sort();
+    assert_eq!(order, (0..s.groups.len()).collect::<Vec<_>>());
+    let at = |id: GroupId| s.placement_order.iter().position(|&g| g == id);
+    for (id, group) in s.groups() {
+        if let Some(position) = group.position.given() {
+            if let Named::Known(relation) = position.relation.value {
+                assert!(s.entries.get(relation).is_some());
+            }
+            match position.reference.value {
+                Reference::Group(parent) => {
+                    assert!(s.group(parent).is_some());
+                    let in_cycle = {
+                        let mut current = parent;
+                        let mut steps = 0;
+                        loop {
+                            if current == id {
+                                break true;
+                            }
+                            match s.group(current).and_then(|g| g.position.given()).map(|p| &p.reference.value) {
+                                Some(Reference::Group(next)) if steps <= s.groups.len() => current = *next,
+                                _ => break false,
+                            }
+                            steps += 1;
+                        }
+                    };
+                    assert!(in_cycle || at(parent) < at(id), "{} before its reference", group.name);
+                }
+                Reference::RoadElement(element) => assert!(s.entries.get(element).is_some()),
+                Reference::Ego | Reference::Unknown(_) => {}
+            }
+        }
+        if let Some(Named::Known(t)) = group.actor_type.given() {
+            assert!(s.entries.get(*t).is_some());
+        }
+    }
+}
+
+fn known<K>(named: Option<&Named<K>>) -> bool {
+    !matches!(named, Some(Named::Unknown(_)))
+}
+
+#[test]
+fn every_example_resolves() {
+    let mut db = tad_db::Database::new(Default::default());
+    for path in examples() {
+        let text = std::fs::read_to_string(&path).unwrap();
+        let scenario = resolve_text(&mut db, &path, &text).unwrap_or_else(|| panic!("{}", path.display()));
+        assert_consistent(&scenario);
+        // the examples check without errors: every name they give is declared
+        let file = db.set_file(path.clone(), text);
+        assert!(!tad_db::check(&db, file).diagnostics.iter().any(|d| d.is_error()), "{}", path.display());
+        assert!(known(scenario.ego.behavior.given()), "{}", path.display());
+        for group in &scenario.groups {
+            assert!(known(group.actor_type.given()) && known(group.behavior.given()), "{}", path.display());
+            if let Some(position) = group.position.given() {
+                assert!(!matches!(position.reference.value, Reference::Unknown(_)), "{}", path.display());
+                assert!(known(Some(&position.relation.value)), "{}", path.display());
+            }
+        }
+    }
+}
+
+#[test]
+fn lanes_speeds_and_relations_of_an_example() {
+    let s = example("safety/lane_changing.tad");
+    assert_eq!(s.name.as_ref().map(|n| n.value.as_str()), Some("lane_changing"));
+    assert_eq!(s.road.lanes.get(), Some(4));
+    assert_eq!(s.ego.lane.get().map(Lane::index), Some(3));
+    let ego_speed = s.ego.speed.get().unwrap();
+    assert!((ego_speed.km_per_hour() - 96.6).abs() < 1e-9);
+    assert_eq!(s.entries.name(s.ego.behavior.given().unwrap()), "change_lane_left");
+    let behavior = s.entries.resolved(s.ego.behavior.given().unwrap()).unwrap();
+    assert_eq!(behavior.attrs.motion, Some(Motion::ChangeLaneLeft));
+    assert_eq!(behavior.module, "core");
+
+    let suv = &s.groups[s.group_named("merging_suv").unwrap().index()];
+    let position = suv.position.given().unwrap();
+    let relation = &s.entries.resolved(&position.relation.value).unwrap();
+    assert_eq!(relation.name, "left_front");
+    assert_eq!(relation.attrs.lateral, Some(Lateral::Left));
+    assert_eq!(relation.attrs.longitudinal, Some(Longitudinal::Front));
+    assert_eq!(position.reference.value, Reference::Ego);
+    // spans point into the file
+    let text = std::fs::read_to_string(repo().join("examples/safety/lane_changing.tad")).unwrap();
+    let span = position.relation.span;
+    assert_eq!(&text[span.start..span.end], "left_front");
+    let lane = suv.lane.span().unwrap();
+    assert_eq!(&text[lane.start..lane.end], "1");
+    let signs = s.road.signs.given().unwrap();
+    assert_eq!(signs.len(), 1);
+    assert_eq!(s.entries.name(&signs[0].value), "speed_limit_sign");
+}
+
+#[test]
+fn groups_are_placed_after_their_reference() {
+    let s = example("regions/yellowstone_bison_and_tractor.tad");
+    let rv = s.group_named("rv_ahead").unwrap();
+    let herd = s.group_named("bison_herd").unwrap();
+    assert_eq!(s.groups[herd.index()].position.given().unwrap().reference.value, Reference::Group(rv));
+    let tractor = &s.groups[s.group_named("oncoming_tractor").unwrap().index()];
+    assert!(tractor.lane.get().unwrap().is_opposite());
+    assert_eq!(s.groups[herd.index()].count(), Some(5));
+    // an animal from `use national_park`, its attributes in SI
+    let bison = s.entries.resolved(s.groups[herd.index()].actor_type.given().unwrap()).unwrap();
+    assert_eq!((bison.name.as_str(), bison.module.as_str()), ("bison", "national_park"));
+    assert_eq!(bison.attrs.length, Some(Metres(3.2)));
+    assert!((bison.attrs.max_speed.unwrap().0 - 55.0 / 3.6).abs() < 1e-9);
+    assert_eq!(s.entries.get(bison.attrs.kind.unwrap()).map(|k| k.name.as_str()), Some("animal"));
+    let light = s.entries.resolved(s.road.light.given().unwrap()).unwrap();
+    assert!(!light.attrs.present);
+}
+
+const FORWARD_REFERENCES: &str = r#"
+scenario aliases_and_references {
+  environment {
+    weather: sunny
+    time: unspecified
+  }
+  road {
+    type: crossroads
+    lanes: 2
+    direction: two_way
+    signs: [stop_sign]
+  }
+  ego {
+    behavior: drive
+    speed: 20 mph
+  }
+  actor follower: unspecified pedestrian {
+    behavior: walking
+    position: behind of leader
+    lane: -2
+  }
+  actor leader: buffalo {
+    position: front_left of zebra_crossing
+  }
+  actor lost: 2 sedan {
+    position: front of nowhere
+    speed: 5 m/s
+  }
+}
+"#;
+
+#[test]
+fn aliases_units_road_elements_and_forward_references() {
+    let s = inline(FORWARD_REFERENCES);
+    assert_consistent(&s);
+    // aliases resolve to the canonical entry and its typed attributes
+    assert_eq!(s.entries.name(s.environment.weather.given().unwrap()), "clear");
+    let road_type = s.entries.resolved(s.road.road_type.given().unwrap()).unwrap();
+    assert_eq!(road_type.name, "intersection");
+    assert!(road_type.attrs.junction && road_type.attrs.signalised);
+    assert!(matches!(s.environment.time, Field::Unspecified(_)));
+    assert_eq!(s.ego.lane, Field::Absent);
+    assert_eq!(s.road.context, Field::Absent);
+    // mph and m/s in SI
+    assert!((s.ego.speed.get().unwrap().0 - 20.0 * 1609.344 / 3600.0).abs() < 1e-9);
+    let lost = &s.groups[2];
+    assert_eq!(lost.speed.get(), Some(MetresPerSecond(5.0)));
+    assert_eq!(lost.count(), Some(2));
+    assert_eq!(lost.position.given().unwrap().reference.value, Reference::Unknown("nowhere".to_string()));
+
+    let follower = &s.groups[0];
+    assert!(matches!(follower.count, Field::Unspecified(_)));
+    assert_eq!(follower.count(), None);
+    assert_eq!(s.entries.name(follower.behavior.given().unwrap()), "walk");
+    assert_eq!(follower.lane.get().and_then(|l| Lane::new(l.index())), Lane::new(-2));
+    // `leader` is written after `follower`, which is positioned relative to it
+    assert_eq!(follower.position.given().unwrap().reference.value, Reference::Group(s.group_named("leader").unwrap()));
+    assert_eq!(s.placement_order.iter().map(|g| g.index()).collect::<Vec<_>>(), vec![1, 2, 0]);
+    // an alias of a road element, and an actor type of a module the file does not use
+    let leader = &s.groups[1];
+    let position = leader.position.given().unwrap();
+    let Reference::RoadElement(element) = position.reference.value else { panic!("a road element") };
+    assert_eq!(s.entries[element].name, "crosswalk");
+    assert_eq!(s.entries.name(&position.relation.value), "left_front");
+    assert_eq!(leader.actor_type.given(), Some(&Named::Unknown("buffalo".to_string())));
+    assert_eq!(leader.count(), Some(1));
+    assert_eq!(leader.count, Field::Absent);
+}
+
+#[test]
+fn cycles_and_lanes_counted_from_zero_resolve() {
+    let s = inline(
+        "scenario cycle {\n  road {\n    lanes: 3\n  }\n  ego {\n    lane: 0\n  }\n\
+         actor a: car {\n    position: front of b\n    lane: 2\n  }\n\
+         actor b: car {\n    position: front of a\n  }\n\
+         actor c: car {\n    position: behind of c\n  }\n}\n",
+    );
+    assert_consistent(&s);
+    assert_eq!(s.placement_order.iter().map(|g| g.index()).collect::<Vec<_>>(), vec![2, 0, 1]);
+    assert!(s.lanes_from_zero);
+    assert_eq!(s.ego.lane.get().map(Lane::index), Some(1));
+    assert_eq!(s.groups[0].lane.get().map(Lane::index), Some(3));
+    // lane 0 among 1-based lanes has no meaning
+    let s = inline("scenario zero {\n  ego {\n    lane: 0\n  }\n  actor a: car {\n    lane: -1\n  }\n}\n");
+    assert!(!s.lanes_from_zero);
+    assert_eq!(s.ego.lane, Field::Absent);
+}
+
+#[test]
+fn a_module_without_a_scenario_has_no_ir() {
+    let mut db = tad_db::Database::new(Default::default());
+    let path = repo().join("stdlib/national_park.tad");
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(resolve_text(&mut db, &path, &text).is_none());
+}
+
+/// xorshift64*: seeded, reproducible.
+struct Rng(u64);
+
+impl Rng {
+    fn below(&mut self, n: usize) -> usize {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 33) as usize % n.max(1)
+    }
+}
+
+const SNIPPETS: &[&str] = &[
+    "{",
+    "}",
+    "[",
+    "]",
+    ",",
+    ":",
+    "\"",
+    "\n",
+    " ",
+    "-",
+    "0",
+    "-7",
+    "km/h",
+    "mph",
+    "unspecified",
+    "of",
+    "ego",
+    "actor x: car {",
+];
+
+/// Byte edits, snippets, and one word replaced by another word of the file (which makes
+/// references point at other groups, cycles, unknown names and wrong kinds).
+fn mutate(rng: &mut Rng, text: &str) -> String {
+    let words: Vec<&str> =
+        text.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_')).filter(|w| !w.is_empty()).collect();
+    let mut out = text.to_string();
+    for _ in 0..1 + rng.below(3) {
+        let mut at = rng.below(out.len() + 1);
+        while !out.is_char_boundary(at) {
+            at -= 1;
+        }
+        match rng.below(4) {
+            0 => {
+                let end = (at + 1 + rng.below(12)).min(out.len());
+                if out.is_char_boundary(end) {
+                    out.replace_range(at..end, "");
+                }
+            }
+            1 => out.insert_str(at, SNIPPETS[rng.below(SNIPPETS.len())]),
+            _ => {
+                let (from, to) = (words[rng.below(words.len())], words[rng.below(words.len())]);
+                if let Some(found) = out[at..].find(from) {
+                    out.replace_range(at + found..at + found + from.len(), to);
+                }
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn mutated_examples_resolve_without_panic() {
+    const SEED: u64 = 0x7AD5_001A;
+    const MUTATIONS: usize = 300;
+    let mut db = tad_db::Database::new(Default::default());
+    let mut rng = Rng(SEED);
+    let files = examples();
+    for path in files.iter().step_by(3) {
+        let text = std::fs::read_to_string(path).unwrap();
+        let mutant_path = std::env::temp_dir().join("tadsl-ir-robustness").join(path.file_name().unwrap());
+        for iteration in 0..MUTATIONS {
+            let mutant = mutate(&mut rng, &text);
+            let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                if let Some(s) = resolve_text(&mut db, &mutant_path, &mutant) {
+                    assert_consistent(&s);
+                }
+            }));
+            assert!(result.is_ok(), "seed {SEED:#x}, {} iteration {iteration}:\n{mutant}", path.display());
+        }
+    }
+}
