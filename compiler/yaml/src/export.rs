@@ -1,9 +1,10 @@
 //! A model written in TrafficAlign's YAML form, with extra keys for what that form lacks.
 
+use crate::dialect::{self, Form, Place, Tad};
 use crate::norm::{self, normalize};
 use serde_norway::Value;
 use tad_syntax::model::*;
-use tad_syntax::schema::Unit;
+use tad_syntax::schema::{Unit, ValueType};
 
 const IN: &str = "    ";
 
@@ -38,142 +39,31 @@ pub fn export(module: &Module, src: &str) -> String {
         return out;
     };
     let w = Writer { src };
-    if let Some(name) = &s.name {
-        out.push_str(&format!("scenario: {}\n", scalar(&name.text)));
-    }
-    if !module.uses.is_empty() {
-        let paths: Vec<String> = module
-            .uses
-            .iter()
-            .map(|u| flow_item(&u.path.iter().map(|n| n.text.as_str()).collect::<Vec<_>>().join(".")))
-            .collect();
-        out.push_str(&format!("use: [{}]\n", paths.join(", ")));
-    }
-    if let Some(source) = s.section("source") {
-        out.push_str("source:");
-        let mut body = String::new();
-        for a in &source.attrs {
-            let value = match a.def.name {
-                "video" | "description" => w.text(&a.value, 1),
-                "time" => w.quantity(a),
-                "frame" => w.integer(&a.value),
-                _ => w.symbol(Field::Plain, &a.value),
-            };
-            body.push_str(&format!("{IN}{}: {value}\n", a.def.name));
-        }
-        block(&mut out, &body);
-    }
-    if let Some(env) = s.section("environment") {
-        out.push_str("environment:");
-        let mut body = String::new();
-        for a in &env.attrs {
-            body.push_str(&format!("{IN}{}: {}\n", a.def.name, w.symbol(Field::Plain, &a.value)));
-        }
-        block(&mut out, &body);
-    }
-    if let Some(road) = s.section("road") {
-        out.push_str("road_network:");
-        let mut body = String::new();
-        let mut line = |key: &str, value: String| body.push_str(&format!("{IN}{key}: {value}\n"));
-        if let Some(a) = road.attr("type") {
-            line("road_type", w.symbol(Field::RoadType, &a.value));
-        }
-        if let Some(a) = road.attr("context") {
-            line("road_context", w.symbol(Field::Plain, &a.value));
-        }
-        if let Some(a) = road.attr("signs") {
-            let (single, full) = match &a.value {
-                Known::Unspecified => ("unspecified".to_string(), None),
-                Known::Given(Val::Symbols(list)) => match list.as_slice() {
-                    [] => ("none".to_string(), None),
-                    [one] if one.name != "none" => (w.name(Field::Plain, &one.name), None),
-                    [first, ..] => (w.name(Field::Plain, &first.name), Some(w.symbols(&a.value))),
-                },
-                other => (w.symbol(Field::Plain, other), None),
-            };
-            line("traffic_sign", single);
-            if let Some(full) = full {
-                line("signs", full);
+    for row in dialect::written(Place::Top) {
+        match row.tad {
+            Tad::ScenarioName => {
+                if let Some(name) = &s.name {
+                    out.push_str(&format!("{}: {}\n", row.key, scalar(&name.text)));
+                }
             }
-        }
-        if let Some(a) = road.attr("light") {
-            line("traffic_light", w.symbol(Field::Plain, &a.value));
-        }
-        if let Some(a) = road.attr("lanes") {
-            line("lane_number", w.integer(&a.value));
-        }
-        if let Some(a) = road.attr("direction") {
-            line("one-way_or_two-way", w.symbol(Field::Direction, &a.value));
-        }
-        for field in ["special_lanes", "traffic", "hazards", "roadworks", "emergency_vehicles", "roadside"] {
-            if let Some(a) = road.attr(field) {
-                let value = if field == "traffic" { w.symbol(Field::Plain, &a.value) } else { w.symbols(&a.value) };
-                line(field, value);
+            Tad::Uses => {
+                if !module.uses.is_empty() {
+                    let paths: Vec<String> = module
+                        .uses
+                        .iter()
+                        .map(|u| flow_item(&u.path.iter().map(|n| n.text.as_str()).collect::<Vec<_>>().join(".")))
+                        .collect();
+                    out.push_str(&format!("{}: [{}]\n", row.key, paths.join(", ")));
+                }
             }
-        }
-        block(&mut out, &body);
-    }
-    let ego = s.section("ego");
-    if ego.is_none() && s.actors.is_empty() {
-        // the paper's form always has `actors`; it also makes an empty scenario a scenario
-        out.push_str("actors: {}\n");
-    } else {
-        out.push_str("actors:\n");
-        if let Some(ego) = ego {
-            out.push_str(&format!("{IN}ego_vehicle:\n"));
-            let mut line = |key: &str, value: String| out.push_str(&format!("{IN}{IN}{key}: {value}\n"));
-            line("type", "none".into());
-            if let Some(a) = ego.attr("behavior") {
-                line("behavior", w.symbol(Field::Plain, &a.value));
+            Tad::Block(place) => {
+                if let Some(section) = place.section().and_then(|def| s.section(def.name)) {
+                    out.push_str(&format!("{}:", row.key));
+                    block(&mut out, &w.keys(place, &|field| section.attr(field), None, 1));
+                }
             }
-            if let Some(a) = ego.attr("speed") {
-                line("speed", w.quantity(a));
-            }
-            line("position_target", "unspecified".into());
-            line("position_relation", "unspecified".into());
-            if let Some(a) = ego.attr("lane") {
-                line("lane_index", w.integer(&a.value));
-            }
-        }
-        for actor in &s.actors {
-            out.push_str(&format!("{IN}{}:\n", scalar(&actor.name.text)));
-            let mut line = |key: &str, value: String| out.push_str(&format!("{IN}{IN}{key}: {value}\n"));
-            let kind = match &actor.kind.value {
-                Known::Given(kind) => w.name(Field::Plain, &kind.name),
-                Known::Unspecified => "unspecified".into(),
-            };
-            line("type", kind);
-            match &actor.count {
-                Some(Spanned { value: Known::Given(n), .. }) => line("number", n.to_string()),
-                Some(Spanned { value: Known::Unspecified, .. }) => line("number", "unspecified".into()),
-                None => {}
-            }
-            if let Some(a) = actor.attr("behavior") {
-                line("behavior", w.symbol(Field::Plain, &a.value));
-            }
-            if let Some(a) = actor.attr("speed") {
-                line("speed", w.quantity(a));
-            }
-            if let Some(a) = actor.attr("position") {
-                let (target, relation) = match &a.value {
-                    Known::Given(Val::Position(p)) => {
-                        let target = if p.reference.name == "ego" {
-                            "ego_vehicle".to_string()
-                        } else if s.actor(&p.reference.name).is_some() {
-                            scalar(&p.reference.name)
-                        } else {
-                            w.name(Field::Plain, &p.reference.name)
-                        };
-                        (target, w.name(Field::Plain, &p.relation.name))
-                    }
-                    _ => ("unspecified".to_string(), "unspecified".to_string()),
-                };
-                line("position_target", target);
-                line("position_relation", relation);
-            }
-            if let Some(a) = actor.attr("lane") {
-                line("lane_index", w.integer(&a.value));
-            }
+            Tad::Actors => w.actors(&mut out, row.key, s),
+            Tad::Field(..) | Tad::Type | Tad::Count | Tad::Nothing => {}
         }
     }
     out
@@ -189,8 +79,9 @@ fn block(out: &mut String, body: &str) {
     }
 }
 
+/// How a name is spelt in the paper's form.
 #[derive(Clone, Copy, PartialEq)]
-enum Field {
+enum Spelling {
     Plain,
     RoadType,
     Direction,
@@ -201,19 +92,138 @@ struct Writer<'a> {
 }
 
 impl Writer<'_> {
+    /// The lines of the keys `export` writes at `place` (indented `depth` levels), for the
+    /// fields `attr` finds; `group` is the actor group at an actor's place.
+    fn keys<'m>(
+        &self,
+        place: Place,
+        attr: &dyn Fn(&str) -> Option<&'m Attr>,
+        group: Option<(&ActorGroup, &Scenario)>,
+        depth: usize,
+    ) -> String {
+        let mut body = String::new();
+        let mut line = |key: &str, value: String| body.push_str(&format!("{}{key}: {value}\n", IN.repeat(depth)));
+        // a field an earlier key summarised, and the full value when the summary is not all of it
+        let mut summarised: Option<(&str, Option<String>)> = None;
+        for row in dialect::written(place) {
+            if let Form::Fixed(value) = row.form {
+                line(row.key, value.to_string());
+                continue;
+            }
+            match (row.tad, group) {
+                (Tad::Type, Some((actor, _))) => {
+                    let kind = match &actor.kind.value {
+                        Known::Given(kind) => self.name(Spelling::Plain, &kind.name),
+                        Known::Unspecified => "unspecified".into(),
+                    };
+                    line(row.key, kind);
+                }
+                (Tad::Count, Some((actor, _))) => match &actor.count {
+                    Some(Spanned { value: Known::Given(n), .. }) => line(row.key, n.to_string()),
+                    Some(Spanned { value: Known::Unspecified, .. }) => line(row.key, "unspecified".into()),
+                    None => {}
+                },
+                (Tad::Field(_, field), _) => {
+                    let Some(a) = attr(field) else { continue };
+                    if let Some((done, full)) = &summarised
+                        && *done == field
+                    {
+                        if let Some(full) = full {
+                            line(row.key, full.clone());
+                        }
+                        continue;
+                    }
+                    let value = match row.form {
+                        Form::SignSummary => {
+                            let (single, full) = self.summary(&a.value);
+                            summarised = Some((field, full));
+                            single
+                        }
+                        Form::RoadType => self.symbol(Spelling::RoadType, &a.value),
+                        Form::Direction => self.symbol(Spelling::Direction, &a.value),
+                        Form::Relation | Form::Target => {
+                            let (target, relation) = self.position(&a.value, group.map(|(_, s)| s));
+                            if row.form == Form::Target { target } else { relation }
+                        }
+                        _ => match a.def.ty {
+                            ValueType::SymbolList => self.symbols(&a.value),
+                            ValueType::Integer => self.integer(&a.value),
+                            ValueType::Speed | ValueType::Duration | ValueType::Length => self.quantity(a),
+                            ValueType::Text => self.text(&a.value, depth),
+                            _ => self.symbol(Spelling::Plain, &a.value),
+                        },
+                    };
+                    line(row.key, value);
+                }
+                _ => {}
+            }
+        }
+        body
+    }
+
+    /// `actors`: the ego vehicle first, then one key per actor group.
+    fn actors(&self, out: &mut String, key: &str, s: &Scenario) {
+        let ego = s.section("ego");
+        if ego.is_none() && s.actors.is_empty() {
+            // the paper's form always has `actors`; it also makes an empty scenario a scenario
+            out.push_str(&format!("{key}: {{}}\n"));
+            return;
+        }
+        out.push_str(&format!("{key}:\n"));
+        if let Some(ego) = ego {
+            out.push_str(&format!("{IN}{}:\n", dialect::EGO_KEY));
+            out.push_str(&self.keys(Place::Ego, &|field| ego.attr(field), None, 2));
+        }
+        for actor in &s.actors {
+            out.push_str(&format!("{IN}{}:\n", scalar(&actor.name.text)));
+            out.push_str(&self.keys(Place::Actor, &|field| actor.attr(field), Some((actor, s)), 2));
+        }
+    }
+
+    /// The paper's one-sign summary of a list of signs, and the full list when the summary
+    /// does not hold it all.
+    fn summary(&self, v: &Known<Val>) -> (String, Option<String>) {
+        match v {
+            Known::Unspecified => ("unspecified".to_string(), None),
+            Known::Given(Val::Symbols(list)) => match list.as_slice() {
+                [] => ("none".to_string(), None),
+                [one] if one.name != "none" => (self.name(Spelling::Plain, &one.name), None),
+                [first, ..] => (self.name(Spelling::Plain, &first.name), Some(self.symbols(v))),
+            },
+            other => (self.symbol(Spelling::Plain, other), None),
+        }
+    }
+
+    /// A position as the paper's `position_target` and `position_relation`.
+    fn position(&self, v: &Known<Val>, s: Option<&Scenario>) -> (String, String) {
+        match v {
+            Known::Given(Val::Position(p)) => {
+                let target = if p.reference.name == "ego" {
+                    dialect::EGO_KEY.to_string()
+                } else if s.is_some_and(|s| s.actor(&p.reference.name).is_some()) {
+                    scalar(&p.reference.name)
+                } else {
+                    self.name(Spelling::Plain, &p.reference.name)
+                };
+                (target, self.name(Spelling::Plain, &p.relation.name))
+            }
+            _ => ("unspecified".to_string(), "unspecified".to_string()),
+        }
+    }
+
     /// A name in the paper's spelling when that reads back as the same name, else as is.
-    fn name(&self, field: Field, name: &str) -> String {
+    fn name(&self, field: Spelling, name: &str) -> String {
         let spaced = match (field, name) {
             (_, "t_intersection") => "t-intersection".to_string(),
             (_, "y_intersection") => "y-intersection".to_string(),
-            (Field::Direction, _) => name.replace('_', "-"),
+            (Spelling::Direction, _) => name.replace('_', "-"),
             _ => name.replace('_', " "),
         };
         let reads_back = normalize(&spaced) == name
             && !norm::is_unspecified(&spaced)
             && !norm::is_none_word(&spaced)
             && match field {
-                Field::RoadType => {
+                Spelling::RoadType => {
                     norm::split_road_type(&spaced)
                         == norm::RoadTypeParts { road_type: Some(spaced.clone()), ..Default::default() }
                 }
@@ -222,7 +232,7 @@ impl Writer<'_> {
         if reads_back || name == "none" { flow_item(&spaced) } else { flow_item(name) }
     }
 
-    fn symbol(&self, field: Field, v: &Known<Val>) -> String {
+    fn symbol(&self, field: Spelling, v: &Known<Val>) -> String {
         match v {
             Known::Given(Val::Symbol(s)) => self.name(field, &s.name),
             other => self.other(other),
@@ -232,7 +242,7 @@ impl Writer<'_> {
     fn symbols(&self, v: &Known<Val>) -> String {
         match v {
             Known::Given(Val::Symbols(list)) => {
-                let items: Vec<String> = list.iter().map(|s| self.name(Field::Plain, &s.name)).collect();
+                let items: Vec<String> = list.iter().map(|s| self.name(Spelling::Plain, &s.name)).collect();
                 format!("[{}]", items.join(", "))
             }
             other => self.other(other),

@@ -2,21 +2,6 @@
 
 use std::ops::Range;
 
-/// Top-level keys of the YAML forms this crate reads (TrafficAlign, TrafficComposer, and
-/// the extra keys `export` writes).
-pub(crate) const TOP_LEVEL_KEYS: &[&str] = &[
-    "environment",
-    "road_network",
-    "actors",
-    "participant",
-    "weather",
-    "lane_num",
-    "traffic_signal",
-    "source",
-    "scenario",
-    "use",
-];
-
 /// Where the YAML is inside a raw LLM answer, as a byte range of `answer`:
 ///
 /// 1. between `<YAML>` and `</YAML>` (case-insensitive). With several blocks the last one
@@ -60,9 +45,9 @@ pub fn extract(answer: &str) -> Option<Range<usize>> {
     unmarked(answer)
 }
 
+/// Whether `key` is a top-level key of the forms this crate reads.
 fn is_known_key(key: &str) -> bool {
-    let key = crate::norm::normalize(key);
-    TOP_LEVEL_KEYS.contains(&key.as_str()) || key == "participants"
+    crate::dialect::is_top_level(key, true)
 }
 
 /// Whether some line of `text` starts (after indentation) with a known top-level key.

@@ -1,5 +1,6 @@
 //! YAML (TrafficAlign or TrafficComposer form) to the scenario model.
 
+use crate::dialect::{self, Dialect, Form, Origin, Place, Tad};
 use crate::norm::{self, normalize};
 use crate::scan::{self, Tree};
 use crate::{extract, parse};
@@ -7,19 +8,8 @@ use serde_norway::Value;
 use tad_diagnostics::{Applicability, Code, Diagnostic, Payload, Span};
 use tad_syntax::cst::{Name, Use};
 use tad_syntax::model::*;
-use tad_syntax::schema::{self, FieldDef, SectionDef, Unit};
+use tad_syntax::schema::{self, FieldDef, SectionDef, Unit, ValueType};
 use tad_syntax::suggest;
-
-/// Which notation a YAML answer is written in, detected from its keys.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Dialect {
-    /// TrafficAlign's translation prompt: `environment`, `road_network` (a mapping),
-    /// `actors`. Also what [`crate::export`] writes.
-    TrafficAlign,
-    /// TrafficComposer's IR: `participant`, and in its older form a top-level `weather`,
-    /// `lane_num`, `traffic_signal` and `road_network` as a list of strings.
-    TrafficComposer,
-}
 
 /// How strongly a key states a field, when several keys state the same one.
 const DERIVED: u8 = 0; // read out of another value's text (`two-way straight road`)
@@ -84,12 +74,9 @@ pub fn lower(text: &str) -> (Module, Vec<Diagnostic>) {
 
 /// The dialect of a top-level mapping.
 pub fn detect(map: &serde_norway::Mapping) -> Dialect {
-    let composer = map.iter().any(|(k, v)| {
-        let key = normalize(&key_text(k));
-        matches!(key.as_str(), "participant" | "participants" | "lane_num" | "traffic_signal" | "weather")
-            || (key == "road_network" && matches!(untag(v), Value::Sequence(_)))
-    });
-    if composer { Dialect::TrafficComposer } else { Dialect::TrafficAlign }
+    map.iter()
+        .find_map(|(k, v)| dialect::identifies(&key_text(k), matches!(untag(v), Value::Sequence(_))))
+        .unwrap_or(Dialect::TrafficAlign)
 }
 
 fn untag(v: &Value) -> &Value {
@@ -186,90 +173,6 @@ struct At {
     value_span: Span,
 }
 
-const TOP_KEYS: &[&str] = &[
-    "environment",
-    "road_network",
-    "actors",
-    "source",
-    "scenario",
-    "use",
-    "participant",
-    "weather",
-    "time",
-    "lane_num",
-    "traffic_signal",
-    "traffic_light",
-    "traffic_sign",
-];
-const ENVIRONMENT_KEYS: &[&str] = &["weather", "time"];
-const ROAD_KEYS: &[&str] = &[
-    "road_type",
-    "road_context",
-    "traffic_sign",
-    "traffic_light",
-    "lane_number",
-    "one-way_or_two-way",
-    "special_lane",
-    "special_lanes",
-    "signs",
-    "traffic",
-    "hazards",
-    "roadworks",
-    "emergency_vehicles",
-    "roadside",
-];
-const EGO_KEYS: &[&str] = &[
-    "type",
-    "behavior",
-    "current_behavior",
-    "speed",
-    "position_target",
-    "position_relation",
-    "lane_index",
-    "lane_idx",
-];
-const ACTOR_KEYS: &[&str] = &[
-    "type",
-    "number",
-    "behavior",
-    "current_behavior",
-    "speed",
-    "position_target",
-    "position_relation",
-    "lane_index",
-    "lane_idx",
-];
-const SOURCE_KEYS: &[&str] = &["video", "time", "frame", "region", "description"];
-
-/// TAD field names and other common spellings, and the YAML key to use instead.
-const KEY_HINTS: &[(&str, &str)] = &[
-    ("lanes", "lane_number"),
-    ("num_lanes", "lane_number"),
-    ("number_of_lanes", "lane_number"),
-    ("type", "road_type"),
-    ("context", "road_context"),
-    ("direction", "one-way_or_two-way"),
-    ("one_way_or_two_way", "one-way_or_two-way"),
-    ("light", "traffic_light"),
-    ("traffic_lights", "traffic_light"),
-    ("traffic_signs", "traffic_sign"),
-    ("time_of_day", "time"),
-    ("behaviour", "behavior"),
-    ("current_behaviour", "current_behavior"),
-    ("action", "behavior"),
-    ("lane", "lane_index"),
-    ("position", "position_relation"),
-    ("relation", "position_relation"),
-    ("target", "position_target"),
-    ("count", "number"),
-    ("kind", "type"),
-    ("velocity", "speed"),
-    ("road", "road_network"),
-    ("ego", "actors"),
-    ("npcs", "actors"),
-    ("participants", "participant"),
-];
-
 fn same_val(a: &Known<Val>, b: &Known<Val>) -> bool {
     fn names(s: &[Symbol]) -> Vec<&str> {
         let mut v: Vec<&str> = s.iter().map(|s| s.name.as_str()).collect();
@@ -350,15 +253,15 @@ impl Importer<'_> {
         }
     }
 
-    fn unknown_key(&mut self, key: &str, at: At, context: &str, known: &[&str]) {
+    fn unknown_key(&mut self, key: &str, at: At, context: &str, place: Place) {
         let mut d = Diagnostic::new(
             Code::E0302,
             format!("unknown key `{key}` in {context}"),
             at.key_span,
             "not a key of this form",
         );
-        let normalized = normalize(key);
-        let hint = KEY_HINTS.iter().find(|(from, to)| *from == normalized && known.contains(to)).map(|(_, to)| *to);
+        let known = dialect::offered(place);
+        let hint = dialect::hint(place, key);
         if let Some(guess) = hint.or_else(|| suggest::closest(key, known.iter().copied())) {
             let sure = if hint.is_some() { Applicability::MachineApplicable } else { Applicability::MaybeIncorrect };
             d = d.with_help(format!("did you mean `{guess}`?")).with_fix(at.key_span, guess, sure);
@@ -782,10 +685,37 @@ impl Importer<'_> {
         }
     }
 
-    fn set_quantity(&mut self, target: Target, field: &str, key: &str, v: &Value, at: At, unit: Unit) {
+    #[allow(clippy::too_many_arguments)]
+    fn set_quantity(&mut self, target: Target, field: &str, key: &str, v: &Value, at: At, unit: Unit, rank: u8) {
         let example = if unit == Unit::Seconds { "195 s" } else { "30 km/h" };
         if let Some(q) = self.quantity(key, v, at, unit, example) {
-            self.set(target, field, key, at, known_map(q, Val::Quantity), PAPER, false);
+            self.set(target, field, key, at, known_map(q, Val::Quantity), rank, false);
+        }
+    }
+
+    /// A key that states a TAD field, read by its YAML form or else by the field's kind.
+    fn field(&mut self, target: Target, row: &dialect::Key, key: &str, v: &Value, at: At) {
+        let Some(def) = row.field() else { return };
+        let rank = if row.origin == Origin::Extra { EXTRA } else { PAPER };
+        match row.form {
+            Form::Weather => self.weather(target, key, v, at),
+            Form::RoadType => self.road_type(target, key, v, at),
+            Form::SignSummary => self.set_traffic_sign(target, key, v, at),
+            Form::Value | Form::Direction => match def.ty {
+                ValueType::Symbol => self.set_symbol(target, def.name, key, v, at, rank),
+                ValueType::SymbolList => self.set_symbols(target, def.name, key, v, at, rank),
+                ValueType::Integer => self.set_integer(target, def.name, key, v, at, rank),
+                ValueType::Speed => self.set_quantity(target, def.name, key, v, at, Unit::KilometresPerHour, rank),
+                ValueType::Duration => self.set_quantity(target, def.name, key, v, at, Unit::Seconds, rank),
+                ValueType::Text => {
+                    if let Some(t) = self.text_value(key, v, at) {
+                        self.set(target, def.name, key, at, known_map(t, Val::Text), rank, false);
+                    }
+                }
+                ValueType::Length | ValueType::Position | ValueType::Flag | ValueType::Choice(_) => {}
+            },
+            // read by their place: the parts of a position, blocks, fixed values
+            Form::Mapping | Form::Relation | Form::Target | Form::Fixed(_) => {}
         }
     }
 
@@ -823,34 +753,22 @@ impl Importer<'_> {
             self.dialect = detect(map);
         }
         for (key, v, at) in self.entries(value, root, "the scenario") {
-            match normalize(&key).as_str() {
-                "environment" => self.environment(v, at),
-                "road_network" => self.road_network(v, at),
-                "actors" | "participant" | "participants" => self.actors(&key, v, at),
-                "source" => self.source(v, at),
-                "scenario" => self.scenario_name(&key, v, at),
-                "use" => self.uses(&key, v, at),
-                "weather" => {
-                    let env = Target::Section(self.section_at("environment", at));
-                    self.weather(env, &key, v, at);
+            let Some(row) = dialect::find(Place::Top, &key) else {
+                self.unknown_key(&key, at, "the scenario", Place::Top);
+                continue;
+            };
+            match row.tad {
+                Tad::Block(Place::Environment) => self.environment(v, at),
+                Tad::Block(Place::Road) => self.road_network(v, at),
+                Tad::Block(Place::Source) => self.source(v, at),
+                Tad::Actors => self.actors(&key, v, at),
+                Tad::ScenarioName => self.scenario_name(&key, v, at),
+                Tad::Uses => self.uses(&key, v, at),
+                Tad::Field(section, _) => {
+                    let target = Target::Section(self.section_at(section.name, at));
+                    self.field(target, row, &key, v, at);
                 }
-                "time" => {
-                    let env = Target::Section(self.section_at("environment", at));
-                    self.set_symbol(env, "time", &key, v, at, PAPER);
-                }
-                "lane_num" => {
-                    let road = Target::Section(self.section_at("road", at));
-                    self.set_integer(road, "lanes", &key, v, at, PAPER);
-                }
-                "traffic_signal" | "traffic_light" => {
-                    let road = Target::Section(self.section_at("road", at));
-                    self.set_symbol(road, "light", &key, v, at, PAPER);
-                }
-                "traffic_sign" => {
-                    let road = Target::Section(self.section_at("road", at));
-                    self.set_traffic_sign(road, &key, v, at);
-                }
-                _ => self.unknown_key(&key, at, "the scenario", TOP_KEYS),
+                Tad::Block(_) | Tad::Type | Tad::Count | Tad::Nothing => {}
             }
         }
         self.resolve_positions();
@@ -860,7 +778,7 @@ impl Importer<'_> {
     /// `scenario: { environment: ..., ... }` or any single wrapper key around the form.
     fn unwrap<'v>(&mut self, value: &'v Value, at: At) -> (&'v Value, At) {
         let Value::Mapping(map) = untag(value) else { return (value, at) };
-        let known = |k: &Value| extract::TOP_LEVEL_KEYS.contains(&normalize(&key_text(k)).as_str());
+        let known = |k: &Value| dialect::is_top_level(&key_text(k), false);
         if map.len() != 1 {
             return (value, at);
         }
@@ -940,10 +858,9 @@ impl Importer<'_> {
         }
         let env = Target::Section(self.section_at("environment", at));
         for (key, v, at) in self.entries(v, at, "environment") {
-            match normalize(&key).as_str() {
-                "weather" => self.weather(env, &key, v, at),
-                "time" => self.set_symbol(env, "time", &key, v, at, PAPER),
-                _ => self.unknown_key(&key, at, "`environment`", ENVIRONMENT_KEYS),
+            match dialect::find(Place::Environment, &key) {
+                Some(row) => self.field(env, row, &key, v, at),
+                None => self.unknown_key(&key, at, "`environment`", Place::Environment),
             }
         }
     }
@@ -1011,20 +928,9 @@ impl Importer<'_> {
             _ => {}
         }
         for (key, v, at) in self.entries(v, at, "road_network") {
-            match normalize(&key).as_str() {
-                "road_type" => self.road_type(road, &key, v, at),
-                "road_context" => self.set_symbol(road, "context", &key, v, at, PAPER),
-                "traffic_sign" => self.set_traffic_sign(road, &key, v, at),
-                "traffic_light" => self.set_symbol(road, "light", &key, v, at, PAPER),
-                "lane_number" | "lane_num" => self.set_integer(road, "lanes", &key, v, at, PAPER),
-                "one_way_or_two_way" => self.set_symbol(road, "direction", &key, v, at, PAPER),
-                "special_lane" => self.set_symbols(road, "special_lanes", &key, v, at, PAPER),
-                "special_lanes" | "signs" | "hazards" | "roadworks" | "emergency_vehicles" | "roadside" => {
-                    let field = normalize(&key);
-                    self.set_symbols(road, &field, &key, v, at, EXTRA)
-                }
-                "traffic" => self.set_symbol(road, "traffic", &key, v, at, EXTRA),
-                _ => self.unknown_key(&key, at, "`road_network`", ROAD_KEYS),
+            match dialect::find(Place::Road, &key) {
+                Some(row) => self.field(road, row, &key, v, at),
+                None => self.unknown_key(&key, at, "`road_network`", Place::Road),
             }
         }
     }
@@ -1153,17 +1059,9 @@ impl Importer<'_> {
         }
         let source = Target::Section(self.section_at("source", at));
         for (key, v, at) in self.entries(v, at, "source") {
-            match normalize(&key).as_str() {
-                "video" | "description" => {
-                    if let Some(t) = self.text_value(&key, v, at) {
-                        let field = normalize(&key);
-                        self.set(source, &field, &key, at, known_map(t, Val::Text), PAPER, false);
-                    }
-                }
-                "time" => self.set_quantity(source, "time", &key, v, at, Unit::Seconds),
-                "frame" => self.set_integer(source, "frame", &key, v, at, PAPER),
-                "region" => self.set_symbol(source, "region", &key, v, at, PAPER),
-                _ => self.unknown_key(&key, at, "`source`", SOURCE_KEYS),
+            match dialect::find(Place::Source, &key) {
+                Some(row) => self.field(source, row, &key, v, at),
+                None => self.unknown_key(&key, at, "`source`", Place::Source),
             }
         }
     }
@@ -1186,8 +1084,12 @@ impl Importer<'_> {
         let ego = Target::Section(self.section_at("ego", at));
         let mut position: Option<Span> = None;
         for (key, v, at) in self.entries(v, at, ego_key) {
-            match normalize(&key).as_str() {
-                "type" => {
+            let Some(row) = dialect::find(Place::Ego, &key) else {
+                self.unknown_key(&key, at, &format!("`{ego_key}`"), Place::Ego);
+                continue;
+            };
+            match row.tad {
+                Tad::Type => {
                     let fine =
                         self.missing(v, false) || matches!(untag(v), Value::String(s) if norm::is_ego(&normalize(s)));
                     if !fine {
@@ -1198,21 +1100,19 @@ impl Importer<'_> {
                         );
                     }
                 }
-                "number" => {
+                Tad::Count => {
                     let fine = self.missing(v, false) || untag(v).as_i64() == Some(1);
                     if !fine {
                         self.ignored(at.value_span, "there is one ego vehicle".to_string(), "remove `number`");
                     }
                 }
-                "behavior" | "current_behavior" => self.set_symbol(ego, "behavior", &key, v, at, PAPER),
-                "speed" => self.set_quantity(ego, "speed", &key, v, at, Unit::KilometresPerHour),
-                "lane_index" | "lane_idx" => self.set_integer(ego, "lane", &key, v, at, PAPER),
-                "position_target" | "position_relation" => {
+                Tad::Nothing => {
                     if !self.missing(v, false) {
                         position = Some(position.map_or(at.value_span, |p: Span| p.to(at.value_span)));
                     }
                 }
-                _ => self.unknown_key(&key, at, &format!("`{ego_key}`"), EGO_KEYS),
+                Tad::Field(..) => self.field(ego, row, &key, v, at),
+                Tad::Block(_) | Tad::Actors | Tad::ScenarioName | Tad::Uses => {}
             }
         }
         if let Some(span) = position {
@@ -1265,23 +1165,25 @@ impl Importer<'_> {
         let mut relation = None;
         let mut target = None;
         for (key, v, at) in self.entries(v, at, actor_key) {
-            match normalize(&key).as_str() {
-                "type" => {
+            let Some(row) = dialect::find(Place::Actor, &key) else {
+                self.unknown_key(&key, at, &format!("actor `{actor_key}`"), Place::Actor);
+                continue;
+            };
+            match (row.tad, row.form) {
+                (Tad::Type, _) => {
                     if let Some(kind) = self.symbol(&key, v, at, "sedan") {
                         self.actors[index].kind = Some(Spanned { value: kind, span: at.value_span });
                     }
                 }
-                "number" => {
+                (Tad::Count, _) => {
                     if let Some(count) = self.integer(&key, v, at, "1") {
                         self.actors[index].count = Some(Spanned { value: count, span: at.value_span });
                     }
                 }
-                "behavior" | "current_behavior" => self.set_symbol(me, "behavior", &key, v, at, PAPER),
-                "speed" => self.set_quantity(me, "speed", &key, v, at, Unit::KilometresPerHour),
-                "lane_index" | "lane_idx" => self.set_integer(me, "lane", &key, v, at, PAPER),
-                "position_relation" => relation = self.part(&key, v, at),
-                "position_target" => target = self.part(&key, v, at),
-                _ => self.unknown_key(&key, at, &format!("actor `{actor_key}`"), ACTOR_KEYS),
+                (_, Form::Relation) => relation = self.part(&key, v, at),
+                (_, Form::Target) => target = self.part(&key, v, at),
+                (Tad::Field(..), _) => self.field(me, row, &key, v, at),
+                _ => {}
             }
         }
         self.pending.push(PendingPosition { actor: index, relation, target });

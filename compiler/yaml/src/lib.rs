@@ -12,8 +12,10 @@
 //! panics; problems are diagnostics (codes `E03xx`/`W03xx`) whose spans are byte ranges
 //! of the text given to [`lower`], so they point at the YAML lines.
 //!
-//! The two dialects and how their values map to TAD are described in `spec/yaml.md`.
+//! The two dialects' keys are one table, [`dialect::KEYS`]; how their values map to TAD
+//! is described in `spec/yaml.md`.
 
+pub mod dialect;
 mod export;
 mod extract;
 mod import;
@@ -22,9 +24,10 @@ mod parse;
 mod scan;
 mod tad;
 
+pub use dialect::Dialect;
 pub use export::export;
 pub use extract::extract;
-pub use import::{Dialect, lower};
+pub use import::lower;
 pub use tad::to_tad;
 
 /// The dialect of the YAML in `answer`, if there is a YAML mapping to judge.
