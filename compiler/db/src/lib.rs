@@ -273,6 +273,14 @@ pub fn check(db: &dyn Db, file: SourceFile) -> Checked {
     checked
 }
 
+/// The scenario of `file`, resolved: names to typed entries, quantities to SI, groups in
+/// placement order. `None` when the file has no scenario. Every later stage (backends,
+/// layout, runtime) reads this, never the string-keyed model.
+#[salsa::tracked(returns(ref))]
+pub fn resolve(db: &dyn Db, file: SourceFile) -> Option<tad_ir::Scenario> {
+    tad_ir::resolve(&analyze(db, file).module, &vocabulary(db, file).vocabulary)
+}
+
 /// Where the host reads modules from.
 pub trait FileSystem {
     /// The text of the file at `path`, if it is a readable file.

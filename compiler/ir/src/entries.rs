@@ -83,8 +83,10 @@ pub struct Entry<K> {
     pub name: String,
     /// The module that declares it: `core`, `national_park`, or the file's own name.
     pub module: String,
-    /// The whole declaration, in the declaring module's text.
+    /// The whole declaration, in the declaring module's file.
     pub span: Span,
+    /// The declaring module's file.
+    pub file: tad_diagnostics::FileId,
     pub attrs: K,
 }
 

@@ -203,7 +203,13 @@ fn table<K: Kind>(vocabulary: &Vocabulary, read: impl Fn(&tad_check::Entry) -> K
     let entries = vocabulary
         .entries(K::KIND)
         .iter()
-        .map(|e| Entry { name: e.name.clone(), module: e.module.clone(), span: e.declaration.span, attrs: read(e) })
+        .map(|e| Entry {
+            name: e.name.clone(),
+            module: e.module.clone(),
+            span: e.declaration.span,
+            file: e.file,
+            attrs: read(e),
+        })
         .collect();
     Table { entries }
 }
