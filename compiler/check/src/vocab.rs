@@ -207,7 +207,8 @@ impl Vocabulary {
     pub fn layered(layers: Vec<Arc<Layer>>) -> (Vocabulary, Vec<Conflict>) {
         let mut hidden = HashSet::new();
         let mut conflicts = Vec::new();
-        for (l, layer) in layers.iter().enumerate() {
+        // the first layer has nothing before it to conflict with
+        for (l, layer) in layers.iter().enumerate().skip(1) {
             for (kind, table) in &layer.kinds {
                 for (i, entry) in table.entries.iter().enumerate() {
                     let earlier = layers[..l].iter().enumerate().find_map(|(k, earlier)| {
@@ -256,17 +257,21 @@ impl Vocabulary {
         for (l, layer) in self.layers.iter().enumerate() {
             let Some((kind, table)) = layer.kinds.get_key_value(kind) else { continue };
             if let Some(&i) = table.names.get(name)
-                && !self.hidden.contains(&(l, *kind, i))
+                && !self.is_hidden(l, kind, i)
             {
                 return Lookup::Exact(&table.entries[i]);
             }
             if let Some(&i) = table.aliases.get(name)
-                && !self.hidden.contains(&(l, *kind, i))
+                && !self.is_hidden(l, kind, i)
             {
                 return Lookup::Alias(&table.entries[i]);
             }
         }
         Lookup::Unknown
+    }
+
+    fn is_hidden(&self, layer: usize, kind: &'static str, index: usize) -> bool {
+        !self.hidden.is_empty() && self.hidden.contains(&(layer, kind, index))
     }
 
     pub fn get(&self, kind: &str, name: &str) -> Option<&Entry> {

@@ -281,6 +281,12 @@ pub fn resolve(db: &dyn Db, file: SourceFile) -> Option<tad_ir::Scenario> {
     tad_ir::resolve(&analyze(db, file).module, &vocabulary(db, file).vocabulary)
 }
 
+/// Whether a source is the prelude's (embedded, or `stdlib/core.tad` checked from disk),
+/// which must not see the prelude a second time.
+fn is_prelude_source(path: &Path, text: &str) -> bool {
+    module_name(path) == PRELUDE && stdlib::source(PRELUDE) == Some(text)
+}
+
 /// Where the host reads modules from.
 pub trait FileSystem {
     /// The text of the file at `path`, if it is a readable file.
@@ -395,7 +401,10 @@ impl Database {
 
     fn register(&mut self, path: PathBuf, text: String, language: Language) -> SourceFile {
         let id = FileId(self.by_id.len() as u32);
-        let file = SourceFile::new(self, id, path.clone(), text, language, Imports::default());
+        // the usual imports from the start, so a file without `use` needs no new revision
+        let prelude = self.stdlib.get(PRELUDE).copied().filter(|_| !is_prelude_source(&path, &text));
+        let imports = Imports { prelude, modules: BTreeMap::new() };
+        let file = SourceFile::new(self, id, path.clone(), text, language, imports);
         self.files.insert(path, file);
         self.by_id.push(file);
         file
@@ -410,7 +419,11 @@ impl Database {
         visiting.push(file);
         let path = file.path(self).clone();
         let is_stdlib = path.starts_with(STDLIB_PREFIX);
-        let prelude = self.stdlib.get(PRELUDE).copied().filter(|p| *p != file && !self.is_prelude_copy(file));
+        let prelude = self
+            .stdlib
+            .get(PRELUDE)
+            .copied()
+            .filter(|p| *p != file && !is_prelude_source(file.path(self), file.text(self)));
         let names: Vec<String> = analyze(self, file)
             .module
             .uses
@@ -442,12 +455,6 @@ impl Database {
         if file.imports(self) != &imports {
             file.set_imports(self).to(imports);
         }
-    }
-
-    /// Whether `file` is a copy of the prelude's source (`stdlib/core.tad` checked from
-    /// disk), which must not see the prelude a second time.
-    fn is_prelude_copy(&self, file: SourceFile) -> bool {
-        module_name(file.path(self)) == PRELUDE && stdlib::source(PRELUDE) == Some(file.text(self).as_str())
     }
 
     pub fn set_options(&mut self, options: Options) {

@@ -2,13 +2,16 @@
 //!
 //! The peer parses the same scenarios written as JSON, measured in the same run, so the
 //! figures compare as a ratio whatever the machine. Each measurement is the best of
-//! `runs` repetitions.
+//! `runs` repetitions. The full check runs through the database, as the CLI and the
+//! language server do; the incremental row edits one line of a 2,000-line file and
+//! re-checks it, against checking that file from scratch.
 
 use crate::Status;
 use crate::corpus;
 use std::hint::black_box;
 use std::path::Path;
 use std::time::{Duration, Instant};
+use tad_db::{Database, Language, NoFs};
 
 fn best_of(runs: usize, mut f: impl FnMut()) -> Duration {
     (0..runs.max(1))
@@ -66,13 +69,21 @@ pub fn run(n: usize, seed: u64, examples: Option<&Path>, runs: usize) -> Status 
             black_box(tad_syntax::analyze(text));
         }
     });
-    // the whole checker: structure, names against the standard vocabulary, semantics and
-    // completeness (the vocabulary is built once, as the database does)
+    // the whole checker through the database: structure, names against the standard
+    // vocabulary (each module's layer built once), semantics and completeness
+    let full = best_of(runs, || {
+        let mut db = Database::new(tad_check::Options::default());
+        for (i, text) in tad.iter().enumerate() {
+            let file = db.set_source(format!("/bench/{i}.tad").into(), text.to_string(), Language::Tad, &NoFs);
+            black_box(tad_db::check(&db, file));
+        }
+    });
+    // the same checker without the database, for the database's own cost
     let prelude = tad_db::stdlib::source(tad_db::PRELUDE).unwrap_or_default();
     let (core, _) = tad_syntax::analyze(prelude);
     let (vocabulary, _) = tad_check::Vocabulary::build([(tad_db::PRELUDE, &core)]);
     let options = tad_check::Options::default();
-    let full = best_of(runs, || {
+    let direct = best_of(runs, || {
         for text in &tad {
             let (module, _) = tad_syntax::analyze(text);
             black_box(tad_check::check(&module, &vocabulary, &options));
@@ -92,26 +103,32 @@ pub fn run(n: usize, seed: u64, examples: Option<&Path>, runs: usize) -> Status 
     Row { what: "peer: serde_json::Value (JSON)".into(), items: n, bytes: json_bytes, time: peer }.print(None);
     Row { what: "lex".into(), items: n, bytes: tad_bytes, time: lex }.print(Some(peer));
     Row { what: "parse (lex+parse+lower)".into(), items: n, bytes: tad_bytes, time: check }.print(Some(peer));
-    Row { what: "check (parse+names+semantics)".into(), items: n, bytes: tad_bytes, time: full }.print(Some(peer));
+    Row { what: "check, no database".into(), items: n, bytes: tad_bytes, time: direct }.print(Some(peer));
+    Row { what: "check through the database".into(), items: n, bytes: tad_bytes, time: full }.print(Some(peer));
     Row { what: "fmt (parse+print)".into(), items: n, bytes: tad_bytes, time: format }.print(Some(peer));
+    incremental(runs);
 
     if let Some(dir) = examples {
         let (paths, errors) = crate::files::collect(&[dir.to_path_buf()]);
         for e in &errors {
             eprintln!("error: {e}");
         }
-        let texts: Vec<String> = paths.iter().filter_map(|p| crate::files::read(p).ok()).map(|i| i.text).collect();
+        let inputs: Vec<crate::files::Input> = paths.iter().filter_map(|p| crate::files::read(p).ok()).collect();
+        let texts: Vec<&str> = inputs.iter().map(|i| i.text.as_str()).collect();
         if texts.is_empty() {
             eprintln!("error: no .tad files in `{}`", dir.display());
             return Status::Usage;
         }
         // Repeat the examples to a measurable amount of work.
-        let repeat = (tad_bytes / texts.iter().map(String::len).sum::<usize>().max(1)).max(1);
-        let bytes = texts.iter().map(String::len).sum::<usize>() * repeat;
+        let repeat = (tad_bytes / texts.iter().map(|t| t.len()).sum::<usize>().max(1)).max(1);
+        let bytes = texts.iter().map(|t| t.len()).sum::<usize>() * repeat;
+        // through the database as `tadslc check` does, a fresh one per repetition
         let time = best_of(runs, || {
             for _ in 0..repeat {
-                for text in &texts {
-                    black_box(tad_syntax::analyze(text));
+                let mut db = Database::new(tad_check::Options::default());
+                for input in &inputs {
+                    let file = crate::check::register(&mut db, input);
+                    black_box(tad_db::check(&db, file));
                 }
             }
         });
@@ -124,4 +141,58 @@ pub fn run(n: usize, seed: u64, examples: Option<&Path>, runs: usize) -> Status 
         .print(None);
     }
     Status::Ok
+}
+
+/// A scenario of about `lines` lines: the usual sections and many actor groups.
+fn long_scenario(lines: usize) -> String {
+    let mut text = String::from(
+        "scenario long {\n  environment {\n    weather: clear\n    time: daytime\n  }\n  road {\n    type: straight_road\n    lanes: 3\n    direction: two_way\n  }\n  ego {\n    behavior: go_forward\n    speed: 40 km/h\n    lane: 2\n  }\n",
+    );
+    let mut i = 0;
+    while text.lines().count() + 8 < lines {
+        text.push_str(&format!(
+            "  // group {i}\n  actor g{i}: 2 sedan {{\n    behavior: go_forward\n    speed: 30 km/h\n    position: front of ego\n    lane: {}\n  }}\n",
+            1 + i % 3
+        ));
+        i += 1;
+    }
+    text.push_str("}\n");
+    text
+}
+
+/// Re-checking a 2,000-line file after a one-line edit, against checking it from scratch.
+fn incremental(runs: usize) {
+    let text = long_scenario(2000);
+    let lines = text.lines().count();
+    let path = std::path::PathBuf::from("/bench/long.tad");
+    let scratch = best_of(runs, || {
+        let mut db = Database::new(tad_check::Options::default());
+        let file = db.set_source(path.clone(), text.clone(), Language::Tad, &NoFs);
+        black_box(tad_db::check(&db, file));
+    });
+    let mut db = Database::new(tad_check::Options::default());
+    let file = db.set_source(path.clone(), text.clone(), Language::Tad, &NoFs);
+    black_box(tad_db::check(&db, file));
+    // edit the speed of one group in the middle, back and forth
+    let at = text.find("speed: 30 km/h").map_or(0, |first| first + text.len() / 2);
+    let at = text[at..].find("speed: 30 km/h").map_or(0, |i| at + i);
+    let edits = [text[..at].to_string() + &text[at..].replacen("30 km/h", "31 km/h", 1), text.clone()];
+    let mut times: Vec<Duration> = Vec::new();
+    for k in 0..200 {
+        let edited = edits[k % 2].clone();
+        let start = Instant::now();
+        let file = db.set_source(path.clone(), edited, Language::Tad, &NoFs);
+        black_box(tad_db::check(&db, file));
+        times.push(start.elapsed());
+    }
+    times.sort();
+    let p50 = times[times.len() / 2];
+    let p99 = times[times.len() * 99 / 100];
+    println!(
+        "incremental: one-line edit of a {lines}-line file, re-checked: p50 {:.3} ms, p99 {:.3} ms; from scratch {:.3} ms ({:.2}x of it)",
+        p50.as_secs_f64() * 1e3,
+        p99.as_secs_f64() * 1e3,
+        scratch.as_secs_f64() * 1e3,
+        p50.as_secs_f64() / scratch.as_secs_f64().max(1e-9)
+    );
 }

@@ -43,7 +43,68 @@ fn json_output_has_the_documented_shape() {
     let text = std::fs::read_to_string(repo().join("tests/ui/structure/unknown_field.tad")).unwrap();
     assert_eq!(&text[start as usize..end as usize], "wether");
     assert_eq!(d["fixes"][0]["replacement"], "weather");
+    assert_eq!(d["fixes"][0]["applicability"], "maybe-incorrect");
+    assert_eq!(
+        d["payload"],
+        serde_json::json!({
+            "kind": "unknown", "namespace": "field", "name": "wether", "candidates": ["weather"], "module": null
+        })
+    );
     assert_eq!(d["help"], "did you mean `weather`?");
+}
+
+#[test]
+fn every_diagnostic_of_every_fixture_has_a_payload_and_every_fix_an_applicability() {
+    let mut yaml: Vec<String> = Vec::new();
+    for dir in ["tests/yaml/answers", "tests/yaml/paper", "tests/yaml/cli"] {
+        for entry in std::fs::read_dir(repo().join(dir)).into_iter().flatten().flatten() {
+            let name = entry.file_name().to_string_lossy().into_owned();
+            if name.ends_with(".yaml") || name.ends_with(".yml") {
+                yaml.push(format!("{dir}/{name}"));
+            }
+        }
+    }
+    yaml.sort();
+    let mut args = vec!["check", "--format", "json", "tests/ui"];
+    args.extend(yaml.iter().map(String::as_str));
+    let dashcam = ["check", "--format", "json", "--profile", "dashcam", "tests/ui/check/dashcam.tad"];
+    let output = format!("{}{}", stdout(&tadslc(&args, "")), stdout(&tadslc(&dashcam, "")));
+    let mut codes = std::collections::BTreeSet::new();
+    for line in output.lines() {
+        let file: Value = serde_json::from_str(line).expect("valid JSON line");
+        for d in file["diagnostics"].as_array().unwrap() {
+            codes.insert(d["code"].as_str().unwrap().to_string());
+            let kind = d["payload"]["kind"].as_str().unwrap_or("");
+            assert!(!kind.is_empty() && kind != "none", "{} in {}: no payload: {d}", d["code"], file["file"]);
+            for fix in d["fixes"].as_array().unwrap() {
+                let applicability = fix["applicability"].as_str().unwrap_or("");
+                assert!(
+                    ["machine-applicable", "maybe-incorrect", "has-placeholders"].contains(&applicability),
+                    "{fix}"
+                );
+            }
+        }
+    }
+    // the fixtures cover every code but the backend's (tested with the backend)
+    let missing: Vec<&str> = tad_diagnostics::Code::ALL
+        .iter()
+        .map(|c| c.as_str())
+        .filter(|c| !c.starts_with("E07") && !c.starts_with("W07") && !codes.contains(*c))
+        .collect();
+    assert!(missing.is_empty(), "codes without a fixture in the JSON run: {missing:?}");
+}
+
+#[test]
+fn a_label_in_another_file_names_that_file() {
+    let out = tadslc(&["check", "--format", "json", "tests/ui/check/declarations.tad"], "");
+    let file: Value = serde_json::from_str(stdout(&out).trim()).expect("one JSON object");
+    let conflict = file["diagnostics"].as_array().unwrap().iter().find(|d| d["code"] == "E0405").expect("E0405");
+    assert_eq!(conflict["labels"][0]["file"], "<stdlib>/core.tad", "{conflict}");
+    assert_eq!(conflict["payload"]["kind"], "duplicate");
+    assert_eq!(conflict["payload"]["earlier_module"], "core");
+    let line = conflict["labels"][0]["span"]["start"]["line"].as_u64().unwrap() as usize;
+    let core = std::fs::read_to_string(repo().join("stdlib/core.tad")).unwrap();
+    assert!(core.lines().nth(line - 1).unwrap().starts_with("weather clear"), "line {line}");
 }
 
 #[test]
@@ -178,9 +239,11 @@ fn bench_reports_throughput_against_the_peer() {
         "peer: serde_json::Value",
         "lex",
         "parse (lex+parse+lower)",
-        "check (parse+names+semantics)",
+        "check, no database",
+        "check through the database",
         "fmt (parse+print)",
         "check examples",
+        "incremental: one-line edit",
     ] {
         assert!(text.contains(row), "{row} missing from\n{text}");
     }

@@ -96,6 +96,10 @@ fn run_fixture(path: &Path) -> Result<(), Failed> {
     actual.sort();
     let wanted = expected(&text);
     let mut problems = Vec::new();
+    // every diagnostic states its fact for programs too
+    for d in diagnostics.iter().filter(|d| d.payload.is_none()) {
+        problems.push(format!("{} `{}` has no payload", d.code, d.message));
+    }
     if actual != wanted {
         let show = |v: &[(String, String, String)]| {
             v.iter().map(|(s, c, r)| annotation(s, c, r)).collect::<Vec<_>>().join("\n")
