@@ -4,9 +4,7 @@
 use std::path::{Path, PathBuf};
 use tad_ir::*;
 
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
+use tad_test_support::repo;
 
 fn resolve_text(db: &mut tad_db::Database, path: &Path, text: &str) -> Option<Scenario> {
     let file = db.set_file(path.to_path_buf(), text.to_string());
@@ -27,21 +25,8 @@ fn inline(text: &str) -> Scenario {
     resolve_text(&mut tad_db::Database::new(Default::default()), &path, text).expect("a scenario")
 }
 
-fn tad_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().path()).collect();
-    entries.sort();
-    for path in entries {
-        if path.is_dir() {
-            tad_files(&path, out);
-        } else if path.extension().is_some_and(|e| e == "tad") {
-            out.push(path);
-        }
-    }
-}
-
 fn examples() -> Vec<PathBuf> {
-    let mut files = Vec::new();
-    tad_files(&repo().join("examples"), &mut files);
+    let files = tad_test_support::examples();
     assert!(files.len() >= 15, "the examples");
     files
 }

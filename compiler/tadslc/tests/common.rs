@@ -4,9 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
-pub fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").canonicalize().expect("repository root")
-}
+pub use tad_test_support::{files, repo};
 
 /// Run `tadslc` from the repository root, with `stdin` as standard input.
 pub fn tadslc(args: &[&str], stdin: &str) -> Output {
@@ -40,26 +38,10 @@ pub fn stderr(output: &Output) -> String {
 
 /// A fresh, empty directory under the target directory.
 pub fn scratch(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("scratch directory");
-    dir
+    tad_test_support::scratch(Path::new(env!("CARGO_TARGET_TMPDIR")), name)
 }
 
 /// Every `*.tad` file under `dir`, sorted.
 pub fn tad_files(dir: &Path) -> Vec<PathBuf> {
-    let mut out = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for entry in std::fs::read_dir(&d).into_iter().flatten().flatten() {
-            let path = entry.path();
-            if path.is_dir() {
-                stack.push(path);
-            } else if path.extension().is_some_and(|e| e == "tad") {
-                out.push(path);
-            }
-        }
-    }
-    out.sort();
-    out
+    files(dir, "tad")
 }

@@ -15,9 +15,7 @@ use std::path::{Path, PathBuf};
 use tad_diagnostics::LineIndex;
 use tad_diagnostics::render::human;
 
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").canonicalize().expect("the repository")
-}
+use tad_test_support::repo;
 
 fn root() -> PathBuf {
     repo().join("tests/ui")

@@ -1,0 +1,123 @@
+//! The Scenic oracle: `shared/scenic/scenic_check.py` run by a Python with Scenic 3.1.1,
+//! on the CARLA maps of `shared/maps/CARLA`.
+//!
+//! Found through `TADSL_SCENIC_PYTHON` (else `.venv-scenic` in the repository, which
+//! `.ci/run` creates), `TADSL_SCENIC_CHECK` and `TADSL_SCENIC_MAPS` (else `../shared`).
+//! Without it a test skips with a message on standard error and a line in its output,
+//! unless `TAD_REQUIRE_SCENIC=1`, which makes the absence a failure.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use crate::{repo, shared};
+
+/// A Python that imports `scenic`.
+pub fn python() -> Option<PathBuf> {
+    let candidates =
+        [std::env::var_os("TADSL_SCENIC_PYTHON").map(PathBuf::from), Some(repo().join(".venv-scenic/bin/python"))];
+    candidates.into_iter().flatten().find(|p| {
+        p.is_file() && Command::new(p).args(["-c", "import scenic"]).output().is_ok_and(|o| o.status.success())
+    })
+}
+
+/// The oracle script.
+pub fn check_script() -> Option<PathBuf> {
+    let candidates =
+        [std::env::var_os("TADSL_SCENIC_CHECK").map(PathBuf::from), shared().map(|s| s.join("scenic/scenic_check.py"))];
+    candidates.into_iter().flatten().find(|p| p.is_file())
+}
+
+/// The CARLA maps.
+pub fn shared_maps() -> Option<PathBuf> {
+    let candidates = [std::env::var_os("TADSL_SCENIC_MAPS").map(PathBuf::from), shared().map(|s| s.join("maps/CARLA"))];
+    candidates.into_iter().flatten().find(|p| p.join("Town10HD.xodr").is_file())
+}
+
+/// A writable directory (under `base`) of links to the maps, so Scenic's map cache
+/// (`.snet`) lands there and is reused across runs.
+pub fn map_dir(base: &Path) -> Option<PathBuf> {
+    let shared = shared_maps()?;
+    let dir = base.join("scenic-maps");
+    std::fs::create_dir_all(&dir).ok()?;
+    for entry in std::fs::read_dir(&shared).ok()?.flatten() {
+        let path = entry.path();
+        if path.extension().is_some_and(|e| e == "xodr") {
+            let link = dir.join(entry.file_name());
+            if !link.exists() {
+                #[cfg(unix)]
+                let made = std::os::unix::fs::symlink(&path, &link);
+                #[cfg(not(unix))]
+                let made = std::fs::copy(&path, &link).map(|_| ());
+                // another test may have made it meanwhile
+                if made.is_err() && !link.exists() {
+                    return None;
+                }
+            }
+        }
+    }
+    Some(dir)
+}
+
+/// The oracle's python, script and map directory; `None` (after saying so where a user
+/// sees it) when it is not installed, a panic when `TAD_REQUIRE_SCENIC=1`.
+pub fn oracle(base: &Path) -> Option<(PathBuf, PathBuf, PathBuf)> {
+    let found = (|| Some((python()?, check_script()?, map_dir(base)?)))();
+    if found.is_none() {
+        let why = "the Scenic oracle is not available (set TADSL_SCENIC_PYTHON to a python with scenic 3.1.1, \
+                   or run `bash ../shared/scenic/setup.sh .venv-scenic`; ../shared/scenic/scenic_check.py and \
+                   ../shared/maps/CARLA must exist)";
+        if std::env::var_os("TAD_REQUIRE_SCENIC").is_some_and(|v| v == "1") {
+            panic!("{why}");
+        }
+        // stdout is shown by `cargo test` for a failing test only; stderr always reaches
+        // the terminal, so the skip is seen
+        eprintln!("warning: SKIPPED: {why}");
+        println!("SKIPPED: {why}");
+    }
+    found
+}
+
+/// Run the oracle on `files` in one process; one JSON object per file.
+pub fn run(python: &Path, check: &Path, args: &[&str], files: &[PathBuf]) -> Vec<serde_json::Value> {
+    // One Scenic process at a time: they share the map cache (`.snet`), which the first
+    // compile of a map writes.
+    static ORACLE: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    let _turn = ORACLE.lock().unwrap_or_else(|e| e.into_inner());
+    let output = Command::new(python)
+        .arg(check)
+        .args(args)
+        .args(files)
+        .env("SCENIC_MAP_CACHE", "none")
+        .output()
+        .expect("the oracle runs");
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let records: Vec<serde_json::Value> =
+        stdout.lines().filter(|l| l.starts_with('{')).filter_map(|l| serde_json::from_str(l).ok()).collect();
+    for line in stdout.lines() {
+        println!("{line}");
+    }
+    if records.len() != files.len() {
+        panic!(
+            "the oracle printed {} records for {} files\n--- stdout\n{stdout}\n--- stderr\n{}",
+            records.len(),
+            files.len(),
+            String::from_utf8_lossy(&output.stderr)
+        );
+    }
+    records
+}
+
+/// The oracle records of programs that did not compile, sample, or simulate at least
+/// `steps` steps without an error, as JSON lines.
+pub fn failures(records: &[serde_json::Value], steps: u64) -> Vec<String> {
+    records
+        .iter()
+        .filter(|r| {
+            !(r["compiled"] == true
+                && r["sampled"] == true
+                && r["error"].is_null()
+                && r["sim_steps"].as_u64().is_some_and(|s| s >= steps))
+        })
+        .map(|r| r.to_string())
+        .collect()
+}
