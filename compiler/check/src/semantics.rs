@@ -9,6 +9,11 @@ use crate::names::{Resolved, Target, format_number, quoted};
 use crate::vocab::{Entry, Vocabulary};
 use crate::{Options, Profile};
 use tad_diagnostics::{Applicability, Code, Diagnostic, Payload, Span};
+use tad_syntax::schema::{Lateral, Longitudinal};
+
+/// The fields of a relation declaration.
+const LATERAL: &str = "lateral";
+const LONGITUDINAL: &str = "longitudinal";
 use tad_syntax::model::{Attr, Known, Scenario, Val};
 
 /// The ego vehicle's actor kind.
@@ -84,7 +89,7 @@ pub fn check(
         if resolved.targets.get(&index) == Some(&Target::Ego)
             && let Some(relation) = relation
         {
-            if options.profile == Profile::Dashcam && relation.symbol("longitudinal") == Some("behind") {
+            if options.profile == Profile::Dashcam && relation.choice(LONGITUDINAL) == Some(Longitudinal::Behind) {
                 out.push(
                         Diagnostic::new(
                             Code::E0510,
@@ -333,33 +338,33 @@ fn relation_vs_lanes(
     if lane < 0 || ego_lane < 0 {
         return;
     }
-    let lateral = relation.symbol("lateral").unwrap_or("same");
+    // an unstated part of a relation means the reference's own lane or place
+    let lateral = relation.choice(LATERAL).unwrap_or(Lateral::Same);
     let actual = match lane.cmp(&ego_lane) {
-        std::cmp::Ordering::Less => "left",
-        std::cmp::Ordering::Greater => "right",
-        std::cmp::Ordering::Equal => "same",
+        std::cmp::Ordering::Less => Lateral::Left,
+        std::cmp::Ordering::Greater => Lateral::Right,
+        std::cmp::Ordering::Equal => Lateral::Same,
     };
     let consistent = match lateral {
-        "same" => actual == "same",
-        "left" | "right" => actual == lateral || actual == "same",
-        _ => true,
+        Lateral::Same => actual == Lateral::Same,
+        Lateral::Left | Lateral::Right => actual == lateral || actual == Lateral::Same,
+        Lateral::Opposite => true,
     };
     if consistent {
         return;
     }
-    let longitudinal = relation.symbol("longitudinal").unwrap_or("same");
-    let better = vocabulary
-        .entries("relation")
-        .into_iter()
-        .find(|r| r.symbol("lateral") == Some(actual) && r.symbol("longitudinal").unwrap_or("same") == longitudinal);
+    let longitudinal = relation.choice(LONGITUDINAL).unwrap_or(Longitudinal::Same);
+    let better = vocabulary.entries("relation").into_iter().find(|r| {
+        r.choice(LATERAL) == Some(actual) && r.choice(LONGITUDINAL).unwrap_or(Longitudinal::Same) == longitudinal
+    });
     let mut d = Diagnostic::new(
         Code::W0505,
         format!(
             "{what} is `{} of ego`, but its lane {lane} is {} the ego's lane {ego_lane}",
             relation.name,
             match actual {
-                "left" => "to the left of",
-                "right" => "to the right of",
+                Lateral::Left => "to the left of",
+                Lateral::Right => "to the right of",
                 _ => "the same as",
             }
         ),

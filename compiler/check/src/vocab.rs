@@ -36,6 +36,11 @@ impl Entry {
         self.declaration.attr(field).and_then(|a| a.symbols()).map(|s| s.iter().map(|s| s.name.as_str()).collect())
     }
 
+    /// A closed-set attribute (`lateral: left`) as its enum.
+    pub fn choice<T: tad_syntax::schema::ClosedSet>(&self, field: &str) -> Option<T> {
+        self.declaration.attr(field).and_then(|a| a.choice())
+    }
+
     /// A speed attribute in m/s.
     pub fn speed(&self, field: &str) -> Option<f64> {
         self.declaration.attr(field).and_then(|a| a.quantity()).map(|q| q.si())
