@@ -22,7 +22,7 @@ mod semantics;
 pub mod vocab;
 
 pub use completeness::{Class, Essential};
-pub use names::{Target, target};
+pub use names::{Groups, Target, target};
 pub use semantics::lanes_counted_from_zero;
 pub use vocab::{Conflict, Entry, Layer, Lookup, Vocabulary};
 

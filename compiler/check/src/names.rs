@@ -138,6 +138,7 @@ pub fn declarations(module: &tad_syntax::model::Module, vocabulary: &Vocabulary,
 /// Names in the scenario; returns what positions refer to.
 pub fn scenario(scenario: &Scenario, vocabulary: &Vocabulary, out: &mut Vec<Diagnostic>) -> Resolved {
     let mut resolved = Resolved::default();
+    let groups = Groups::new(scenario);
     for section in &scenario.sections {
         for a in &section.attrs {
             attr(vocabulary, a, out);
@@ -151,7 +152,7 @@ pub fn scenario(scenario: &Scenario, vocabulary: &Vocabulary, out: &mut Vec<Diag
             attr(vocabulary, a, out);
             let Known::Given(Val::Position(position)) = &a.value else { continue };
             resolve_symbol(vocabulary, "relation", "position", &position.relation, out);
-            if let Some(target) = reference(scenario, vocabulary, &position.reference, out) {
+            if let Some(target) = reference(scenario, &groups, vocabulary, &position.reference, out) {
                 resolved.targets.insert(index, target);
             }
         }
@@ -159,10 +160,25 @@ pub fn scenario(scenario: &Scenario, vocabulary: &Vocabulary, out: &mut Vec<Diag
     resolved
 }
 
+/// The actor groups of a scenario by name, built once for all its positions (a scenario
+/// may have hundreds of groups).
+pub struct Groups<'s>(HashMap<&'s str, usize>);
+
+impl<'s> Groups<'s> {
+    pub fn new(scenario: &'s Scenario) -> Self {
+        let mut index = HashMap::with_capacity(scenario.actors.len());
+        for (i, g) in scenario.actors.iter().enumerate() {
+            // the first of a name wins, as a linear search would
+            index.entry(g.name.text.as_str()).or_insert(i);
+        }
+        Groups(index)
+    }
+}
+
 /// What a position's reference names, in this order: an actor group of the scenario, a
 /// `reference` (`ego`) or a `road_element` (by name or alias); `None` for anything else.
-pub fn target(scenario: &Scenario, vocabulary: &Vocabulary, name: &str) -> Option<Target> {
-    if let Some(i) = scenario.actors.iter().position(|g| g.name.text == name) {
+pub fn target(groups: &Groups<'_>, vocabulary: &Vocabulary, name: &str) -> Option<Target> {
+    if let Some(&i) = groups.0.get(name) {
         return Some(Target::Group(i));
     }
     if vocabulary.get("reference", name).is_some() {
@@ -174,11 +190,12 @@ pub fn target(scenario: &Scenario, vocabulary: &Vocabulary, name: &str) -> Optio
 /// A position's reference, reported when it names nothing and when written as an alias.
 fn reference(
     scenario: &Scenario,
+    groups: &Groups<'_>,
     vocabulary: &Vocabulary,
     symbol: &Symbol,
     out: &mut Vec<Diagnostic>,
 ) -> Option<Target> {
-    if let Some(target) = target(scenario, vocabulary, &symbol.name) {
+    if let Some(target) = target(groups, vocabulary, &symbol.name) {
         match target {
             Target::Group(_) => {}
             Target::Ego => resolve_symbol(vocabulary, "reference", "position", symbol, out),

@@ -19,7 +19,7 @@ use tad_syntax::schema::ValueType;
 /// for a module without a scenario.
 pub fn resolve(module: &Module, vocabulary: &Vocabulary) -> Option<Scenario> {
     let model = module.scenario.as_ref()?;
-    let r = Resolver { vocabulary, model };
+    let r = Resolver { vocabulary, groups: tad_check::Groups::new(model) };
     let section = |name: &str| model.section(name);
     let attr = |s: &str, f: &str| model.attr(s, f);
 
@@ -106,7 +106,7 @@ pub fn resolve(module: &Module, vocabulary: &Vocabulary) -> Option<Scenario> {
 
 struct Resolver<'a> {
     vocabulary: &'a Vocabulary,
-    model: &'a model::Scenario,
+    groups: tad_check::Groups<'a>,
 }
 
 impl Resolver<'_> {
@@ -140,7 +140,7 @@ impl Resolver<'_> {
 
     fn position(&self, p: &model::Position) -> Position {
         let name = &p.reference.name;
-        let reference = match tad_check::target(self.model, self.vocabulary, name) {
+        let reference = match tad_check::target(&self.groups, self.vocabulary, name) {
             Some(Target::Ego) => Reference::Ego,
             Some(Target::Group(i)) => Reference::Group(Id::new(i)),
             Some(Target::RoadElement(element)) => {

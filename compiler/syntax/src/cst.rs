@@ -95,7 +95,7 @@ impl<T> Body<T> {
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub enum Member {
     Section(Section),
-    Actor(Actor),
+    Actor(Box<Actor>),
     Error(Span),
 }
 

@@ -15,7 +15,7 @@ use crate::suggest;
 use tad_diagnostics::{Applicability, Code, Diagnostic, Payload, Span};
 
 pub fn lower(src: &str, file: &cst::File) -> (Module, Vec<Diagnostic>) {
-    let mut lowerer = Lowerer { src, diagnostics: Vec::new() };
+    let mut lowerer = Lowerer { src, diagnostics: Vec::new(), groups: Default::default() };
     let module = lowerer.file(file);
     (module, lowerer.diagnostics)
 }
@@ -23,6 +23,8 @@ pub fn lower(src: &str, file: &cst::File) -> (Module, Vec<Diagnostic>) {
 struct Lowerer<'a> {
     src: &'a str,
     diagnostics: Vec<Diagnostic>,
+    /// The scenario's actor groups by name, for duplicates without a quadratic search.
+    groups: std::collections::HashMap<String, usize>,
 }
 
 impl Lowerer<'_> {
@@ -131,6 +133,7 @@ impl Lowerer<'_> {
                 cst::Member::Section(section) => self.section(section, &mut scenario),
                 cst::Member::Actor(actor) => {
                     if let Some(group) = self.actor(actor, &scenario) {
+                        self.groups.entry(group.name.text.clone()).or_insert(scenario.actors.len());
                         scenario.actors.push(group);
                     }
                 }
@@ -204,7 +207,7 @@ impl Lowerer<'_> {
                 .with_payload(Payload::Reserved { name: "ego".into() })
                 .with_help("describe the ego vehicle in the `ego { ... }` section, or rename this group"),
             );
-        } else if let Some(previous) = scenario.actor(&name.text) {
+        } else if let Some(previous) = self.groups.get(&name.text).map(|&i| &scenario.actors[i]) {
             self.report(
                 Diagnostic::new(
                     Code::E0209,
