@@ -17,20 +17,37 @@ use tad_diagnostics::{Code, Diagnostic, Element, Payload, Span};
 use tad_syntax::model::{Attr, Known, Scenario, Section};
 use tad_syntax::schema::{self, SectionDef};
 
+/// What the pipeline does with a scenario: keep it, refine it, discard it, or send it back
+/// for repair.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Class {
+    /// No errors and every essential attribute stated: keep.
     Complete,
+    /// No errors, but essential attributes missing: ask the extractor for them.
     Incomplete,
+    /// Not a traffic scenario (a title card, a map): discard.
     NonScenario,
+    /// Errors: send back for repair. Completeness is not judged.
+    Invalid,
 }
 
 impl Class {
+    pub const ALL: [Class; 4] = [Class::Complete, Class::Incomplete, Class::NonScenario, Class::Invalid];
+
     pub fn as_str(self) -> &'static str {
         match self {
             Class::Complete => "complete",
             Class::Incomplete => "incomplete",
             Class::NonScenario => "non_scenario",
+            Class::Invalid => "invalid",
         }
+    }
+
+    /// The class of a scenario with `diagnostics` (all of them: syntax, structure,
+    /// names, semantics), whose completeness alone gives `completeness`: any error makes
+    /// it invalid.
+    pub fn of(completeness: Class, diagnostics: &[Diagnostic]) -> Class {
+        if diagnostics.iter().any(Diagnostic::is_error) { Class::Invalid } else { completeness }
     }
 }
 

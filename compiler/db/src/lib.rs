@@ -270,6 +270,7 @@ pub fn check(db: &dyn Db, file: SourceFile) -> Checked {
     checked.diagnostics.extend(scope.diagnostics.iter().cloned());
     checked.diagnostics.extend(uses(db, file));
     tad_diagnostics::sort(&mut checked.diagnostics);
+    checked.class = checked.class.map(|c| tad_check::Class::of(c, &checked.diagnostics));
     checked
 }
 

@@ -123,7 +123,7 @@ pub fn run(paths: &[std::path::PathBuf], format: Format, deny_warnings: bool, co
     }
 
     let (mut errors, mut warnings) = (0, 0);
-    let mut classes = [0usize; 3];
+    let mut classes = [0usize; Class::ALL.len()];
     let mut sarif_reports = Vec::new();
     for c in &done {
         errors += c.result.diagnostics.iter().filter(|d| d.severity == Severity::Error).count();
@@ -144,7 +144,11 @@ pub fn run(paths: &[std::path::PathBuf], format: Format, deny_warnings: bool, co
                 let mut object = json::file_object(&report);
                 object.insert("class".into(), c.result.class.map_or(serde_json::Value::Null, |c| c.as_str().into()));
                 let vocabulary = &tad_db::vocabulary(&db, c.file).vocabulary;
-                let refinement = tad_feedback::refinement(&c.result.diagnostics, vocabulary);
+                // only what an otherwise valid scenario lacks is asked for
+                let refinement = match c.result.class {
+                    Some(Class::Incomplete) => tad_feedback::refinement(&c.result.diagnostics, vocabulary),
+                    _ => Vec::new(),
+                };
                 object.insert("refinement".into(), refinement.into());
                 println!("{}", serde_json::Value::Object(object));
             }
@@ -165,7 +169,15 @@ pub fn run(paths: &[std::path::PathBuf], format: Format, deny_warnings: bool, co
                         .with_related(related.iter().map(|(n, t, f)| Source { file: *f, name: n, text: t }).collect())
                 })
                 .collect();
-            println!("{}", sarif::render(&reports, env!("CARGO_PKG_VERSION")));
+            let mut log = sarif::render(&reports, env!("CARGO_PKG_VERSION"));
+            // each artifact says its scenario's class
+            if let Some(artifacts) = log["runs"][0]["artifacts"].as_array_mut() {
+                for (artifact, c) in artifacts.iter_mut().zip(&done) {
+                    let class = c.result.class.map_or(serde_json::Value::Null, |c| c.as_str().into());
+                    artifact["properties"] = serde_json::json!({ "class": class });
+                }
+            }
+            println!("{log}");
         }
         Format::Human => eprintln!("{}", summary(inputs.len(), errors, warnings, classes)),
         Format::Json => {}
@@ -180,16 +192,19 @@ fn plural(n: usize, word: &str) -> String {
     if n == 1 { format!("1 {word}") } else { format!("{n} {word}s") }
 }
 
-fn summary(files: usize, errors: usize, warnings: usize, classes: [usize; 3]) -> String {
+fn summary(files: usize, errors: usize, warnings: usize, classes: [usize; Class::ALL.len()]) -> String {
     let problems = match (errors, warnings) {
         (0, 0) => "no problems".to_string(),
         (e, 0) => plural(e, "error"),
         (0, w) => plural(w, "warning"),
         (e, w) => format!("{}, {}", plural(e, "error"), plural(w, "warning")),
     };
-    let names = ["complete", "incomplete", "non_scenario"];
-    let classes: Vec<String> =
-        classes.iter().zip(names).filter(|(n, _)| **n > 0).map(|(n, name)| format!("{n} {name}")).collect();
+    let classes: Vec<String> = classes
+        .iter()
+        .zip(Class::ALL)
+        .filter(|(n, _)| **n > 0)
+        .map(|(n, class)| format!("{n} {}", class.as_str()))
+        .collect();
     if classes.is_empty() {
         format!("checked {}: {problems}", plural(files, "file"))
     } else {

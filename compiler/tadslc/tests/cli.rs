@@ -108,6 +108,25 @@ fn a_label_in_another_file_names_that_file() {
 }
 
 #[test]
+fn errors_make_a_scenario_invalid_whatever_it_states() {
+    // complete in every essential, but a reference names nothing
+    let broken = CLEAN.replace(
+        "  ego {",
+        "  actor lead: car {\n    behavior: go_forward\n    position: front of nobody\n    lane: 1\n  }\n  ego {",
+    );
+    let out = tadslc(&["check", "--format", "json", "-"], &broken);
+    assert_eq!(code(&out), 1);
+    let file: Value = serde_json::from_str(stdout(&out).trim()).expect("one JSON object");
+    assert_eq!(file["class"], "invalid");
+    assert_eq!(file["refinement"], serde_json::json!([]));
+    let human = tadslc(&["check", "-"], &broken);
+    assert!(stderr(&human).contains("scenarios: 1 invalid"), "{}", stderr(&human));
+    let sarif = tadslc(&["check", "--format", "sarif", "-"], &broken);
+    let log: Value = serde_json::from_str(&stdout(&sarif)).expect("SARIF");
+    assert_eq!(log["runs"][0]["artifacts"][0]["properties"]["class"], "invalid");
+}
+
+#[test]
 fn sarif_output_is_a_valid_sarif_log() {
     let out = tadslc(&["check", "--format", "sarif", "tests/ui/structure"], "");
     assert_eq!(code(&out), 1);
