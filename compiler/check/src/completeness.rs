@@ -92,20 +92,31 @@ fn absent(def: &SectionDef, section: Option<&Section>) -> Vec<String> {
     def.essential().filter(|f| !present(section.and_then(|s| s.attr(f.name)))).map(|f| f.name.to_string()).collect()
 }
 
-pub fn classify(scenario: &Scenario, options: &Options, out: &mut Vec<Diagnostic>) -> Class {
+pub fn classify(scenario: &Scenario, options: &Options, prior: &[Diagnostic], out: &mut Vec<Diagnostic>) -> Class {
     let anchor = scenario.name.as_ref().map_or(Span::new(scenario.span.start, scenario.span.start + 8), |n| n.span);
+    // A part with an error in it may state what could not be read; with an error in the
+    // scenario outside its parts, a whole part may be lost. Neither is judged missing.
+    let errors: Vec<Span> = prior.iter().filter(|d| d.is_error()).map(Diagnostic::span).collect();
+    let damaged = |span: Span| errors.iter().any(|e| span.contains(*e));
+    let parts: Vec<Span> =
+        scenario.sections.iter().map(|s| s.span).chain(scenario.actors.iter().map(|g| g.span)).collect();
+    let lost = errors.iter().any(|e| scenario.span.contains(*e) && !parts.iter().any(|p| p.contains(*e)));
     // (where to report, element, missing fields)
     let mut missing: Vec<(Span, Element, Vec<String>)> = Vec::new();
     for (def, element) in
         [(&schema::ENVIRONMENT, Element::Environment), (&schema::ROAD, Element::Road), (&schema::EGO, Element::Ego)]
     {
         let section = scenario.section(def.name);
+        let judged = match section {
+            Some(s) => !damaged(s.span),
+            None => !lost,
+        };
         let fields = absent(def, section);
-        if !fields.is_empty() {
+        if judged && !fields.is_empty() {
             missing.push((section.map_or(anchor, |s| s.name_span), element, fields));
         }
     }
-    for group in &scenario.actors {
+    for group in scenario.actors.iter().filter(|g| !damaged(g.span)) {
         let mut fields = Vec::new();
         if matches!(group.kind.value, Known::Unspecified) {
             fields.push("type".to_string());
@@ -119,15 +130,17 @@ pub fn classify(scenario: &Scenario, options: &Options, out: &mut Vec<Diagnostic
         }
     }
 
-    let none_of = |def: &SectionDef| def.essential().all(|f| !present(scenario.attr(def.name, f.name)));
+    // a damaged section may state what could not be read: it is not gone
+    let unread = |def: &SectionDef| scenario.section(def.name).is_some_and(|s| damaged(s.span));
+    let none_of = |def: &SectionDef| !unread(def) && def.essential().all(|f| !present(scenario.attr(def.name, f.name)));
     let gone = |essential: Essential| match essential {
-        Essential::Weather => !present(scenario.attr("environment", "weather")),
-        Essential::Time => !present(scenario.attr("environment", "time")),
+        Essential::Weather => !unread(&schema::ENVIRONMENT) && !present(scenario.attr("environment", "weather")),
+        Essential::Time => !unread(&schema::ENVIRONMENT) && !present(scenario.attr("environment", "time")),
         Essential::Road => none_of(&schema::ROAD),
         Essential::Ego => none_of(&schema::EGO),
         Essential::Actors => scenario.actors.is_empty(),
     };
-    if !options.non_scenario.is_empty() && options.non_scenario.iter().all(|e| gone(*e)) {
+    if !lost && !options.non_scenario.is_empty() && options.non_scenario.iter().all(|e| gone(*e)) {
         let parts: Vec<&str> = options.non_scenario.iter().map(|e| e.as_str()).collect();
         out.push(
             Diagnostic::new(

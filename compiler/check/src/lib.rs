@@ -59,14 +59,16 @@ pub struct Checked {
     pub class: Option<Class>,
 }
 
-/// Check `module` against `vocabulary`. Diagnostics are sorted by position.
-pub fn check(module: &Module, vocabulary: &Vocabulary, options: &Options) -> Checked {
+/// Check `module` against `vocabulary`. `prior` are the problems found reading the file
+/// (syntax, structure): where they are, what is missing is not judged, since the text
+/// that states it may be what could not be read. Diagnostics are sorted by position.
+pub fn check(module: &Module, vocabulary: &Vocabulary, options: &Options, prior: &[Diagnostic]) -> Checked {
     let mut out = Checked::default();
     names::declarations(module, vocabulary, &mut out.diagnostics);
     if let Some(scenario) = &module.scenario {
         let resolved = names::scenario(scenario, vocabulary, &mut out.diagnostics);
         semantics::check(scenario, vocabulary, &resolved, options, &mut out.diagnostics);
-        out.class = Some(completeness::classify(scenario, options, &mut out.diagnostics));
+        out.class = Some(completeness::classify(scenario, options, prior, &mut out.diagnostics));
     }
     tad_diagnostics::sort(&mut out.diagnostics);
     out

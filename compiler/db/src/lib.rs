@@ -264,7 +264,7 @@ pub fn check(db: &dyn Db, file: SourceFile) -> Checked {
     let analysis = analyze(db, file);
     let scope = vocabulary(db, file);
     let options = db.settings().options(db);
-    let mut checked = tad_check::check(&analysis.module, &scope.vocabulary, options);
+    let mut checked = tad_check::check(&analysis.module, &scope.vocabulary, options, &analysis.diagnostics);
     checked.diagnostics = stamp(std::mem::take(&mut checked.diagnostics), file.id(db));
     checked.diagnostics.extend(analysis.diagnostics.iter().cloned());
     checked.diagnostics.extend(scope.diagnostics.iter().cloned());

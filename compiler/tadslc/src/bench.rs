@@ -85,8 +85,8 @@ pub fn run(n: usize, seed: u64, examples: Option<&Path>, runs: usize) -> Status 
     let options = tad_check::Options::default();
     let direct = best_of(runs, || {
         for text in &tad {
-            let (module, _) = tad_syntax::analyze(text);
-            black_box(tad_check::check(&module, &vocabulary, &options));
+            let (module, prior) = tad_syntax::analyze(text);
+            black_box(tad_check::check(&module, &vocabulary, &options, &prior));
         }
     });
     let format = best_of(runs, || {
