@@ -38,6 +38,7 @@ codes! {
     E0004 => Error,
     E0005 => Error,
     E0006 => Error,
+    E0007 => Error,
     E0100 => Error,
     E0101 => Error,
     E0102 => Error,

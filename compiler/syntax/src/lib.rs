@@ -17,16 +17,22 @@ mod parse;
 pub mod schema;
 pub mod suggest;
 
+mod sniff;
+
 pub use parse::{Parsed, parse};
 use tad_diagnostics::Diagnostic;
 
 /// Parse and lower one file: its model and every lexical, syntax and structure
-/// diagnostic, sorted by position.
+/// diagnostic, sorted by position. A text that is not TAD at all (Markdown, JSON, YAML,
+/// prose) is one E0007 naming what it looks like, not hundreds of syntax errors.
 pub fn analyze(src: &str) -> (model::Module, Vec<Diagnostic>) {
     let parsed = parse(src);
     let (module, lowered) = lower::lower(src, &parsed.file);
     let mut diagnostics = parsed.diagnostics;
     diagnostics.extend(lowered);
     tad_diagnostics::sort(&mut diagnostics);
+    if let Some(not_tad) = sniff::not_tad(src, &diagnostics) {
+        return (model::Module::default(), vec![not_tad]);
+    }
     (module, diagnostics)
 }
