@@ -31,19 +31,19 @@ pub fn examples() -> Vec<PathBuf> {
 /// Check `text` as the file at `path` (with the standard library) and emit it. Panics when
 /// the file has errors: only checked scenarios are built.
 pub fn build_text(path: &Path, text: &str, options: &EmitOptions) -> Emitted {
-    let (module, vocabulary) = checked(path, text);
-    tad_scenic::emit(&module, &vocabulary, options)
+    let (module, scenario) = checked(path, text);
+    tad_scenic::build(&module, scenario.as_ref(), options)
 }
 
-/// The lowered module of `text` (as the file at `path`) and the vocabulary it sees. Panics
-/// when the file has errors: only checked scenarios are built.
-pub fn checked(path: &Path, text: &str) -> (tad_syntax::model::Module, tad_check::Vocabulary) {
+/// The lowered module of `text` (as the file at `path`) and its resolved scenario
+/// (`tad_db::resolve`). Panics when the file has errors: only checked scenarios are built.
+pub fn checked(path: &Path, text: &str) -> (tad_syntax::model::Module, Option<tad_ir::Scenario>) {
     let mut db = tad_db::Database::new(tad_check::Options::default());
     let file = db.set_file(path.to_path_buf(), text.to_string());
     let checked = tad_db::check(&db, file);
     let errors: Vec<_> = checked.diagnostics.iter().filter(|d| d.is_error()).collect();
     assert!(errors.is_empty(), "{} has errors: {errors:#?}", path.display());
-    (tad_db::analyze(&db, file).module.clone(), tad_db::vocabulary(&db, file).vocabulary.clone())
+    (tad_db::analyze(&db, file).module.clone(), tad_db::resolve(&db, file).clone())
 }
 
 pub fn build(path: &Path, options: &EmitOptions) -> Emitted {
