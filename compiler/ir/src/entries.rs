@@ -15,7 +15,7 @@ use std::hash::{Hash, Hasher};
 use std::marker::PhantomData;
 use std::ops::Index;
 use tad_diagnostics::Span;
-use tad_syntax::schema::{Lateral, Longitudinal, Motion};
+use tad_syntax::schema::{Lateral, Longitudinal, Motion, RoadShape, Signal, SimulatedAs};
 
 /// The index of an item of type `K` in its table (for a [`crate::Group`], in the
 /// scenario's groups). Ids are made by [`crate::resolve`] and are valid for the scenario
@@ -249,18 +249,46 @@ macro_rules! name_only {
 }
 
 name_only! {
-    Weather;
-    TimeOfDay;
     SpecialLane;
     TrafficDensity;
     Hazard;
     Roadwork;
     EmergencyVehicle;
-    Roadside;
-    ActorKind;
-    RoadElement;
-    /// A built-in reference point (`ego`).
-    ReferencePoint;
+}
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Roadside {
+    /// It is a path for pedestrians along the road (default no).
+    pub walkway: bool,
+}
+
+/// A weather's sky and road, on the 0 (none) to 100 (most) scales of CARLA's weather
+/// parameters; `None` when not declared.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Weather {
+    pub cloudiness: Option<i64>,
+    pub precipitation: Option<i64>,
+    pub precipitation_deposits: Option<i64>,
+    pub wetness: Option<i64>,
+    pub wind_intensity: Option<i64>,
+    pub fog_density: Option<i64>,
+    /// Where the fog begins.
+    pub fog_distance: Option<Metres>,
+}
+
+impl Weather {
+    /// Whether any parameter is declared.
+    pub fn is_described(&self) -> bool {
+        *self != Weather::default()
+    }
+}
+
+/// Where the sun is, in degrees; `None` when not declared.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct TimeOfDay {
+    /// Above the horizon (negative: below).
+    pub sun_altitude: Option<i64>,
+    pub sun_azimuth: Option<i64>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -269,13 +297,21 @@ pub struct RoadType {
     pub junction: bool,
     /// Traffic lights can control it (default yes).
     pub signalised: bool,
+    /// For a junction: how many road arms meet in it; `None` when not declared.
+    pub arms: Option<i64>,
+    /// `None` when not declared.
+    pub shape: Option<RoadShape>,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct RoadContext {
     pub max_speed: Option<MetresPerSecond>,
     /// Traffic lights occur there (default yes).
     pub signalised: bool,
+    /// The CARLA towns that look most like it, best first (none declared: empty).
+    pub carla_towns: Vec<String>,
+    /// What the CARLA towns cannot show of it.
+    pub carla_note: Option<String>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -288,12 +324,16 @@ pub struct Direction {
 pub struct TrafficSign {
     /// Light states that contradict it.
     pub conflicts_with: Vec<Id<LightState>>,
+    /// Its OpenDRIVE signal type (`206` a stop sign); `None` when not declared.
+    pub opendrive_type: Option<i64>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct LightState {
     /// There is a light at all (default yes; `none` has no).
     pub present: bool,
+    /// What the light shows; `None` when not declared.
+    pub signal: Option<Signal>,
 }
 
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
@@ -302,7 +342,24 @@ pub struct Region {
     pub style: Option<String>,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// How a simulator shows an actor: its body and the CARLA actor standing for it. Every
+/// field is `None` when not declared.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Simulation {
+    pub simulated_as: Option<SimulatedAs>,
+    /// A CARLA 0.9.15 blueprint name (`vehicle.tesla.model3`).
+    pub carla_blueprint: Option<String>,
+    /// Why the CARLA actor only approximates it.
+    pub carla_note: Option<String>,
+}
+
+/// A broad class of actors; its [`Simulation`] is for types of the kind that declare none.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Hash)]
+pub struct ActorKind {
+    pub simulation: Simulation,
+}
+
+#[derive(Clone, Debug, PartialEq)]
 pub struct ActorType {
     pub kind: Option<Id<ActorKind>>,
     pub length: Option<Metres>,
@@ -310,6 +367,7 @@ pub struct ActorType {
     pub height: Option<Metres>,
     pub typical_speed: Option<MetresPerSecond>,
     pub max_speed: Option<MetresPerSecond>,
+    pub simulation: Simulation,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -326,6 +384,19 @@ impl Behavior {
     pub fn performed_by(&self, kind: Id<ActorKind>) -> bool {
         self.performers.as_ref().is_none_or(|p| p.contains(&kind))
     }
+}
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct RoadElement {
+    /// It is at the junction ahead (default no).
+    pub at_junction: bool,
+}
+
+/// A built-in reference point (`ego`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct ReferencePoint {
+    /// The actor type it is, for its size and speed.
+    pub actor_type: Option<Id<ActorType>>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

@@ -9,7 +9,8 @@
 //! consumer would otherwise redo: names become [`Id`]s into typed [`Entries`] tables
 //! (aliases resolved to their canonical entry), quantities SI, lanes [`Lane`]s, positions
 //! a [`Relation`] and a [`Reference`] (the ego, a group, a road element), and groups get a
-//! [`Scenario::placement_order`]. Closed sets ([`Lateral`], [`Longitudinal`], [`Motion`])
+//! [`Scenario::placement_order`]. Closed sets ([`Lateral`], [`Longitudinal`], [`Motion`],
+//! [`SimulatedAs`], [`Signal`], [`RoadShape`])
 //! are the schema's enums. It is pure and total, and reports nothing: the checker has.
 //!
 //! Modules: [`entries`](crate::Entries) (vocabulary tables and ids), `scenario` (the
@@ -28,4 +29,4 @@ pub use resolve::resolve;
 pub use scenario::*;
 pub use tad_diagnostics::Span;
 pub use tad_syntax::model::Spanned;
-pub use tad_syntax::schema::{ClosedSet, Lateral, Longitudinal, Motion};
+pub use tad_syntax::schema::{ClosedSet, Lateral, Longitudinal, Motion, RoadShape, Signal, SimulatedAs};

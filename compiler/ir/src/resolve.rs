@@ -214,29 +214,62 @@ fn table<K: Kind>(vocabulary: &Vocabulary, read: impl Fn(&tad_check::Entry) -> K
     Table { entries }
 }
 
+fn simulation(e: &tad_check::Entry) -> Simulation {
+    Simulation {
+        simulated_as: e.declaration.attr("simulated_as").and_then(Attr::choice),
+        carla_blueprint: declared(e, "carla_blueprint", text),
+        carla_note: declared(e, "carla_note", text),
+    }
+}
+
 fn entries(v: &Vocabulary) -> Entries {
     let flag = |e: &tad_check::Entry, f: &str, default: bool| e.flag(f).unwrap_or(default);
     let length = |e: &tad_check::Entry, f: &str| declared(e, f, |v| quantity(v, ValueType::Length)).map(Metres);
+    let int = |e: &tad_check::Entry, f: &str| declared(e, f, integer);
     let max_speed = |e: &tad_check::Entry| declared(e, "max_speed", speed);
     Entries {
-        weather: table(v, |_| Weather),
-        times_of_day: table(v, |_| TimeOfDay),
+        weather: table(v, |e| Weather {
+            cloudiness: int(e, "cloudiness"),
+            precipitation: int(e, "precipitation"),
+            precipitation_deposits: int(e, "precipitation_deposits"),
+            wetness: int(e, "wetness"),
+            wind_intensity: int(e, "wind_intensity"),
+            fog_density: int(e, "fog_density"),
+            fog_distance: length(e, "fog_distance"),
+        }),
+        times_of_day: table(v, |e| TimeOfDay {
+            sun_altitude: int(e, "sun_altitude"),
+            sun_azimuth: int(e, "sun_azimuth"),
+        }),
         road_types: table(v, |e| RoadType {
             junction: flag(e, "junction", false),
             signalised: flag(e, "signalised", true),
+            arms: int(e, "arms"),
+            shape: e.declaration.attr("shape").and_then(Attr::choice),
         }),
-        road_contexts: table(v, |e| RoadContext { max_speed: max_speed(e), signalised: flag(e, "signalised", true) }),
+        road_contexts: table(v, |e| RoadContext {
+            max_speed: max_speed(e),
+            signalised: flag(e, "signalised", true),
+            carla_towns: e.symbols("carla_towns").unwrap_or_default().into_iter().map(str::to_string).collect(),
+            carla_note: declared(e, "carla_note", text),
+        }),
         directions: table(v, |e| Direction { opposite_lanes: e.flag("opposite_lanes") }),
         special_lanes: table(v, |_| SpecialLane),
-        traffic_signs: table(v, |e| TrafficSign { conflicts_with: ids(v, e, "conflicts_with").unwrap_or_default() }),
-        light_states: table(v, |e| LightState { present: flag(e, "present", true) }),
+        traffic_signs: table(v, |e| TrafficSign {
+            conflicts_with: ids(v, e, "conflicts_with").unwrap_or_default(),
+            opendrive_type: int(e, "opendrive_type"),
+        }),
+        light_states: table(v, |e| LightState {
+            present: flag(e, "present", true),
+            signal: e.declaration.attr("signal").and_then(Attr::choice),
+        }),
         traffic_densities: table(v, |_| TrafficDensity),
         hazards: table(v, |_| Hazard),
         roadworks: table(v, |_| Roadwork),
         emergency_vehicles: table(v, |_| EmergencyVehicle),
-        roadsides: table(v, |_| Roadside),
+        roadsides: table(v, |e| Roadside { walkway: flag(e, "walkway", false) }),
         regions: table(v, |e| Region { style: e.symbol("style").map(str::to_string) }),
-        actor_kinds: table(v, |_| ActorKind),
+        actor_kinds: table(v, |e| ActorKind { simulation: simulation(e) }),
         actor_types: table(v, |e| ActorType {
             kind: e.symbol("kind").and_then(|k| id(v, k)),
             length: length(e, "length"),
@@ -244,6 +277,7 @@ fn entries(v: &Vocabulary) -> Entries {
             height: length(e, "height"),
             typical_speed: declared(e, "typical_speed", speed),
             max_speed: max_speed(e),
+            simulation: simulation(e),
         }),
         behaviors: table(v, |e| Behavior {
             performers: ids(v, e, "performers"),
@@ -254,8 +288,8 @@ fn entries(v: &Vocabulary) -> Entries {
             lateral: e.declaration.attr("lateral").and_then(Attr::choice),
             longitudinal: e.declaration.attr("longitudinal").and_then(Attr::choice),
         }),
-        road_elements: table(v, |_| RoadElement),
-        reference_points: table(v, |_| ReferencePoint),
+        road_elements: table(v, |e| RoadElement { at_junction: flag(e, "at_junction", false) }),
+        reference_points: table(v, |e| ReferencePoint { actor_type: e.symbol("actor_type").and_then(|t| id(v, t)) }),
     }
 }
 

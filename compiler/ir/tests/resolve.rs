@@ -147,6 +147,41 @@ fn groups_are_placed_after_their_reference() {
     assert!(!light.attrs.present);
 }
 
+#[test]
+fn simulator_mappings_are_typed_attributes() {
+    let s = example("regions/yellowstone_bison_and_tractor.tad");
+    let e = &s.entries;
+    let bison = &e[e.actor_types.find("bison").unwrap()].attrs.simulation;
+    assert_eq!(bison.simulated_as, Some(SimulatedAs::Pedestrian));
+    assert_eq!(bison.carla_blueprint.as_deref(), Some("walker.pedestrian.0001"));
+    assert!(bison.carla_note.as_deref().is_some_and(|n| n.contains("no animals")));
+    let sedan = &e[e.actor_types.find("sedan").unwrap()].attrs.simulation;
+    assert_eq!((sedan.simulated_as, sedan.carla_note.as_deref()), (Some(SimulatedAs::Car), None));
+    let vehicle = &e[e.actor_kinds.find("vehicle").unwrap()].attrs.simulation;
+    assert_eq!(vehicle.carla_blueprint.as_deref(), Some("vehicle.toyota.prius"));
+    let foggy = e[e.weather.find("foggy").unwrap()].attrs;
+    assert_eq!((foggy.cloudiness, foggy.fog_density, foggy.fog_distance), (Some(50), Some(60), Some(Metres(10.0))));
+    assert!(!e[e.weather.find("snowy").unwrap()].attrs.is_described());
+    let night = e[e.times_of_day.find("nighttime").unwrap()].attrs;
+    assert_eq!((night.sun_altitude, night.sun_azimuth), (Some(-40), Some(0)));
+    assert_eq!(e[e.light_states.find("broken").unwrap()].attrs.signal, Some(Signal::Off));
+    assert_eq!(e[e.light_states.find("none").unwrap()].attrs.signal, None);
+    let t = e[e.road_types.find("t_intersection").unwrap()].attrs;
+    assert_eq!((t.junction, t.arms, t.shape), (true, Some(3), None));
+    assert_eq!(e[e.road_types.find("roundabout").unwrap()].attrs.shape, Some(RoadShape::Roundabout));
+    assert_eq!(e[e.road_types.find("curved_road").unwrap()].attrs.shape, Some(RoadShape::Curved));
+    let dirt = &e[e.road_contexts.find("dirt_road").unwrap()].attrs;
+    assert_eq!(dirt.carla_towns, ["Town07"]);
+    assert!(dirt.carla_note.is_some());
+    assert_eq!(e[e.traffic_signs.find("stop_sign").unwrap()].attrs.opendrive_type, Some(206));
+    assert_eq!(e[e.traffic_signs.find("school_zone").unwrap()].attrs.opendrive_type, None);
+    assert!(e[e.roadsides.find("sidewalk").unwrap()].attrs.walkway);
+    assert!(e[e.road_elements.find("crosswalk").unwrap()].attrs.at_junction);
+    assert!(!e[e.road_elements.find("bus_stop").unwrap()].attrs.at_junction);
+    let ego = e.reference_points.iter().find_map(|(_, r)| r.attrs.actor_type).unwrap();
+    assert_eq!(e[ego].name, "car");
+}
+
 const FORWARD_REFERENCES: &str = r#"
 scenario aliases_and_references {
   environment {

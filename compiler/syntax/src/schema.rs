@@ -7,7 +7,8 @@
 //! weather, behaviors, ...) are not here: they are declared in TAD in `stdlib/`.
 //!
 //! The few sets of words the compiler itself gives meaning to (a relation's [`Lateral`]
-//! and [`Longitudinal`] parts, a behavior's [`Motion`]) are closed sets: each is one Rust
+//! and [`Longitudinal`] parts, a behavior's [`Motion`], an actor type's [`SimulatedAs`], a
+//! light state's [`Signal`], a road type's [`RoadShape`]) are closed sets: each is one Rust
 //! enum declared here with its words, a field takes it as [`ValueType::Choice`], lowering
 //! rejects any other word, and later stages (the IR) use the enum.
 
@@ -143,6 +144,41 @@ closed_set! {
         Overtake = "overtake",
         Yield = "yield",
         Reverse = "reverse",
+    }
+}
+
+closed_set! {
+    /// How an actor type is simulated: the body a simulator gives it.
+    SimulatedAs {
+        /// A vehicle driven along lanes (cars, trucks, two-wheelers).
+        Car = "car",
+        /// A walker (people; animals where the simulator has none).
+        Pedestrian = "pedestrian",
+        /// A static object that does not move by itself.
+        Object = "object",
+    }
+}
+
+closed_set! {
+    /// What a traffic light shows.
+    Signal {
+        Green = "green",
+        Red = "red",
+        Yellow = "yellow",
+        /// Dark or flashing: out of order.
+        Off = "off",
+    }
+}
+
+closed_set! {
+    /// The shape of a road type.
+    RoadShape {
+        /// Turning less than 10° over the stretch a scenario needs.
+        Straight = "straight",
+        /// Turning more than 20° over it.
+        Curved = "curved",
+        /// A circular junction.
+        Roundabout = "roundabout",
     }
 }
 
@@ -282,19 +318,38 @@ macro_rules! declaration {
 /// The kinds of vocabulary declaration (`KIND NAME { ... }`) and their fields. A scenario
 /// field with a `vocabulary` takes the names declared with that kind.
 pub const DECLARATIONS: &[&SectionDef] = &[
-    &declaration!("weather", "a weather condition"),
-    &declaration!("time_of_day", "a time of day"),
+    &declaration!(
+        "weather",
+        "a weather condition",
+        field!("cloudiness", Integer, "80", "cloud cover, 0 (none) to 100 (overcast)"),
+        field!("precipitation", Integer, "70", "rain intensity, 0 to 100"),
+        field!("precipitation_deposits", Integer, "60", "puddles on the road, 0 to 100"),
+        field!("wetness", Integer, "80", "how wet the road surface is, 0 to 100"),
+        field!("wind_intensity", Integer, "30", "wind, 0 to 100"),
+        field!("fog_density", Integer, "60", "fog thickness, 0 to 100"),
+        field!("fog_distance", Length, "10 m", "where the fog begins"),
+    ),
+    &declaration!(
+        "time_of_day",
+        "a time of day",
+        field!("sun_altitude", Integer, "60", "the sun's altitude above the horizon, in degrees (negative below)"),
+        field!("sun_azimuth", Integer, "135", "the sun's azimuth, in degrees"),
+    ),
     &declaration!(
         "road_type",
         "a kind of road layout",
         field!("signalised", Flag, "no", "whether traffic lights can control it (default `yes`)"),
         field!("junction", Flag, "yes", "whether roads meet or cross in it (default `no`)"),
+        field!("arms", Integer, "4", "for a junction: how many road arms meet in it"),
+        field!("shape", one of RoadShape, "straight", "its shape: `straight`, `curved` or `roundabout`"),
     ),
     &declaration!(
         "road_context",
         "the kind of area a road runs through",
         field!("max_speed", Speed, "60 km/h", "the highest plausible speed there"),
         field!("signalised", Flag, "no", "whether traffic lights occur there (default `yes`)"),
+        field!("carla_towns", SymbolList, "[Town10HD, Town01]", "the CARLA towns that look most like it, best first"),
+        field!("carla_note", Text, "\"...\"", "what the CARLA towns cannot show of it"),
     ),
     &declaration!(
         "direction",
@@ -306,23 +361,40 @@ pub const DECLARATIONS: &[&SectionDef] = &[
         "traffic_sign",
         "a traffic sign",
         field!("conflicts_with", SymbolList in "light_state", "[green]", "light states that contradict it"),
+        field!("opendrive_type", Integer, "206", "its OpenDRIVE signal type (a map's signals of that type are it)"),
     ),
     &declaration!(
         "light_state",
         "the state of the traffic light facing the ego vehicle",
         field!("present", Flag, "no", "whether there is a light at all (default `yes`)"),
+        field!("signal", one of Signal, "red", "what the light shows: `green`, `red`, `yellow` or `off`"),
     ),
     &declaration!("traffic_density", "how dense the traffic is"),
     &declaration!("hazard", "an accident or other hazard on the road"),
     &declaration!("roadwork", "roadworks or a lane closure"),
     &declaration!("emergency_vehicle", "a kind of emergency vehicle"),
-    &declaration!("roadside", "something that lines the road"),
+    &declaration!(
+        "roadside",
+        "something that lines the road",
+        field!("walkway", Flag, "yes", "whether it is a path for pedestrians along the road (default `no`)"),
+    ),
     &declaration!(
         "region",
         "a region scenarios come from",
         field!("style", Symbol, "metropolitan", "its kind of region")
     ),
-    &declaration!("actor_kind", "a broad class of actors that share behaviors"),
+    &declaration!(
+        "actor_kind",
+        "a broad class of actors that share behaviors",
+        field!("simulated_as", one of SimulatedAs, "car", "how a type of this kind without its own is simulated"),
+        field!(
+            "carla_blueprint",
+            Text,
+            "\"vehicle.toyota.prius\"",
+            "the CARLA blueprint of a type of this kind without its own"
+        ),
+        field!("carla_note", Text, "\"...\"", "why that blueprint only approximates such a type"),
+    ),
     &declaration!(
         "actor_type",
         "a type of actor with its physical attributes",
@@ -332,6 +404,9 @@ pub const DECLARATIONS: &[&SectionDef] = &[
         field!("height", Length, "1.5 m", "its height"),
         field!("typical_speed", Speed, "40 km/h", "its usual speed"),
         field!("max_speed", Speed, "180 km/h", "the highest plausible speed"),
+        field!("simulated_as", one of SimulatedAs, "car", "how it is simulated: `car`, `pedestrian` or `object`"),
+        field!("carla_blueprint", Text, "\"vehicle.tesla.model3\"", "the CARLA 0.9.15 blueprint of its actor"),
+        field!("carla_note", Text, "\"...\"", "why the CARLA actor only approximates it"),
     ),
     &declaration!(
         "behavior",
@@ -346,8 +421,16 @@ pub const DECLARATIONS: &[&SectionDef] = &[
         field!("lateral", one of Lateral, "left", "across the road: `left`, `right`, `same` or `opposite`"),
         field!("longitudinal", one of Longitudinal, "front", "along the road: `front`, `behind` or `same`"),
     ),
-    &declaration!("road_element", "a point of the road a position can refer to"),
-    &declaration!("reference", "a built-in reference point (`ego`)"),
+    &declaration!(
+        "road_element",
+        "a point of the road a position can refer to",
+        field!("at_junction", Flag, "yes", "whether it is at the junction ahead (default `no`)"),
+    ),
+    &declaration!(
+        "reference",
+        "a built-in reference point (`ego`)",
+        field!("actor_type", Symbol in "actor_type", "car", "the actor type it is, for its size and speed"),
+    ),
 ];
 
 pub fn declaration(kind: &str) -> Option<&'static SectionDef> {

@@ -1,8 +1,8 @@
 //! `tadslc build --target scenic`: a Scenic 3 program per scenario.
 //!
 //! Each file is checked first: a file with errors is refused (its errors are printed and
-//! the status is 1); the others are emitted by `tad-scenic`, whose warnings (W07xx) are
-//! printed. One file without `-o` goes to standard output; otherwise `NAME.scenic` is
+//! the status is 1); the others are resolved (`tad_db::resolve`, the typed IR) and emitted
+//! by `tad-scenic`, whose warnings (W07xx) are printed. One file without `-o` goes to standard output; otherwise `NAME.scenic` is
 //! written into the `-o` directory.
 
 use std::path::{Path, PathBuf};
@@ -62,14 +62,14 @@ pub fn run(
         }
         let file = crate::check::register(&mut db, input);
         let module = &tad_db::analyze(&db, file).module;
-        let vocabulary = &tad_db::vocabulary(&db, file).vocabulary;
+        let scenario = tad_db::resolve(&db, file);
         let options = EmitOptions {
             simulator,
             map: map.map(str::to_string),
             map_dir: map_dir.as_ref().map(|d| d.to_string_lossy().into_owned()),
             source: Some(input.name.clone()),
         };
-        let emitted = tad_scenic::emit(module, vocabulary, &options);
+        let emitted = tad_scenic::build(module, scenario.as_ref(), &options);
         let report = FileReport::new(&input.name, &input.text, &emitted.diagnostics);
         eprint!("{}", human::render(&report, color));
         if emitted.diagnostics.iter().any(|d| d.is_error()) {

@@ -14,6 +14,16 @@ pub use table::RUNS;
 /// Town10HD is the smallest map with four-way junctions, two-lane roads and sidewalks.
 pub const KNOWN: &[&str] = &["Town10HD", "Town04", "Town07", "Town06", "Town01", "Town02"];
 
+/// The map table's names of the OpenDRIVE signal types it records at junctions, as
+/// `tools/map_features.py` writes them (`Junction::signs`). Which TAD sign is which type is
+/// declared with the sign (`opendrive_type`).
+pub const SIGN_TYPES: &[(i64, &str)] = &[(206, "stop"), (205, "yield")];
+
+/// The table's name of OpenDRIVE signal type `opendrive_type`, if the table records it.
+pub fn sign_name(opendrive_type: i64) -> Option<&'static str> {
+    SIGN_TYPES.iter().find(|(t, _)| *t == opendrive_type).map(|(_, name)| *name)
+}
+
 /// Metres of lane kept spare: the table rounds lengths, and the program steps along lanes.
 const SLACK: f64 = 1.0;
 
@@ -31,7 +41,7 @@ pub struct Junction {
     pub signalised: bool,
     /// First letters of the maneuvers from the lane: `L`eft, `R`ight, `S`traight, `U`-turn.
     pub turns: &'static str,
-    /// Signs of the junction (`stop`, `yield`).
+    /// Signs of the junction, by their names in [`SIGN_TYPES`] (`stop`, `yield`).
     pub signs: &'static [&'static str],
 }
 
@@ -71,7 +81,8 @@ pub struct JunctionNeed {
     pub signalised: Option<bool>,
     /// The maneuver letter the ego needs (`L`, `R`, `S`, `U`).
     pub turn: Option<char>,
-    pub signs: Vec<&'static str>,
+    /// OpenDRIVE signal types the junction has (`206`).
+    pub signs: Vec<i64>,
 }
 
 /// What the ego's surroundings must have; every field is optional.
@@ -109,7 +120,7 @@ impl Needs {
                 need.kind.is_none_or(|k| k == junction.kind)
                     && need.signalised.is_none_or(|s| s == junction.signalised)
                     && need.turn.is_none_or(|t| junction.turns.contains(t))
-                    && need.signs.iter().all(|s| junction.signs.contains(s))
+                    && need.signs.iter().all(|t| sign_name(*t).is_some_and(|s| junction.signs.contains(&s)))
                     && run.length >= self.approach + self.behind + SLACK
             }
             (None, None) => {

@@ -90,6 +90,9 @@ fn run(path: &Path) -> Result<(), String> {
     }
     let wanted = annotations(&text);
     let mut problems = Vec::new();
+    for d in emitted.diagnostics.iter().filter(|d| d.payload.is_none()) {
+        problems.push(format!("{name}: {} `{}` has no payload", d.code, d.message));
+    }
     if wanted != actual {
         problems.push(format!(
             "{name}: expected\n  {}\nbut the backend reports\n  {}",

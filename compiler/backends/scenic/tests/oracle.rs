@@ -24,11 +24,12 @@ fn emit_all(simulator: Simulator, dir: &Path, maps: &Path) -> (Vec<PathBuf>, Vec
     let mut times = Vec::new();
     for example in common::examples() {
         let text = std::fs::read_to_string(&example).unwrap();
-        let (module, vocabulary) = common::checked(&example, &text);
+        let (_, scenario) = common::checked(&example, &text);
+        let scenario = scenario.expect("an example has a scenario");
         let start = Instant::now();
-        let mut emitted = tad_scenic::emit(&module, &vocabulary, &options);
+        let mut emitted = tad_scenic::emit(&scenario, &options);
         for _ in 1..EMIT_RUNS {
-            emitted = tad_scenic::emit(&module, &vocabulary, &options);
+            emitted = tad_scenic::emit(&scenario, &options);
         }
         times.push(start.elapsed().as_secs_f64() / f64::from(EMIT_RUNS));
         let path = dir.join(format!("{}.scenic", common::stem(&example)));

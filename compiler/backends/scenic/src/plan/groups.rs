@@ -1,0 +1,334 @@
+//! Every actor group resolved but for its place: the Scenic class and CARLA blueprint its
+//! actor type declares (`simulated_as`, `carla_blueprint`, `carla_note`; else its kind's),
+//! its size, count, motion, speed, what its position refers to, and its lane (from the
+//! relation's `lateral` part when not written).
+
+use tad_diagnostics::{Code, Span};
+use tad_ir::{ActorType, Entry, Field, Lane, Lateral, Longitudinal, Reference, Scenario};
+
+use super::report::{Annotate, Report, named, unsupported};
+use super::{MAX_GROUP, Place, kmh, motion};
+use crate::mapping::{self, Class};
+
+/// Where a group's position points.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Target {
+    Ego,
+    /// The group of that index.
+    Group(usize),
+    /// The stop line of the junction ahead of the ego.
+    Junction,
+}
+
+/// What stands for an actor type in the program.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mapping {
+    pub class: Class,
+    pub blueprint: String,
+    /// Why the blueprint only approximates the type (W0703).
+    pub approximation: Option<String>,
+}
+
+/// An actor group with everything resolved but its place.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Resolved {
+    /// The group's name in the scenario.
+    pub name: String,
+    pub summary: String,
+    pub mapping: Mapping,
+    pub length: f64,
+    pub width: f64,
+    /// At most [`MAX_GROUP`].
+    pub count: usize,
+    pub motion: Option<tad_ir::Motion>,
+    /// m/s.
+    pub speed: f64,
+    /// TAD lane index; 0 until [`infer_lanes`] when not written.
+    pub lane: i64,
+    pub target: Target,
+    pub longitudinal: Longitudinal,
+    pub lateral: Option<Lateral>,
+    pub span: Span,
+}
+
+impl Resolved {
+    pub fn across(&self) -> bool {
+        self.motion == Some(tad_ir::Motion::Cross)
+    }
+
+    /// Length along the lane: crossing actors stand across it.
+    pub fn extent(&self) -> f64 {
+        if self.across() { self.width } else { self.length }
+    }
+
+    pub fn place(&self) -> Place {
+        match self.motion {
+            Some(tad_ir::Motion::Parked) => Place::Curb,
+            Some(tad_ir::Motion::Walk) => Place::Sidewalk,
+            _ => Place::Centre,
+        }
+    }
+
+    /// Bumper-to-bumper gap inside the group.
+    pub fn gap(&self) -> f64 {
+        match self.mapping.class {
+            Class::Car => 1.0 + self.speed.min(25.0),
+            Class::Pedestrian => 0.5,
+            Class::Debris => 1.0,
+        }
+    }
+
+    /// Gap to the reference.
+    pub fn lead_gap(&self, reference_speed: f64) -> f64 {
+        let base = if self.mapping.class == Class::Car { 2.0 } else { 1.0 };
+        (base + self.speed.max(reference_speed)).min(30.0)
+    }
+}
+
+/// What stands for an actor type: its own declared simulation, else its kind's (W0703 with
+/// the kind's `carla_note`), else a default of its class.
+pub fn mapping(scenario: &Scenario, actor_type: Option<&Entry<ActorType>>) -> Mapping {
+    let own = actor_type.map(|t| &t.attrs.simulation);
+    let kind = actor_type.and_then(|t| t.attrs.kind).and_then(|k| scenario.entries.get(k)).map(|k| &k.attrs.simulation);
+    let class = own.and_then(|s| s.simulated_as).or(kind.and_then(|k| k.simulated_as)).map_or(Class::Car, Class::of);
+    if let Some(blueprint) = own.and_then(|s| s.carla_blueprint.clone()) {
+        return Mapping { class, blueprint, approximation: own.and_then(|s| s.carla_note.clone()) };
+    }
+    match kind.filter(|k| k.carla_blueprint.is_some() && k.simulated_as.map_or(Class::Car, Class::of) == class) {
+        Some(k) => Mapping {
+            class,
+            blueprint: k.carla_blueprint.clone().unwrap_or_default(),
+            approximation: Some(k.carla_note.clone().unwrap_or_else(|| mapping::FALLBACK_NOTE.to_string())),
+        },
+        None => Mapping {
+            class,
+            blueprint: class.default_blueprint().to_string(),
+            approximation: Some(match class {
+                Class::Car => mapping::FALLBACK_NOTE.to_string(),
+                _ => format!("no CARLA blueprint is declared for it: `{}` stands in", class.default_blueprint()),
+            }),
+        },
+    }
+}
+
+/// The text of a position's reference.
+pub fn reference_name<'s>(scenario: &'s Scenario, reference: &'s Reference) -> &'s str {
+    match reference {
+        Reference::Ego => "ego",
+        Reference::Group(id) => scenario.group(*id).map_or("", |g| g.name.as_str()),
+        Reference::RoadElement(id) => scenario.entries.get(*id).map_or("", |e| e.name.as_str()),
+        Reference::Unknown(name) => name,
+    }
+}
+
+/// Every group of `scenario`, in source order.
+pub fn resolve(scenario: &Scenario, report: &mut Report) -> Vec<Resolved> {
+    let entries = &scenario.entries;
+    let mut out = Vec::new();
+    for group in &scenario.groups {
+        let who = format!("group `{}`", group.name);
+        let (type_name, entry) = match &group.actor_type {
+            Field::Given(written, _) => (entries.name(written).to_string(), entries.resolved(written)),
+            _ => ("unspecified".to_string(), None),
+        };
+        let type_span = group.actor_type.span().unwrap_or(group.name_span);
+        let mapping = mapping(scenario, entry);
+        if let Some(why) = &mapping.approximation {
+            report
+                .warn(
+                    Code::W0703,
+                    format!("actor type `{type_name}` has no exact Scenic counterpart"),
+                    type_span,
+                    "approximated",
+                    unsupported(named("actor_type", &type_name), Some(format!("`{}`", mapping.blueprint))),
+                )
+                .note(why.clone());
+        }
+        let (default_length, default_width) = mapping.class.default_size();
+        let positive = |m: Option<tad_ir::Metres>| m.map(|m| m.0).filter(|v| *v > 0.0);
+        let length = positive(entry.and_then(|e| e.attrs.length)).unwrap_or(default_length);
+        let width = positive(entry.and_then(|e| e.attrs.width)).unwrap_or(default_width);
+        let count_span = group.count.span().unwrap_or(group.name_span);
+        let count = match group.count() {
+            Some(n) if n >= 1 => usize::try_from(n).unwrap_or(usize::MAX),
+            Some(_) => 1,
+            None => {
+                report.warn(
+                    Code::W0706,
+                    format!("the number of actors of {who} is not given"),
+                    count_span,
+                    "1 chosen",
+                    unsupported("actor.count", Some("1".into())),
+                );
+                1
+            }
+        };
+        let count = if count > MAX_GROUP {
+            report
+                .warn(
+                    Code::W0702,
+                    format!("{who} is capped at {MAX_GROUP} actors"),
+                    count_span,
+                    format!("{count} written"),
+                    unsupported(format!("{count} actors in {who}"), Some(format!("{MAX_GROUP} actors"))),
+                )
+                .note("a Scenic scene with very many objects samples slowly and rarely fits on one stretch of road");
+            MAX_GROUP
+        } else {
+            count
+        };
+        let (motion, behavior) = motion::of(scenario, &group.behavior, mapping.class, &who, group.name_span, report);
+        let typical = entry.and_then(|e| e.attrs.typical_speed).map_or(0.0, |s| s.0);
+        let speed = if mapping.class == Class::Debris {
+            0.0
+        } else {
+            motion::speed(&group.speed, typical, behavior, &who, group.name_span, report)
+        };
+        let (target, longitudinal, lateral) = match group.position.given() {
+            None => {
+                report.warn(
+                    Code::W0706,
+                    format!("the position of {who} is not given"),
+                    group.position.span().unwrap_or(group.name_span),
+                    "`front of ego` chosen",
+                    unsupported("actor.position", Some("`front of ego`".into())),
+                );
+                (Target::Ego, Longitudinal::Front, None)
+            }
+            Some(p) => {
+                let relation = entries.resolved(&p.relation.value).map(|r| r.attrs);
+                let longitudinal = match relation.and_then(|r| r.longitudinal) {
+                    Some(Longitudinal::Front) => Longitudinal::Front,
+                    Some(Longitudinal::Behind) => Longitudinal::Behind,
+                    _ => Longitudinal::Same,
+                };
+                let target = match &p.reference.value {
+                    Reference::Group(id) => Target::Group(id.index()),
+                    Reference::Ego => Target::Ego,
+                    Reference::RoadElement(id) if entries.get(*id).is_some_and(|e| e.attrs.at_junction) => {
+                        Target::Junction
+                    }
+                    other => {
+                        let element = reference_name(scenario, other);
+                        report.warn(
+                            Code::W0700,
+                            format!("road element `{element}` has no Scenic mapping"),
+                            p.reference.span,
+                            "placed relative to the ego vehicle instead",
+                            unsupported(named("road_element", element), Some("relative to the ego vehicle".into())),
+                        )
+                        .note("the CARLA maps as Scenic reads them have junctions, lanes and sidewalks, but no bus stops or parking lots");
+                        Target::Ego
+                    }
+                };
+                (target, longitudinal, relation.and_then(|r| r.lateral))
+            }
+        };
+        let summary = summary(scenario, group, &type_name, count);
+        out.push(Resolved {
+            name: group.name.clone(),
+            summary,
+            mapping,
+            length,
+            width,
+            count,
+            motion,
+            speed,
+            lane: group.lane.get().map_or(0, Lane::index),
+            target,
+            longitudinal,
+            lateral,
+            span: group.span,
+        });
+    }
+    out
+}
+
+/// The IR's placement order (each group after its reference), with the groups that depend
+/// on the junction last: they are placed once the ego's approach to it is known.
+pub fn placement_order(scenario: &Scenario, groups: &[Resolved]) -> Vec<usize> {
+    let n = groups.len();
+    let depends_on_junction = |mut i: usize| {
+        for _ in 0..=n {
+            match groups[i].target {
+                Target::Junction => return true,
+                Target::Group(j) if j < n => i = j,
+                _ => return false,
+            }
+        }
+        false
+    };
+    let order: Vec<usize> = scenario.placement_order.iter().map(|id| id.index()).filter(|&i| i < n).collect();
+    let (mut early, late): (Vec<usize>, Vec<usize>) = order.into_iter().partition(|&i| !depends_on_junction(i));
+    early.extend(late);
+    early
+}
+
+/// The lanes not written: from the relation's `lateral` part and the reference's lane,
+/// clamped to the road (W0706).
+pub fn infer_lanes(
+    scenario: &Scenario,
+    groups: &mut [Resolved],
+    order: &[usize],
+    ego_lane: i64,
+    lanes: Option<u32>,
+    one_way: bool,
+    report: &mut Report,
+) {
+    for &i in order {
+        if groups[i].lane != 0 {
+            continue;
+        }
+        let reference_lane = match groups[i].target {
+            Target::Group(j) if groups[j].lane != 0 => groups[j].lane,
+            _ => ego_lane,
+        };
+        let shifted = |by: i64| Lane::new(reference_lane).map_or(reference_lane, |l| l.shift(by).index());
+        let mut lane = match groups[i].lateral {
+            Some(Lateral::Left) => shifted(-1),
+            Some(Lateral::Right) => shifted(1),
+            Some(Lateral::Opposite) => -reference_lane,
+            _ => reference_lane,
+        };
+        if let Some(n) = lanes {
+            lane = lane.clamp(-i64::from(n), i64::from(n));
+            if lane == 0 {
+                lane = reference_lane;
+            }
+        }
+        if one_way && lane < 0 {
+            lane = reference_lane.max(1);
+        }
+        let group = &scenario.groups[i];
+        report
+            .warn(
+                Code::W0706,
+                format!("the lane of group `{}` is not given", group.name),
+                group.lane.span().unwrap_or(group.name_span),
+                format!("lane {lane} chosen"),
+                unsupported("actor.lane", Some(format!("lane {lane}"))),
+            )
+            .note("taken from the position's relation and the lane of its reference");
+        groups[i].lane = lane;
+    }
+}
+
+/// `group `NAME`: COUNT TYPE, BEHAVIOR, SPEED, RELATION of REFERENCE, lane N`: what the
+/// source says, for a comment.
+fn summary(scenario: &Scenario, group: &tad_ir::Group, type_name: &str, count: usize) -> String {
+    let mut parts = vec![format!("{count} {type_name}")];
+    if let Some(b) = group.behavior.given() {
+        parts.push(scenario.entries.name(b).to_string());
+    }
+    if let Some(speed) = group.speed.get() {
+        parts.push(kmh(speed.0));
+    }
+    if let Some(p) = group.position.given() {
+        let relation = scenario.entries.name(&p.relation.value);
+        parts.push(format!("{relation} of {}", reference_name(scenario, &p.reference.value)));
+    }
+    if let Some(lane) = group.lane.get() {
+        parts.push(format!("lane {}", lane.index()));
+    }
+    format!("group `{}`: {}", group.name, parts.join(", "))
+}

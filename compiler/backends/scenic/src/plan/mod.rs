@@ -1,0 +1,174 @@
+//! From a resolved scenario (`tad_ir::Scenario`) to a plan of the Scenic program: the map
+//! and what the ego's surroundings must have, and every actor with its class, blueprint,
+//! size, lane, place along the lane, motion and speeds. The plan holds typed data only;
+//! `crate::print` writes it as Scenic.
+//!
+//! Placement is decided here, not sampled: every actor gets a TAD lane index and an offset
+//! in metres along the ego's lane from the ego's centre, so actors never overlap and the
+//! stretch of road the scenario needs is known before the map is chosen. Only the ego's
+//! place on the map is left to Scenic, among places the map table says exist.
+//!
+//! [`plan`] runs the steps in order, each in its own module with a typed result:
+//!
+//! 1. [`road`]: what the road section asks of the map ([`road::RoadRequest`]);
+//! 2. [`ego`]: the ego vehicle's size, motion, speed and lane ([`ego::EgoPlan`]);
+//! 3. [`groups`]: every actor group's mapping, count, motion, speed, reference and lane
+//!    ([`groups::Resolved`]), and the order they are placed in;
+//! 4. [`choice`]: the road features in priority order and the map that keeps the most
+//!    important ones ([`choice::Choice`]), moving actors into lanes the map has;
+//! 5. [`layout`]: offsets along the lane, capping groups to the stretch the map has;
+//! 6. [`actors`]: the objects of the program, with their identifiers;
+//! 7. [`environment`]: CARLA's weather parameters, and the traffic light.
+//!
+//! Every step reads names through the IR's typed entries: what a name maps to is declared
+//! with it in TAD (see `crate::mapping`).
+
+pub mod actors;
+pub mod choice;
+pub mod ego;
+pub mod environment;
+pub mod groups;
+pub mod layout;
+pub mod motion;
+pub mod report;
+pub mod road;
+
+use tad_diagnostics::{Diagnostic, Span};
+use tad_ir::{Motion, Scenario, Signal};
+
+use crate::EmitOptions;
+use crate::mapping::Class;
+use crate::maps::Needs;
+use report::Report;
+
+/// The most actors one group becomes.
+pub const MAX_GROUP: usize = 20;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Place {
+    /// The centre of the lane.
+    Centre,
+    /// The curb side of the lane, when it is the outermost lane of its direction.
+    Curb,
+    /// The sidewalk beside the lane, when it is the outermost lane and has one.
+    Sidewalk,
+}
+
+/// One object of the Scenic program.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Actor {
+    pub ident: String,
+    pub class: Class,
+    /// The CARLA blueprint.
+    pub blueprint: String,
+    /// The ego vehicle (`with rolename 'hero'`).
+    pub is_ego: bool,
+    pub length: f64,
+    pub width: f64,
+    /// TAD lane index.
+    pub lane: i64,
+    /// Metres along the ego's lane from the ego's centre.
+    pub offset: f64,
+    pub place: Place,
+    /// Facing across the road (to the left of its lane's direction) instead of along it.
+    pub across: bool,
+    /// What it does; `None` for a behavior that declares no motion.
+    pub motion: Option<Motion>,
+    /// The speed its behavior keeps, in m/s.
+    pub target_speed: f64,
+    /// The speed it starts at, in m/s (0 for actors that start at rest).
+    pub initial_speed: f64,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Group {
+    /// What the source says about the group, for a comment.
+    pub summary: String,
+    pub actors: Vec<Actor>,
+}
+
+/// The traffic light the program holds.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Light {
+    pub signal: Signal,
+    /// The TAD light state it comes from.
+    pub name: String,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Plan {
+    pub scenario: String,
+    pub map: String,
+    /// Whether the map is one the table describes.
+    pub map_known: bool,
+    pub needs: Needs,
+    pub ego: Actor,
+    pub ego_summary: String,
+    pub groups: Vec<Group>,
+    /// `carla.WeatherParameters` and what they stand for.
+    pub weather: Vec<(&'static str, f64)>,
+    pub weather_summary: String,
+    pub light: Option<Light>,
+    /// The road features asked for, and those left out, for comments.
+    pub kept: Vec<String>,
+    pub dropped: Vec<String>,
+}
+
+/// The span of a section's keyword (the section's span starts with it), or `fallback`.
+pub(crate) fn keyword(section: Option<Span>, word: &str, fallback: Span) -> Span {
+    section.map_or(fallback, |s| Span::new(s.start, s.start + word.len()))
+}
+
+pub(crate) fn kmh(speed: f64) -> String {
+    format!("{:.0} km/h", speed * 3.6)
+}
+
+pub(crate) fn plural(n: usize, word: &str) -> String {
+    if n == 1 { format!("1 {word}") } else { format!("{n} {word}s") }
+}
+
+/// `a`, `` `a` and `b` ``, `` `a`, `b` and `c` ``.
+pub(crate) fn list(names: &[&str]) -> String {
+    let quoted: Vec<String> = names.iter().map(|n| format!("`{n}`")).collect();
+    match quoted.len() {
+        0 => String::new(),
+        1 => quoted[0].clone(),
+        n => format!("{} and {}", quoted[..n - 1].join(", "), quoted[n - 1]),
+    }
+}
+
+/// The plan of `scenario`'s program, and the backend's diagnostics (unsorted).
+pub fn plan(scenario: &Scenario, options: &EmitOptions) -> (Plan, Vec<Diagnostic>) {
+    let mut report = Report::default();
+    let scenario_span = scenario.name.as_ref().map_or(scenario.span, |n| n.span);
+    let road_span = keyword(scenario.road.span, "road", scenario_span);
+
+    let ego = ego::plan(scenario, scenario_span, &mut report);
+    let road = road::request(scenario, road_span, &mut report);
+    let mut groups = groups::resolve(scenario, &mut report);
+    let order = groups::placement_order(scenario, &groups);
+    groups::infer_lanes(scenario, &mut groups, &order, ego.lane, road.lanes, road.one_way, &mut report);
+
+    let choice = choice::choose(scenario, &road, ego, &mut groups, &order, options.map.as_deref(), &mut report);
+    let ego = choice.ego;
+    let layout = layout::fit(scenario, &groups, &order, &ego, &choice, &mut report);
+
+    let actors = actors::build(scenario, &ego, &groups, &layout);
+    let environment = environment::plan(scenario, &road, options.simulator, &mut report);
+
+    let plan = Plan {
+        scenario: scenario.name.as_ref().map_or_else(|| "scenario".to_string(), |n| n.value.clone()),
+        map: choice.map,
+        map_known: choice.map_known,
+        needs: layout.needs,
+        ego: actors.ego,
+        ego_summary: actors.ego_summary,
+        groups: actors.groups,
+        weather: environment.weather,
+        weather_summary: environment.summary,
+        light: environment.light,
+        kept: choice.kept,
+        dropped: choice.dropped,
+    };
+    (plan, report.diagnostics)
+}
