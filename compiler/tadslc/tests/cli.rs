@@ -737,3 +737,21 @@ fn counts_are_singular_or_plural() {
         }
     }
 }
+
+#[test]
+fn the_readme_and_the_spec_show_what_check_prints() {
+    // README: `$ tadslc check FILE` followed by exactly what it prints
+    let readme = std::fs::read_to_string(repo().join("README.md")).unwrap();
+    let start = readme.find("```text\n$ tadslc check ").expect("a sample run in README.md") + "```text\n$ ".len();
+    let block = &readme[start..start + readme[start..].find("```\n").unwrap()];
+    let (command, shown) = block.split_once('\n').unwrap();
+    let args: Vec<&str> = command.split_whitespace().skip(1).collect();
+    let out = tadslc(&args, "");
+    assert_eq!(shown, stderr(&out), "README.md's sample output of `{command}` is stale");
+    // spec/output.md: the location line and a whole diagnostic as codespan prints them
+    let spec = std::fs::read_to_string(repo().join("spec/output.md")).unwrap();
+    assert!(spec.contains("`┌─ file:line:column`") && !spec.contains("`--> file"));
+    let human = spec.find("```text\nerror[E0203]").expect("a human example in spec/output.md") + "```text\n".len();
+    let example = &spec[human..human + spec[human..].find("```\n").unwrap()];
+    assert!(stderr(&tadslc(&["check", "tests/ui/structure/unknown_field.tad"], "")).contains(example), "{example}");
+}
