@@ -3,7 +3,9 @@
 //! Each file is checked first: a file with errors is refused (its errors are printed and
 //! the status is 1); the others are emitted by `tad-scenic`, whose warnings (W07xx) are
 //! printed. One file without `-o` goes to standard output; otherwise `NAME.scenic` is
-//! written into the `-o` directory.
+//! written into the `-o` directory. A map file that is not where a program will load it
+//! from (`--map-dir`, or beside the program) is a warning, once per map
+//! (`spec/output.md`).
 
 use std::path::{Path, PathBuf};
 
