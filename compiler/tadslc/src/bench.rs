@@ -6,8 +6,8 @@
 //! language server do; the incremental row edits one line of a 2,000-line file and
 //! re-checks it, against checking that file from scratch.
 
-use crate::Status;
-use crate::corpus;
+use crate::output::Closed;
+use crate::{Status, corpus, errln, outln};
 use std::hint::black_box;
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -32,21 +32,25 @@ struct Row {
 }
 
 impl Row {
-    fn print(&self, peer: Option<Duration>) {
+    fn print(&self, peer: Option<Duration>) -> Result<(), Closed> {
         let secs = self.time.as_secs_f64().max(1e-9);
         let ratio = peer.map_or(String::new(), |p| format!("{:>8.2}x", secs / p.as_secs_f64().max(1e-9)));
-        println!(
+        outln!(
             "{:<34} {:>9} {:>10.1} {:>12.0} {:>9.1} {ratio}",
             self.what,
             self.items,
             self.bytes as f64 / 1e6,
             self.items as f64 / secs,
             self.bytes as f64 / 1e6 / secs,
-        );
+        )
     }
 }
 
 pub fn run(n: usize, seed: u64, examples: Option<&Path>, runs: usize) -> Status {
+    crate::output::run(|status| run_in(n, seed, examples, runs, status))
+}
+
+fn run_in(n: usize, seed: u64, examples: Option<&Path>, runs: usize, status: &mut Status) -> Result<(), Closed> {
     let corpus = corpus::generate(n, seed);
     let tad: Vec<&str> = corpus.iter().map(|g| g.tad.as_str()).collect();
     let json: Vec<&str> = corpus.iter().map(|g| g.json.as_str()).collect();
@@ -95,29 +99,36 @@ pub fn run(n: usize, seed: u64, examples: Option<&Path>, runs: usize) -> Status 
         }
     });
 
-    println!("corpus: {n} generated scenarios, seed {seed}, best of {runs} runs, one core");
-    println!(
+    outln!("corpus: {n} generated scenarios, seed {seed}, best of {runs} runs, one core")?;
+    outln!(
         "{:<34} {:>9} {:>10} {:>12} {:>9} {:>9}",
-        "measurement", "scenarios", "MB", "scenarios/s", "MB/s", "vs peer"
-    );
-    Row { what: "peer: serde_json::Value (JSON)".into(), items: n, bytes: json_bytes, time: peer }.print(None);
-    Row { what: "lex".into(), items: n, bytes: tad_bytes, time: lex }.print(Some(peer));
-    Row { what: "parse (lex+parse+lower)".into(), items: n, bytes: tad_bytes, time: check }.print(Some(peer));
-    Row { what: "check, no database".into(), items: n, bytes: tad_bytes, time: direct }.print(Some(peer));
-    Row { what: "check through the database".into(), items: n, bytes: tad_bytes, time: full }.print(Some(peer));
-    Row { what: "fmt (parse+print)".into(), items: n, bytes: tad_bytes, time: format }.print(Some(peer));
-    incremental(runs);
+        "measurement",
+        "scenarios",
+        "MB",
+        "scenarios/s",
+        "MB/s",
+        "vs peer"
+    )?;
+    Row { what: "peer: serde_json::Value (JSON)".into(), items: n, bytes: json_bytes, time: peer }.print(None)?;
+    Row { what: "lex".into(), items: n, bytes: tad_bytes, time: lex }.print(Some(peer))?;
+    Row { what: "parse (lex+parse+lower)".into(), items: n, bytes: tad_bytes, time: check }.print(Some(peer))?;
+    Row { what: "check, no database".into(), items: n, bytes: tad_bytes, time: direct }.print(Some(peer))?;
+    Row { what: "check through the database".into(), items: n, bytes: tad_bytes, time: full }.print(Some(peer))?;
+    Row { what: "fmt (parse+print)".into(), items: n, bytes: tad_bytes, time: format }.print(Some(peer))?;
+    incremental(runs)?;
 
     if let Some(dir) = examples {
-        let (paths, errors) = crate::files::collect(&[dir.to_path_buf()]);
+        let (paths, errors) = crate::files::collect(&[dir.to_path_buf()], crate::files::Search::Tad);
         for e in &errors {
-            eprintln!("error: {e}");
+            *status = Status::Usage;
+            errln!("error: {e}")?;
         }
         let inputs: Vec<crate::files::Input> = paths.iter().filter_map(|p| crate::files::read(p).ok()).collect();
         let texts: Vec<&str> = inputs.iter().map(|i| i.text.as_str()).collect();
         if texts.is_empty() {
-            eprintln!("error: no .tad files in `{}`", dir.display());
-            return Status::Usage;
+            // `collect` said why
+            *status = Status::Usage;
+            return Ok(());
         }
         // Repeat the examples to a measurable amount of work.
         let repeat = (tad_bytes / texts.iter().map(|t| t.len()).sum::<usize>().max(1)).max(1);
@@ -133,14 +144,14 @@ pub fn run(n: usize, seed: u64, examples: Option<&Path>, runs: usize) -> Status 
             }
         });
         Row {
-            what: format!("check examples ({} files x{repeat})", texts.len()),
+            what: format!("check examples ({} x{repeat})", crate::plural(texts.len(), "file")),
             items: texts.len() * repeat,
             bytes,
             time,
         }
-        .print(None);
+        .print(None)?;
     }
-    Status::Ok
+    Ok(())
 }
 
 /// A scenario of about `lines` lines: the usual sections and many actor groups.
@@ -161,7 +172,7 @@ fn long_scenario(lines: usize) -> String {
 }
 
 /// Re-checking a 2,000-line file after a one-line edit, against checking it from scratch.
-fn incremental(runs: usize) {
+fn incremental(runs: usize) -> Result<(), Closed> {
     let text = long_scenario(2000);
     let lines = text.lines().count();
     let path = std::path::PathBuf::from("/bench/long.tad");
@@ -188,11 +199,11 @@ fn incremental(runs: usize) {
     times.sort();
     let p50 = times[times.len() / 2];
     let p99 = times[times.len() * 99 / 100];
-    println!(
+    outln!(
         "incremental: one-line edit of a {lines}-line file, re-checked: p50 {:.3} ms, p99 {:.3} ms; from scratch {:.3} ms ({:.2}x of it)",
         p50.as_secs_f64() * 1e3,
         p99.as_secs_f64() * 1e3,
         scratch.as_secs_f64() * 1e3,
         p50.as_secs_f64() / scratch.as_secs_f64().max(1e-9)
-    );
+    )
 }

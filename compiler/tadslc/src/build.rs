@@ -3,12 +3,15 @@
 //! Each file is checked first: a file with errors is refused (its errors are printed and
 //! the status is 1); the others are resolved (`tad_db::resolve`, the typed IR) and emitted
 //! by `tad-scenic`, whose warnings (W07xx) are printed. One file without `-o` goes to standard output; otherwise `NAME.scenic` is
-//! written into the `-o` directory.
+//! written into the `-o` directory. A map file that is not where a program will load it
+//! from (`--map-dir`, or beside the program) is a warning, once per map
+//! (`spec/output.md`).
 
 use std::path::{Path, PathBuf};
 
-use crate::Status;
-use crate::files;
+use crate::files::{self, Search};
+use crate::output::Closed;
+use crate::{Status, err, errln, out, plural};
 use tad_check::Options;
 use tad_db::Database;
 use tad_diagnostics::render::{FileReport, human};
@@ -26,38 +29,61 @@ pub fn run(
     simulator: &str,
     color: bool,
 ) -> Status {
+    crate::output::run(|status| run_in(paths, target, out, map_dir, map, simulator, color, status))
+}
+
+/// Where a program written to `out` (a directory, or standard output) will look for its
+/// map, when that file is not there: the programs that load it, in words, and the file.
+struct MissingMap {
+    file: PathBuf,
+    programs: Vec<String>,
+}
+
+#[allow(clippy::too_many_arguments)]
+fn run_in(
+    paths: &[PathBuf],
+    target: &str,
+    out: Option<&Path>,
+    map_dir: Option<&Path>,
+    map: Option<&str>,
+    simulator: &str,
+    color: bool,
+    status: &mut Status,
+) -> Result<(), Closed> {
     if !target.eq_ignore_ascii_case("scenic") {
-        eprintln!("error: unknown target `{target}` (targets: {})", TARGETS.join(", "));
-        return Status::Usage;
+        *status = Status::Usage;
+        return errln!("error: unknown target `{target}` (targets: {})", TARGETS.join(", "));
     }
     let Some(simulator) = Simulator::parse(simulator) else {
-        eprintln!("error: unknown simulator `{simulator}` (simulators: carla, newtonian)");
-        return Status::Usage;
+        *status = Status::Usage;
+        return errln!("error: unknown simulator `{simulator}` (simulators: carla, newtonian)");
     };
-    let (inputs, mut status) = files::load(paths);
+    let inputs = files::load(paths, Search::Tad, status)?;
     if out.is_none() && inputs.len() > 1 {
-        eprintln!("error: {} files to build: give an output directory with -o", inputs.len());
-        return Status::Usage;
+        *status = Status::Usage;
+        return errln!("error: {} to build: give an output directory with -o", plural(inputs.len(), "file"));
     }
     if let Some(dir) = out
         && let Err(e) = std::fs::create_dir_all(dir)
     {
-        eprintln!("error: cannot create `{}`: {e}", dir.display());
-        return Status::Usage;
+        *status = Status::Usage;
+        return errln!("error: cannot create `{}`: {e}", dir.display());
     }
     // The program names its map by path: make a relative map directory absolute, so the
     // program finds it wherever it is written.
     let map_dir = map_dir.map(|d| std::path::absolute(d).unwrap_or_else(|_| d.to_path_buf()));
     let mut written: Vec<PathBuf> = Vec::new();
+    let mut missing: Vec<MissingMap> = Vec::new();
+    let mut to_stdout: Option<(String, String)> = None;
     let mut db = Database::new(Options::default());
     for input in &inputs {
         let checked = crate::check::diagnose_in(&mut db, input);
         if checked.diagnostics.iter().any(|d| d.is_error()) {
+            *status = (*status).max(Status::Failed);
             let errors: Vec<_> = checked.diagnostics.iter().filter(|d| d.is_error()).cloned().collect();
             let report = FileReport::new(&input.name, &input.text, &errors);
-            eprint!("{}", human::render(&report, color));
-            eprintln!("{}: not built: it has errors", input.name);
-            status = status.max(Status::Failed);
+            err!("{}", human::render(&report, color))?;
+            errln!("{}: not built: it has errors", input.name)?;
             continue;
         }
         let file = crate::check::register(&mut db, input);
@@ -71,21 +97,23 @@ pub fn run(
         };
         let emitted = tad_scenic::build(module, scenario.as_ref(), &options);
         let report = FileReport::new(&input.name, &input.text, &emitted.diagnostics);
-        eprint!("{}", human::render(&report, color));
+        err!("{}", human::render(&report, color))?;
         if emitted.diagnostics.iter().any(|d| d.is_error()) {
-            eprintln!("{}: not built", input.name);
-            status = status.max(Status::Failed);
+            *status = (*status).max(Status::Failed);
+            errln!("{}: not built", input.name)?;
             continue;
         }
-        if let Some(dir) = &map_dir {
-            let file = dir.join(format!("{}.xodr", emitted.map));
-            if !file.is_file() {
-                eprintln!("{}: note: the program loads `{}`, which does not exist yet", input.name, file.display());
-            }
-        }
+        let map_file = format!("{}.xodr", emitted.map);
         let warnings = emitted.diagnostics.len();
         match out {
-            None => print!("{}", emitted.text),
+            None => {
+                match &map_dir {
+                    Some(dir) => note_missing(&mut missing, dir.join(&map_file), &input.name),
+                    // `localPath`: beside the program, wherever it is saved
+                    None => to_stdout = Some((input.name.clone(), map_file)),
+                }
+                out!("{}", emitted.text)?;
+            }
             Some(dir) => {
                 let stem = input
                     .path
@@ -94,20 +122,20 @@ pub fn run(
                     .map_or_else(|| "stdin".to_string(), |s| s.to_string_lossy().into_owned());
                 let target = dir.join(format!("{stem}.scenic"));
                 if written.contains(&target) {
-                    eprintln!(
+                    *status = (*status).max(Status::Usage);
+                    errln!(
                         "error: {} would overwrite `{}`, written for an earlier file",
                         input.name,
                         target.display()
-                    );
-                    status = status.max(Status::Usage);
+                    )?;
                     continue;
                 }
                 if let Err(e) = std::fs::write(&target, &emitted.text) {
-                    eprintln!("error: cannot write `{}`: {e}", target.display());
-                    status = status.max(Status::Usage);
+                    *status = (*status).max(Status::Usage);
+                    errln!("error: cannot write `{}`: {e}", target.display())?;
                     continue;
                 }
-                eprintln!(
+                errln!(
                     "{}: wrote {} ({}, {}, {})",
                     input.name,
                     target.display(),
@@ -115,15 +143,57 @@ pub fn run(
                     simulator.as_str(),
                     match warnings {
                         0 => "no warnings".to_string(),
-                        1 => "1 warning".to_string(),
-                        n => format!("{n} warnings"),
+                        n => plural(n, "warning"),
                     }
-                );
+                )?;
+                let map_file = map_dir.as_deref().unwrap_or(dir).join(&map_file);
+                note_missing(&mut missing, map_file, &target.display().to_string());
                 written.push(target);
             }
         }
     }
-    status
+    report_missing_maps(&missing, map_dir.is_some())?;
+    if let Some((name, map_file)) = to_stdout {
+        errln!(
+            "{name}: note: the program loads `{map_file}` from the directory it is saved in (`localPath`); \
+             save it beside the CARLA maps, or build with `--map-dir DIR`, DIR the directory of the CARLA maps"
+        )?;
+    }
+    Ok(())
+}
+
+/// Remember that `program` loads `file`, if `file` does not exist.
+fn note_missing(missing: &mut Vec<MissingMap>, file: PathBuf, program: &str) {
+    if file.is_file() {
+        return;
+    }
+    match missing.iter_mut().find(|m| m.file == file) {
+        Some(known) => known.programs.push(program.to_string()),
+        None => missing.push(MissingMap { file, programs: vec![program.to_string()] }),
+    }
+}
+
+/// One warning per map file that a program loads and that does not exist.
+fn report_missing_maps(missing: &[MissingMap], map_dir_given: bool) -> Result<(), Closed> {
+    for m in missing {
+        let others = match m.programs.len() {
+            1 => String::new(),
+            n => format!(" (so do {})", plural(n - 1, "other program")),
+        };
+        errln!("{}: warning: the program loads `{}`, which does not exist{others}", m.programs[0], m.file.display())?;
+        let dir = m.file.parent().map_or_else(String::new, |d| d.display().to_string());
+        let name = m.file.file_name().map_or_else(String::new, |f| f.to_string_lossy().into_owned());
+        if map_dir_given {
+            errln!(
+                "  = help: give `--map-dir` the directory of the CARLA maps (`TownNN.xodr`), or put `{name}` in `{dir}`"
+            )?;
+        } else {
+            errln!(
+                "  = help: build with `--map-dir DIR`, DIR the directory of the CARLA maps (`TownNN.xodr`), or put `{name}` in `{dir}`"
+            )?;
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

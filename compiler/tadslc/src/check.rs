@@ -4,8 +4,9 @@
 //! (a used module, the prelude) is rendered with that file's text. A local module used by
 //! an input and having errors is reported once, in its own file, after the inputs.
 
-use crate::files::{self, Input};
-use crate::{Format, Status};
+use crate::files::{self, Input, Search};
+use crate::output::Closed;
+use crate::{Format, Status, err, errln, outln, plural};
 use tad_check::{Checked, Class, Options};
 use tad_db::{Database, Language, RealFs, SourceFile};
 use tad_diagnostics::render::{FileReport, Source, human, json, sarif};
@@ -91,8 +92,22 @@ struct Checked1 {
     result: Checked,
 }
 
+/// Check every file `paths` name, then report. Every file is checked before anything is
+/// reported, so the status is the whole run's even if the reader of the report stops
+/// reading early (`spec/output.md`).
 pub fn run(paths: &[std::path::PathBuf], format: Format, deny_warnings: bool, color: bool, options: Options) -> Status {
-    let (inputs, mut status) = files::load(paths);
+    crate::output::run(|status| run_in(paths, format, deny_warnings, color, options, status))
+}
+
+fn run_in(
+    paths: &[std::path::PathBuf],
+    format: Format,
+    deny_warnings: bool,
+    color: bool,
+    options: Options,
+    status: &mut Status,
+) -> Result<(), Closed> {
+    let inputs = files::load(paths, Search::Scenarios, status)?;
     let mut db = Database::new(options);
     let mut done: Vec<Checked1> = Vec::new();
     for input in &inputs {
@@ -124,20 +139,26 @@ pub fn run(paths: &[std::path::PathBuf], format: Format, deny_warnings: bool, co
 
     let (mut errors, mut warnings) = (0, 0);
     let mut classes = [0usize; Class::ALL.len()];
-    let mut sarif_reports = Vec::new();
     for c in &done {
         errors += c.result.diagnostics.iter().filter(|d| d.severity == Severity::Error).count();
         warnings += c.result.diagnostics.iter().filter(|d| d.severity == Severity::Warning).count();
         if let Some(class) = c.result.class {
             classes[class as usize] += 1;
         }
+    }
+    if errors > 0 || (deny_warnings && warnings > 0) {
+        *status = (*status).max(Status::Failed);
+    }
+
+    let mut sarif_reports = Vec::new();
+    for c in &done {
         let related = related(&db, c.file, &c.result.diagnostics);
         let report = report(&c.name, &c.text, &c.result.diagnostics, &related);
         match format {
             Format::Human => {
-                eprint!("{}", human::render(&report, color));
+                err!("{}", human::render(&report, color))?;
                 if let Some(class) = c.result.class.filter(|c| *c != Class::Complete) {
-                    eprintln!("{}: {}", c.name, class.as_str());
+                    errln!("{}: {}", c.name, class.as_str())?;
                 }
             }
             Format::Json => {
@@ -150,7 +171,7 @@ pub fn run(paths: &[std::path::PathBuf], format: Format, deny_warnings: bool, co
                     _ => Vec::new(),
                 };
                 object.insert("refinement".into(), refinement.into());
-                println!("{}", serde_json::Value::Object(object));
+                outln!("{}", serde_json::Value::Object(object))?;
             }
             Format::Sarif => sarif_reports.push((
                 c.name.clone(),
@@ -177,19 +198,14 @@ pub fn run(paths: &[std::path::PathBuf], format: Format, deny_warnings: bool, co
                     artifact["properties"] = serde_json::json!({ "class": class });
                 }
             }
-            println!("{log}");
+            outln!("{log}")?;
         }
-        Format::Human => eprintln!("{}", summary(inputs.len(), errors, warnings, classes)),
+        // nothing was checked: the errors above say why
+        Format::Human if inputs.is_empty() => {}
+        Format::Human => errln!("{}", summary(inputs.len(), errors, warnings, classes))?,
         Format::Json => {}
     }
-    if errors > 0 || (deny_warnings && warnings > 0) {
-        status = status.max(Status::Failed);
-    }
-    status
-}
-
-fn plural(n: usize, word: &str) -> String {
-    if n == 1 { format!("1 {word}") } else { format!("{n} {word}s") }
+    Ok(())
 }
 
 fn summary(files: usize, errors: usize, warnings: usize, classes: [usize; Class::ALL.len()]) -> String {

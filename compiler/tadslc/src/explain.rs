@@ -1,24 +1,107 @@
 //! `tadslc explain CODE`: print a code's reference text from `spec/diagnostics.md`.
+//!
+//! A code is found by its number, whatever its letter and case: `E0203`, `e203`, `203`
+//! and `0203` are E0203; `600`, `w600` and `E0600` are W0600. Where an error and a
+//! warning share a number, the letter given chooses, and a bare number means the error.
 
-use crate::Status;
+use crate::output::Closed;
+use crate::{Status, errln, outln};
 use tad_diagnostics::Code;
 
 pub fn run(code: Option<&str>) -> Status {
+    crate::output::run(|status| run_in(code, status))
+}
+
+fn run_in(code: Option<&str>, status: &mut Status) -> Result<(), Closed> {
     let Some(text) = code else {
         for code in Code::ALL {
-            println!("{code}  {}", code.title());
+            outln!("{code}  {}", code.title())?;
         }
-        return Status::Ok;
+        return Ok(());
     };
-    match Code::parse(text) {
-        Some(code) => {
-            println!("{}", code.reference().trim_start_matches("## "));
-            Status::Ok
+    match resolve(text) {
+        Ok(code) => {
+            outln!("{}", code.reference().trim_start_matches("## "))?;
+            if let Some(twin) = twin(code) {
+                errln!("note: {twin} ({}) has the same number: `tadslc explain {twin}`", twin.title())?;
+            }
         }
-        None => {
-            eprintln!("error: `{text}` is not a TADSL diagnostic code");
-            eprintln!("note: `tadslc explain` without a code lists them all");
-            Status::Usage
+        Err(nearest) => {
+            *status = Status::Usage;
+            errln!("error: `{text}` is not a TADSL diagnostic code")?;
+            if nearest.is_empty() {
+                errln!("note: a code is a number such as `203`, with or without its letter (`E0203`)")?;
+            } else {
+                let names: Vec<String> = nearest.iter().map(|c| format!("{c} ({})", c.title())).collect();
+                errln!("help: the closest codes are {}", names.join(", "))?;
+            }
+            errln!("note: `tadslc explain` without a code lists them all")?;
         }
+    }
+    Ok(())
+}
+
+/// The number of a code: 203 for E0203.
+fn number(code: Code) -> u32 {
+    code.as_str()[1..].parse().unwrap_or(u32::MAX)
+}
+
+/// The letter a code is written with, and its number, if `text` is one: `[EeWw]?digits`.
+fn split(text: &str) -> Option<(Option<char>, u32)> {
+    let text = text.trim();
+    let (letter, digits) = match text.chars().next()? {
+        c @ ('e' | 'E' | 'w' | 'W') => (Some(c.to_ascii_uppercase()), &text[1..]),
+        _ => (None, text),
+    };
+    if digits.is_empty() || digits.len() > 6 || !digits.bytes().all(|b| b.is_ascii_digit()) {
+        return None;
+    }
+    Some((letter, digits.parse().ok()?))
+}
+
+/// The code `text` names, or the codes with the closest numbers (none if `text` is not
+/// a number at all).
+pub fn resolve(text: &str) -> Result<Code, Vec<Code>> {
+    let Some((letter, n)) = split(text) else {
+        return Err(Vec::new());
+    };
+    let same: Vec<Code> = Code::ALL.iter().copied().filter(|c| number(*c) == n).collect();
+    let preferred = letter.unwrap_or('E');
+    if let Some(code) = same.iter().find(|c| c.as_str().starts_with(preferred)).or(same.first()) {
+        return Ok(*code);
+    }
+    let mut nearest: Vec<Code> = Code::ALL.to_vec();
+    // closest number first; among as close, the letter given, then the smaller number
+    nearest.sort_by_key(|c| (number(*c).abs_diff(n), !c.as_str().starts_with(preferred), number(*c)));
+    nearest.truncate(3);
+    nearest.sort();
+    Err(nearest)
+}
+
+/// The code of the other severity with the same number, if there is one.
+fn twin(code: Code) -> Option<Code> {
+    Code::ALL.iter().copied().find(|c| *c != code && number(*c) == number(code))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_resolve_whatever_the_letter() {
+        assert_eq!(resolve("E0203"), Ok(Code::E0203));
+        assert_eq!(resolve("e203"), Ok(Code::E0203));
+        assert_eq!(resolve("203"), Ok(Code::E0203));
+        assert_eq!(resolve("600"), Ok(Code::W0600));
+        assert_eq!(resolve("w600"), Ok(Code::W0600));
+        assert_eq!(resolve("E0600"), Ok(Code::W0600));
+        assert_eq!(resolve("w0200"), Ok(Code::W0200));
+        assert_eq!(resolve("0200"), Ok(Code::E0200));
+        assert_eq!(resolve("x203"), Err(Vec::new()));
+        assert_eq!(resolve(""), Err(Vec::new()));
+        let nearest = resolve("E0299").unwrap_err();
+        assert_eq!(nearest.len(), 3);
+        assert_eq!(nearest[0], Code::E0300);
+        assert!(nearest.iter().all(|c| (200..=400).contains(&number(*c))), "{nearest:?}");
     }
 }

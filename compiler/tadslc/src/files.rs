@@ -1,5 +1,7 @@
 //! Finding and reading input files.
 
+use crate::errln;
+use crate::output::Closed;
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
@@ -14,10 +16,41 @@ pub struct Input {
     pub invalid_utf8: Option<usize>,
 }
 
+/// Which files a directory is searched for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Search {
+    /// Scenarios in either language: `*.tad`, and `*.yaml`/`*.yml` (read as answers).
+    Scenarios,
+    /// TAD only: `*.tad` (what `fmt`, `build` and `bench` take from a directory).
+    Tad,
+}
+
+impl Search {
+    fn wants(self, path: &Path) -> bool {
+        let Some(ext) = path.extension().and_then(|e| e.to_str()) else {
+            return false;
+        };
+        match self {
+            Search::Scenarios => ["tad", "yaml", "yml"].iter().any(|x| ext.eq_ignore_ascii_case(x)),
+            Search::Tad => ext == "tad",
+        }
+    }
+
+    /// The files searched for, in words: `.tad or .yaml files`.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Search::Scenarios => ".tad or .yaml files",
+            Search::Tad => ".tad files",
+        }
+    }
+}
+
 /// Expand paths into the files to process: files as given, directories searched
-/// recursively for `*.tad` (hidden directories and `target` skipped), sorted; `-` is
-/// standard input. Unreadable paths are returned as errors, the rest still processed.
-pub fn collect(paths: &[PathBuf]) -> (Vec<PathBuf>, Vec<String>) {
+/// recursively for the files `search` wants (hidden directories, `target` and
+/// `node_modules` skipped), sorted; `-` is standard input. Unreadable paths, and
+/// directories with no file to process, are returned as errors; the rest are still
+/// processed.
+pub fn collect(paths: &[PathBuf], search: Search) -> (Vec<PathBuf>, Vec<String>) {
     let mut files = Vec::new();
     let mut errors = Vec::new();
     for path in paths {
@@ -25,7 +58,10 @@ pub fn collect(paths: &[PathBuf]) -> (Vec<PathBuf>, Vec<String>) {
             files.push(path.clone());
         } else if path.is_dir() {
             let mut found = Vec::new();
-            walk(path, &mut found, &mut errors);
+            walk(path, search, &mut found, &mut errors);
+            if found.is_empty() {
+                errors.push(format!("no {} in `{}`", search.describe(), path.display()));
+            }
             found.sort();
             files.extend(found);
         } else if path.exists() {
@@ -37,7 +73,7 @@ pub fn collect(paths: &[PathBuf]) -> (Vec<PathBuf>, Vec<String>) {
     (files, errors)
 }
 
-fn walk(dir: &Path, found: &mut Vec<PathBuf>, errors: &mut Vec<String>) {
+fn walk(dir: &Path, search: Search, found: &mut Vec<PathBuf>, errors: &mut Vec<String>) {
     let entries = match std::fs::read_dir(dir) {
         Ok(entries) => entries,
         Err(e) => {
@@ -53,11 +89,8 @@ fn walk(dir: &Path, found: &mut Vec<PathBuf>, errors: &mut Vec<String>) {
         let name = entry.file_name();
         let hidden = name.to_string_lossy().starts_with('.');
         if kind.is_dir() && !hidden && name != "target" && name != "node_modules" {
-            walk(&path, found, errors);
-        } else if (kind.is_file() || kind.is_symlink())
-            && path.extension().is_some_and(|e| e == "tad")
-            && path.is_file()
-        {
+            walk(&path, search, found, errors);
+        } else if (kind.is_file() || kind.is_symlink()) && search.wants(&path) && path.is_file() {
             found.push(path);
         }
     }
@@ -84,24 +117,23 @@ pub fn read(path: &Path) -> Result<Input, String> {
 }
 
 /// Every input `paths` name (see [`collect`]), in order. Paths that cannot be read are
-/// reported on standard error; the status is then [`Status::Usage`](crate::Status), and
+/// reported on standard error and raise `status` to [`Status::Usage`](crate::Status);
 /// the other inputs are still returned.
-pub fn load(paths: &[PathBuf]) -> (Vec<Input>, crate::Status) {
-    let (files, errors) = collect(paths);
-    let mut status = crate::Status::Ok;
+pub fn load(paths: &[PathBuf], search: Search, status: &mut crate::Status) -> Result<Vec<Input>, Closed> {
+    let (files, errors) = collect(paths, search);
     for error in &errors {
-        eprintln!("error: {error}");
-        status = crate::Status::Usage;
+        *status = crate::Status::Usage;
+        errln!("error: {error}")?;
     }
     let mut inputs = Vec::with_capacity(files.len());
     for path in &files {
         match read(path) {
             Ok(input) => inputs.push(input),
             Err(e) => {
-                eprintln!("error: {e}");
-                status = crate::Status::Usage;
+                *status = crate::Status::Usage;
+                errln!("error: {e}")?;
             }
         }
     }
-    (inputs, status)
+    Ok(inputs)
 }

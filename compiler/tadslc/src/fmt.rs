@@ -1,7 +1,8 @@
 //! `tadslc fmt`: rewrite files in the canonical layout, or check that they are.
 
-use crate::Status;
-use crate::files;
+use crate::files::{self, Search};
+use crate::output::Closed;
+use crate::{Status, err, errln, out, plural};
 use tad_diagnostics::render::{FileReport, human};
 
 /// The codes whose fixes `--canonicalize` applies (their machine-applicable ones).
@@ -25,29 +26,41 @@ pub fn canonicalize(db: &mut tad_db::Database, input: &files::Input) -> String {
     text
 }
 
+/// Format every `.tad` file `paths` name (directories are searched for `*.tad` only:
+/// YAML is not TAD, and is skipped).
 pub fn run(paths: &[std::path::PathBuf], check: bool, canonical: bool, color: bool) -> Status {
+    crate::output::run(|status| run_in(paths, check, canonical, color, status))
+}
+
+fn run_in(
+    paths: &[std::path::PathBuf],
+    check: bool,
+    canonical: bool,
+    color: bool,
+    status: &mut Status,
+) -> Result<(), Closed> {
     let mut db = tad_db::Database::new(tad_check::Options::default());
-    let (inputs, mut status) = files::load(paths);
+    let inputs = files::load(paths, Search::Tad, status)?;
     let mut unformatted = 0;
     for input in &inputs {
         if input.invalid_utf8.is_some() {
-            eprintln!("error: `{}` is not valid UTF-8; not formatted", input.name);
-            status = status.max(Status::Failed);
+            *status = (*status).max(Status::Failed);
+            errln!("error: `{}` is not valid UTF-8; not formatted", input.name)?;
             continue;
         }
         let source = if canonical { canonicalize(&mut db, input) } else { input.text.clone() };
         let formatted = match tad_syntax::format::format(&source) {
             Ok(formatted) => formatted,
             Err(diagnostics) => {
+                *status = (*status).max(Status::Failed);
                 let report = FileReport::new(&input.name, &input.text, &diagnostics);
-                eprint!("{}", human::render(&report, color));
-                eprintln!("error: `{}` has syntax errors; not formatted", input.name);
-                status = status.max(Status::Failed);
+                err!("{}", human::render(&report, color))?;
+                errln!("error: `{}` has syntax errors; not formatted", input.name)?;
                 continue;
             }
         };
         let Some(target) = &input.path else {
-            print!("{formatted}");
+            out!("{formatted}")?;
             continue;
         };
         if formatted == input.text {
@@ -55,20 +68,25 @@ pub fn run(paths: &[std::path::PathBuf], check: bool, canonical: bool, color: bo
         }
         unformatted += 1;
         if check {
+            *status = (*status).max(Status::Failed);
             let line = first_difference(&input.text, &formatted);
-            eprintln!("{}: not formatted (first difference at line {line})", input.name);
-            status = status.max(Status::Failed);
+            errln!("{}: not formatted (first difference at line {line})", input.name)?;
         } else if let Err(e) = write_atomically(target, &formatted) {
-            eprintln!("error: cannot write `{}`: {e}", input.name);
-            status = Status::Usage;
+            *status = Status::Usage;
+            errln!("error: cannot write `{}`: {e}", input.name)?;
         } else {
-            eprintln!("formatted {}", input.name);
+            errln!("formatted {}", input.name)?;
         }
     }
     if check && unformatted > 0 {
-        eprintln!("{unformatted} of {} files would be reformatted; run `tadslc fmt` on them", inputs.len());
+        errln!(
+            "{} would be reformatted ({} checked); run `tadslc fmt` on {}",
+            plural(unformatted, "file"),
+            inputs.len(),
+            if unformatted == 1 { "it" } else { "them" }
+        )?;
     }
-    status
+    Ok(())
 }
 
 fn first_difference(a: &str, b: &str) -> usize {

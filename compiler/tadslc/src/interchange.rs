@@ -7,33 +7,28 @@
 //! What was understood is written even when something was not: the errors say what is
 //! missing, and the status is 1.
 
-use crate::Status;
 use crate::files::{self, Input};
+use crate::output::Closed;
+use crate::{Status, err, errln, out, plural};
 use std::path::{Path, PathBuf};
 use tad_check::Options;
 use tad_db::{Database, Language, RealFs};
 use tad_diagnostics::render::{FileReport, human};
 use tad_diagnostics::{Diagnostic, Severity};
 
-fn report(input: &Input, diagnostics: &[Diagnostic], color: bool) -> usize {
-    eprint!("{}", human::render(&FileReport::new(&input.name, &input.text, diagnostics), color));
-    diagnostics.iter().filter(|d| d.severity == Severity::Error).count()
+fn report(input: &Input, diagnostics: &[Diagnostic], color: bool) -> Result<usize, Closed> {
+    err!("{}", human::render(&FileReport::new(&input.name, &input.text, diagnostics), color))?;
+    Ok(diagnostics.iter().filter(|d| d.severity == Severity::Error).count())
 }
 
-fn write_output(out: Option<&Path>, text: &str) -> Status {
+fn write_output(out: Option<&Path>, text: &str, status: &mut Status) -> Result<(), Closed> {
     match out {
-        None => {
-            print!("{text}");
-            Status::Ok
-        }
+        None => out!("{text}"),
         Some(path) => match std::fs::write(path, text) {
-            Ok(()) => {
-                eprintln!("wrote {}", path.display());
-                Status::Ok
-            }
+            Ok(()) => errln!("wrote {}", path.display()),
             Err(e) => {
-                eprintln!("error: cannot write `{}`: {e}", path.display());
-                Status::Usage
+                *status = (*status).max(Status::Usage);
+                errln!("error: cannot write `{}`: {e}", path.display())
             }
         },
     }
@@ -62,45 +57,53 @@ pub fn import(db: &mut Database, input: &Input) -> (String, Vec<Diagnostic>) {
 }
 
 /// Read one input, or say why not.
-fn read(path: &Path) -> Result<Input, Status> {
-    files::read(path).map_err(|e| {
-        eprintln!("error: {e}");
-        Status::Usage
-    })
+fn read(path: &Path, status: &mut Status) -> Result<Option<Input>, Closed> {
+    match files::read(path) {
+        Ok(input) => Ok(Some(input)),
+        Err(e) => {
+            *status = Status::Usage;
+            errln!("error: {e}")?;
+            Ok(None)
+        }
+    }
 }
 
 pub fn run_import(path: &Path, out: Option<&Path>, color: bool) -> Status {
-    let input = match read(path) {
-        Ok(input) => input,
-        Err(status) => return status,
-    };
-    let mut db = Database::new(Options::default());
-    let (text, diagnostics) = import(&mut db, &input);
-    let errors = report(&input, &diagnostics, color);
-    let status = write_output(out, &text);
-    if errors > 0 {
-        eprintln!(
-            "imported `{}` with {errors} error{}: the output lacks what they name",
-            input.name,
-            if errors == 1 { "" } else { "s" }
-        );
-        return status.max(Status::Failed);
-    }
-    status
+    crate::output::run(|status| {
+        let Some(input) = read(path, status)? else {
+            return Ok(());
+        };
+        let mut db = Database::new(Options::default());
+        let (text, diagnostics) = import(&mut db, &input);
+        let errors = report(&input, &diagnostics, color)?;
+        if errors > 0 {
+            *status = (*status).max(Status::Failed);
+        }
+        write_output(out, &text, status)?;
+        if errors > 0 {
+            errln!("imported `{}` with {}: the output lacks what they name", input.name, plural(errors, "error"))?;
+        }
+        Ok(())
+    })
 }
 
 pub fn run_export(path: &Path, out: Option<&Path>, color: bool) -> Status {
-    let input = match read(path) {
-        Ok(input) => input,
-        Err(status) => return status,
-    };
-    let mut db = Database::new(Options::default());
-    let checked = crate::check::diagnose_in(&mut db, &input);
-    if report(&input, &checked.diagnostics, color) > 0 {
-        eprintln!("error: `{}` has errors; not exported", input.name);
-        return Status::Failed;
-    }
-    let file = crate::check::register(&mut db, &input);
-    let module = &tad_db::analyze(&db, file).module;
-    write_output(out, &tad_yaml::export(module, &input.text))
+    crate::output::run(|status| {
+        let Some(input) = read(path, status)? else {
+            return Ok(());
+        };
+        let mut db = Database::new(Options::default());
+        let checked = crate::check::diagnose_in(&mut db, &input);
+        let errors = checked.diagnostics.iter().filter(|d| d.severity == Severity::Error).count();
+        if errors > 0 {
+            *status = Status::Failed;
+        }
+        report(&input, &checked.diagnostics, color)?;
+        if errors > 0 {
+            return errln!("error: `{}` has errors; not exported", input.name);
+        }
+        let file = crate::check::register(&mut db, &input);
+        let module = &tad_db::analyze(&db, file).module;
+        write_output(out, &tad_yaml::export(module, &input.text), status)
+    })
 }

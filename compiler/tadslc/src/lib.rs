@@ -11,6 +11,8 @@ pub mod explain;
 pub mod files;
 pub mod fmt;
 pub mod interchange;
+pub mod manual;
+pub mod output;
 
 /// Output format of `check`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -32,4 +34,9 @@ impl From<Status> for std::process::ExitCode {
     fn from(status: Status) -> Self {
         std::process::ExitCode::from(status as u8)
     }
+}
+
+/// `1 file`, `2 files`: a count with its noun in the right number (regular plurals).
+pub fn plural(n: usize, word: &str) -> String {
+    if n == 1 { format!("1 {word}") } else { format!("{n} {word}s") }
 }

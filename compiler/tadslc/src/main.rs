@@ -5,15 +5,25 @@
 //! [`ExitCode`]-like status; `main` only parses arguments and dispatches.
 //!
 //! Exit codes: 0 success, 1 the input has errors (or warnings with `--deny-warnings`, or
-//! unformatted files with `fmt --check`), 2 usage or I/O failure.
+//! unformatted files with `fmt --check`), 2 usage or I/O failure. A closed standard
+//! output or error (a broken pipe) stops the output quietly and leaves the status as the
+//! run had it (`spec/output.md`).
 
-use clap::{Parser, Subcommand, ValueEnum};
+use clap::{CommandFactory, Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use tadslc::{Format, bench, check, explain, fmt};
 
 #[derive(Parser)]
-#[command(name = "tadslc", version, about = "The TADSL compiler: check, format and explain traffic scenarios")]
+#[command(
+    name = "tadslc",
+    version,
+    about = "The TADSL compiler: check, format, convert, build and explain traffic scenarios",
+    after_help = "Run `tadslc explain CODE` for what a diagnostic code means and how to fix it \
+                  (`tadslc explain` lists them all).\n\
+                  Exit status: 0 no errors, 1 errors, 2 usage or I/O failure; the output formats \
+                  and statuses are specified in spec/output.md."
+)]
 struct Cli {
     /// When to colour terminal output (default: on a terminal, unless NO_COLOR is set)
     #[arg(long, value_enum, global = true, default_value_t = Color::Auto)]
@@ -24,9 +34,10 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Check scenario files and report every problem
+    /// Check scenario files (TAD or YAML answers) and report every problem
     Check {
-        /// Files or directories (searched recursively for *.tad); `-` reads standard input
+        /// Files or directories (searched recursively for *.tad, *.yaml and *.yml);
+        /// `-` reads standard input
         #[arg(required = true)]
         paths: Vec<PathBuf>,
         /// Output format
@@ -38,9 +49,10 @@ enum Command {
         #[command(flatten)]
         rules: Rules,
     },
-    /// Format scenario files in place in the canonical layout
+    /// Format TAD files in place in the canonical layout
     Fmt {
-        /// Files or directories; `-` formats standard input to standard output
+        /// Files or directories (searched recursively for *.tad; YAML is skipped); `-`
+        /// formats standard input to standard output
         #[arg(required = true)]
         paths: Vec<PathBuf>,
         /// Change nothing; exit 1 if any file is not formatted
@@ -51,9 +63,9 @@ enum Command {
         #[arg(long)]
         canonicalize: bool,
     },
-    /// Compile checked scenarios for a simulator
+    /// Compile checked scenarios to Scenic 3 programs for a simulator
     Build {
-        /// Scenario files or directories
+        /// Scenario files or directories (searched recursively for *.tad)
         #[arg(required = true)]
         paths: Vec<PathBuf>,
         /// The target language
@@ -62,7 +74,8 @@ enum Command {
         /// Output directory (default: standard output for a single file)
         #[arg(short, long)]
         output: Option<PathBuf>,
-        /// Directory of the CARLA OpenDRIVE maps (`TownNN.xodr`)
+        /// Directory of the CARLA OpenDRIVE maps (`TownNN.xodr`); default: the map
+        /// next to the program
         #[arg(long)]
         map_dir: Option<PathBuf>,
         /// The town to use, e.g. `Town10HD` (default: the first map with the road's features)
@@ -72,8 +85,10 @@ enum Command {
         #[arg(long, value_enum, default_value_t = Simulator::Carla)]
         simulator: Simulator,
     },
-    /// Convert a YAML scenario (TrafficAlign's form, TrafficComposer's IR, or a whole LLM
-    /// answer around one) to canonical TAD
+    /// Convert a YAML scenario or LLM answer to canonical TAD
+    ///
+    /// Reads TrafficAlign's YAML form, TrafficComposer's IR, or a whole LLM answer around
+    /// one, whatever the file's extension.
     Import {
         /// The YAML file or answer
         path: PathBuf,
@@ -81,10 +96,14 @@ enum Command {
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
-    /// Print a scenario in another form
+    /// Print a TAD scenario in TrafficAlign's YAML form
     Export {
-        /// TrafficAlign's YAML form (with extra keys for everything TAD adds)
-        #[arg(long, required = true)]
+        /// The form to write: TrafficAlign's YAML form, with extra keys for everything
+        /// TAD adds (the only one, and the default)
+        #[arg(long, value_enum, default_value_t = ExportFormat::Yaml)]
+        format: ExportFormat,
+        /// The same as `--format yaml` (kept for compatibility)
+        #[arg(long)]
         yaml: bool,
         /// The TAD file
         path: PathBuf,
@@ -94,7 +113,8 @@ enum Command {
     },
     /// Explain a diagnostic code, e.g. `tadslc explain E0203`
     Explain {
-        /// The code; omit it to list every code
+        /// The code, or its number whatever its letter (`203`, `w600`); omit it to list
+        /// every code
         code: Option<String>,
     },
     /// Measure check throughput on a generated corpus and on the examples
@@ -111,6 +131,21 @@ enum Command {
         /// Timed repetitions of each measurement (the best is reported)
         #[arg(long, default_value_t = 5)]
         runs: usize,
+    },
+    /// Print the shell completion script for a shell
+    ///
+    /// For example `tadslc completions bash > ~/.local/share/bash-completion/completions/tadslc`.
+    Completions {
+        /// The shell
+        #[arg(value_enum)]
+        shell: clap_complete::Shell,
+    },
+    /// Print the manual page, or write every page into a directory
+    Man {
+        /// Write `tadslc.1` and a page per subcommand (`tadslc-check.1`, ...) into this
+        /// directory instead of printing `tadslc.1`
+        #[arg(short, long)]
+        output: Option<PathBuf>,
     },
 }
 
@@ -164,6 +199,12 @@ impl Rules {
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum ExportFormat {
+    /// TrafficAlign's YAML form
+    Yaml,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum Target {
     Scenic,
 }
@@ -209,9 +250,13 @@ fn main() -> ExitCode {
             color,
         ),
         Command::Import { path, output } => tadslc::interchange::run_import(&path, output.as_deref(), color),
-        Command::Export { yaml: _, path, output } => tadslc::interchange::run_export(&path, output.as_deref(), color),
+        Command::Export { format: ExportFormat::Yaml, yaml: _, path, output } => {
+            tadslc::interchange::run_export(&path, output.as_deref(), color)
+        }
         Command::Explain { code } => explain::run(code.as_deref()),
         Command::Bench { scenarios, seed, examples, runs } => bench::run(scenarios, seed, examples.as_deref(), runs),
+        Command::Completions { shell } => tadslc::manual::completions(Cli::command(), shell),
+        Command::Man { output } => tadslc::manual::man(Cli::command(), output.as_deref()),
     };
     status.into()
 }

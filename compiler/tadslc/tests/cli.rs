@@ -424,3 +424,334 @@ fn build_writes_scenic_programs_and_refuses_broken_files() {
     assert_eq!(code(&broken), 1);
     assert!(stdout(&broken).is_empty(), "nothing is emitted for a file with errors");
 }
+
+/// Every subcommand, as `--help` lists them.
+const SUBCOMMANDS: &[&str] = &["check", "fmt", "build", "import", "export", "explain", "bench", "completions", "man"];
+
+/// Which standard stream the reader closes.
+#[derive(Clone, Copy)]
+enum Stream {
+    Stdout,
+    Stderr,
+}
+
+/// Run `tadslc` and close `stream`'s read end, after reading `first` lines of it: the
+/// rest of its writes meet a broken pipe. Returns the exit status and the other stream.
+fn closed_early(args: &[&str], stdin: &str, stream: Stream, first: usize) -> (i32, String) {
+    use std::io::{BufRead, Read, Write};
+    use std::process::{Command, Stdio};
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tadslc"))
+        .args(args)
+        .current_dir(repo())
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("tadslc runs");
+    let (closed, mut other): (Box<dyn Read + Send>, Box<dyn Read + Send>) = match stream {
+        Stream::Stdout => (Box::new(child.stdout.take().unwrap()), Box::new(child.stderr.take().unwrap())),
+        Stream::Stderr => (Box::new(child.stderr.take().unwrap()), Box::new(child.stdout.take().unwrap())),
+    };
+    let mut reader = std::io::BufReader::new(closed);
+    for _ in 0..first {
+        let mut line = String::new();
+        assert!(reader.read_line(&mut line).unwrap() > 0, "{args:?}: fewer than {first} lines");
+    }
+    drop(reader);
+    if let Some(mut input) = child.stdin.take() {
+        let _ = input.write_all(stdin.as_bytes());
+    }
+    let drain = std::thread::spawn(move || {
+        let mut text = String::new();
+        let _ = other.read_to_string(&mut text);
+        text
+    });
+    let status = child.wait().expect("tadslc finishes");
+    let other = drain.join().unwrap();
+    assert!(!other.contains("panicked"), "{args:?}: {other}");
+    (status.code().expect("exited normally, not by a signal"), other)
+}
+
+#[test]
+fn a_closed_pipe_ends_the_run_quietly_with_its_status() {
+    // more JSON than a pipe holds; the one file with errors comes last
+    let dir = scratch("pipe");
+    for i in 0..1500 {
+        std::fs::write(dir.join(format!("clean_{i:04}.tad")), CLEAN).unwrap();
+    }
+    std::fs::write(dir.join("zz_broken.tad"), "scenario {").unwrap();
+    let dir_arg = dir.to_str().unwrap();
+    let (status, stderr_text) = closed_early(&["check", "--format", "json", dir_arg], "", Stream::Stdout, 1);
+    assert_eq!(status, 1, "the status of the whole check: {stderr_text}");
+    assert!(stderr_text.is_empty(), "quietly: {stderr_text}");
+    assert_eq!(closed_early(&["check", "--format", "json", "-"], CLEAN, Stream::Stdout, 0).0, 0);
+    assert_eq!(closed_early(&["check", "--format", "sarif", dir_arg], "", Stream::Stdout, 1).0, 1);
+    assert_eq!(closed_early(&["check", dir_arg], "", Stream::Stderr, 0).0, 1);
+    assert_eq!(closed_early(&["check", "-"], CLEAN, Stream::Stderr, 0).0, 0);
+
+    // every other subcommand's printing
+    let unformatted = scratch("pipe-fmt");
+    std::fs::write(unformatted.join("messy.tad"), "scenario demo { ego { speed:30 km/h } }\n").unwrap();
+    let out = scratch("pipe-build");
+    let cases: &[(&[&str], &str, Stream, i32)] = &[
+        (&["fmt", "-"], "scenario  demo{}", Stream::Stdout, 0),
+        (&["fmt", "--check", unformatted.to_str().unwrap()], "", Stream::Stderr, 1),
+        (&["import", "tests/yaml/cli/missing_lane.yaml"], "", Stream::Stdout, 0),
+        (&["import", "tests/yaml/cli/missing_lane.yaml"], "", Stream::Stderr, 0),
+        (&["export", "examples/paper/nl_to_dsl_example_2.tad"], "", Stream::Stdout, 0),
+        (&["export", "tests/ui/structure/unknown_field.tad"], "", Stream::Stderr, 1),
+        (&["build", "examples/safety/right_turn.tad"], "", Stream::Stdout, 0),
+        (&["build", "examples/safety", "-o", out.to_str().unwrap()], "", Stream::Stderr, 0),
+        (&["explain"], "", Stream::Stdout, 0),
+        (&["explain", "E0203"], "", Stream::Stdout, 0),
+        (&["explain", "E9999"], "", Stream::Stderr, 2),
+        (&["bench", "--scenarios", "20", "--runs", "1"], "", Stream::Stdout, 0),
+        (&["completions", "bash"], "", Stream::Stdout, 0),
+        (&["man"], "", Stream::Stdout, 0),
+        (&["--help"], "", Stream::Stdout, 0),
+    ];
+    for (args, stdin, stream, expected) in cases {
+        assert_eq!(closed_early(args, stdin, *stream, 0).0, *expected, "{args:?}");
+    }
+}
+
+#[test]
+fn a_standard_output_that_cannot_be_written_is_an_io_failure() {
+    let Ok(full) = std::fs::File::create("/dev/full") else {
+        return; // not on this system
+    };
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_tadslc"))
+        .args(["explain"])
+        .current_dir(repo())
+        .stdout(full)
+        .stderr(std::process::Stdio::piped())
+        .output()
+        .unwrap();
+    assert_eq!(code(&out), 2);
+    assert!(stderr(&out).contains("error: cannot write to standard output"), "{}", stderr(&out));
+    assert!(!stderr(&out).contains("panicked"), "{}", stderr(&out));
+}
+
+#[test]
+fn a_directory_without_scenarios_is_an_error() {
+    let empty = scratch("empty");
+    let out = tadslc(&["check", empty.to_str().unwrap()], "");
+    assert_eq!(code(&out), 2);
+    assert!(
+        stderr(&out).contains(&format!("error: no .tad or .yaml files in `{}`", empty.display())),
+        "{}",
+        stderr(&out)
+    );
+    assert!(!stderr(&out).contains("no problems"), "{}", stderr(&out));
+    std::fs::write(empty.join("notes.txt"), "not a scenario").unwrap();
+    let out = tadslc(&["check", "--format", "json", empty.to_str().unwrap(), "-"], CLEAN);
+    assert_eq!(code(&out), 2);
+    assert_eq!(stdout(&out).lines().count(), 1, "the other input is still checked");
+    // fmt takes TAD only: a directory of answers has nothing to format
+    let answers = scratch("answers-only");
+    std::fs::copy(repo().join("tests/yaml/cli/missing_lane.yaml"), answers.join("a.yaml")).unwrap();
+    let out = tadslc(&["fmt", answers.to_str().unwrap()], "");
+    assert_eq!(code(&out), 2);
+    assert!(stderr(&out).contains("no .tad files in"), "{}", stderr(&out));
+}
+
+#[test]
+fn directories_hold_yaml_answers_too() {
+    let dir = scratch("walk-yaml");
+    std::fs::create_dir_all(dir.join("a")).unwrap();
+    std::fs::write(dir.join("a/one.tad"), CLEAN).unwrap();
+    std::fs::copy(repo().join("tests/yaml/paper/nl_to_dsl_example_1.yaml"), dir.join("a/two.yaml")).unwrap();
+    std::fs::copy(repo().join("tests/yaml/cli/non_scenario.yaml"), dir.join("three.yml")).unwrap();
+    let dir_arg = dir.to_str().unwrap();
+    let out = tadslc(&["check", "--format", "json", dir_arg], "");
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    let files: Vec<Value> = stdout(&out).lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    let names: Vec<&str> = files.iter().map(|f| f["file"].as_str().unwrap()).collect();
+    assert_eq!(names.len(), 3, "{names:?}");
+    assert!(names[0].ends_with("a/one.tad") && names[1].ends_with("a/two.yaml") && names[2].ends_with("three.yml"));
+    assert_eq!(files[2]["class"], "non_scenario");
+    let human = tadslc(&["check", dir_arg], "");
+    assert!(stderr(&human).contains("checked 3 files: "), "{}", stderr(&human));
+    // fmt formats the TAD and leaves the YAML alone, quietly
+    let yaml = std::fs::read(dir.join("a/two.yaml")).unwrap();
+    let out = tadslc(&["fmt", dir_arg], "");
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    assert!(stderr(&out).is_empty(), "{}", stderr(&out));
+    assert_eq!(std::fs::read(dir.join("a/two.yaml")).unwrap(), yaml);
+}
+
+#[test]
+fn build_warns_when_the_map_is_not_where_the_program_looks() {
+    let dir = scratch("build-maps");
+    let out_dir = dir.join("out");
+    let args = ["build", "--map", "Town10HD", "examples/safety/right_turn.tad", "-o", out_dir.to_str().unwrap()];
+    let out = tadslc(&args, "");
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    let text = stderr(&out);
+    let missing = out_dir.join("Town10HD.xodr");
+    assert!(
+        text.contains(&format!(
+            "{}: warning: the program loads `{}`, which does not exist",
+            out_dir.join("right_turn.scenic").display(),
+            missing.display()
+        )),
+        "{text}"
+    );
+    assert!(text.contains("--map-dir DIR"), "{text}");
+    // one warning for a map that several programs load
+    let out = tadslc(&["build", "--map", "Town10HD", "examples/safety", "-o", out_dir.to_str().unwrap()], "");
+    let text = stderr(&out);
+    assert_eq!(text.matches("which does not exist").count(), 1, "{text}");
+    assert!(text.contains("(so do 7 other programs)"), "{text}");
+    // with the maps where the program looks, nothing to say
+    let maps = dir.join("maps");
+    std::fs::create_dir_all(&maps).unwrap();
+    std::fs::write(maps.join("Town10HD.xodr"), "").unwrap();
+    let mut with_maps = args.to_vec();
+    with_maps.extend(["--map-dir", maps.to_str().unwrap()]);
+    let out = tadslc(&with_maps, "");
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    assert!(!stderr(&out).contains("does not exist"), "{}", stderr(&out));
+    let out = tadslc(
+        &["build", "--map", "Town04", "--map-dir", maps.to_str().unwrap(), "examples/safety/right_turn.tad"],
+        "",
+    );
+    assert!(
+        stderr(&out).contains(&format!("`{}`, which does not exist", maps.join("Town04.xodr").display())),
+        "{}",
+        stderr(&out)
+    );
+    // to standard output, the map is read beside wherever the program is saved
+    let out = tadslc(&["build", "examples/safety/right_turn.tad"], "");
+    assert!(stderr(&out).contains("note: the program loads `"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("--map-dir DIR"), "{}", stderr(&out));
+}
+
+#[test]
+fn export_needs_no_format_flag() {
+    let example = "examples/paper/nl_to_dsl_example_2.tad";
+    let plain = tadslc(&["export", example], "");
+    assert_eq!(code(&plain), 0, "{}", stderr(&plain));
+    assert!(!stdout(&plain).is_empty());
+    for flags in [&["--yaml"][..], &["--format", "yaml"], &["--yaml", "--format", "yaml"]] {
+        let mut args = vec!["export"];
+        args.extend_from_slice(flags);
+        args.push(example);
+        let out = tadslc(&args, "");
+        assert_eq!((code(&out), stdout(&out)), (0, stdout(&plain)), "{flags:?}");
+    }
+    assert_eq!(code(&tadslc(&["export", "--format", "json", example], "")), 2);
+}
+
+#[test]
+fn explain_finds_a_code_by_its_number_whatever_its_letter() {
+    for (asked, expected) in [
+        ("600", "W0600"),
+        ("w600", "W0600"),
+        ("W0600", "W0600"),
+        ("E0600", "W0600"),
+        ("e203", "E0203"),
+        ("203", "E0203"),
+        ("w0200", "W0200"),
+        ("200", "E0200"),
+    ] {
+        let out = tadslc(&["explain", asked], "");
+        assert_eq!(code(&out), 0, "{asked}: {}", stderr(&out));
+        assert!(stdout(&out).starts_with(&format!("{expected} ")), "{asked}: {}", stdout(&out));
+    }
+    let out = tadslc(&["explain", "299"], "");
+    assert_eq!(code(&out), 2);
+    assert!(stderr(&out).contains("help: the closest codes are "), "{}", stderr(&out));
+    assert_eq!(code(&tadslc(&["explain", "nonsense"], "")), 2);
+}
+
+#[test]
+fn help_lists_every_subcommand_and_points_at_explain_and_the_spec() {
+    let out = tadslc(&["--help"], "");
+    assert_eq!(code(&out), 0);
+    let text = stdout(&out);
+    for sub in SUBCOMMANDS {
+        let line = text
+            .lines()
+            .find(|l| l.trim_start().starts_with(&format!("{sub} ")))
+            .unwrap_or_else(|| panic!("{sub} missing from\n{text}"));
+        assert!(line.len() > 2 + sub.len() + 10, "{sub} has a description: {line}");
+        assert!(line.len() <= 100, "one line: {line}");
+    }
+    assert!(text.contains("tadslc explain") && text.contains("spec/output.md"), "{text}");
+}
+
+#[test]
+fn completions_and_man_pages_name_every_subcommand() {
+    for shell in ["bash", "zsh", "fish", "powershell", "elvish"] {
+        let out = tadslc(&["completions", shell], "");
+        assert_eq!(code(&out), 0, "{shell}: {}", stderr(&out));
+        let script = stdout(&out);
+        for sub in SUBCOMMANDS {
+            assert!(script.contains(sub), "{shell} completion lacks {sub}");
+        }
+    }
+    assert_eq!(code(&tadslc(&["completions", "tcsh"], "")), 2);
+    let out = tadslc(&["man"], "");
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    let page = stdout(&out);
+    // after the preamble that defines the apostrophe (`.ie`/`.el`), the title
+    let first = page.lines().find(|l| !l.starts_with(".ie ") && !l.starts_with(".el ")).unwrap_or("");
+    assert!(first.starts_with(".TH tadslc 1"), "{}", &page[..page.len().min(200)]);
+    for sub in SUBCOMMANDS {
+        assert!(page.contains(&format!("tadslc\\-{sub}(1)")), "the man page lacks {sub}");
+    }
+    let dir = scratch("man");
+    let out = tadslc(&["man", "-o", dir.to_str().unwrap()], "");
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    assert!(std::fs::read_to_string(dir.join("tadslc.1")).unwrap().contains("\n.TH tadslc 1"));
+    for sub in SUBCOMMANDS {
+        assert!(dir.join(format!("tadslc-{sub}.1")).is_file(), "no page for {sub}");
+    }
+}
+
+#[test]
+fn counts_are_singular_or_plural() {
+    let dir = scratch("plural");
+    std::fs::write(dir.join("messy.tad"), "scenario demo { ego { speed:30 km/h } }\n").unwrap();
+    let out = tadslc(&["fmt", "--check", dir.to_str().unwrap()], "");
+    assert_eq!(code(&out), 1);
+    assert!(
+        stderr(&out).contains("1 file would be reformatted (1 checked); run `tadslc fmt` on it"),
+        "{}",
+        stderr(&out)
+    );
+    std::fs::write(dir.join("messy2.tad"), "scenario demo { ego { speed:30 km/h } }\n").unwrap();
+    let out = tadslc(&["fmt", "--check", dir.to_str().unwrap()], "");
+    assert!(
+        stderr(&out).contains("2 files would be reformatted (2 checked); run `tadslc fmt` on them"),
+        "{}",
+        stderr(&out)
+    );
+    // no count in the crate is written with a fixed plural
+    let src = repo().join("compiler/tadslc/src");
+    for entry in std::fs::read_dir(&src).unwrap().flatten() {
+        let text = std::fs::read_to_string(entry.path()).unwrap();
+        for phrase in ["} files", "} errors", "} warnings", "} scenarios would", "of {} files"] {
+            assert!(!text.contains(phrase), "{}: `{phrase}`: use `plural`", entry.path().display());
+        }
+    }
+}
+
+#[test]
+fn the_readme_and_the_spec_show_what_check_prints() {
+    // README: `$ tadslc check FILE` followed by exactly what it prints
+    let readme = std::fs::read_to_string(repo().join("README.md")).unwrap();
+    let start = readme.find("```text\n$ tadslc check ").expect("a sample run in README.md") + "```text\n$ ".len();
+    let block = &readme[start..start + readme[start..].find("```\n").unwrap()];
+    let (command, shown) = block.split_once('\n').unwrap();
+    let args: Vec<&str> = command.split_whitespace().skip(1).collect();
+    let out = tadslc(&args, "");
+    assert_eq!(shown, stderr(&out), "README.md's sample output of `{command}` is stale");
+    // spec/output.md: the location line and a whole diagnostic as codespan prints them
+    let spec = std::fs::read_to_string(repo().join("spec/output.md")).unwrap();
+    assert!(spec.contains("`┌─ file:line:column`") && !spec.contains("`--> file"));
+    let human = spec.find("```text\nerror[E0203]").expect("a human example in spec/output.md") + "```text\n".len();
+    let example = &spec[human..human + spec[human..].find("```\n").unwrap()];
+    assert!(stderr(&tadslc(&["check", "tests/ui/structure/unknown_field.tad"], "")).contains(example), "{example}");
+}

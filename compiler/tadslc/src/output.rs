@@ -1,0 +1,93 @@
+//! Writing to standard output and standard error without panicking.
+//!
+//! `print!` panics when the reader of a pipe has gone (`tadslc check DIR | head`). Every
+//! subcommand writes through [`out`] and [`err`] instead (the [`outln!`](crate::outln)
+//! family of macros), which return [`Closed`] when a stream cannot be written; the
+//! subcommand then stops writing and returns the status it had reached, merged with
+//! [`Closed::status`]. A closed pipe is not a failure of the run: it is quiet and leaves
+//! the status as it was. Any other write error (a full disk) is reported on standard
+//! error, if it can be, and makes the status 2 (`spec/output.md`).
+
+use crate::Status;
+use std::io::Write;
+
+/// A standard stream could not be written: stop writing.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Closed {
+    /// What the failure adds to the run's status: [`Status::Ok`] for a closed pipe,
+    /// [`Status::Usage`] for any other write error.
+    pub status: Status,
+}
+
+impl Closed {
+    /// `status`, the status the run had reached, with this failure's.
+    pub fn merge(self, status: Status) -> Status {
+        status.max(self.status)
+    }
+}
+
+fn closed(stream: &str, error: std::io::Error) -> Closed {
+    if error.kind() == std::io::ErrorKind::BrokenPipe {
+        return Closed { status: Status::Ok };
+    }
+    // best effort: standard error may be the stream that failed
+    let _ = writeln!(std::io::stderr().lock(), "error: cannot write to {stream}: {error}");
+    Closed { status: Status::Usage }
+}
+
+/// Write to standard output.
+pub fn out(args: std::fmt::Arguments<'_>) -> Result<(), Closed> {
+    std::io::stdout().lock().write_fmt(args).map_err(|e| closed("standard output", e))
+}
+
+/// Write raw bytes to standard output, then flush it.
+pub fn out_bytes(bytes: &[u8]) -> Result<(), Closed> {
+    let mut stdout = std::io::stdout().lock();
+    stdout.write_all(bytes).and_then(|()| stdout.flush()).map_err(|e| closed("standard output", e))
+}
+
+/// Flush standard output (what a `print!` without a newline left in its buffer).
+pub fn flush() -> Result<(), Closed> {
+    std::io::stdout().lock().flush().map_err(|e| closed("standard output", e))
+}
+
+/// Write to standard error.
+pub fn err(args: std::fmt::Arguments<'_>) -> Result<(), Closed> {
+    std::io::stderr().lock().write_fmt(args).map_err(|e| closed("standard error", e))
+}
+
+/// `print!` that returns [`Closed`] instead of panicking.
+#[macro_export]
+macro_rules! out {
+    ($($arg:tt)*) => { $crate::output::out(format_args!($($arg)*)) };
+}
+
+/// `println!` that returns [`Closed`] instead of panicking.
+#[macro_export]
+macro_rules! outln {
+    () => { $crate::output::out(format_args!("\n")) };
+    ($($arg:tt)*) => { $crate::output::out(format_args!("{}\n", format_args!($($arg)*))) };
+}
+
+/// `eprint!` that returns [`Closed`] instead of panicking.
+#[macro_export]
+macro_rules! err {
+    ($($arg:tt)*) => { $crate::output::err(format_args!($($arg)*)) };
+}
+
+/// `eprintln!` that returns [`Closed`] instead of panicking.
+#[macro_export]
+macro_rules! errln {
+    () => { $crate::output::err(format_args!("\n")) };
+    ($($arg:tt)*) => { $crate::output::err(format_args!("{}\n", format_args!($($arg)*))) };
+}
+
+/// Run `body` with a status it raises as it goes; if it stops because a stream was
+/// closed, the status reached so far is returned, merged with the failure's.
+pub fn run(body: impl FnOnce(&mut Status) -> Result<(), Closed>) -> Status {
+    let mut status = Status::Ok;
+    match body(&mut status).and_then(|()| flush()) {
+        Ok(()) => status,
+        Err(closed) => closed.merge(status),
+    }
+}
