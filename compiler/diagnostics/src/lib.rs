@@ -89,6 +89,9 @@ impl From<std::ops::Range<usize>> for Span {
 pub enum Severity {
     Error,
     Warning,
+    /// Only a different way of writing the same thing (an alias): shown, with a
+    /// machine-applicable fix, but not a warning.
+    Hint,
 }
 
 impl Severity {
@@ -96,6 +99,7 @@ impl Severity {
         match self {
             Severity::Error => "error",
             Severity::Warning => "warning",
+            Severity::Hint => "hint",
         }
     }
 }

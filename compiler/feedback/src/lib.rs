@@ -45,7 +45,7 @@ fn request(element: &Element, field: &str, vocabulary: &Vocabulary) -> String {
             other => format!("State the road's {other}{}.", one_of(&schema::ROAD, field, vocabulary)),
         },
         Element::Ego => match field {
-            "behavior" => "State what the ego vehicle is doing (for example go_forward, turn_left, stopped).".into(),
+            "behavior" => "State what the ego vehicle is doing (for example move_forward, turn_left, stopped).".into(),
             "speed" => "State the ego vehicle's speed in km/h.".into(),
             "lane" => "State the ego vehicle's lane index (1 is the leftmost lane in its direction).".into(),
             other => format!("State the ego vehicle's {other}."),

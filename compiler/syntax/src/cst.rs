@@ -161,7 +161,7 @@ pub enum Value {
     String(Span),
     /// `"""..."""`
     TextBlock(Span),
-    /// One or more names: `go_forward`, or `go forward` (reported when lowered).
+    /// One or more names: `move_forward`, or `go forward` (reported when lowered).
     Words(Vec<Name>),
     /// `RELATION of REFERENCE`, e.g. `left_front of ego`
     Position { span: Span, relation: Vec<Name>, of: Span, reference: Vec<Name> },

@@ -379,7 +379,7 @@ mod tests {
     fn keys_values_and_units() {
         use Token::*;
         assert_eq!(
-            kinds("{ speed: 38 km/h lane : -2 kind: go_forward }"),
+            kinds("{ speed: 38 km/h lane : -2 kind: move_forward }"),
             vec![LBrace, Key, Number, Unit, Key, Number, Key, Ident, RBrace]
         );
         assert_eq!(kinds("{ x\n: 1 }"), vec![LBrace, Ident, Colon, Number, RBrace]);

@@ -178,7 +178,7 @@ pub enum Val {
     Flag(bool),
 }
 
-/// A name from a vocabulary, as written (`clear`, `go_forward`).
+/// A name from a vocabulary, as written (`clear`, `move_forward`).
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct Symbol {
     pub name: String,

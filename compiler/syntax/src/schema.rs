@@ -15,7 +15,7 @@
 /// The kind of value a field takes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum ValueType {
-    /// One name from a vocabulary: `clear`, `go_forward`.
+    /// One name from a vocabulary: `clear`, `move_forward`.
     Symbol,
     /// A list of names: `[stop_sign, school_zone]`; `[]` for none.
     SymbolList,
@@ -286,7 +286,7 @@ pub const EGO: SectionDef = SectionDef {
     name: "ego",
     doc: "the ego vehicle",
     fields: &[
-        field!(essential "behavior", Symbol in "behavior", "go_forward", "what the ego vehicle does"),
+        field!(essential "behavior", Symbol in "behavior", "move_forward", "what the ego vehicle does"),
         field!(essential "speed", Speed, "30 km/h", "its speed"),
         field!(essential "lane", Integer, "1", "its lane index: 1 is the leftmost lane in its direction"),
     ],
@@ -297,7 +297,7 @@ pub const ACTOR: SectionDef = SectionDef {
     name: "actor",
     doc: "a group of actors of one type that move together",
     fields: &[
-        field!(essential "behavior", Symbol in "behavior", "go_forward", "what every actor of the group does"),
+        field!(essential "behavior", Symbol in "behavior", "move_forward", "what every actor of the group does"),
         field!("speed", Speed, "30 km/h", "their speed"),
         field!(essential "position", Position, "front of ego", "where the group is, relative to a reference"),
         field!(essential "lane", Integer, "1", "their lane index; negative for the opposite direction"),
@@ -381,11 +381,18 @@ pub const DECLARATIONS: &[&SectionDef] = &[
     &declaration!(
         "region",
         "a region scenarios come from",
-        field!("style", Symbol, "metropolitan", "its kind of region")
+        field!("style", Symbol, "metropolitan", "its kind of region"),
+        field!(
+            "module",
+            Symbol,
+            "national_park",
+            "the standard module with the region's own vocabulary, in scope for its scenarios"
+        ),
     ),
     &declaration!(
         "actor_kind",
         "a broad class of actors that share behaviors",
+        field!("max_speed", Speed, "45 km/h", "the physical limit: no actor of the kind is faster"),
         field!("simulated_as", one of SimulatedAs, "car", "how a type of this kind without its own is simulated"),
         field!(
             "carla_blueprint",

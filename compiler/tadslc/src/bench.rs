@@ -157,12 +157,12 @@ fn run_in(n: usize, seed: u64, examples: Option<&Path>, runs: usize, status: &mu
 /// A scenario of about `lines` lines: the usual sections and many actor groups.
 fn long_scenario(lines: usize) -> String {
     let mut text = String::from(
-        "scenario long {\n  environment {\n    weather: clear\n    time: daytime\n  }\n  road {\n    type: straight_road\n    lanes: 3\n    direction: two_way\n  }\n  ego {\n    behavior: go_forward\n    speed: 40 km/h\n    lane: 2\n  }\n",
+        "scenario long {\n  environment {\n    weather: clear\n    time: daytime\n  }\n  road {\n    type: straight_road\n    lanes: 3\n    direction: two_way\n  }\n  ego {\n    behavior: move_forward\n    speed: 40 km/h\n    lane: 2\n  }\n",
     );
     let mut i = 0;
     while text.lines().count() + 8 < lines {
         text.push_str(&format!(
-            "  // group {i}\n  actor g{i}: 2 sedan {{\n    behavior: go_forward\n    speed: 30 km/h\n    position: front of ego\n    lane: {}\n  }}\n",
+            "  // group {i}\n  actor g{i}: 2 sedan {{\n    behavior: move_forward\n    speed: 30 km/h\n    position: front of ego\n    lane: {}\n  }}\n",
             1 + i % 3
         ));
         i += 1;

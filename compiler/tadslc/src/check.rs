@@ -139,9 +139,11 @@ fn run_in(
 
     let (mut errors, mut warnings) = (0, 0);
     let mut classes = [0usize; Class::ALL.len()];
+    let mut hints = 0;
     for c in &done {
         errors += c.result.diagnostics.iter().filter(|d| d.severity == Severity::Error).count();
         warnings += c.result.diagnostics.iter().filter(|d| d.severity == Severity::Warning).count();
+        hints += c.result.diagnostics.iter().filter(|d| d.severity == Severity::Hint).count();
         if let Some(class) = c.result.class {
             classes[class as usize] += 1;
         }
@@ -202,19 +204,22 @@ fn run_in(
         }
         // nothing was checked: the errors above say why
         Format::Human if inputs.is_empty() => {}
-        Format::Human => errln!("{}", summary(inputs.len(), errors, warnings, classes))?,
+        Format::Human => errln!("{}", summary(inputs.len(), errors, warnings, hints, classes))?,
         Format::Json => {}
     }
     Ok(())
 }
 
-fn summary(files: usize, errors: usize, warnings: usize, classes: [usize; Class::ALL.len()]) -> String {
-    let problems = match (errors, warnings) {
+fn summary(files: usize, errors: usize, warnings: usize, hints: usize, classes: [usize; Class::ALL.len()]) -> String {
+    let mut problems = match (errors, warnings) {
         (0, 0) => "no problems".to_string(),
         (e, 0) => plural(e, "error"),
         (0, w) => plural(w, "warning"),
         (e, w) => format!("{}, {}", plural(e, "error"), plural(w, "warning")),
     };
+    if hints > 0 {
+        problems.push_str(&format!(" ({})", plural(hints, "hint")));
+    }
     let classes: Vec<String> = classes
         .iter()
         .zip(Class::ALL)

@@ -43,7 +43,8 @@ const LIGHT: &[&str] = &["green", "red", "yellow", "broken", "none"];
 const TRAFFIC: &[&str] = &["free_flow", "light", "moderate", "heavy", "jam"];
 const ROADSIDE: &[&str] = &["sidewalk", "buildings", "trees", "shops", "parked_cars", "fields", "forest", "houses"];
 const TYPES: &[&str] = &["sedan", "suv", "car", "truck", "bus", "van", "taxi", "motorcycle", "bicycle", "pedestrian"];
-const BEHAVIORS: &[&str] = &["go_forward", "stopped", "parked", "turn_left", "turn_right", "change_lane_left", "yield"];
+const BEHAVIORS: &[&str] =
+    &["move_forward", "stopped", "parked", "turn_left", "turn_right", "change_lane_left", "yield"];
 const RELATIONS: &[&str] =
     &["front", "behind", "left", "right", "left_front", "right_front", "left_behind", "right_behind"];
 const REGIONS: &[&str] = &["los_angeles", "new_york_city", "yellowstone", "yosemite", "switzerland"];
@@ -83,7 +84,7 @@ pub fn scenario(rng: &mut Rng, index: usize) -> Generated {
         "// generated scenario {index}\nscenario generated_{index} {{\n  source {{\n    video: \"video_{index}.mp4\"\n    time: {} s\n    region: {region}\n  }}\n  \
          environment {{\n    weather: {weather}\n    time: {time}\n  }}\n  road {{\n    type: {road}\n    context: {context}\n    lanes: {lanes}\n    \
          direction: {direction}\n    signs: [{}]\n    light: {light}\n    traffic: {traffic}\n    roadside: [{}]\n  }}\n  \
-         ego {{\n    behavior: go_forward\n    speed: {ego_speed} km/h\n    lane: {ego_lane}\n  }}\n",
+         ego {{\n    behavior: move_forward\n    speed: {ego_speed} km/h\n    lane: {ego_lane}\n  }}\n",
         15 * index,
         signs.join(", "),
         roadside.join(", "),
@@ -94,7 +95,7 @@ pub fn scenario(rng: &mut Rng, index: usize) -> Generated {
         "{{\"name\":\"generated_{index}\",\"source\":{{\"video\":\"video_{index}.mp4\",\"time\":{{\"value\":{},\"unit\":\"s\"}},\"region\":\"{region}\"}},\
          \"environment\":{{\"weather\":\"{weather}\",\"time\":\"{time}\"}},\"road\":{{\"type\":\"{road}\",\"context\":\"{context}\",\"lanes\":{lanes},\
          \"direction\":\"{direction}\",\"signs\":[{}],\"light\":\"{light}\",\"traffic\":\"{traffic}\",\"roadside\":[{}]}},\
-         \"ego\":{{\"behavior\":\"go_forward\",\"speed\":{{\"value\":{ego_speed},\"unit\":\"km/h\"}},\"lane\":{ego_lane}}},\"actors\":[",
+         \"ego\":{{\"behavior\":\"move_forward\",\"speed\":{{\"value\":{ego_speed},\"unit\":\"km/h\"}},\"lane\":{ego_lane}}},\"actors\":[",
         15 * index,
         quoted(&signs),
         quoted(&roadside),

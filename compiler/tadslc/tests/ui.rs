@@ -54,7 +54,7 @@ fn expected(text: &str) -> Vec<(String, String, String)> {
         let Some((severity, code)) = head.split_once('[') else {
             continue;
         };
-        if severity == "error" || severity == "warning" {
+        if matches!(severity, "error" | "warning" | "hint") {
             out.push((severity.to_string(), code.to_string(), range.trim().to_string()));
         }
     }
@@ -187,6 +187,7 @@ fn main() {
             String::from_utf8_lossy(&bytes)
                 .replace("\n# error[", "\n// error[")
                 .replace("\n# warning[", "\n// warning[")
+                .replace("\n# hint[", "\n// hint[")
         })
         .flat_map(|t| expected(&t).into_iter().map(|(_, c, _)| c))
         .collect();

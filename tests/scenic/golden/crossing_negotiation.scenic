@@ -243,7 +243,7 @@ tadRoad = dict(same=1, other=1, minSame=1, minOther=1, index=1, sidewalk=False,
                shape=None, ahead=15.0, behind=4.0, approach=17.0)
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
-# ego vehicle: go_forward, 10 km/h, lane 1
+# ego vehicle: move_forward, 10 km/h, lane 1
 tadEgoAt = tadSpot(tadAnchor, 0.0, 1)
 ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 2.778, with behavior FollowLaneBehavior(target_speed=2.778)

@@ -245,12 +245,12 @@ tadRoad = dict(same=3, other=3, minSame=3, minOther=3, index=2, sidewalk=False,
                shape=None, ahead=73.0, behind=4.0, approach=75.0)
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
-# ego vehicle: go_forward, 38 km/h, lane 2
+# ego vehicle: move_forward, 38 km/h, lane 2
 tadEgoAt = tadSpot(tadAnchor, 0.0, 2)
 ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 10.556, with behavior FollowLaneBehavior(target_speed=10.556)
 
-# group `bus_ahead`: 1 bus, go_forward, 35 km/h, front of ego
+# group `bus_ahead`: 1 bus, move_forward, 35 km/h, front of ego
 tadAt1 = tadSpot(tadAnchor, 20.806, 2)
 bus_ahead = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.mitsubishi.fusorosa', with width 2.55, with length 12.0,
@@ -328,7 +328,7 @@ parked_sedans_opposite_7 = new Car at tadAt18[0], facing tadAt18[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
 
-# group `oncoming_truck`: 1 truck, go_forward, 40 km/h, front of ego, lane -2
+# group `oncoming_truck`: 1 truck, move_forward, 40 km/h, front of ego, lane -2
 tadAt19 = tadSpot(tadAnchor, 19.111, -2)
 oncoming_truck = new Car at tadAt19[0], facing tadAt19[1],
     with blueprint 'vehicle.carlamotors.carlacola', with width 2.5, with length 7.5,

@@ -247,7 +247,7 @@ tadEgoAt = tadSpot(tadAnchor, 0.0, 3)
 ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 26.833, with behavior TadChangeLane(26.833, True)
 
-# group `slow_truck`: 1 truck, go_forward, 72 km/h, front of ego, lane 3
+# group `slow_truck`: 1 truck, move_forward, 72 km/h, front of ego, lane 3
 tadAt1 = tadSpot(tadAnchor, 34.833, 3)
 slow_truck = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.carlamotors.carlacola', with width 2.5, with length 7.5,
@@ -259,7 +259,7 @@ merging_suv = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.nissan.patrol', with width 1.95, with length 4.8,
     with regionContainedIn None, with speed 27.722, with behavior TadChangeLane(27.722, False)
 
-# group `fast_sedan`: 1 sedan, go_forward, 116 km/h, left_behind of ego, lane 2
+# group `fast_sedan`: 1 sedan, move_forward, 116 km/h, left_behind of ego, lane 2
 tadAt3 = tadSpot(tadAnchor, -34.65, 2)
 fast_sedan = new Car at tadAt3[0], facing tadAt3[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,

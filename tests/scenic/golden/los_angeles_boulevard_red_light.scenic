@@ -270,7 +270,7 @@ left_lane_queue_3 = new Car at tadAt4[0], facing tadAt4[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadStop()
 
-# group `lane_splitting_motorcycle`: 1 motorcycle, go_forward, 15 km/h, left of ego, lane 1
+# group `lane_splitting_motorcycle`: 1 motorcycle, move_forward, 15 km/h, left of ego, lane 1
 tadAt5 = tadSpot(tadAnchor, 0.0, 1)
 lane_splitting_motorcycle = new Car at tadAt5[0], facing tadAt5[1],
     with blueprint 'vehicle.yamaha.yzf', with width 0.8, with length 2.1,

@@ -244,24 +244,24 @@ tadRoad = dict(same=2, other=0, minSame=2, minOther=0, index=2, sidewalk=False,
                shape=None, ahead=41.0, behind=4.0, approach=43.0)
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
-# ego vehicle: go_forward, 30 km/h, lane 2
+# ego vehicle: move_forward, 30 km/h, lane 2
 tadEgoAt = tadSpot(tadAnchor, 0.0, 2)
 ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 8.333, with behavior FollowLaneBehavior(target_speed=8.333)
 
-# group `bus`: 1 bus, go_forward, 25 km/h, left_front of ego, lane 1
+# group `bus`: 1 bus, move_forward, 25 km/h, left_front of ego, lane 1
 tadAt1 = tadSpot(tadAnchor, 18.583, 1)
 bus = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.mitsubishi.fusorosa', with width 2.55, with length 12.0,
     with regionContainedIn None, with speed 6.944, with behavior FollowLaneBehavior(target_speed=6.944)
 
-# group `car_ahead`: 1 car, go_forward, 30 km/h, front of ego, lane 2
+# group `car_ahead`: 1 car, move_forward, 30 km/h, front of ego, lane 2
 tadAt2 = tadSpot(tadAnchor, 14.833, 2)
 car_ahead = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with speed 8.333, with behavior FollowLaneBehavior(target_speed=8.333)
 
-# group `suv_ahead_of_bus`: 1 suv, go_forward, 30 km/h, front of bus, lane 1
+# group `suv_ahead_of_bus`: 1 suv, move_forward, 30 km/h, front of bus, lane 1
 tadAt3 = tadSpot(tadAnchor, 37.317, 1)
 suv_ahead_of_bus = new Car at tadAt3[0], facing tadAt3[1],
     with blueprint 'vehicle.nissan.patrol', with width 1.95, with length 4.8,

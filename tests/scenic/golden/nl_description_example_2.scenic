@@ -247,7 +247,7 @@ tadRoad = dict(same=4, other=0, minSame=4, minOther=0, index=3, sidewalk=False,
                shape='straight', ahead=97.0, behind=4.0, approach=None)
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
-# ego vehicle: go_forward, 35 km/h, lane 3
+# ego vehicle: move_forward, 35 km/h, lane 3
 tadEgoAt = tadSpot(tadAnchor, 0.0, 3)
 ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 9.722, with behavior FollowLaneBehavior(target_speed=9.722)
@@ -282,7 +282,7 @@ pedestrians_7 = new Pedestrian at tadAt7[0], facing tadAt7[1] + 90 deg,
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
 
-# group `taxis`: 2 taxi, go_forward, 30 km/h, right_front of ego, lane 4
+# group `taxis`: 2 taxi, move_forward, 30 km/h, right_front of ego, lane 4
 tadAt8 = tadSpot(tadAnchor, 16.372, 4)
 taxis_1 = new Car at tadAt8[0], facing tadAt8[1],
     with blueprint 'vehicle.ford.crown', with width 1.85, with length 4.8,

@@ -242,24 +242,24 @@ tadRoad = dict(same=1, other=1, minSame=1, minOther=1, index=1, sidewalk=True,
                shape='straight', ahead=66.0, behind=4.0, approach=None)
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
-# ego vehicle: go_forward, 28 km/h, lane 1
+# ego vehicle: move_forward, 28 km/h, lane 1
 tadEgoAt = tadSpot(tadAnchor, 0.0, 1)
 ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 7.778, with behavior FollowLaneBehavior(target_speed=7.778)
 
-# group `vehicle_in_front_1`: 1 sedan, go_forward, 30 km/h, front of ego, lane 1
+# group `vehicle_in_front_1`: 1 sedan, move_forward, 30 km/h, front of ego, lane 1
 tadAt1 = tadSpot(tadAnchor, 14.983, 1)
 vehicle_in_front_1 = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with speed 8.333, with behavior FollowLaneBehavior(target_speed=8.333)
 
-# group `vehicle_in_front_2`: 1 suv, go_forward, 32 km/h, front of ego, lane 1
+# group `vehicle_in_front_2`: 1 suv, move_forward, 32 km/h, front of ego, lane 1
 tadAt2 = tadSpot(tadAnchor, 29.672, 1)
 vehicle_in_front_2 = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.nissan.patrol', with width 1.95, with length 4.8,
     with regionContainedIn None, with speed 8.889, with behavior FollowLaneBehavior(target_speed=8.889)
 
-# group `vehicles_opposite_direction`: 4 car, go_forward, 35 km/h, front of ego, lane -1
+# group `vehicles_opposite_direction`: 4 car, move_forward, 35 km/h, front of ego, lane -1
 tadAt3 = tadSpot(tadAnchor, 16.222, -1)
 vehicles_opposite_direction_1 = new Car at tadAt3[0], facing tadAt3[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,

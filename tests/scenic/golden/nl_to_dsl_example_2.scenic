@@ -243,12 +243,12 @@ tadRoad = dict(same=1, other=1, minSame=1, minOther=1, index=1, sidewalk=False,
                shape='curved', ahead=36.0, behind=4.0, approach=None)
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
-# ego vehicle: go_forward, 45 km/h, lane 1
+# ego vehicle: move_forward, 45 km/h, lane 1
 tadEgoAt = tadSpot(tadAnchor, 0.0, 1)
 ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 12.5, with behavior FollowLaneBehavior(target_speed=12.5)
 
-# group `construction_vehicles`: 2 construction_vehicle, go_forward, 3 km/h, front of ego, lane -1
+# group `construction_vehicles`: 2 construction_vehicle, move_forward, 3 km/h, front of ego, lane -1
 tadAt1 = tadSpot(tadAnchor, 20.75, -1)
 construction_vehicles_1 = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.carlamotors.european_hgv', with width 2.5, with length 8.0,

@@ -242,12 +242,12 @@ tadRoad = dict(same=1, other=1, minSame=1, minOther=1, index=1, sidewalk=True,
                shape='straight', ahead=34.0, behind=4.0, approach=None)
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
-# ego vehicle: go_forward, 35 km/h, lane 1
+# ego vehicle: move_forward, 35 km/h, lane 1
 tadEgoAt = tadSpot(tadAnchor, 0.0, 1)
 ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 9.722, with behavior FollowLaneBehavior(target_speed=9.722)
 
-# group `pickup_truck`: 1 truck, go_forward, 35 km/h, front of ego, lane 1
+# group `pickup_truck`: 1 truck, move_forward, 35 km/h, front of ego, lane 1
 tadAt1 = tadSpot(tadAnchor, 17.722, 1)
 pickup_truck = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.carlamotors.carlacola', with width 2.5, with length 7.5,
@@ -263,7 +263,7 @@ parked_cars_2 = new Car at tadAt3[0], facing tadAt3[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadParked()
 
-# group `oncoming_suv`: 1 suv, go_forward, 40 km/h, front of ego, lane -1
+# group `oncoming_suv`: 1 suv, move_forward, 40 km/h, front of ego, lane -1
 tadAt4 = tadSpot(tadAnchor, 17.761, -1)
 oncoming_suv = new Car at tadAt4[0], facing tadAt4[1],
     with blueprint 'vehicle.nissan.patrol', with width 1.95, with length 4.8,

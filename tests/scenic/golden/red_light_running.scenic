@@ -244,24 +244,24 @@ tadRoad = dict(same=3, other=3, minSame=3, minOther=2, index=2, sidewalk=False,
                shape=None, ahead=42.0, behind=4.0, approach=44.0)
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
-# ego vehicle: go_forward, 50 km/h, lane 2
+# ego vehicle: move_forward, 50 km/h, lane 2
 tadEgoAt = tadSpot(tadAnchor, 0.0, 2)
 ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 13.889, with behavior FollowLaneBehavior(target_speed=13.889)
 
-# group `red_light_runner`: 1 sedan, go_forward, 60 km/h, right_front of ego, lane 2
+# group `red_light_runner`: 1 sedan, move_forward, 60 km/h, right_front of ego, lane 2
 tadAt1 = tadSpot(tadAnchor, 23.317, 2)
 red_light_runner = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with speed 16.667, with behavior FollowLaneBehavior(target_speed=16.667)
 
-# group `box_truck`: 1 truck, go_forward, 40 km/h, right_front of ego, lane 3
+# group `box_truck`: 1 truck, move_forward, 40 km/h, right_front of ego, lane 3
 tadAt2 = tadSpot(tadAnchor, 21.889, 3)
 box_truck = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.carlamotors.carlacola', with width 2.5, with length 7.5,
     with regionContainedIn None, with speed 11.111, with behavior FollowLaneBehavior(target_speed=11.111)
 
-# group `oncoming_cars`: 2 car, go_forward, 45 km/h, front of ego, lane -2
+# group `oncoming_cars`: 2 car, move_forward, 45 km/h, front of ego, lane -2
 tadAt3 = tadSpot(tadAnchor, 20.389, -2)
 oncoming_cars_1 = new Car at tadAt3[0], facing tadAt3[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,

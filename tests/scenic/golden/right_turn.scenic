@@ -271,7 +271,7 @@ crossing_pedestrians_4 = new Pedestrian at tadAt5[0], facing tadAt5[1] + 90 deg,
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
 
-# group `through_cars`: 3 car, go_forward, 25 km/h, left_front of ego, lane 1
+# group `through_cars`: 3 car, move_forward, 25 km/h, left_front of ego, lane 1
 tadAt6 = tadSpot(tadAnchor, 13.444, 1)
 through_cars_1 = new Car at tadAt6[0], facing tadAt6[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,

@@ -242,7 +242,7 @@ tadRoad = dict(same=2, other=2, minSame=2, minOther=1, index=1, sidewalk=True,
                shape='straight', ahead=52.0, behind=4.0, approach=None)
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
-# ego vehicle: go_forward, 45 km/h, lane 1
+# ego vehicle: move_forward, 45 km/h, lane 1
 tadEgoAt = tadSpot(tadAnchor, 0.0, 1)
 ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 12.5, with behavior FollowLaneBehavior(target_speed=12.5)
@@ -281,7 +281,7 @@ darting_pedestrian = new Pedestrian at tadAt7[0], facing tadAt7[1] + 90 deg,
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.667)
 
-# group `oncoming_cars`: 2 car, go_forward, 40 km/h, front of ego, lane -1
+# group `oncoming_cars`: 2 car, move_forward, 40 km/h, front of ego, lane -1
 tadAt8 = tadSpot(tadAnchor, 19.0, -1)
 oncoming_cars_1 = new Car at tadAt8[0], facing tadAt8[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,

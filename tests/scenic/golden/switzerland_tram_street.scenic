@@ -245,7 +245,7 @@ tadRoad = dict(same=1, other=1, minSame=1, minOther=1, index=1, sidewalk=True,
                shape='straight', ahead=73.0, behind=4.0, approach=None)
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
-# ego vehicle: go_forward, 25 km/h, lane 1
+# ego vehicle: move_forward, 25 km/h, lane 1
 tadEgoAt = tadSpot(tadAnchor, 0.0, 1)
 ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 6.944, with behavior FollowLaneBehavior(target_speed=6.944)
@@ -264,19 +264,19 @@ crossing_pedestrians_3 = new Pedestrian at tadAt3[0], facing tadAt3[1] + 90 deg,
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
 
-# group `cyclist`: 1 bicycle, go_forward, 18 km/h, right_front of ego, lane 1
+# group `cyclist`: 1 bicycle, move_forward, 18 km/h, right_front of ego, lane 1
 tadAt4 = tadSpot(tadAnchor, 17.694, 1)
 cyclist = new Car at tadAt4[0], facing tadAt4[1],
     with blueprint 'vehicle.diamondback.century', with width 0.6, with length 1.8,
     with regionContainedIn None, with speed 5.0, with behavior FollowLaneBehavior(target_speed=5.0)
 
-# group `oncoming_tram`: 1 tram, go_forward, 30 km/h, front of ego, lane -1
+# group `oncoming_tram`: 1 tram, move_forward, 30 km/h, front of ego, lane -1
 tadAt5 = tadSpot(tadAnchor, 27.583, -1)
 oncoming_tram = new Car at tadAt5[0], facing tadAt5[1],
     with blueprint 'vehicle.mitsubishi.fusorosa', with width 2.4, with length 30.0,
     with regionContainedIn None, with speed 8.333, with behavior FollowLaneBehavior(target_speed=8.333)
 
-# group `cars_behind_tram`: 2 car, go_forward, 30 km/h, behind of oncoming_tram, lane -1
+# group `cars_behind_tram`: 2 car, move_forward, 30 km/h, behind of oncoming_tram, lane -1
 tadAt6 = tadSpot(tadAnchor, 55.167, -1)
 cars_behind_tram_1 = new Car at tadAt6[0], facing tadAt6[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,

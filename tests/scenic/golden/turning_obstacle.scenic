@@ -258,7 +258,7 @@ crossing_cyclist = new Car at tadAt1[0], facing tadAt1[1] + 90 deg,
     with blueprint 'vehicle.diamondback.century', with width 0.6, with length 1.8,
     with regionContainedIn None, with speed 3.889, with behavior TadRide(3.889)
 
-# group `taxis`: 2 taxi, go_forward, 25 km/h, right of ego, lane 2
+# group `taxis`: 2 taxi, move_forward, 25 km/h, right of ego, lane 2
 tadAt2 = tadSpot(tadAnchor, 0.0, 2)
 taxis_1 = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.ford.crown', with width 1.85, with length 4.8,

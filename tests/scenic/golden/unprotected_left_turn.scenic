@@ -251,7 +251,7 @@ turning_van = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.mercedes.sprinter', with width 2.0, with length 5.2,
     with regionContainedIn None, with speed 2.778, with behavior TadTurn(2.778, 'LEFT_TURN')
 
-# group `oncoming_car`: 1 car, go_forward, 50 km/h, behind of turning_van, lane -1
+# group `oncoming_car`: 1 car, move_forward, 50 km/h, behind of turning_van, lane -1
 tadAt2 = tadSpot(tadAnchor, 30.367, -1)
 oncoming_car = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,

@@ -253,7 +253,7 @@ delivery_truck = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.carlamotors.carlacola', with width 2.5, with length 7.5,
     with regionContainedIn None, with behavior TadParked()
 
-# group `oncoming_motorcycle`: 1 motorcycle, go_forward, 45 km/h, front of ego, lane -1
+# group `oncoming_motorcycle`: 1 motorcycle, move_forward, 45 km/h, front of ego, lane -1
 tadAt2 = tadSpot(tadAnchor, 17.8, -1)
 oncoming_motorcycle = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.yamaha.yzf', with width 0.8, with length 2.1,

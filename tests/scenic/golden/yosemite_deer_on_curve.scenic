@@ -244,7 +244,7 @@ tadRoad = dict(same=1, other=1, minSame=1, minOther=1, index=1, sidewalk=False,
                shape='curved', ahead=24.0, behind=30.0, approach=None)
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
-# ego vehicle: go_forward, 35 km/h, lane 1
+# ego vehicle: move_forward, 35 km/h, lane 1
 tadEgoAt = tadSpot(tadAnchor, 0.0, 1)
 ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 9.722, with behavior FollowLaneBehavior(target_speed=9.722)
@@ -259,13 +259,13 @@ deer_2 = new Pedestrian at tadAt2[0], facing tadAt2[1] + 90 deg,
     with blueprint 'walker.pedestrian.0001', with width 0.5, with length 1.8,
     with regionContainedIn None, with behavior TadWalk(2.222)
 
-# group `oncoming_rv`: 1 rv, go_forward, 30 km/h, front of ego, lane -1
+# group `oncoming_rv`: 1 rv, move_forward, 30 km/h, front of ego, lane -1
 tadAt3 = tadSpot(tadAnchor, 18.472, -1)
 oncoming_rv = new Car at tadAt3[0], facing tadAt3[1],
     with blueprint 'vehicle.volkswagen.t2', with width 2.5, with length 9.0,
     with regionContainedIn None, with speed 8.333, with behavior FollowLaneBehavior(target_speed=8.333)
 
-# group `following_motorcycles`: 2 motorcycle, go_forward, 35 km/h, behind of ego, lane 1
+# group `following_motorcycles`: 2 motorcycle, move_forward, 35 km/h, behind of ego, lane 1
 tadAt4 = tadSpot(tadAnchor, -15.022, 1)
 following_motorcycles_1 = new Car at tadAt4[0], facing tadAt4[1],
     with blueprint 'vehicle.yamaha.yzf', with width 0.8, with length 2.1,

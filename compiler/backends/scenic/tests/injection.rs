@@ -51,7 +51,7 @@ fn scenarios() -> Vec<(&'static str, String)> {
     for (i, name) in names.iter().enumerate() {
         let reference = if i == 0 { "ego" } else { names[i - 1] };
         groups.push_str(&format!(
-            "  actor {name}: {} car {{\n    behavior: go_forward\n    speed: 20 km/h\n    position: front of {reference}\n    lane: {}\n  }}\n",
+            "  actor {name}: {} car {{\n    behavior: move_forward\n    speed: 20 km/h\n    position: front of {reference}\n    lane: {}\n  }}\n",
             1 + i % 2,
             1 + i % 2,
         ));
@@ -59,7 +59,7 @@ fn scenarios() -> Vec<(&'static str, String)> {
     out.push((
         "keywords_as_names",
         format!(
-            "scenario import {{\n  road {{\n    type: straight_road\n    lanes: 2\n    direction: one_way\n  }}\n  ego {{\n    behavior: go_forward\n    speed: 20 km/h\n    lane: 1\n  }}\n{groups}}}\n"
+            "scenario import {{\n  road {{\n    type: straight_road\n    lanes: 2\n    direction: one_way\n  }}\n  ego {{\n    behavior: move_forward\n    speed: 20 km/h\n    lane: 1\n  }}\n{groups}}}\n"
         ),
     ));
     let strings = [
@@ -78,7 +78,7 @@ fn scenarios() -> Vec<(&'static str, String)> {
         out.push((
             ["s0", "s1", "s2", "s3", "s4", "s5", "s6", "s7", "s8", "s9"][i],
             format!(
-                "scenario injection_{i} {{\n  source {{\n    video: \"{s}\"\n    description: \"{s}\"\n  }}\n  environment {{\n    weather: clear\n    time: daytime\n  }}\n  road {{\n    type: straight_road\n    lanes: 1\n    direction: two_way\n  }}\n  ego {{\n    behavior: go_forward\n    speed: 30 km/h\n    lane: 1\n  }}\n  actor x: 1 pedestrian {{\n    behavior: cross\n    speed: 5 km/h\n    position: front of ego\n    lane: 1\n  }}\n}}\n"
+                "scenario injection_{i} {{\n  source {{\n    video: \"{s}\"\n    description: \"{s}\"\n  }}\n  environment {{\n    weather: clear\n    time: daytime\n  }}\n  road {{\n    type: straight_road\n    lanes: 1\n    direction: two_way\n  }}\n  ego {{\n    behavior: move_forward\n    speed: 30 km/h\n    lane: 1\n  }}\n  actor x: 1 pedestrian {{\n    behavior: cross\n    speed: 5 km/h\n    position: front of ego\n    lane: 1\n  }}\n}}\n"
             ),
         ));
     }

@@ -55,7 +55,7 @@ pub fn scenarios() -> Vec<(String, String)> {
                 Some("static_object") => "parked",
                 Some("pedestrian") => "walk",
                 Some("animal") => "graze",
-                _ => "go_forward",
+                _ => "move_forward",
             };
             pairs.push((t.name.clone(), behavior.to_string()));
         }

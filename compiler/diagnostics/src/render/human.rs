@@ -52,6 +52,7 @@ fn convert(
     let severity = match d.severity {
         Severity::Error => CsSeverity::Error,
         Severity::Warning => CsSeverity::Warning,
+        Severity::Hint => CsSeverity::Help,
     };
     let len = report.text.len();
     let mut labels =
