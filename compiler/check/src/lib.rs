@@ -35,20 +35,53 @@ pub struct Options {
     pub profile: Profile,
     /// A scenario missing all of these is not a scenario.
     pub non_scenario: Vec<Essential>,
+    /// The region of scenarios that name none (`--region`): its module is in scope.
+    pub region: Option<String>,
+    /// The file is a model's answer from the video pipeline (a YAML answer); set per file
+    /// by the database.
+    pub answer: bool,
 }
 
 impl Default for Options {
     fn default() -> Self {
-        Options { profile: Profile::Default, non_scenario: vec![Essential::Weather, Essential::Time, Essential::Road] }
+        Options {
+            profile: Profile::Auto,
+            non_scenario: vec![Essential::Weather, Essential::Time, Essential::Road],
+            region: None,
+            answer: false,
+        }
     }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Profile {
+    /// The dash-cam rules for what comes from the video pipeline — a YAML answer, or a
+    /// scenario whose `source` names a video, a frame or a time in one — and no camera
+    /// rules otherwise.
+    Auto,
+    /// No camera rules.
     Default,
     /// TrafficAlign's extraction rules for forward-facing dash-cam frames: nothing is
     /// described behind the ego vehicle.
     Dashcam,
+}
+
+impl Options {
+    /// Whether the dash-cam rules apply to `module`.
+    pub fn dashcam(&self, module: &Module) -> bool {
+        match self.profile {
+            Profile::Dashcam => true,
+            Profile::Default => false,
+            Profile::Auto => {
+                self.answer
+                    || module.scenario.as_ref().and_then(|s| s.section("source")).is_some_and(|source| {
+                        ["video", "frame", "time"]
+                            .iter()
+                            .any(|f| source.attr(f).is_some_and(|a| a.value.given().is_some()))
+                    })
+            }
+        }
+    }
 }
 
 /// The result of checking one module.
@@ -67,7 +100,7 @@ pub fn check(module: &Module, vocabulary: &Vocabulary, options: &Options, prior:
     names::declarations(module, vocabulary, &mut out.diagnostics);
     if let Some(scenario) = &module.scenario {
         let resolved = names::scenario(scenario, vocabulary, &mut out.diagnostics);
-        semantics::check(scenario, vocabulary, &resolved, options, &mut out.diagnostics);
+        semantics::check(scenario, vocabulary, &resolved, options.dashcam(module), &mut out.diagnostics);
         out.class = Some(completeness::classify(scenario, options, prior, &mut out.diagnostics));
     }
     tad_diagnostics::sort(&mut out.diagnostics);

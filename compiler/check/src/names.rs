@@ -49,10 +49,12 @@ pub fn resolve_symbol(vocabulary: &Vocabulary, kind: &str, field: &str, symbol: 
                 Code::E0400,
                 format!("unknown {} `{}`", kind_label(kind), symbol.name),
                 symbol.span,
-                format!("not a {} `{field}` can take", kind_label(kind)),
+                format!("not {} `{field}` can take", with_article(&kind_label(kind))),
             );
             let candidates = vocabulary.candidates(kind, &symbol.name, 5);
-            if let Some(guess) = candidates.first() {
+            // a name another standard module declares is not a typo
+            let elsewhere = vocabulary.declared_elsewhere(kind, &symbol.name);
+            if let (None, Some(guess)) = (elsewhere, candidates.first()) {
                 d = d.with_help(format!("did you mean `{guess}`?")).with_fix(
                     symbol.span,
                     guess.to_string(),
@@ -63,10 +65,24 @@ pub fn resolve_symbol(vocabulary: &Vocabulary, kind: &str, field: &str, symbol: 
                 namespace: kind.to_string(),
                 name: symbol.name.clone(),
                 candidates: candidates.iter().map(|c| c.to_string()).collect(),
-                module: None,
+                module: elsewhere.map(str::to_string),
             });
             let names = vocabulary.names(kind);
-            d = if names.is_empty() {
+            d = if let Some(module) = elsewhere {
+                let regions: Vec<&str> = vocabulary
+                    .entries("region")
+                    .into_iter()
+                    .filter(|r| r.symbol("module") == Some(module))
+                    .map(|r| r.name.as_str())
+                    .collect();
+                let region = regions.first().map_or(String::new(), |r| {
+                    format!(", or name the region (`source {{ region: {r} }}`, or `--region {r}`)")
+                });
+                d.with_help(format!(
+                    "`{}` is declared in the standard module `{module}`: write `use {module}` at the top{region}",
+                    symbol.name
+                ))
+            } else if names.is_empty() {
                 d.with_note(format!("no {} is declared; is a `use` missing?", kind_label(kind)))
             } else if names.len() <= 12 {
                 d.with_note(format!("the {} names are {}", kind_label(kind), quoted(&names)))
@@ -76,6 +92,12 @@ pub fn resolve_symbol(vocabulary: &Vocabulary, kind: &str, field: &str, symbol: 
             out.push(d);
         }
     }
+}
+
+/// "a weather", "an actor type".
+fn with_article(noun: &str) -> String {
+    let vowel = noun.starts_with(['a', 'e', 'i', 'o', 'u']);
+    format!("{} {noun}", if vowel { "an" } else { "a" })
 }
 
 pub fn quoted(names: &[&str]) -> String {

@@ -7,7 +7,6 @@
 
 use crate::names::{Resolved, Target, format_number, quoted};
 use crate::vocab::{Entry, Vocabulary};
-use crate::{Options, Profile};
 use tad_diagnostics::{Applicability, Code, Diagnostic, Payload, Span};
 use tad_syntax::schema::{Lateral, Longitudinal};
 
@@ -31,7 +30,7 @@ pub fn check(
     scenario: &Scenario,
     vocabulary: &Vocabulary,
     resolved: &Resolved,
-    options: &Options,
+    dashcam: bool,
     out: &mut Vec<Diagnostic>,
 ) {
     let road = scenario.section("road");
@@ -51,7 +50,8 @@ pub fn check(
     if let Some(ego) = ego {
         let behavior = entry(vocabulary, "behavior", ego.attr("behavior"));
         performers(behavior, ego.attr("behavior"), EGO_KIND, "the ego vehicle", out);
-        speeds(ego.attr("speed"), behavior, None, context, "the ego vehicle", out);
+        let kind = vocabulary.get("actor_kind", EGO_KIND);
+        speeds(ego.attr("speed"), behavior, kind, None, context, "the ego vehicle", out);
     }
 
     for (index, group) in scenario.actors.iter().enumerate() {
@@ -81,15 +81,42 @@ pub fn check(
         if let Some(kind) = actor_kind {
             performers(behavior, behavior_attr, kind, &what, out);
         }
-        speeds(group.attr("speed"), behavior, actor_type, context, &what, out);
+        let kind = actor_kind.and_then(|k| vocabulary.get("actor_kind", k));
+        speeds(group.attr("speed"), behavior, kind, actor_type, context, &what, out);
 
         let Some(position_attr) = group.attr("position") else { continue };
         let Known::Given(Val::Position(position)) = &position_attr.value else { continue };
         let relation = vocabulary.get("relation", &position.relation.name);
+        if let Some(relation) = relation
+            && relation.choice(LATERAL) == Some(Lateral::Opposite)
+            && opposite_lanes == Some(false)
+        {
+            let mut d = Diagnostic::new(
+                Code::E0501,
+                format!(
+                    "{what} is `{} of {}`, but the road is {}",
+                    relation.name,
+                    position.reference.name,
+                    direction.map_or("one-way", |d| d.name.as_str())
+                ),
+                position.relation.span,
+                "no opposite direction",
+            )
+            .with_payload(Payload::Incompatible {
+                subject: direction.map_or("one_way", |d| d.name.as_str()).to_string(),
+                value: relation.name.clone(),
+                allowed: Vec::new(),
+            })
+            .with_help("a one-way road has no oncoming lanes: correct the relation or the road's direction");
+            if let Some(d_attr) = road_attr("direction") {
+                d = d.with_secondary(d_attr.value_span, "the road's direction");
+            }
+            out.push(d);
+        }
         if resolved.targets.get(&index) == Some(&Target::Ego)
             && let Some(relation) = relation
         {
-            if options.profile == Profile::Dashcam && relation.choice(LONGITUDINAL) == Some(Longitudinal::Behind) {
+            if dashcam && relation.choice(LONGITUDINAL) == Some(Longitudinal::Behind) {
                 out.push(
                         Diagnostic::new(
                             Code::E0510,
@@ -252,9 +279,13 @@ fn performers(behavior: Option<&Entry>, attr: Option<&Attr>, kind: &str, what: &
     }
 }
 
+/// A speed against, in order: the behavior's limit (error), a negative value (error), the
+/// actor kind's physical limit (error: impossible), the type's plausible maximum and the
+/// road context's (warnings: implausible). The first that applies is reported.
 fn speeds(
     attr: Option<&Attr>,
     behavior: Option<&Entry>,
+    kind: Option<&Entry>,
     actor_type: Option<&Entry>,
     context: Option<&Entry>,
     what: &str,
@@ -288,6 +319,22 @@ fn speeds(
                 "speeds are not negative",
             )
             .with_payload(speed_range(speed, Some(0.0), None)),
+        );
+        return;
+    }
+    if let Some((k, max)) = kind.and_then(|k| k.speed("max_speed").map(|m| (k, m)))
+        && speed > max + EPSILON
+    {
+        let kind_name = k.name.replace('_', " ");
+        out.push(
+            Diagnostic::new(
+                Code::E0511,
+                format!("{what} moves at {}, impossibly fast for a {kind_name}", speed_text(speed)),
+                attr.value_span,
+                format!("no {kind_name} is faster than {}", speed_text(max)),
+            )
+            .with_payload(speed_range(speed, None, Some(max)))
+            .with_help("check the unit and the number; a speed this high is a misreading"),
         );
         return;
     }

@@ -136,6 +136,9 @@ impl Layer {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Vocabulary {
     layers: Vec<Arc<Layer>>,
+    /// Modules out of scope (the other standard modules), consulted only to say where an
+    /// unknown name is declared.
+    elsewhere: Vec<Arc<Layer>>,
     /// Declarations of a later layer that an earlier one already has: (layer, kind, index).
     hidden: HashSet<(usize, &'static str, usize)>,
 }
@@ -240,7 +243,7 @@ impl Vocabulary {
                 }
             }
         }
-        (Vocabulary { layers, hidden }, conflicts)
+        (Vocabulary { layers, hidden, elsewhere: Vec::new() }, conflicts)
     }
 
     /// Index the declarations of `modules`, in order, as one layer each (for callers
@@ -252,6 +255,17 @@ impl Vocabulary {
         let (vocabulary, between) = Vocabulary::layered(layers);
         conflicts.extend(between);
         (vocabulary, conflicts)
+    }
+
+    /// The same vocabulary, told which modules out of scope to name for unknown names.
+    pub fn with_elsewhere(mut self, elsewhere: Vec<Arc<Layer>>) -> Self {
+        self.elsewhere = elsewhere;
+        self
+    }
+
+    /// The module out of scope that declares `name` (or an alias of it) as a `kind`.
+    pub fn declared_elsewhere(&self, kind: &str, name: &str) -> Option<&str> {
+        self.elsewhere.iter().find(|l| l.kinds.get(kind).is_some_and(|t| t.find(name).is_some())).map(|l| l.module())
     }
 
     pub fn layers(&self) -> &[Arc<Layer>] {

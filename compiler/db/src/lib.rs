@@ -103,6 +103,8 @@ pub struct Settings {
 #[salsa::db]
 pub trait Db: salsa::Database {
     fn settings(&self) -> Settings;
+    /// The embedded standard modules (fixed when the database is made).
+    fn standard_modules(&self) -> Vec<SourceFile>;
 }
 
 /// A file parsed and lowered.
@@ -180,9 +182,17 @@ pub fn scope(db: &dyn Db, file: SourceFile) -> Vec<SourceFile> {
 #[salsa::tracked(returns(ref))]
 pub fn vocabulary(db: &dyn Db, file: SourceFile) -> Scope {
     let own = layer(db, file);
-    let mut layers: Vec<Arc<Layer>> = scope(db, file).iter().map(|m| layer(db, *m)).collect();
+    let in_scope = scope(db, file);
+    let mut layers: Vec<Arc<Layer>> = in_scope.iter().map(|m| layer(db, *m)).collect();
     layers.push(own.clone());
     let (vocabulary, between) = Vocabulary::layered(layers);
+    let elsewhere = db
+        .standard_modules()
+        .into_iter()
+        .filter(|m| *m != file && !in_scope.contains(m))
+        .map(|m| layer(db, m))
+        .collect();
+    let vocabulary = vocabulary.with_elsewhere(elsewhere);
     let id = file.id(db);
     let diagnostics = own
         .conflicts()
@@ -263,8 +273,9 @@ fn uses(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
 pub fn check(db: &dyn Db, file: SourceFile) -> Checked {
     let analysis = analyze(db, file);
     let scope = vocabulary(db, file);
-    let options = db.settings().options(db);
-    let mut checked = tad_check::check(&analysis.module, &scope.vocabulary, options, &analysis.diagnostics);
+    let mut options = db.settings().options(db).clone();
+    options.answer = file.language(db) == Language::Yaml;
+    let mut checked = tad_check::check(&analysis.module, &scope.vocabulary, &options, &analysis.diagnostics);
     checked.diagnostics = stamp(std::mem::take(&mut checked.diagnostics), file.id(db));
     checked.diagnostics.extend(analysis.diagnostics.iter().cloned());
     checked.diagnostics.extend(scope.diagnostics.iter().cloned());
@@ -425,13 +436,30 @@ impl Database {
             .get(PRELUDE)
             .copied()
             .filter(|p| *p != file && !is_prelude_source(file.path(self), file.text(self)));
-        let names: Vec<String> = analyze(self, file)
-            .module
-            .uses
-            .iter()
-            .map(|u| u.path.iter().map(|n| n.text.as_str()).collect::<Vec<_>>().join("."))
-            .collect();
+        let module = &analyze(self, file).module;
+        let mut names: Vec<String> =
+            module.uses.iter().map(|u| u.path.iter().map(|n| n.text.as_str()).collect::<Vec<_>>().join(".")).collect();
+        // a scenario sees its region's own module: the region it states, else the run's
+        let region = module.scenario.as_ref().and_then(|scenario| {
+            let stated = scenario.attr("source", "region").and_then(|a| a.symbol()).map(|s| s.name.clone());
+            stated.or_else(|| self.settings().options(self).region.clone())
+        });
+        let region_module = match (region, prelude) {
+            (Some(region), Some(prelude)) => vocabulary(self, prelude)
+                .vocabulary
+                .get("region", &region)
+                .and_then(|r| r.symbol("module"))
+                .map(str::to_string),
+            _ => None,
+        };
         let mut modules = BTreeMap::new();
+        if let Some(m) = region_module.filter(|m| !names.contains(m))
+            && let Some(standard) = self.stdlib.get(&m).copied()
+            && standard != file
+        {
+            modules.insert(m, standard);
+        }
+        names.retain(|n| !modules.contains_key(n));
         for name in names {
             let relative: PathBuf = name.split('.').collect::<PathBuf>().with_extension("tad");
             let local = if is_stdlib { None } else { path.parent().map(|dir| dir.join(&relative)) };
@@ -490,5 +518,9 @@ impl Database {
 impl Db for Database {
     fn settings(&self) -> Settings {
         self.settings.expect("set in Database::with_storage")
+    }
+
+    fn standard_modules(&self) -> Vec<SourceFile> {
+        self.stdlib.values().copied().collect()
     }
 }

@@ -83,6 +83,7 @@ codes! {
     E0506 => Error,
     E0509 => Error,
     E0510 => Error,
+    E0511 => Error,
     W0200 => Warning,
     W0201 => Warning,
     W0401 => Hint,

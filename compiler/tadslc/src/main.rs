@@ -152,9 +152,15 @@ enum Command {
 /// Checking rules.
 #[derive(clap::Args)]
 struct Rules {
-    /// Extra rules: `dashcam` applies TrafficAlign's extraction rules for dash-cam frames
-    #[arg(long, value_enum, default_value_t = ProfileArg::Default)]
+    /// Camera rules: `dashcam` applies TrafficAlign's extraction rules for dash-cam frames
+    /// (nothing behind the ego); `auto` applies them to YAML answers and to scenarios whose
+    /// `source` names a video, frame or time; `default` never
+    #[arg(long, value_enum, default_value_t = ProfileArg::Auto)]
     profile: ProfileArg,
+    /// The region of scenarios that state none (e.g. `yellowstone`): its vocabulary module
+    /// is in scope
+    #[arg(long, value_name = "REGION")]
+    region: Option<String>,
     /// The essentials whose absence together makes a non-scenario
     #[arg(long, value_delimiter = ',', default_value = "weather,time,road")]
     non_scenario: Vec<EssentialArg>,
@@ -162,6 +168,7 @@ struct Rules {
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum ProfileArg {
+    Auto,
     Default,
     Dashcam,
 }
@@ -180,9 +187,12 @@ impl Rules {
         use tad_check::{Essential, Profile};
         tad_check::Options {
             profile: match self.profile {
+                ProfileArg::Auto => Profile::Auto,
                 ProfileArg::Default => Profile::Default,
                 ProfileArg::Dashcam => Profile::Dashcam,
             },
+            region: self.region.clone(),
+            answer: false,
             non_scenario: self
                 .non_scenario
                 .iter()
