@@ -95,14 +95,22 @@ struct Checked1 {
 /// Check every file `paths` name, then report. Every file is checked before anything is
 /// reported, so the status is the whole run's even if the reader of the report stops
 /// reading early (`spec/output.md`).
-pub fn run(paths: &[std::path::PathBuf], format: Format, deny_warnings: bool, color: bool, options: Options) -> Status {
-    crate::output::run(|status| run_in(paths, format, deny_warnings, color, options, status))
+pub fn run(
+    paths: &[std::path::PathBuf],
+    format: Format,
+    deny_warnings: bool,
+    limit: usize,
+    color: bool,
+    options: Options,
+) -> Status {
+    crate::output::run(|status| run_in(paths, format, deny_warnings, limit, color, options, status))
 }
 
 fn run_in(
     paths: &[std::path::PathBuf],
     format: Format,
     deny_warnings: bool,
+    limit: usize,
     color: bool,
     options: Options,
     status: &mut Status,
@@ -158,7 +166,24 @@ fn run_in(
         let report = report(&c.name, &c.text, &c.result.diagnostics, &related);
         match format {
             Format::Human => {
+                // a file with hundreds of problems: the first ones, and how many more
+                let shown = if limit > 0 && c.result.diagnostics.len() > limit {
+                    &c.result.diagnostics[..limit]
+                } else {
+                    &c.result.diagnostics[..]
+                };
+                let report = FileReport { diagnostics: shown, ..report };
                 err!("{}", human::render(&report, color))?;
+                let hidden = &c.result.diagnostics[shown.len()..];
+                if !hidden.is_empty() {
+                    let errors = hidden.iter().filter(|d| d.is_error()).count();
+                    errln!(
+                        "{}: and {} ({}); `--max-diagnostics 0` or `--format json` shows all\n",
+                        c.name,
+                        plural(hidden.len(), "more diagnostic"),
+                        plural(errors, "error")
+                    )?;
+                }
                 if let Some(class) = c.result.class.filter(|c| *c != Class::Complete) {
                     errln!("{}: {}", c.name, class.as_str())?;
                 }

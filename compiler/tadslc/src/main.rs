@@ -46,6 +46,10 @@ enum Command {
         /// Treat warnings as errors for the exit code
         #[arg(long)]
         deny_warnings: bool,
+        /// In human output, show at most this many diagnostics per file, then how many more
+        /// there are (0: all); JSON and SARIF always carry all
+        #[arg(long, value_name = "N", default_value_t = 50)]
+        max_diagnostics: usize,
         #[command(flatten)]
         rules: Rules,
     },
@@ -243,8 +247,8 @@ fn main() -> ExitCode {
         }
     };
     let status = match cli.command {
-        Command::Check { paths, format, deny_warnings, rules } => {
-            check::run(&paths, format, deny_warnings, color, rules.options())
+        Command::Check { paths, format, deny_warnings, max_diagnostics, rules } => {
+            check::run(&paths, format, deny_warnings, max_diagnostics, color, rules.options())
         }
         Command::Fmt { paths, check, canonicalize } => fmt::run(&paths, check, canonicalize, color),
         Command::Build { paths, target: Target::Scenic, output, map_dir, map, simulator } => tadslc::build::run(

@@ -127,6 +127,23 @@ fn errors_make_a_scenario_invalid_whatever_it_states() {
 }
 
 #[test]
+fn human_output_caps_the_diagnostics_of_a_file() {
+    let fields: String = (1..=80).map(|i| format!("    wether{i}: clear\n")).collect();
+    let many = format!("scenario x {{\n  environment {{\n{fields}  }}\n}}\n");
+    let out = tadslc(&["check", "-"], &many);
+    assert_eq!(code(&out), 1);
+    let text = stderr(&out);
+    assert_eq!(text.matches("error[E0203]").count(), 48, "the first 50 diagnostics");
+    assert!(text.contains("<stdin>: and 32 more diagnostics (32 errors)"), "{text}");
+    assert!(text.contains("checked 1 file: 80 errors"), "the summary counts all: {text}");
+    let all = tadslc(&["check", "--max-diagnostics", "0", "-"], &many);
+    assert_eq!(stderr(&all).matches("error[E0203]").count(), 80);
+    let json = tadslc(&["check", "--format", "json", "-"], &many);
+    let file: Value = serde_json::from_str(stdout(&json).trim()).unwrap();
+    assert_eq!(file["diagnostics"].as_array().unwrap().len(), 82);
+}
+
+#[test]
 fn sarif_output_is_a_valid_sarif_log() {
     let out = tadslc(&["check", "--format", "sarif", "tests/ui/structure"], "");
     assert_eq!(code(&out), 1);
