@@ -272,7 +272,19 @@ impl Vocabulary {
         &self.layers
     }
 
+    /// A name of `kind` as declared, as an alias, or as the plural of either (`pedestrians`,
+    /// `buses`, `bodies`: answers name a group by its plural); a plural is another spelling.
     pub fn lookup(&self, kind: &str, name: &str) -> Lookup<'_> {
+        match self.lookup_exact(kind, name) {
+            Lookup::Unknown => singulars(name)
+                .into_iter()
+                .find_map(|singular| self.lookup_exact(kind, &singular).entry())
+                .map_or(Lookup::Unknown, Lookup::Alias),
+            found => found,
+        }
+    }
+
+    fn lookup_exact(&self, kind: &str, name: &str) -> Lookup<'_> {
         for (l, layer) in self.layers.iter().enumerate() {
             let Some((kind, table)) = layer.kinds.get_key_value(kind) else { continue };
             if let Some(&i) = table.names.get(name)
@@ -342,5 +354,36 @@ impl Vocabulary {
     /// are tried in declaration order, so ties resolve the same way every time.
     pub fn suggest(&self, kind: &str, word: &str) -> Option<&str> {
         self.candidates(kind, word, 1).into_iter().next()
+    }
+}
+
+/// The singulars an English plural may have: `buses` → `buse`, `bus`; `bodies` → `body`;
+/// `pedestrians` → `pedestrian`; for a compound, of its last word (`school_buses`).
+fn singulars(name: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    if let Some(stem) = name.strip_suffix("ies") {
+        out.push(format!("{stem}y"));
+    }
+    if let Some(stem) = name.strip_suffix("es") {
+        out.push(stem.to_string());
+    }
+    if let Some(stem) = name.strip_suffix('s').filter(|s| !s.ends_with('s')) {
+        out.push(stem.to_string());
+    }
+    out.retain(|s| s.len() >= 2);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::singulars;
+
+    #[test]
+    fn plurals_have_their_singulars() {
+        assert!(singulars("pedestrians").contains(&"pedestrian".to_string()));
+        assert!(singulars("buses").contains(&"bus".to_string()));
+        assert!(singulars("bodies").contains(&"body".to_string()));
+        assert!(singulars("school_buses").contains(&"school_bus".to_string()));
+        assert!(singulars("glass").is_empty());
     }
 }

@@ -69,6 +69,20 @@ impl Language {
         let yaml = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("yaml") || e.eq_ignore_ascii_case("yml"));
         if yaml { Language::Yaml } else { Language::Tad }
     }
+
+    /// The language of a file for a host that has only its path and text: `.tad` is TAD
+    /// and `.yaml`/`.yml` YAML; another file (a model's answer saved as `.txt` or `.md`) is
+    /// a YAML answer when it holds a YAML scenario and does not begin like TAD.
+    pub fn guess(path: &Path, text: &str) -> Language {
+        let extension = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
+        match extension.as_deref() {
+            Some("tad") => Language::Tad,
+            Some("yaml" | "yml") => Language::Yaml,
+            _ if tad_syntax::begins_like_tad(text) => Language::Tad,
+            _ if tad_yaml::dialect(text).is_some() => Language::Yaml,
+            _ => Language::Tad,
+        }
+    }
 }
 
 /// What a file's names refer to: the prelude it sees (none for the prelude itself) and

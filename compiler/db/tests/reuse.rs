@@ -69,9 +69,9 @@ fn an_edit_re_runs_only_the_edited_file() {
 
 #[test]
 fn a_used_module_is_indexed_once_and_rebuilt_only_when_its_declarations_change() {
-    let module = "weather drizzle {\n  aliases: [light_rain]\n}\n".to_string();
+    let module = "weather hail {\n  aliases: [hailstorm]\n}\n".to_string();
     let scenario =
-        |name: &str| format!("use local\nscenario {name} {{\n  environment {{\n    weather: light_rain\n  }}\n}}\n");
+        |name: &str| format!("use local\nscenario {name} {{\n  environment {{\n    weather: hailstorm\n  }}\n}}\n");
     let mut fs = Memory(HashMap::from([(PathBuf::from("/v/local.tad"), module.clone())]));
     let mut db = Database::logged(Options::default());
     let a = db.set_source("/v/a.tad".into(), scenario("a"), Language::Tad, &fs);
@@ -86,7 +86,7 @@ fn a_used_module_is_indexed_once_and_rebuilt_only_when_its_declarations_change()
     assert_eq!(executed(&first, "layer"), tad_db::stdlib::MODULES.len() + 3, "{first:#?}");
 
     // editing a scenario touches neither the module's layer nor the other file
-    db.set_source("/v/a.tad".into(), scenario("a").replace("light_rain", "drizzle"), Language::Tad, &fs);
+    db.set_source("/v/a.tad".into(), scenario("a").replace("hailstorm", "hail"), Language::Tad, &fs);
     check(&db, a);
     check(&db, b);
     let second = db.take_log();
@@ -107,7 +107,7 @@ fn a_used_module_is_indexed_once_and_rebuilt_only_when_its_declarations_change()
 fn errors_of_a_used_module_are_reported_in_its_file() {
     let fs = Memory(HashMap::from([(
         PathBuf::from("/v/broken.tad"),
-        "weather drizzle {\n  aliases: [light_rain\n}\nweather clear\n".to_string(),
+        "weather hail {\n  aliases: [hailstorm\n}\nweather clear\n".to_string(),
     )]));
     let mut db = Database::new(Options::default());
     let main = db.set_source("/v/main.tad".into(), "use broken\n".into(), Language::Tad, &fs);

@@ -20,6 +20,7 @@ pub mod suggest;
 mod sniff;
 
 pub use parse::{Parsed, parse};
+pub use sniff::begins_like_tad;
 use tad_diagnostics::Diagnostic;
 
 /// Parse and lower one file: its model and every lexical, syntax and structure

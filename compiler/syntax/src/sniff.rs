@@ -16,11 +16,10 @@ pub fn not_tad(src: &str, diagnostics: &[Diagnostic]) -> Option<Diagnostic> {
     if errors.len() < MANY {
         return None;
     }
-    let (start, first_line) = first_content(src)?;
-    let word: String = first_line.chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '_').collect();
-    if word == "scenario" || word == "use" || schema::declaration(&word).is_some() {
+    if begins_like_tad(src) {
         return None;
     }
+    let (start, first_line) = first_content(src)?;
     let looks = looks_like(src, first_line);
     let index = LineIndex::new(src);
     let first = errors[0];
@@ -45,6 +44,14 @@ pub fn not_tad(src: &str, diagnostics: &[Diagnostic]) -> Option<Diagnostic> {
         _ => d.with_help("check `.tad` files, or a YAML answer named `.yaml`"),
     };
     Some(d)
+}
+
+/// Whether the first word of `src` that is not in a comment starts a TAD item (`scenario`,
+/// `use`, a declaration kind).
+pub fn begins_like_tad(src: &str) -> bool {
+    let Some((_, first_line)) = first_content(src) else { return false };
+    let word: String = first_line.chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '_').collect();
+    word == "scenario" || word == "use" || schema::declaration(&word).is_some()
 }
 
 /// The first line that is neither blank nor a `//` comment, and where it starts.

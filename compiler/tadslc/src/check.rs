@@ -15,7 +15,7 @@ use tad_diagnostics::{Code, Diagnostic, Payload, Severity, Span};
 /// Register one input in the database, in the language its path suggests.
 pub fn register(db: &mut Database, input: &Input) -> SourceFile {
     let path = input.path.clone().unwrap_or_else(|| std::path::PathBuf::from(&input.name));
-    let language = Language::of_path(&path);
+    let language = Language::guess(&path, &input.text);
     db.set_source(path, input.text.clone(), language, &RealFs)
 }
 

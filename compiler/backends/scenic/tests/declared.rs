@@ -105,7 +105,7 @@ fn every_backend_diagnostic_has_a_payload() {
             assert!(!d.payload.is_none(), "{}: {} {} has no payload", example.display(), d.code, d.message);
         }
     }
-    let no_scenario = common::build_text(Path::new("/nonexistent/m.tad"), "weather drizzle\n", &EmitOptions::default());
+    let no_scenario = common::build_text(Path::new("/nonexistent/m.tad"), "weather hail\n", &EmitOptions::default());
     assert!(no_scenario.diagnostics.iter().all(|d| d.code == Code::E0700 && !d.payload.is_none()));
     let unknown = common::build_text(
         Path::new("/nonexistent/camel.tad"),
