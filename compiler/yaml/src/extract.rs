@@ -25,7 +25,11 @@ pub fn extract(answer: &str) -> Option<Range<usize>> {
         }
         return Some(block);
     }
-    if let Some(fence) = fenced(answer) {
+    // a fence whose block holds none of the form's keys while the rest does is stray (a
+    // closing fence left after an unfenced answer): the answer is read without it
+    if let Some(fence) = fenced(answer)
+        && (has_known_key(&answer[fence.clone()]) || !has_known_key(answer))
+    {
         return Some(fence);
     }
     let parsed = if crate::parse::too_deep(answer).is_some() {

@@ -237,6 +237,8 @@ impl Importer<'_> {
                 })
                 .collect(),
             Value::Null => Vec::new(),
+            // TrafficComposer's `road_network: None`, or a model's `N/A`: nothing stated
+            Value::String(s) if norm::is_none_word(s) || norm::is_unspecified(s) => Vec::new(),
             other => {
                 self.report(
                     Diagnostic::new(
@@ -299,6 +301,26 @@ impl Importer<'_> {
             ))
             .with_payload(shape(key, expected, found))
             .with_fix(span, "unspecified", Applicability::MaybeIncorrect),
+        );
+    }
+
+    /// A word that says something but gives no value (`several`, `slow`): read as
+    /// `unspecified`, and said, so nothing the answer gave is lost without a word.
+    fn vague(&mut self, key: &str, text: &str, span: Span, expected: &str, meaning: &str) {
+        self.report(
+            Diagnostic::new(
+                Code::W0302,
+                format!("`{key}: {}` gives no number: read as `unspecified`", text.trim()),
+                span,
+                format!("not {expected}"),
+            )
+            .with_payload(Payload::WrongValue {
+                field: key.to_string(),
+                expected: expected.to_string(),
+                found: text.trim().to_string(),
+            })
+            .with_note(format!("{meaning}; the scenario counts it as missing"))
+            .with_help(format!("write {expected} if the description gives one")),
         );
     }
 
@@ -491,18 +513,12 @@ impl Importer<'_> {
                     return Some(Known::Given(i));
                 }
                 if let Some(i) = norm::number_word(s) {
-                    self.report(
-                        Diagnostic::new(
-                            Code::E0303,
-                            format!("`{key}` takes a whole number, found `{}`", s.trim()),
-                            span,
-                            "a number in words",
-                        )
-                        .with_payload(shape(key, "a whole number", s.trim()))
-                        .with_help(format!("write `{i}`"))
-                        .with_fix(span, i.to_string(), Applicability::MachineApplicable),
-                    );
-                    return None;
+                    // `two` means 2
+                    return Some(Known::Given(i));
+                }
+                if norm::is_count_word(s) {
+                    self.vague(key, s, span, "a count", "how many is not known");
+                    return Some(Known::Unspecified);
                 }
                 self.malformed(key, s, span, "a whole number", example);
                 None
@@ -534,10 +550,18 @@ impl Importer<'_> {
             },
             Value::String(s) => match norm::parse_quantity(s, default) {
                 Some((value, unit)) => Some(Known::Given(Quantity { value, unit })),
-                None => {
-                    self.malformed(key, s.trim(), span, what, example);
-                    None
-                }
+                None => match norm::speed_word(s).filter(|_| default != Unit::Seconds) {
+                    // the paper: a stopped vehicle is 0 km/h
+                    Some(norm::SpeedWord::Still) => Some(Known::Given(Quantity { value: 0.0, unit: default })),
+                    Some(norm::SpeedWord::Vague) => {
+                        self.vague(key, s, span, what, "the speed is not known");
+                        Some(Known::Unspecified)
+                    }
+                    None => {
+                        self.malformed(key, s.trim(), span, what, example);
+                        None
+                    }
+                },
             },
             Value::Bool(b) => {
                 self.malformed(key, &b.to_string(), span, what, example);

@@ -53,7 +53,103 @@ pub fn is_ego(normalized: &str) -> bool {
 
 /// Whether a value is the word `unspecified`.
 pub fn is_unspecified(text: &str) -> bool {
-    text.trim().eq_ignore_ascii_case("unspecified")
+    let t = text.trim().trim_end_matches('.').to_ascii_lowercase();
+    UNKNOWN_WORDS.contains(&t.as_str())
+}
+
+/// What answers write for a value they cannot see (TrafficAlign asks for `unspecified`;
+/// models also write these).
+const UNKNOWN_WORDS: &[&str] = &[
+    "unspecified",
+    "unknown",
+    "n/a",
+    "na",
+    "not visible",
+    "not_visible",
+    "unclear",
+    "not clear",
+    "not specified",
+    "not_specified",
+    "not stated",
+    "not given",
+    "not applicable",
+    "undetermined",
+    "indeterminate",
+    "cannot be determined",
+    "can't tell",
+    "not sure",
+    "uncertain",
+    "?",
+    "-",
+    "--",
+    "tbd",
+];
+
+/// Words for how many actors a group has that give no number (`several`, `a few`).
+pub fn is_count_word(text: &str) -> bool {
+    const WORDS: &[&str] = &[
+        "several",
+        "a few",
+        "few",
+        "some",
+        "many",
+        "multiple",
+        "a couple",
+        "a couple of",
+        "couple",
+        "numerous",
+        "a group",
+        "a group of",
+        "a number of",
+        "lots",
+        "a lot",
+        "dozens",
+        "a handful",
+        "handful",
+        "various",
+    ];
+    WORDS.contains(&text.trim().to_ascii_lowercase().as_str())
+}
+
+/// Words for a speed that give no number (`slow`), and those that mean standing still.
+pub fn speed_word(text: &str) -> Option<SpeedWord> {
+    const STILL: &[&str] = &["stopped", "stationary", "parked", "standing still", "not moving", "zero", "standing"];
+    const VAGUE: &[&str] = &[
+        "slow",
+        "slowly",
+        "very slow",
+        "fast",
+        "quickly",
+        "quick",
+        "moderate",
+        "normal",
+        "normal speed",
+        "high speed",
+        "low speed",
+        "crawling",
+        "walking pace",
+        "walking speed",
+        "steady",
+        "cruising",
+        "speeding",
+    ];
+    let t = text.trim().to_ascii_lowercase();
+    if STILL.contains(&t.as_str()) {
+        Some(SpeedWord::Still)
+    } else if VAGUE.contains(&t.as_str()) {
+        Some(SpeedWord::Vague)
+    } else {
+        None
+    }
+}
+
+/// What a speed word says.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SpeedWord {
+    /// 0 km/h.
+    Still,
+    /// A speed without a number.
+    Vague,
 }
 
 /// Whether a value is the word `none` (any case).

@@ -106,7 +106,8 @@ fn bad_values_point_at_their_line() {
     let text = "<YAML>\nenvironment:\n    weather: 42\nroad_network:\n    lane_number: many\n    lane_number2: 2\n    special_lane: [bike lane, {x: 1}]\nactors:\n    ego_vehicle:\n        speed: fast\n        lane_index: 1.5\n    bus:\n        number: 2.0\n        speed: 30-40 km/h\n        type: [bus]\n</YAML>\n";
     assert_eq!(
         codes_at(text),
-        ["E0303@3", "E0303@5", "E0302@6", "E0304@7", "E0303@10", "E0303@11", "E0303@13", "E0303@14", "E0304@15"]
+        // `many` lanes and a `fast` speed give no number: warnings, read as unspecified
+        ["E0303@3", "W0302@5", "E0302@6", "E0304@7", "W0302@10", "E0303@11", "E0303@13", "E0303@14", "E0304@15"]
     );
     let (_, d) = lower(text);
     let unknown = d.iter().find(|d| d.code == Code::E0302).unwrap();
@@ -185,10 +186,17 @@ fn mph_and_other_units() {
         let q = model.scenario.unwrap().attr("ego", "speed").unwrap().quantity().unwrap();
         assert_eq!((q.value, q.unit.as_str()), (value, unit), "{speed}");
     }
-    for speed in ["fast", "30 s", "30-40 km/h", "[30]", "true", ".nan", "1e999"] {
+    for speed in ["30 s", "30-40 km/h", "[30]", "true", ".nan", "1e999"] {
         let text = format!("actors:\n  ego_vehicle:\n    speed: {speed}\n");
         assert_eq!(errors(&lower(&text).1).len(), 1, "{speed}");
     }
+    // words: `stopped` is 0 km/h (the paper's rule); `fast` gives no number, a warning
+    let (model, d) = lower("actors:\n  ego_vehicle:\n    speed: stopped\n");
+    assert!(d.is_empty(), "{d:?}");
+    assert_eq!(model.scenario.unwrap().attr("ego", "speed").unwrap().quantity().map(|q| q.value), Some(0.0));
+    let (model, d) = lower("actors:\n  ego_vehicle:\n    speed: fast\n");
+    assert_eq!(d.iter().map(|d| d.code).collect::<Vec<_>>(), [Code::W0302]);
+    assert!(matches!(model.scenario.unwrap().attr("ego", "speed").unwrap().value, Known::Unspecified));
 }
 
 #[test]
@@ -222,4 +230,37 @@ fn wrappers_and_names() {
     assert!(tad(text).contains("weather: clear"));
     let text = "scenario: Left Turn At Night\nuse: [national_park]\nenvironment:\n  weather: clear\n";
     assert!(tad(text).starts_with("use national_park\n\nscenario left_turn_at_night {"));
+}
+
+#[test]
+fn words_for_unknown_values_are_unspecified_and_none_is_lost_silently() {
+    for word in ["unknown", "N/A", "n/a", "not visible", "Unclear", "\"?\""] {
+        let text = format!("environment:\n  weather: {word}\nactors:\n  ego_vehicle:\n    lane_index: {word}\n");
+        let (model, d) = lower(&text);
+        assert!(d.is_empty(), "{word}: {d:?}");
+        let scenario = model.scenario.unwrap();
+        assert!(matches!(scenario.attr("environment", "weather").unwrap().value, Known::Unspecified), "{word}");
+        assert!(matches!(scenario.attr("ego", "lane").unwrap().value, Known::Unspecified), "{word}");
+    }
+    // a count in words is its number; a count word that gives none is said, not taken as 1
+    let (model, d) = lower("actors:\n  a:\n    type: car\n    number: two\n");
+    assert!(d.is_empty(), "{d:?}");
+    assert_eq!(model.scenario.unwrap().actors[0].count(), Some(2));
+    let (model, d) = lower("actors:\n  a:\n    type: car\n    number: a few\n");
+    assert_eq!(d.iter().map(|d| d.code).collect::<Vec<_>>(), [Code::W0302]);
+    assert_eq!(model.scenario.unwrap().actors[0].count(), None, "not silently one");
+    // TrafficComposer's `road_network: None` states no road
+    let (model, d) = lower(
+        "environment:\n  weather: clear\nroad_network: None\nparticipant:\n  ego_vehicle:\n    current_behavior: go forward\n",
+    );
+    assert!(errors(&d).is_empty(), "{d:?}");
+    assert!(model.scenario.unwrap().section("road").is_none_or(|r| r.attrs.is_empty()));
+}
+
+#[test]
+fn a_stray_closing_fence_does_not_hide_the_answer() {
+    let text = "environment:\n  weather: clear\n  time: daytime\n```\n";
+    let (model, d) = lower(text);
+    assert!(errors(&d).is_empty(), "{d:?}");
+    assert!(model.scenario.unwrap().attr("environment", "time").is_some());
 }
