@@ -4,6 +4,7 @@
 use std::path::{Path, PathBuf};
 use tad_ir::*;
 
+use tad_test_support::mutate::{self, Rng};
 use tad_test_support::repo;
 
 fn resolve_text(db: &mut tad_db::Database, path: &Path, text: &str) -> Option<Scenario> {
@@ -278,81 +279,18 @@ fn a_module_without_a_scenario_has_no_ir() {
     assert!(resolve_text(&mut db, &path, &text).is_none());
 }
 
-/// xorshift64*: seeded, reproducible.
-struct Rng(u64);
-
-impl Rng {
-    fn below(&mut self, n: usize) -> usize {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 33) as usize % n.max(1)
-    }
-}
-
-const SNIPPETS: &[&str] = &[
-    "{",
-    "}",
-    "[",
-    "]",
-    ",",
-    ":",
-    "\"",
-    "\n",
-    " ",
-    "-",
-    "0",
-    "-7",
-    "km/h",
-    "mph",
-    "unspecified",
-    "of",
-    "ego",
-    "actor x: car {",
-];
-
-/// Byte edits, snippets, and one word replaced by another word of the file (which makes
-/// references point at other groups, cycles, unknown names and wrong kinds).
-fn mutate(rng: &mut Rng, text: &str) -> String {
-    let words: Vec<&str> =
-        text.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_')).filter(|w| !w.is_empty()).collect();
-    let mut out = text.to_string();
-    for _ in 0..1 + rng.below(3) {
-        let mut at = rng.below(out.len() + 1);
-        while !out.is_char_boundary(at) {
-            at -= 1;
-        }
-        match rng.below(4) {
-            0 => {
-                let end = (at + 1 + rng.below(12)).min(out.len());
-                if out.is_char_boundary(end) {
-                    out.replace_range(at..end, "");
-                }
-            }
-            1 => out.insert_str(at, SNIPPETS[rng.below(SNIPPETS.len())]),
-            _ => {
-                let (from, to) = (words[rng.below(words.len())], words[rng.below(words.len())]);
-                if let Some(found) = out[at..].find(from) {
-                    out.replace_range(at + found..at + found + from.len(), to);
-                }
-            }
-        }
-    }
-    out
-}
-
 #[test]
 fn mutated_examples_resolve_without_panic() {
     const SEED: u64 = 0x7AD5_001A;
     const MUTATIONS: usize = 300;
     let mut db = tad_db::Database::new(Default::default());
-    let mut rng = Rng(SEED);
+    let mut rng = Rng::new(SEED);
     let files = examples();
     for path in files.iter().step_by(3) {
         let text = std::fs::read_to_string(path).unwrap();
         let mutant_path = std::env::temp_dir().join("tadsl-ir-robustness").join(path.file_name().unwrap());
         for iteration in 0..MUTATIONS {
-            let mutant = mutate(&mut rng, &text);
+            let mutant = mutate::words(&mut rng, &text);
             let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
                 if let Some(s) = resolve_text(&mut db, &mutant_path, &mutant) {
                     assert_consistent(&s);

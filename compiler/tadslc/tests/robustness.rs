@@ -3,7 +3,7 @@
 //! UI fixtures; a failure names the seed and iteration, and saves the input.
 
 mod common;
-use tadslc::corpus::Rng;
+use tad_test_support::mutate::{self, Rng};
 
 const SEED: u64 = 0x7AD5;
 const BYTE_MUTATIONS: usize = 3000;
@@ -17,86 +17,6 @@ fn corpus() -> Vec<String> {
         files.iter().filter_map(|p| std::fs::read(p).ok()).map(|b| String::from_utf8_lossy(&b).into_owned()).collect();
     assert!(texts.len() >= 20, "the corpus needs the examples and the UI fixtures");
     texts
-}
-
-const SNIPPETS: &[&str] = &[
-    "{",
-    "}",
-    "[",
-    "]",
-    ",",
-    ":",
-    ".",
-    "\"",
-    "\"\"\"",
-    "//",
-    "\n",
-    " ",
-    "-",
-    "km/h",
-    "unspecified",
-    "of",
-    "actor",
-    "scenario",
-    "use",
-    "x:",
-    "ego",
-    "é",
-    "\u{0}",
-    "\u{FEFF}",
-    "1.5",
-    "99999999999999999999999",
-    "\\",
-    "\\u{",
-    "\r\n",
-];
-
-fn mutate_bytes(rng: &mut Rng, text: &str) -> String {
-    let mut bytes = text.as_bytes().to_vec();
-    for _ in 0..1 + rng.below(4) {
-        let at = rng.below(bytes.len() + 1);
-        match rng.below(5) {
-            0 if !bytes.is_empty() => {
-                let end = (at + 1 + rng.below(8)).min(bytes.len());
-                bytes.drain(at.min(end)..end);
-            }
-            1 => {
-                let snippet = rng.pick(SNIPPETS).as_bytes();
-                bytes.splice(at..at, snippet.iter().copied());
-            }
-            2 => bytes.insert(at, rng.below(256) as u8),
-            3 if !bytes.is_empty() => {
-                let from = rng.below(bytes.len());
-                let end = (from + rng.below(40)).min(bytes.len());
-                let chunk: Vec<u8> = bytes[from..end].to_vec();
-                bytes.splice(at..at, chunk);
-            }
-            _ if at < bytes.len() => bytes[at] = rng.below(128) as u8,
-            _ => {}
-        }
-    }
-    String::from_utf8_lossy(&bytes).into_owned()
-}
-
-fn mutate_tokens(rng: &mut Rng, text: &str) -> String {
-    let lexed = tad_syntax::lexer::lex(text);
-    let mut pieces: Vec<String> = lexed.tokens.iter().map(|t| text[t.0..t.2].to_string()).collect();
-    for _ in 0..1 + rng.below(3) {
-        let at = rng.below(pieces.len() + 1);
-        match rng.below(4) {
-            0 if at < pieces.len() => {
-                pieces.remove(at);
-            }
-            1 if !pieces.is_empty() => {
-                let from = rng.below(pieces.len());
-                pieces.insert(at, pieces[from].clone());
-            }
-            2 if at + 1 < pieces.len() => pieces.swap(at, at + 1),
-            _ => pieces.insert(at, rng.pick(SNIPPETS).to_string()),
-        }
-    }
-    let sep = if rng.chance(50) { " " } else { "\n" };
-    pieces.join(sep)
 }
 
 fn codes(text: &str) -> Vec<String> {
@@ -148,7 +68,7 @@ fn byte_mutations_never_panic() {
     let mut db = tad_db::Database::new(tad_check::Options::default());
     for i in 0..BYTE_MUTATIONS {
         let source = rng.pick(&corpus).clone();
-        exercise(&mut db, &mutate_bytes(&mut rng, &source), "byte", i);
+        exercise(&mut db, &mutate::bytes(&mut rng, &source), "byte", i);
     }
 }
 
@@ -159,7 +79,7 @@ fn token_mutations_never_panic() {
     let mut db = tad_db::Database::new(tad_check::Options::default());
     for i in 0..TOKEN_MUTATIONS {
         let source = rng.pick(&corpus).clone();
-        exercise(&mut db, &mutate_tokens(&mut rng, &source), "token", i);
+        exercise(&mut db, &mutate::tokens(&mut rng, &source), "token", i);
     }
 }
 

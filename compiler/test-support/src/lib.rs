@@ -1,11 +1,12 @@
 //! What TADSL's tests share: where the repository and `../shared` are, the files of a
-//! directory, the examples, a scratch directory, and the Scenic oracle (the real Scenic
-//! 3.1.1 in a Python venv).
+//! directory, the examples, a scratch directory, seeded mutations of TAD texts, and the
+//! Scenic oracle (the real Scenic 3.1.1 in a Python venv).
 //!
 //! No machine paths: everything is found from this crate's own location, or from an
 //! environment variable a user or CI sets (`TADSL_SHARED`, `TADSL_SCENIC_PYTHON`,
 //! `TADSL_SCENIC_CHECK`, `TADSL_SCENIC_MAPS`).
 
+pub mod mutate;
 pub mod scenic;
 
 use std::path::{Path, PathBuf};
