@@ -139,7 +139,10 @@ pub fn words(rng: &mut Rng, text: &str) -> String {
                     out.replace_range(at..end, "");
                 }
             }
-            1 => out.insert_str(at, *rng.pick(SNIPPETS)),
+            1 => {
+                let snippet: &&str = rng.pick(SNIPPETS);
+                out.insert_str(at, snippet);
+            }
             _ if !words.is_empty() => {
                 let (from, to) = (words[rng.below(words.len())], words[rng.below(words.len())]);
                 if let Some(found) = out[at..].find(from) {
