@@ -110,7 +110,7 @@ fn attr(vocabulary: &Vocabulary, attr: &Attr, out: &mut Vec<Diagnostic>) {
     let def: &FieldDef = attr.def;
     match (value, def.vocabulary) {
         (Val::Symbol(symbol), Some(kind)) => resolve_symbol(vocabulary, kind, def.name, symbol, out),
-        (Val::Symbols(symbols), Some(kind)) => {
+        (Val::Symbols(symbols) | Val::Choice(symbols), Some(kind)) => {
             for symbol in symbols {
                 resolve_symbol(vocabulary, kind, def.name, symbol, out);
             }
@@ -136,6 +136,29 @@ fn attr(vocabulary: &Vocabulary, attr: &Attr, out: &mut Vec<Diagnostic>) {
                 })
                 .with_help(format!("write `{text} km/h`"))
                 .with_fix(attr.value_span, format!("{text} km/h"), Applicability::MachineApplicable),
+            );
+        }
+        (Val::Range(low, high), _) if matches!(low.unit, Unit::MilesPerHour | Unit::MetresPerSecond) => {
+            let (lo, hi) = (format_number(low.si() * 3.6), format_number(high.si() * 3.6));
+            let written = format!("{}..{} {}", format_number(low.value), format_number(high.value), low.unit.as_str());
+            out.push(
+                Diagnostic::new(
+                    Code::W0402,
+                    format!("speeds are written in km/h: {written} is {lo}..{hi} km/h"),
+                    attr.value_span,
+                    "not in km/h",
+                )
+                .with_payload(Payload::Alias {
+                    namespace: "unit".into(),
+                    written,
+                    canonical: format!("{lo}..{hi} km/h"),
+                })
+                .with_help(format!("write `{lo}..{hi} km/h`"))
+                .with_fix(
+                    attr.value_span,
+                    format!("{lo}..{hi} km/h"),
+                    Applicability::MachineApplicable,
+                ),
             );
         }
         _ => {}

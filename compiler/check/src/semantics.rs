@@ -22,6 +22,11 @@ fn entry<'v>(vocabulary: &'v Vocabulary, kind: &str, attr: Option<&Attr>) -> Opt
     vocabulary.get(kind, &attr?.symbol()?.name)
 }
 
+/// The entry of every name a name field states: its one name, or each name of a choice.
+fn entries<'v>(vocabulary: &'v Vocabulary, kind: &str, attr: Option<&Attr>) -> Vec<&'v Entry> {
+    attr.map(Attr::names).unwrap_or_default().into_iter().filter_map(|s| vocabulary.get(kind, &s.name)).collect()
+}
+
 fn speed_text(si: f64) -> String {
     format!("{} km/h", format_number(si * 3.6))
 }
@@ -48,16 +53,19 @@ pub fn check(
     let ego = scenario.section("ego");
     let ego_lane = ego.and_then(|e| e.attr("lane")).and_then(Attr::integer);
     if let Some(ego) = ego {
-        let behavior = entry(vocabulary, "behavior", ego.attr("behavior"));
-        performers(behavior, ego.attr("behavior"), EGO_KIND, "the ego vehicle", out);
+        let behaviors = entries(vocabulary, "behavior", ego.attr("behavior"));
+        for behavior in &behaviors {
+            performers(Some(behavior), ego.attr("behavior"), EGO_KIND, "the ego vehicle", out);
+        }
         let kind = vocabulary.get("actor_kind", EGO_KIND);
-        speeds(ego.attr("speed"), behavior, kind, None, context, "the ego vehicle", out);
+        speeds(ego.attr("speed"), &behaviors, kind, None, context, "the ego vehicle", out);
     }
 
     for (index, group) in scenario.actors.iter().enumerate() {
         let what = format!("group `{}`", group.name.text);
         if let Some(count) = &group.count
             && let Known::Given(n) = count.value
+            && let (n, _) = n.bounds()
             && n < 1
         {
             out.push(
@@ -77,12 +85,14 @@ pub fn check(
         };
         let actor_kind = actor_type.and_then(|t| t.symbol("kind"));
         let behavior_attr = group.attr("behavior");
-        let behavior = entry(vocabulary, "behavior", behavior_attr);
+        let behaviors = entries(vocabulary, "behavior", behavior_attr);
         if let Some(kind) = actor_kind {
-            performers(behavior, behavior_attr, kind, &what, out);
+            for behavior in &behaviors {
+                performers(Some(behavior), behavior_attr, kind, &what, out);
+            }
         }
         let kind = actor_kind.and_then(|k| vocabulary.get("actor_kind", k));
-        speeds(group.attr("speed"), behavior, kind, actor_type, context, &what, out);
+        speeds(group.attr("speed"), &behaviors, kind, actor_type, context, &what, out);
 
         let Some(position_attr) = group.attr("position") else { continue };
         let Known::Given(Val::Position(position)) = &position_attr.value else { continue };
@@ -279,12 +289,13 @@ fn performers(behavior: Option<&Entry>, attr: Option<&Attr>, kind: &str, what: &
     }
 }
 
-/// A speed against, in order: the behavior's limit (error), a negative value (error), the
+/// A speed, or a range of speeds, judged by its bounds, in order: its upper bound against
+/// the behaviors' limits (each of a choice; error), its lower bound against 0 (error), the
 /// actor kind's physical limit (error: impossible), the type's plausible maximum and the
 /// road context's (warnings: implausible). The first that applies is reported.
 fn speeds(
     attr: Option<&Attr>,
-    behavior: Option<&Entry>,
+    behaviors: &[&Entry],
     kind: Option<&Entry>,
     actor_type: Option<&Entry>,
     context: Option<&Entry>,
@@ -292,25 +303,34 @@ fn speeds(
     out: &mut Vec<Diagnostic>,
 ) {
     let Some(attr) = attr else { return };
-    let Some(speed) = attr.quantity().map(|q| q.si()) else { return };
+    let Some((low, speed)) = attr.bounds() else { return };
+    let ranged = low != speed;
+    let moves_at = if ranged { "up to " } else { "" };
     const EPSILON: f64 = 1e-9;
-    if let Some((behavior, max)) = behavior.and_then(|b| b.speed("max_speed").map(|m| (b, m)))
-        && speed > max + EPSILON
+    if let Some((behavior, max)) =
+        behaviors.iter().find_map(|b| b.speed("max_speed").filter(|m| speed > m + EPSILON).map(|m| (b, m)))
     {
+        // a range keeps what of it the behavior allows
+        let fixed = if ranged && low < max - EPSILON {
+            format!("{}..{} km/h", format_number(low * 3.6), format_number(max * 3.6))
+        } else {
+            speed_text(max)
+        };
         out.push(
             Diagnostic::new(
                 Code::E0503,
-                format!("{what} is `{}` but moves at {}", behavior.name, speed_text(speed)),
+                format!("{what} is `{}` but moves at {moves_at}{}", behavior.name, speed_text(speed)),
                 attr.value_span,
                 format!("`{}` allows at most {}", behavior.name, speed_text(max)),
             )
             .with_payload(speed_range(speed, None, Some(max)))
-            .with_help(format!("write `{}`, or a behavior that moves", speed_text(max)))
-            .with_fix(attr.value_span, speed_text(max), Applicability::MaybeIncorrect),
+            .with_help(format!("write `{fixed}`, or a behavior that moves"))
+            .with_fix(attr.value_span, fixed, Applicability::MaybeIncorrect),
         );
         return;
     }
-    if speed < 0.0 {
+    if low < 0.0 {
+        let speed = low;
         out.push(
             Diagnostic::new(
                 Code::E0503,
@@ -344,7 +364,7 @@ fn speeds(
         out.push(
             Diagnostic::new(
                 Code::W0504,
-                format!("{what} moves at {}, implausibly fast for a {}", speed_text(speed), t.name),
+                format!("{what} moves at {moves_at}{}, implausibly fast for a {}", speed_text(speed), t.name),
                 attr.value_span,
                 format!("a {} reaches about {}", t.name, speed_text(max)),
             )
@@ -359,7 +379,7 @@ fn speeds(
             Diagnostic::new(
                 Code::W0504,
                 format!(
-                    "{what} moves at {}, implausibly fast on a {} road",
+                    "{what} moves at {moves_at}{}, implausibly fast on a {} road",
                     speed_text(speed),
                     c.name.replace('_', " ")
                 ),

@@ -59,6 +59,8 @@ codes! {
     E0212 => Error,
     E0213 => Error,
     E0214 => Error,
+    E0215 => Error,
+    E0216 => Error,
     // YAML import (3xx): add codes below this line
     E0300 => Error,
     E0301 => Error,
@@ -104,6 +106,7 @@ codes! {
     W0704 => Warning,
     W0705 => Warning,
     W0706 => Warning,
+    W0707 => Warning,
     // end of Scenic codes
 }
 

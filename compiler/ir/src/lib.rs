@@ -14,16 +14,19 @@
 //! are the schema's enums. It is pure and total, and reports nothing: the checker has.
 //!
 //! Modules: [`entries`](crate::Entries) (vocabulary tables and ids), `scenario` (the
-//! scenario's parts and field states), `lane`, `quantity` (SI newtypes), `resolve`.
+//! scenario's parts and field states), `lane`, `quantity` (SI newtypes), `param` (ranges
+//! and choices: [`Param`], with seeded sampling), `resolve`.
 
 mod entries;
 mod lane;
+mod param;
 mod quantity;
 mod resolve;
 mod scenario;
 
 pub use entries::*;
 pub use lane::Lane;
+pub use param::{Param, ParamValue, Rng, SplitMix64};
 pub use quantity::{Metres, MetresPerSecond, Seconds};
 pub use resolve::resolve;
 pub use scenario::*;

@@ -9,6 +9,7 @@
 
 use crate::entries::*;
 use crate::lane::Lane;
+use crate::param::Param;
 use crate::quantity::{Metres, MetresPerSecond, Seconds};
 use crate::scenario::*;
 use tad_check::{Target, Vocabulary};
@@ -41,8 +42,8 @@ pub fn resolve(module: &Module, vocabulary: &Vocabulary) -> Option<Scenario> {
     };
     let environment = Environment {
         span: section("environment").map(|s| s.span),
-        weather: r.named(attr("environment", "weather")),
-        time: r.named(attr("environment", "time")),
+        weather: r.named_param(attr("environment", "weather")),
+        time: r.named_param(attr("environment", "time")),
     };
     let road = Road {
         span: section("road").map(|s| s.span),
@@ -61,8 +62,8 @@ pub fn resolve(module: &Module, vocabulary: &Vocabulary) -> Option<Scenario> {
     };
     let ego = Ego {
         span: section("ego").map(|s| s.span),
-        behavior: r.named(attr("ego", "behavior")),
-        speed: r.field(attr("ego", "speed"), speed),
+        behavior: r.named_param(attr("ego", "behavior")),
+        speed: r.field(attr("ego", "speed"), |v| quantity_param(v, ValueType::Speed, MetresPerSecond)),
         lane: lane(attr("ego", "lane")),
     };
     let groups: Vec<Group> = model
@@ -75,19 +76,28 @@ pub fn resolve(module: &Module, vocabulary: &Vocabulary) -> Option<Scenario> {
             count: match &g.count {
                 None => Field::Absent,
                 Some(Spanned { value: Known::Unspecified, span }) => Field::Unspecified(*span),
-                Some(Spanned { value: Known::Given(n), span }) => Field::Given(*n, *span),
+                Some(Spanned { value: Known::Given(n), span }) => Field::Given(
+                    match *n {
+                        model::Count::Exactly(n) => Param::Fixed(n),
+                        model::Count::Between(min, max) => Param::Range { min, max },
+                    },
+                    *span,
+                ),
             },
             actor_type: match &g.kind.value {
                 Known::Unspecified => Field::Unspecified(g.kind.span),
                 Known::Given(symbol) => Field::Given(r.name(&symbol.name), g.kind.span),
             },
-            behavior: r.named(g.attr("behavior")),
-            speed: r.field(g.attr("speed"), speed),
+            behavior: r.named_param(g.attr("behavior")),
+            speed: r.field(g.attr("speed"), |v| quantity_param(v, ValueType::Speed, MetresPerSecond)),
             position: r.field(g.attr("position"), |v| match v {
                 Val::Position(p) => Some(r.position(p)),
                 _ => None,
             }),
             lane: lane(g.attr("lane")),
+            distance: r.field(g.attr("distance"), |v| quantity_param(v, ValueType::Length, Metres)),
+            delay: r.field(g.attr("delay"), |v| quantity_param(v, ValueType::Duration, Seconds)),
+            trigger: r.field(g.attr("trigger"), |v| quantity_param(v, ValueType::Length, Metres)),
         })
         .collect();
     Some(Scenario {
@@ -125,6 +135,15 @@ impl Resolver<'_> {
     fn named<K: Kind>(&self, attr: Option<&Attr>) -> Field<Named<K>> {
         self.field(attr, |v| match v {
             Val::Symbol(s) => Some(self.name(&s.name)),
+            _ => None,
+        })
+    }
+
+    /// A name, or a choice of names.
+    fn named_param<K: Kind>(&self, attr: Option<&Attr>) -> Field<Param<Named<K>>> {
+        self.field(attr, |v| match v {
+            Val::Symbol(s) => Some(Param::Fixed(self.name(&s.name))),
+            Val::Choice(options) => Some(Param::Choice(options.iter().map(|s| self.name(&s.name)).collect())),
             _ => None,
         })
     }
@@ -179,6 +198,17 @@ fn text(v: &Val) -> Option<String> {
 fn quantity(v: &Val, what: ValueType) -> Option<f64> {
     match v {
         Val::Quantity(q) if q.unit.measures() == what => Some(q.si()),
+        _ => None,
+    }
+}
+
+/// A quantity or a range of quantities in SI, if it measures `what`.
+fn quantity_param<T>(v: &Val, what: ValueType, si: impl Fn(f64) -> T) -> Option<Param<T>> {
+    match v {
+        Val::Quantity(q) if q.unit.measures() == what => Some(Param::Fixed(si(q.si()))),
+        Val::Range(low, high) if low.unit.measures() == what => {
+            Some(Param::Range { min: si(low.si()), max: si(high.si()) })
+        }
         _ => None,
     }
 }

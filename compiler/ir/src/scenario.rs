@@ -9,7 +9,8 @@
 
 use crate::entries::*;
 use crate::lane::Lane;
-use crate::quantity::{MetresPerSecond, Seconds};
+use crate::param::Param;
+use crate::quantity::{Metres, MetresPerSecond, Seconds};
 use tad_diagnostics::Span;
 use tad_syntax::model::Spanned;
 
@@ -59,6 +60,13 @@ impl<T> Field<T> {
 impl<T: Copy> Field<T> {
     pub fn get(&self) -> Option<T> {
         self.given().copied()
+    }
+}
+
+impl<T> Field<Param<T>> {
+    /// The value when given as a single one (not a range or a choice).
+    pub fn fixed(&self) -> Option<&T> {
+        self.given().and_then(Param::fixed)
     }
 }
 
@@ -121,8 +129,9 @@ pub struct Source {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Environment {
     pub span: Option<Span>,
-    pub weather: Field<Named<Weather>>,
-    pub time: Field<Named<TimeOfDay>>,
+    /// A name, or a choice of names (`clear | cloudy`).
+    pub weather: Field<Param<Named<Weather>>>,
+    pub time: Field<Param<Named<TimeOfDay>>>,
 }
 
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -147,8 +156,8 @@ pub struct Road {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Ego {
     pub span: Option<Span>,
-    pub behavior: Field<Named<Behavior>>,
-    pub speed: Field<MetresPerSecond>,
+    pub behavior: Field<Param<Named<Behavior>>>,
+    pub speed: Field<Param<MetresPerSecond>>,
     pub lane: Field<Lane>,
 }
 
@@ -158,23 +167,35 @@ pub struct Group {
     pub name: String,
     pub name_span: Span,
     pub span: Span,
-    /// The header's count: absent means one actor.
-    pub count: Field<i64>,
+    /// The header's count, one or a range (`3..5`): absent means one actor.
+    pub count: Field<Param<i64>>,
     /// The header's type: given or `unspecified`, never absent.
     pub actor_type: Field<Named<ActorType>>,
-    pub behavior: Field<Named<Behavior>>,
-    pub speed: Field<MetresPerSecond>,
+    pub behavior: Field<Param<Named<Behavior>>>,
+    pub speed: Field<Param<MetresPerSecond>>,
     pub position: Field<Position>,
     pub lane: Field<Lane>,
+    /// The gap along the road from the position's reference to the nearest actor.
+    pub distance: Field<Param<Metres>>,
+    /// The time before the group starts its behavior.
+    pub delay: Field<Param<Seconds>>,
+    /// The group starts its behavior when the ego vehicle is within this distance.
+    pub trigger: Field<Param<Metres>>,
 }
 
 impl Group {
-    /// The number of actors when known: 1 without a count in the header.
+    /// The number of actors when known as one number: 1 without a count in the header;
+    /// `None` when `unspecified` or a range (see [`Group::count_param`]).
     pub fn count(&self) -> Option<i64> {
-        match self.count {
-            Field::Absent => Some(1),
+        self.count_param().and_then(|p| p.fixed().copied())
+    }
+
+    /// The number of actors, one or a range, when known: `Fixed(1)` without a count.
+    pub fn count_param(&self) -> Option<Param<i64>> {
+        match &self.count {
+            Field::Absent => Some(Param::Fixed(1)),
             Field::Unspecified(_) => None,
-            Field::Given(n, _) => Some(n),
+            Field::Given(n, _) => Some(n.clone()),
         }
     }
 }

@@ -87,9 +87,9 @@ fn every_example_resolves() {
         // the examples check without errors: every name they give is declared
         let file = db.set_file(path.clone(), text);
         assert!(!tad_db::check(&db, file).diagnostics.iter().any(|d| d.is_error()), "{}", path.display());
-        assert!(known(scenario.ego.behavior.given()), "{}", path.display());
+        assert!(known(scenario.ego.behavior.fixed()), "{}", path.display());
         for group in &scenario.groups {
-            assert!(known(group.actor_type.given()) && known(group.behavior.given()), "{}", path.display());
+            assert!(known(group.actor_type.given()) && known(group.behavior.fixed()), "{}", path.display());
             if let Some(position) = group.position.given() {
                 assert!(!matches!(position.reference.value, Reference::Unknown(_)), "{}", path.display());
                 assert!(known(Some(&position.relation.value)), "{}", path.display());
@@ -104,10 +104,10 @@ fn lanes_speeds_and_relations_of_an_example() {
     assert_eq!(s.name.as_ref().map(|n| n.value.as_str()), Some("lane_changing"));
     assert_eq!(s.road.lanes.get(), Some(4));
     assert_eq!(s.ego.lane.get().map(Lane::index), Some(3));
-    let ego_speed = s.ego.speed.get().unwrap();
+    let ego_speed = s.ego.speed.fixed().copied().unwrap();
     assert!((ego_speed.km_per_hour() - 96.6).abs() < 1e-9);
-    assert_eq!(s.entries.name(s.ego.behavior.given().unwrap()), "change_lane_left");
-    let behavior = s.entries.resolved(s.ego.behavior.given().unwrap()).unwrap();
+    assert_eq!(s.entries.name(s.ego.behavior.fixed().unwrap()), "change_lane_left");
+    let behavior = s.entries.resolved(s.ego.behavior.fixed().unwrap()).unwrap();
     assert_eq!(behavior.attrs.motion, Some(Motion::ChangeLaneLeft));
     assert_eq!(behavior.module, "core");
 
@@ -219,7 +219,7 @@ fn aliases_units_road_elements_and_forward_references() {
     let s = inline(FORWARD_REFERENCES);
     assert_consistent(&s);
     // aliases resolve to the canonical entry and its typed attributes
-    assert_eq!(s.entries.name(s.environment.weather.given().unwrap()), "clear");
+    assert_eq!(s.entries.name(s.environment.weather.fixed().unwrap()), "clear");
     let road_type = s.entries.resolved(s.road.road_type.given().unwrap()).unwrap();
     assert_eq!(road_type.name, "intersection");
     assert!(road_type.attrs.junction && road_type.attrs.signalised);
@@ -227,16 +227,16 @@ fn aliases_units_road_elements_and_forward_references() {
     assert_eq!(s.ego.lane, Field::Absent);
     assert_eq!(s.road.context, Field::Absent);
     // mph and m/s in SI
-    assert!((s.ego.speed.get().unwrap().0 - 20.0 * 1609.344 / 3600.0).abs() < 1e-9);
+    assert!((s.ego.speed.fixed().copied().unwrap().0 - 20.0 * 1609.344 / 3600.0).abs() < 1e-9);
     let lost = &s.groups[2];
-    assert_eq!(lost.speed.get(), Some(MetresPerSecond(5.0)));
+    assert_eq!(lost.speed.fixed().copied(), Some(MetresPerSecond(5.0)));
     assert_eq!(lost.count(), Some(2));
     assert_eq!(lost.position.given().unwrap().reference.value, Reference::Unknown("nowhere".to_string()));
 
     let follower = &s.groups[0];
     assert!(matches!(follower.count, Field::Unspecified(_)));
     assert_eq!(follower.count(), None);
-    assert_eq!(s.entries.name(follower.behavior.given().unwrap()), "walk");
+    assert_eq!(s.entries.name(follower.behavior.fixed().unwrap()), "walk");
     assert_eq!(follower.lane.get().and_then(|l| Lane::new(l.index())), Lane::new(-2));
     // `leader` is written after `follower`, which is positioned relative to it
     assert_eq!(follower.position.given().unwrap().reference.value, Reference::Group(s.group_named("leader").unwrap()));

@@ -157,6 +157,11 @@ pub enum Value {
     Unspecified(Span),
     /// `38` or `38 km/h`
     Number { span: Span, number: Span, unit: Option<Span> },
+    /// `LOW..HIGH UNIT` (`30..40 km/h`, `3..5`); each end may carry a unit, checked
+    /// when lowered.
+    Range { span: Span, low: Bound, high: Bound },
+    /// `NAME | NAME ...` (`clear | cloudy`): one of the names; at least two.
+    Choice { span: Span, options: Vec<Vec<Name>> },
     /// `"..."`, escapes not yet decoded.
     String(Span),
     /// `"""..."""`
@@ -179,6 +184,8 @@ impl Value {
             | Value::TextBlock(span)
             | Value::Error(span)
             | Value::Number { span, .. }
+            | Value::Range { span, .. }
+            | Value::Choice { span, .. }
             | Value::Position { span, .. }
             | Value::List { span, .. } => *span,
             Value::Words(words) => words_span(words),
@@ -191,6 +198,8 @@ impl Value {
             Value::Unspecified(_) => "`unspecified`",
             Value::Number { unit: Some(_), .. } => "a quantity",
             Value::Number { .. } => "a number",
+            Value::Range { .. } => "a range",
+            Value::Choice { .. } => "a choice of names",
             Value::String(_) => "a string",
             Value::TextBlock(_) => "a text block",
             Value::Words(w) if w.len() > 1 => "several words",
@@ -199,6 +208,19 @@ impl Value {
             Value::List { .. } => "a list",
             Value::Error(_) => "invalid text",
         }
+    }
+}
+
+/// One end of a range: `30` or `30 km/h`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Bound {
+    pub number: Span,
+    pub unit: Option<Span>,
+}
+
+impl Bound {
+    pub fn span(&self) -> Span {
+        self.unit.map_or(self.number, |u| self.number.to(u))
     }
 }
 

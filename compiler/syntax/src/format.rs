@@ -240,6 +240,20 @@ impl Printer<'_> {
                 Some(unit) => format!("{} {}", self.text(*number), self.text(*unit)),
                 None => self.text(*number).into(),
             },
+            Value::Range { low, high, .. } => {
+                let bound = |b: &crate::cst::Bound| match b.unit {
+                    Some(unit) => format!("{} {}", self.text(b.number), self.text(unit)),
+                    None => self.text(b.number).to_string(),
+                };
+                match (low.unit, high.unit) {
+                    // one unit for both ends is written once, after the range
+                    (Some(a), Some(b)) if self.text(a) == self.text(b) => {
+                        format!("{}..{} {}", self.text(low.number), self.text(high.number), self.text(b))
+                    }
+                    _ => format!("{}..{}", bound(low), bound(high)),
+                }
+            }
+            Value::Choice { options, .. } => options.iter().map(|o| words_text(o)).collect::<Vec<_>>().join(" | "),
             Value::String(span) | Value::TextBlock(span) | Value::Error(span) => self.text(*span).into(),
             Value::Words(words) => words_text(words),
             Value::Position { relation, reference, .. } => {
@@ -314,6 +328,17 @@ mod tests {
         assert_eq!(
             out,
             "scenario demo {\n  source {\n    description: \"\"\"\n      line one\n        indented\n    \"\"\"\n  }\n}\n"
+        );
+        assert_eq!(fmt(&out), out);
+    }
+
+    #[test]
+    fn ranges_and_choices_are_canonical() {
+        let src = "scenario demo {\n  environment { weather: clear|cloudy   |  foggy }\n  actor a : 3 .. 5 pedestrian { speed: 3 km/h .. 5 km/h // slow\n distance: 15..25 m delay: 1.5 ..2 s }\n}\n";
+        let out = fmt(src);
+        assert_eq!(
+            out,
+            "scenario demo {\n  environment {\n    weather: clear | cloudy | foggy\n  }\n  actor a: 3..5 pedestrian {\n    speed: 3..5 km/h // slow\n    distance: 15..25 m\n    delay: 1.5..2 s\n  }\n}\n"
         );
         assert_eq!(fmt(&out), out);
     }

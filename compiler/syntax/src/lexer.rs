@@ -44,6 +44,12 @@ pub enum Token {
     Comma,
     #[token(".")]
     Dot,
+    /// `..` between the bounds of a range (`30..40 km/h`).
+    #[token("..")]
+    DotDot,
+    /// `|` between the names of a choice (`clear | cloudy`).
+    #[token("|")]
+    Pipe,
     #[token(":")]
     Colon,
     /// A field key: a name followed by `:` on the same line (`weather:`).
@@ -382,6 +388,11 @@ mod tests {
             kinds("{ speed: 38 km/h lane : -2 kind: move_forward }"),
             vec![LBrace, Key, Number, Unit, Key, Number, Key, Ident, RBrace]
         );
+        assert_eq!(
+            kinds("30..40 km/h 2.5..3 m -1..1"),
+            vec![Number, DotDot, Number, Unit, Number, DotDot, Number, Unit, Number, DotDot, Number]
+        );
+        assert_eq!(kinds("{ clear | cloudy }"), vec![LBrace, Ident, Pipe, Ident, RBrace]);
         assert_eq!(kinds("{ x\n: 1 }"), vec![LBrace, Ident, Colon, Number, RBrace]);
         assert_eq!(kinds("{ actor a: big bus {} }"), vec![LBrace, Actor, Key, Ident, Head, LBrace, RBrace, RBrace]);
         assert_eq!(

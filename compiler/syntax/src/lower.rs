@@ -229,7 +229,15 @@ impl Lowerer<'_> {
             let span = value.span();
             let value = match value {
                 Value::Unspecified(_) => Known::Unspecified,
-                Value::Number { number, .. } => Known::Given(self.integer(*number, "count")?),
+                Value::Number { number, .. } => Known::Given(Count::Exactly(self.integer(*number, "count")?)),
+                Value::Range { low, high, span } => {
+                    let (lo, hi) = (self.integer(low.number, "count")?, self.integer(high.number, "count")?);
+                    if lo > hi {
+                        self.reversed("count", *span, (lo as f64, hi as f64), &format!("{hi}..{lo}"), None);
+                        return None;
+                    }
+                    Known::Given(Count::Between(lo, hi))
+                }
                 _ => return None,
             };
             Some(Spanned { value, span })
@@ -335,6 +343,45 @@ impl Lowerer<'_> {
             _ => {}
         }
         let val = match (def.ty, value) {
+            (ValueType::Speed | ValueType::Duration | ValueType::Length, Value::Range { low, high, span })
+                if def.param =>
+            {
+                self.quantity_range(def, *low, *high, *span)?
+            }
+            (ValueType::Symbol, Value::Choice { options, span }) if def.param => self.names_choice(def, options, *span),
+            (
+                ValueType::Speed | ValueType::Duration | ValueType::Length | ValueType::Integer,
+                Value::Range { low, span, .. },
+            ) => {
+                let low_text = &self.src[low.span().start..low.span().end];
+                self.report(
+                    Diagnostic::new(
+                        Code::E0205,
+                        format!("`{}` takes a single value, not a range", def.name),
+                        *span,
+                        format!("expected {}", def.ty.describe()),
+                    )
+                    .with_payload(wrong(def.name, def.ty.describe(), "a range"))
+                    .with_help(format!("write one value, for example `{}: {}`", def.name, def.example))
+                    .with_fix(*span, low_text.to_string(), Applicability::MaybeIncorrect),
+                );
+                return None;
+            }
+            (ValueType::Symbol | ValueType::Choice(_), Value::Choice { options, span }) => {
+                let first = join(options.first().map_or(&[][..], |o| o.as_slice()));
+                self.report(
+                    Diagnostic::new(
+                        Code::E0205,
+                        format!("`{}` takes one name, not a choice", def.name),
+                        *span,
+                        "expected a name",
+                    )
+                    .with_payload(wrong(def.name, "a name", "a choice of names"))
+                    .with_help(format!("write one name, for example `{}: {first}`", def.name))
+                    .with_fix(*span, first, Applicability::MaybeIncorrect),
+                );
+                return None;
+            }
             (ValueType::Symbol, Value::Words(words)) => Val::Symbol(self.symbol_from_words(words)),
             (ValueType::SymbolList, Value::List { items, span }) => Val::Symbols(self.symbol_list(def, items, *span)?),
             (ValueType::SymbolList, Value::Words(words)) => {
@@ -382,7 +429,9 @@ impl Lowerer<'_> {
                 Val::Integer(self.integer(*number, def.name)?)
             }
             (ValueType::Speed | ValueType::Duration | ValueType::Length, Value::Number { number, unit, .. }) => {
-                Val::Quantity(self.quantity(def, *number, *unit)?)
+                let q = self.quantity(def, *number, *unit)?;
+                self.not_negative(def, q.value, *number)?;
+                Val::Quantity(q)
             }
             (ValueType::Text, Value::String(span)) => {
                 Val::Text(lexer::unescape(&self.src[span.start..span.end], span.start, &mut self.diagnostics))
@@ -419,6 +468,138 @@ impl Lowerer<'_> {
             }
         };
         Some(Known::Given(val))
+    }
+
+    /// `LOW..HIGH UNIT` of a quantity field: one unit (written once after the range, or
+    /// the same at both ends), `low <= high`, neither end negative where that means nothing.
+    fn quantity_range(&mut self, def: &FieldDef, low: cst::Bound, high: cst::Bound, span: Span) -> Option<Val> {
+        let text = |s: Span| self.src[s.start..s.end].to_string();
+        let unit = match (low.unit, high.unit) {
+            (None, Some(h)) => h,
+            (Some(l), Some(h)) if text(l) == text(h) => h,
+            (Some(l), Some(h)) => {
+                self.report(
+                    Diagnostic::new(
+                        Code::E0206,
+                        format!("the ends of a range are in one unit, not `{}` and `{}`", text(l), text(h)),
+                        l,
+                        "another unit than the upper end's",
+                    )
+                    .with_secondary(h, "the upper end's unit")
+                    .with_payload(wrong(def.name, &format!("both ends in `{}`", text(h)), &text(l)))
+                    .with_help(format!(
+                        "convert the lower end to `{}` and write the unit once, after the range",
+                        text(h)
+                    )),
+                );
+                return None;
+            }
+            (Some(l), None) => {
+                let canonical = format!("{}..{} {}", text(low.number), text(high.number), text(l));
+                self.report(
+                    Diagnostic::new(
+                        Code::E0206,
+                        format!("the unit of a range goes after it: `{canonical}`"),
+                        l,
+                        "the upper end has no unit",
+                    )
+                    .with_payload(wrong(def.name, &canonical, &text(span)))
+                    .with_help(format!("write `{canonical}`"))
+                    .with_fix(span, canonical, Applicability::MachineApplicable),
+                );
+                return None;
+            }
+            (None, None) => {
+                // reported as a value without a unit, with the unit added after the range
+                self.quantity(def, high.number, None);
+                return None;
+            }
+        };
+        let lo = self.quantity(def, low.number, Some(unit))?;
+        let hi = self.quantity(def, high.number, Some(unit))?;
+        self.not_negative(def, lo.value, low.number)?;
+        if lo.value > hi.value {
+            let swapped = format!("{}..{} {}", text(high.number), text(low.number), text(unit));
+            self.reversed(def.name, span, (lo.value, hi.value), &swapped, Some(lo.unit.as_str()));
+            return None;
+        }
+        Some(Val::Range(lo, hi))
+    }
+
+    /// E0215: a range whose lower end is above its upper end; the fix swaps them.
+    fn reversed(&mut self, field: &str, span: Span, (low, high): (f64, f64), swapped: &str, unit: Option<&str>) {
+        self.report(
+            Diagnostic::new(
+                Code::E0215,
+                format!("the range of `{field}` is reversed: its lower end is above its upper end"),
+                span,
+                "empty: nothing lies between these ends",
+            )
+            .with_payload(Payload::OutOfRange {
+                quantity: field.into(),
+                value: low,
+                min: None,
+                max: Some(high),
+                unit: unit.map(str::to_string),
+            })
+            .with_help(format!("write the lower end first: `{swapped}`"))
+            .with_fix(span, swapped.to_string(), Applicability::MachineApplicable),
+        );
+    }
+
+    /// E0216: a distance, delay or trigger distance below 0 (speeds are the checker's).
+    fn not_negative(&mut self, def: &FieldDef, value: f64, number: Span) -> Option<()> {
+        if value >= 0.0 || !def.param || def.ty == ValueType::Speed {
+            return Some(());
+        }
+        let unit = if def.ty == ValueType::Duration { "s" } else { "m" };
+        let text = &self.src[number.start..number.end];
+        self.report(
+            Diagnostic::new(Code::E0216, format!("`{}` is not negative, found `{text}`", def.name), number, "below 0")
+                .with_payload(Payload::OutOfRange {
+                    quantity: def.name.into(),
+                    value,
+                    min: Some(0.0),
+                    max: None,
+                    unit: Some(unit.into()),
+                })
+                .with_help(format!("`{}` is {}; write `{}`", def.name, def.doc, text.trim_start_matches('-')))
+                .with_fix(number, text.trim_start_matches('-').to_string(), Applicability::MaybeIncorrect),
+        );
+        None
+    }
+
+    /// `a | b | c` for a name field that takes a choice; a name given twice is W0201.
+    fn names_choice(&mut self, def: &FieldDef, options: &[Vec<Name>], span: Span) -> Val {
+        let mut symbols: Vec<Symbol> = Vec::new();
+        let mut duplicate = None;
+        for words in options {
+            let symbol = self.symbol_from_words(words);
+            if symbols.iter().any(|s| s.name == symbol.name) {
+                duplicate.get_or_insert(symbol);
+            } else {
+                symbols.push(symbol);
+            }
+        }
+        if let Some(again) = duplicate {
+            let deduped = symbols.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(" | ");
+            self.report(
+                Diagnostic::new(
+                    Code::W0201,
+                    format!("the choice of `{}` names `{}` twice", def.name, again.name),
+                    again.span,
+                    "already a choice",
+                )
+                .with_help(format!("write `{deduped}`"))
+                .with_payload(Payload::Duplicate {
+                    namespace: def.name.into(),
+                    name: again.name.clone(),
+                    earlier_module: None,
+                })
+                .with_fix(span, deduped, Applicability::MachineApplicable),
+            );
+        }
+        if symbols.len() == 1 { Val::Symbol(symbols.remove(0)) } else { Val::Choice(symbols) }
     }
 
     fn symbol_from_words(&mut self, words: &[Name]) -> Symbol {

@@ -73,7 +73,7 @@ pub struct ActorGroup {
     pub span: Span,
     pub name: Name,
     /// `None` when the header gives no count: the group is one actor.
-    pub count: Option<Spanned<Known<i64>>>,
+    pub count: Option<Spanned<Known<Count>>>,
     pub kind: Spanned<Known<Symbol>>,
     pub attrs: Vec<Attr>,
 }
@@ -83,12 +83,54 @@ impl ActorGroup {
         self.attrs.iter().find(|a| a.def.name == name)
     }
 
-    /// The number of actors, when known (1 when the header gives none).
+    /// The number of actors, when known as one number (1 when the header gives none);
+    /// `None` for `unspecified` and for a range (see [`ActorGroup::count_bounds`]).
     pub fn count(&self) -> Option<i64> {
+        self.count_bounds().filter(|(low, high)| low == high).map(|(n, _)| n)
+    }
+
+    /// The least and the most actors, when known: `(n, n)` for a single count.
+    pub fn count_bounds(&self) -> Option<(i64, i64)> {
         match &self.count {
-            None => Some(1),
-            Some(Spanned { value: Known::Given(n), .. }) => Some(*n),
+            None => Some((1, 1)),
+            Some(Spanned { value: Known::Given(count), .. }) => Some(count.bounds()),
             Some(_) => None,
+        }
+    }
+}
+
+/// The count in an actor group's header: `3`, or a range `3..5` (`low <= high` once
+/// lowered).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Count {
+    Exactly(i64),
+    Between(i64, i64),
+}
+
+impl std::fmt::Display for Count {
+    /// As TAD writes it: `3`, `3..5`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Count::Exactly(n) => write!(f, "{n}"),
+            Count::Between(low, high) => write!(f, "{low}..{high}"),
+        }
+    }
+}
+
+impl Count {
+    /// The single count, `None` for a range.
+    pub fn single(self) -> Option<i64> {
+        match self {
+            Count::Exactly(n) => Some(n),
+            Count::Between(..) => None,
+        }
+    }
+
+    /// `(low, high)`; `(n, n)` for a single count.
+    pub fn bounds(self) -> (i64, i64) {
+        match self {
+            Count::Exactly(n) => (n, n),
+            Count::Between(low, high) => (low, high),
         }
     }
 }
@@ -158,11 +200,28 @@ impl Attr {
         self.symbol().and_then(|s| T::parse(&s.name))
     }
 
+    /// A single quantity (not a range).
     pub fn quantity(&self) -> Option<Quantity> {
         match &self.value {
             Known::Given(Val::Quantity(q)) => Some(*q),
             _ => None,
         }
+    }
+
+    /// The given value, when it is a single one: `None` for a range or a choice (and
+    /// when not given).
+    pub fn single(&self) -> Option<&Val> {
+        self.value.given().and_then(Val::single)
+    }
+
+    /// A quantity's bounds in SI: `(v, v)` for a single value, `(low, high)` for a range.
+    pub fn bounds(&self) -> Option<(f64, f64)> {
+        self.value.given().and_then(Val::bounds)
+    }
+
+    /// Every name a name field states: its one name, or each name of a choice.
+    pub fn names(&self) -> Vec<&Symbol> {
+        self.value.given().map(Val::names).unwrap_or_default()
     }
 }
 
@@ -176,6 +235,45 @@ pub enum Val {
     Text(String),
     Position(Position),
     Flag(bool),
+    /// `LOW..HIGH UNIT`: a quantity between two bounds, both in one unit, `low <= high`.
+    /// Only fields that take a parameter (`FieldDef::param`) have one.
+    Range(Quantity, Quantity),
+    /// `a | b | c`: one of these names (at least two, no name twice). Only name fields
+    /// that take a parameter have one. (Not to be confused with
+    /// [`crate::schema::ValueType::Choice`], a word of a closed set.)
+    Choice(Vec<Symbol>),
+}
+
+impl Val {
+    /// Whether it is a parameter: a range or a choice.
+    pub fn is_param(&self) -> bool {
+        matches!(self, Val::Range(..) | Val::Choice(_))
+    }
+
+    /// The value itself when it is a single one; `None` for a range or a choice, so a
+    /// consumer that understands single values only sees no value rather than a wrong one.
+    pub fn single(&self) -> Option<&Val> {
+        if self.is_param() { None } else { Some(self) }
+    }
+
+    /// A quantity's bounds in SI: `(v, v)` for a single quantity, `(low, high)` for a
+    /// range; `None` for anything else.
+    pub fn bounds(&self) -> Option<(f64, f64)> {
+        match self {
+            Val::Quantity(q) => Some((q.si(), q.si())),
+            Val::Range(low, high) => Some((low.si(), high.si())),
+            _ => None,
+        }
+    }
+
+    /// The names a name value states: its one name, or each name of a choice.
+    pub fn names(&self) -> Vec<&Symbol> {
+        match self {
+            Val::Symbol(s) => vec![s],
+            Val::Choice(options) => options.iter().collect(),
+            _ => Vec::new(),
+        }
+    }
 }
 
 /// A name from a vocabulary, as written (`clear`, `move_forward`).

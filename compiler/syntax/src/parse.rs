@@ -114,11 +114,13 @@ fn drop_values_with_unknown_units(src: &str, file: &mut File, syntax: &[Diagnost
         .map(|d| d.primary.span)
         .collect();
     for field in fields_mut(file) {
-        if let Value::Number { number, unit: None, .. } = field.value
-            && let Some(bad) =
-                units.iter().find(|u| u.start >= number.end && src[number.end..u.start].trim().is_empty())
-        {
-            field.value = Value::Error(number.to(*bad));
+        let (start, number) = match field.value {
+            Value::Number { number, unit: None, .. } => (number, number),
+            Value::Range { span, high: crate::cst::Bound { number, unit: None }, .. } => (span, number),
+            _ => continue,
+        };
+        if let Some(bad) = units.iter().find(|u| u.start >= number.end && src[number.end..u.start].trim().is_empty()) {
+            field.value = Value::Error(start.to(*bad));
         }
     }
 }
@@ -320,7 +322,8 @@ fn expected_list(expected: &[String]) -> Vec<String> {
         words.push((2, "a value".into()));
     }
     for e in expected {
-        if is_value && VALUE_STARTS.contains(&e.as_str()) {
+        // what continues a value into a range or a choice is not worth listing
+        if (is_value && VALUE_STARTS.contains(&e.as_str())) || matches!(e.as_str(), "\"|\"" | "\"..\"") {
             continue;
         }
         let word = match e.as_str() {

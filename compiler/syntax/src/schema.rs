@@ -193,6 +193,9 @@ pub struct FieldDef {
     pub doc: &'static str,
     /// Whether a complete scenario states it (TrafficAlign's semantic validation).
     pub essential: bool,
+    /// Whether it takes a parameter: a range (`30..40 km/h`) for a quantity, a choice
+    /// (`a | b`) for a name. Other fields take single values only (E0205).
+    pub param: bool,
 }
 
 #[derive(Debug, PartialEq, Eq, Hash)]
@@ -215,7 +218,15 @@ impl SectionDef {
 
 macro_rules! field {
     ($name:literal, $ty:ident, $example:literal, $doc:literal) => {
-        FieldDef { name: $name, ty: ValueType::$ty, vocabulary: None, example: $example, doc: $doc, essential: false }
+        FieldDef {
+            name: $name,
+            ty: ValueType::$ty,
+            vocabulary: None,
+            example: $example,
+            doc: $doc,
+            essential: false,
+            param: false,
+        }
     };
     ($name:literal, $ty:ident in $vocabulary:literal, $example:literal, $doc:literal) => {
         FieldDef {
@@ -225,10 +236,14 @@ macro_rules! field {
             example: $example,
             doc: $doc,
             essential: false,
+            param: false,
         }
     };
-    (essential $name:literal, $($rest:tt)*) => {
-        FieldDef { essential: true, ..field!($name, $($rest)*) }
+    (essential $($rest:tt)*) => {
+        FieldDef { essential: true, ..field!($($rest)*) }
+    };
+    (param $($rest:tt)*) => {
+        FieldDef { param: true, ..field!($($rest)*) }
     };
     ($name:literal, one of $set:ident, $example:literal, $doc:literal) => {
         FieldDef {
@@ -238,6 +253,7 @@ macro_rules! field {
             example: $example,
             doc: $doc,
             essential: false,
+            param: false,
         }
     };
 }
@@ -258,8 +274,8 @@ pub const ENVIRONMENT: SectionDef = SectionDef {
     name: "environment",
     doc: "weather and time of day",
     fields: &[
-        field!(essential "weather", Symbol in "weather", "clear", "the weather"),
-        field!(essential "time", Symbol in "time_of_day", "daytime", "the time of day"),
+        field!(essential param "weather", Symbol in "weather", "clear", "the weather"),
+        field!(essential param "time", Symbol in "time_of_day", "daytime", "the time of day"),
     ],
 };
 
@@ -286,8 +302,8 @@ pub const EGO: SectionDef = SectionDef {
     name: "ego",
     doc: "the ego vehicle",
     fields: &[
-        field!(essential "behavior", Symbol in "behavior", "move_forward", "what the ego vehicle does"),
-        field!(essential "speed", Speed, "30 km/h", "its speed"),
+        field!(essential param "behavior", Symbol in "behavior", "move_forward", "what the ego vehicle does"),
+        field!(essential param "speed", Speed, "30 km/h", "its speed"),
         field!(essential "lane", Integer, "1", "its lane index: 1 is the leftmost lane in its direction"),
     ],
 };
@@ -297,10 +313,18 @@ pub const ACTOR: SectionDef = SectionDef {
     name: "actor",
     doc: "a group of actors of one type that move together",
     fields: &[
-        field!(essential "behavior", Symbol in "behavior", "move_forward", "what every actor of the group does"),
-        field!("speed", Speed, "30 km/h", "their speed"),
+        field!(essential param "behavior", Symbol in "behavior", "move_forward", "what every actor of the group does"),
+        field!(param "speed", Speed, "30 km/h", "their speed"),
         field!(essential "position", Position, "front of ego", "where the group is, relative to a reference"),
         field!(essential "lane", Integer, "1", "their lane index; negative for the opposite direction"),
+        field!(
+            param "distance",
+            Length,
+            "15 m",
+            "the gap along the road from the position's reference to the group's nearest actor"
+        ),
+        field!(param "delay", Duration, "2 s", "the time before the group starts its behavior"),
+        field!(param "trigger", Length, "30 m", "the group starts its behavior when the ego vehicle is this close"),
     ],
 };
 

@@ -119,7 +119,11 @@ impl Writer<'_> {
                     line(row.key, kind);
                 }
                 (Tad::Count, Some((actor, _))) => match &actor.count {
-                    Some(Spanned { value: Known::Given(n), .. }) => line(row.key, n.to_string()),
+                    Some(Spanned { value: Known::Given(Count::Exactly(n)), .. }) => line(row.key, n.to_string()),
+                    // the form import reads back as a range
+                    Some(Spanned { value: Known::Given(Count::Between(low, high)), .. }) => {
+                        line(row.key, format!("{low}-{high}"))
+                    }
                     Some(Spanned { value: Known::Unspecified, .. }) => line(row.key, "unspecified".into()),
                     None => {}
                 },
@@ -257,6 +261,11 @@ impl Writer<'_> {
     }
 
     fn quantity(&self, a: &Attr) -> String {
+        if let Known::Given(Val::Range(low, high)) = &a.value {
+            // the form import reads back as a range
+            let number = crate::tad::number;
+            return format!("{}-{} {}", number(low.value), number(high.value), high.unit.as_str());
+        }
         let Known::Given(Val::Quantity(q)) = &a.value else { return self.other(&a.value) };
         let default = if q.unit == Unit::Seconds { Unit::Seconds } else { Unit::KilometresPerHour };
         if let Some(written) = self.src.get(a.value_span.start..a.value_span.end) {

@@ -132,7 +132,7 @@ struct ActorBuild {
     key: String,
     name: Name,
     span: Span,
-    count: Option<Spanned<Known<i64>>>,
+    count: Option<Spanned<Known<Count>>>,
     kind: Option<Spanned<Known<Symbol>>>,
     props: Vec<Prop>,
 }
@@ -712,6 +712,16 @@ impl Importer<'_> {
     #[allow(clippy::too_many_arguments)]
     fn set_quantity(&mut self, target: Target, field: &str, key: &str, v: &Value, at: At, unit: Unit, rank: u8) {
         let example = if unit == Unit::Seconds { "195 s" } else { "30 km/h" };
+        // a range, where the field takes one (`25-30 km/h`, `between 25 and 30 km/h`)
+        let takes_range =
+            schema::SECTIONS.iter().chain([&&schema::ACTOR]).any(|s| s.field(field).is_some_and(|f| f.param));
+        if let (true, Value::String(s)) = (takes_range, untag(v))
+            && let Some((low, high, unit)) = norm::parse_quantity_range(s, unit)
+        {
+            let range = Val::Range(Quantity { value: low, unit }, Quantity { value: high, unit });
+            self.set(target, field, key, at, Known::Given(range), rank, false);
+            return;
+        }
         if let Some(q) = self.quantity(key, v, at, unit, example) {
             self.set(target, field, key, at, known_map(q, Val::Quantity), rank, false);
         }
@@ -1200,7 +1210,18 @@ impl Importer<'_> {
                     }
                 }
                 (Tad::Count, _) => {
-                    if let Some(count) = self.integer(&key, v, at, "1") {
+                    let range = match untag(v) {
+                        Value::String(s) => norm::parse_integer_range(s),
+                        _ => None,
+                    };
+                    if let Some((low, high)) = range {
+                        let count = Known::Given(Count::Between(low, high));
+                        self.actors[index].count = Some(Spanned { value: count, span: at.value_span });
+                    } else if let Some(count) = self.integer(&key, v, at, "1") {
+                        let count = match count {
+                            Known::Given(n) => Known::Given(Count::Exactly(n)),
+                            Known::Unspecified => Known::Unspecified,
+                        };
                         self.actors[index].count = Some(Spanned { value: count, span: at.value_span });
                     }
                 }

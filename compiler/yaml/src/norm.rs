@@ -300,6 +300,49 @@ pub fn parse_quantity(text: &str, default: Unit) -> Option<(f64, Unit)> {
     (unit.measures() == default.measures()).then_some((value, unit))
 }
 
+/// The two ends of a range written in words: `25-30`, `25 - 30`, `25 to 30`,
+/// `between 25 and 30` (with any text after them, such as a unit); `None` for anything
+/// else, a single number included.
+fn range_ends(text: &str) -> Option<(String, String)> {
+    let t = text.trim().to_lowercase();
+    if let Some(rest) = t.strip_prefix("between ") {
+        let (low, high) = rest.split_once(" and ")?;
+        return Some((low.trim().to_string(), high.trim().to_string()));
+    }
+    if let Some((low, high)) = t.split_once(" to ") {
+        return Some((low.trim().to_string(), high.trim().to_string()));
+    }
+    // a `-` after a digit (and spaces): not a sign
+    let bytes = t.as_bytes();
+    let dash = (1..bytes.len()).find(|&i| {
+        bytes[i] == b'-'
+            && t[..i].trim_end().as_bytes().last().is_some_and(|b| b.is_ascii_digit() || b.is_ascii_alphabetic())
+    })?;
+    Some((t[..dash].trim().to_string(), t[dash + 1..].trim().to_string()))
+}
+
+/// A range of quantities written as YAML text (`25-30 km/h`, `25 to 30 km/h`,
+/// `between 25 and 30 km/h`, `25 km/h - 30 km/h`): both ends in one unit, written after
+/// the upper end (and optionally after the lower one too), ordered low to high.
+pub fn parse_quantity_range(text: &str, default: Unit) -> Option<(f64, f64, Unit)> {
+    let (low, high) = range_ends(text)?;
+    let (high, unit) = parse_quantity(&high, default)?;
+    let low_has_unit = low.trim_end().ends_with(|c: char| c.is_ascii_alphabetic() || c == '/');
+    let (low, low_unit) = parse_quantity(&low, if low_has_unit { default } else { unit })?;
+    if low_has_unit && low_unit != unit {
+        return None;
+    }
+    Some((low.min(high), low.max(high), unit))
+}
+
+/// A range of whole numbers written as YAML text: `3-5`, `3 to 5`, `between 3 and 5`,
+/// ordered low to high.
+pub fn parse_integer_range(text: &str) -> Option<(i64, i64)> {
+    let (low, high) = range_ends(text)?;
+    let (low, high) = (parse_integer(&low)?, parse_integer(&high)?);
+    Some((low.min(high), low.max(high)))
+}
+
 /// A whole number written as YAML text: `3`, `-1`, `"3"`, `about 10`.
 pub fn parse_integer(text: &str) -> Option<i64> {
     let mut t = text.trim().to_lowercase();

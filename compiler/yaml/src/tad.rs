@@ -94,6 +94,8 @@ pub fn value(v: &Known<Val>, depth: usize) -> String {
         Val::Text(t) => text(t, depth),
         Val::Position(p) => format!("{} of {}", p.relation.name, p.reference.name),
         Val::Flag(b) => (if *b { "yes" } else { "no" }).into(),
+        Val::Range(low, high) => format!("{}..{} {}", number(low.value), number(high.value), high.unit.as_str()),
+        Val::Choice(options) => options.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(" | "),
     }
 }
 

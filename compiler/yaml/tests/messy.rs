@@ -106,8 +106,8 @@ fn bad_values_point_at_their_line() {
     let text = "<YAML>\nenvironment:\n    weather: 42\nroad_network:\n    lane_number: many\n    lane_number2: 2\n    special_lane: [bike lane, {x: 1}]\nactors:\n    ego_vehicle:\n        speed: fast\n        lane_index: 1.5\n    bus:\n        number: 2.0\n        speed: 30-40 km/h\n        type: [bus]\n</YAML>\n";
     assert_eq!(
         codes_at(text),
-        // `many` lanes and a `fast` speed give no number: warnings, read as unspecified
-        ["E0303@3", "W0302@5", "E0302@6", "E0304@7", "W0302@10", "E0303@11", "E0303@13", "E0303@14", "E0304@15"]
+        // `many` lanes and a `fast` speed give no number: warnings, read as unspecified; 30-40 km/h is a range
+        ["E0303@3", "W0302@5", "E0302@6", "E0304@7", "W0302@10", "E0303@11", "E0303@13", "E0304@15"]
     );
     let (_, d) = lower(text);
     let unknown = d.iter().find(|d| d.code == Code::E0302).unwrap();
@@ -186,7 +186,7 @@ fn mph_and_other_units() {
         let q = model.scenario.unwrap().attr("ego", "speed").unwrap().quantity().unwrap();
         assert_eq!((q.value, q.unit.as_str()), (value, unit), "{speed}");
     }
-    for speed in ["30 s", "30-40 km/h", "[30]", "true", ".nan", "1e999"] {
+    for speed in ["30 s", "30-40 s", "30 km/h-40 mph", "[30]", "true", ".nan", "1e999"] {
         let text = format!("actors:\n  ego_vehicle:\n    speed: {speed}\n");
         assert_eq!(errors(&lower(&text).1).len(), 1, "{speed}");
     }
@@ -197,6 +197,31 @@ fn mph_and_other_units() {
     let (model, d) = lower("actors:\n  ego_vehicle:\n    speed: fast\n");
     assert_eq!(d.iter().map(|d| d.code).collect::<Vec<_>>(), [Code::W0302]);
     assert!(matches!(model.scenario.unwrap().attr("ego", "speed").unwrap().value, Known::Unspecified));
+}
+
+#[test]
+fn ranges_of_speeds_and_counts() {
+    for speed in
+        ["25-30 km/h", "25 - 30 km/h", "25 to 30 km/h", "between 25 and 30 km/h", "25 km/h - 30 km/h", "30-25 km/h"]
+    {
+        let text = format!("actors:\n  ego_vehicle:\n    speed: {speed}\n");
+        let (model, d) = lower(&text);
+        assert!(d.is_empty(), "{speed}: {d:?}");
+        let attr = model.scenario.unwrap().attr("ego", "speed").cloned().unwrap();
+        assert_eq!(
+            attr.bounds().map(|(l, h)| (l * 3.6, h * 3.6)).map(|(l, h)| (l.round(), h.round())),
+            Some((25.0, 30.0)),
+            "{speed}"
+        );
+        assert!(tad(&text).contains("speed: 25..30 km/h"), "{speed}");
+    }
+    for count in ["3-5", "3 to 5", "between 3 and 5"] {
+        let text = format!("actors:\n  walkers:\n    type: pedestrian\n    number: {count}\n");
+        let (model, d) = lower(&text);
+        assert!(d.is_empty(), "{count}: {d:?}");
+        assert_eq!(model.scenario.unwrap().actors[0].count_bounds(), Some((3, 5)), "{count}");
+        assert!(tad(&text).contains("actor walkers: 3..5 pedestrian"), "{count}");
+    }
 }
 
 #[test]

@@ -42,6 +42,10 @@ pub const PRELUDE_PLACEMENT: &str = include_str!("prelude/placement.py");
 /// The prelude's behaviors, verbatim in every program.
 pub const PRELUDE_BEHAVIORS: &str = include_str!("prelude/behaviors.scenic");
 
+/// The behaviors of parameters (a choice of behaviors, a delay, a trigger), added after the
+/// prelude only in programs that use them.
+pub const PRELUDE_PARAMS: &str = include_str!("prelude/params.scenic");
+
 /// The simulator a program is written for.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Simulator {

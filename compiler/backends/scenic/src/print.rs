@@ -12,9 +12,9 @@ use tad_ir::{Motion, Scenario};
 
 use crate::mapping::{self, Class};
 use crate::maps;
-use crate::plan::{Actor, Light, Place, Plan};
+use crate::plan::{Actor, Light, Place, Plan, Sampled};
 use crate::python::{comment_lines, comment_text, number, string};
-use crate::{EmitOptions, PRELUDE_BEHAVIORS, PRELUDE_PLACEMENT, Simulator};
+use crate::{EmitOptions, PRELUDE_BEHAVIORS, PRELUDE_PARAMS, PRELUDE_PLACEMENT, Simulator};
 
 /// The source section's fields as header lines: (label, value).
 fn source_lines(scenario: &Scenario) -> Vec<(&'static str, String)> {
@@ -109,6 +109,11 @@ pub fn program(scenario: &Scenario, plan: &Plan, diagnostics: &[Diagnostic], opt
     out.push_str(PRELUDE_PLACEMENT.trim_end());
     out.push_str("\n\n");
     out.push_str(PRELUDE_BEHAVIORS.trim_end());
+    let actors = std::iter::once(&plan.ego).chain(plan.groups.iter().flat_map(|g| &g.actors));
+    if actors.into_iter().any(|a| a.params.motions.len() > 1 || a.params.waits()) {
+        out.push_str("\n\n# Parameters: a choice of behaviors, a delay, a trigger.\n");
+        out.push_str(PRELUDE_PARAMS.trim_end());
+    }
     out.push_str("\n# ---- end of the prelude ----\n\n");
 
     // --- road
@@ -177,11 +182,15 @@ pub fn program(scenario: &Scenario, plan: &Plan, diagnostics: &[Diagnostic], opt
 
     // --- actors
     out.push_str(&comment_lines(&plan.ego_summary, ""));
+    params(&mut out, &plan.ego.params);
     actor(&mut out, &plan.ego, "tadEgoAt");
     let mut spot = 0;
     for group in &plan.groups {
         out.push('\n');
         out.push_str(&comment_lines(&group.summary, ""));
+        if let Some(first) = group.actors.first() {
+            params(&mut out, &first.params);
+        }
         for a in &group.actors {
             spot += 1;
             actor(&mut out, a, &format!("tadAt{spot}"));
@@ -222,6 +231,33 @@ pub fn program(scenario: &Scenario, plan: &Plan, diagnostics: &[Diagnostic], opt
     out
 }
 
+/// A range as a Scenic value: `Range(low, high)`, or the number when both ends agree.
+fn range((low, high): (f64, f64)) -> String {
+    if low < high { format!("Range({}, {})", number(low), number(high)) } else { number(low) }
+}
+
+/// The variables of a group's (or the ego's) ranges and choices, sampled once per scene
+/// and shared by its actors: `tadSpeedTAG`, `tadPickTAG`, `tadShiftTAG`, `tadDelayTAG`,
+/// `tadTriggerTAG`.
+fn params(out: &mut String, p: &Sampled) {
+    let tag = &p.tag;
+    if let Some(speed) = p.speed {
+        let _ = writeln!(out, "tadSpeed{tag} = {}", range(speed));
+    }
+    if p.motions.len() > 1 {
+        let _ = writeln!(out, "tadPick{tag} = DiscreteRange(0, {})", p.motions.len() - 1);
+    }
+    if let Some((shift, _)) = p.shift {
+        let _ = writeln!(out, "tadShift{tag} = Range(0, {})", number(shift));
+    }
+    if let Some(delay) = p.delay {
+        let _ = writeln!(out, "tadDelay{tag} = {}", range(delay));
+    }
+    if let Some(trigger) = p.trigger {
+        let _ = writeln!(out, "tadTrigger{tag} = {}", range(trigger));
+    }
+}
+
 /// `SPOT = tadSpot(...)` and `NAME = new CLASS at SPOT[0], facing SPOT[1], ...`.
 fn actor(out: &mut String, a: &Actor, spot: &str) {
     let place = match a.place {
@@ -229,7 +265,14 @@ fn actor(out: &mut String, a: &Actor, spot: &str) {
         Place::Curb => format!(", 'curb', {}", number(a.width)),
         Place::Sidewalk => ", 'sidewalk'".to_string(),
     };
-    let _ = writeln!(out, "{spot} = tadSpot(tadAnchor, {}, {}{place})", number(a.offset), a.lane);
+    let p = &a.params;
+    let offset = match p.shift {
+        Some((_, sign)) if sign < 0.0 => format!("{} - tadShift{}", number(a.offset), p.tag),
+        Some(_) => format!("{} + tadShift{}", number(a.offset), p.tag),
+        None => number(a.offset),
+    };
+    let speed = if p.speed.is_some() { format!("tadSpeed{}", p.tag) } else { number(a.target_speed) };
+    let _ = writeln!(out, "{spot} = tadSpot(tadAnchor, {offset}, {}{place})", a.lane);
     let facing = if a.across { format!("{spot}[1] + 90 deg") } else { format!("{spot}[1]") };
     let _ = write!(
         out,
@@ -250,9 +293,25 @@ fn actor(out: &mut String, a: &Actor, spot: &str) {
         out.push_str(", with requireVisible False");
     }
     if a.initial_speed > 0.0 {
-        let _ = write!(out, ", with speed {}", number(a.initial_speed));
+        let initial = if p.speed.is_some() { speed.clone() } else { number(a.initial_speed) };
+        let _ = write!(out, ", with speed {initial}");
     }
-    if let Some(behavior) = behavior_call(a.motion, a.class, a.target_speed) {
+    let call = if p.motions.len() > 1 {
+        let calls: Option<Vec<String>> = p.motions.iter().map(|m| behavior_call_with(*m, a.class, &speed)).collect();
+        calls.map(|calls| format!("TadOneOf(tadPick{}, [{}])", p.tag, calls.join(", ")))
+    } else {
+        behavior_call_with(a.motion, a.class, &speed)
+    };
+    let hold = if a.class == Class::Pedestrian { "TadStand()" } else { "TadStop()" };
+    let call = call.map(|call| match p.delay {
+        Some(_) => format!("TadDelayed(tadDelay{}, {hold}, {call})", p.tag),
+        None => call,
+    });
+    let call = call.map(|call| match p.trigger {
+        Some(_) => format!("TadTriggered(tadTrigger{}, {hold}, {call})", p.tag),
+        None => call,
+    });
+    if let Some(behavior) = call {
         let _ = write!(out, ", with behavior {behavior}");
     }
     out.push('\n');
@@ -262,12 +321,18 @@ fn actor(out: &mut String, a: &Actor, spot: &str) {
 /// the prelude's `Tad...` behaviors and Scenic's `FollowLaneBehavior`; none for `Debris`.
 /// A behavior without a motion follows the lane (stands still at 0).
 pub fn behavior_call(motion: Option<Motion>, class: Class, speed: f64) -> Option<String> {
-    let v = number(speed);
+    behavior_call_with(motion, class, &number(speed))
+}
+
+/// [`behavior_call`] with the speed as a Scenic expression (a number, or a sampled
+/// variable such as `tadSpeed2`, which is positive).
+fn behavior_call_with(motion: Option<Motion>, class: Class, v: &str) -> Option<String> {
+    let moving = v.parse::<f64>().map_or(true, |s| s > 0.0);
     match class {
         Class::Debris => None,
         Class::Car => Some(match motion {
             Some(Motion::Follow | Motion::Walk | Motion::Graze) => format!("FollowLaneBehavior(target_speed={v})"),
-            None if speed > 0.0 => format!("FollowLaneBehavior(target_speed={v})"),
+            None if moving => format!("FollowLaneBehavior(target_speed={v})"),
             None | Some(Motion::Stop | Motion::Stand) => "TadStop()".into(),
             Some(Motion::Parked) => "TadParked()".into(),
             Some(Motion::Cross) => format!("TadRide({v})"),
@@ -282,7 +347,7 @@ pub fn behavior_call(motion: Option<Motion>, class: Class, speed: f64) -> Option
         }),
         Class::Pedestrian => Some(match motion {
             Some(Motion::Stop | Motion::Stand | Motion::Parked | Motion::Yield) => "TadStand()".into(),
-            _ if speed <= 0.0 => "TadStand()".into(),
+            _ if !moving => "TadStand()".into(),
             _ => format!("TadWalk({v})"),
         }),
     }

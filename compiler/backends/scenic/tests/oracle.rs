@@ -92,3 +92,66 @@ fn every_example_compiles_and_samples_with_the_carla_model() {
         .collect();
     assert!(failures.is_empty(), "{} of {} examples failed:\n{}", failures.len(), records.len(), failures.join("\n"));
 }
+
+/// The programs of `tests/scenic/fixtures/ranges.tad` (ranges and choices) for `simulator`.
+fn emit_ranges(simulator: Simulator, dir: &Path, maps: &Path) -> PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
+    let path = common::repo().join("tests/scenic/fixtures/ranges.tad");
+    let options =
+        EmitOptions { simulator, map_dir: Some(maps.to_string_lossy().into_owned()), ..EmitOptions::default() };
+    let emitted = common::build(&path, &options);
+    let out = dir.join("ranges.scenic");
+    std::fs::write(&out, &emitted.text).unwrap();
+    out
+}
+
+#[test]
+fn ranges_and_choices_compile_sample_and_simulate_in_scenic() {
+    let Some((python, check, maps)) = common::oracle() else { return };
+    let base = Path::new(env!("CARGO_TARGET_TMPDIR"));
+    let newtonian = emit_ranges(Simulator::Newtonian, &base.join("scenic-ranges-newtonian"), &maps);
+    let steps = STEPS.to_string();
+    let records = common::run_oracle(&python, &check, &["--sim", &steps, "--max-iters", "500"], &[newtonian]);
+    let failures = common::failures(&records, STEPS);
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    let carla = emit_ranges(Simulator::Carla, &base.join("scenic-ranges-carla"), &maps);
+    let records = common::run_oracle(&python, &check, &["--max-iters", "500"], &[carla]);
+    assert!(records[0]["compiled"] == true && records[0]["sampled"] == true, "{}", records[0]);
+}
+
+/// Two seeds sample two speeds: the program's `Range` is Scenic's, sampled per scene.
+#[test]
+fn two_scenic_seeds_sample_different_speeds() {
+    let Some((python, _, maps)) = common::oracle() else { return };
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("scenic-ranges-seeds");
+    let program = emit_ranges(Simulator::Newtonian, &dir, &maps);
+    let text = std::fs::read_to_string(&program).unwrap();
+    assert!(text.contains("tadSpeedEgo = Range(6.944, 9.722)"), "{text}");
+    assert!(text.contains("with speed tadSpeedEgo"), "{text}");
+    const SAMPLE: &str = r#"
+import random, sys, warnings
+warnings.simplefilter("ignore")
+import numpy, scenic
+speeds = []
+for seed in (1, 2):
+    random.seed(seed)
+    numpy.random.seed(seed)
+    scenario = scenic.scenarioFromFile(sys.argv[1], mode2D=True, model="scenic.simulators.newtonian.driving_model")
+    scene, _ = scenario.generate(maxIterations=500)
+    speeds.append(scene.egoObject.speed)
+print(" ".join(repr(s) for s in speeds))
+"#;
+    let output = std::process::Command::new(&python)
+        .arg("-c")
+        .arg(SAMPLE)
+        .arg(&program)
+        .env("SCENIC_MAP_CACHE", "none")
+        .output()
+        .expect("python runs");
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let speeds: Vec<f64> = stdout.split_whitespace().filter_map(|s| s.parse().ok()).collect();
+    assert_eq!(speeds.len(), 2, "{stdout}\n{}", String::from_utf8_lossy(&output.stderr));
+    println!("ego speeds sampled with seeds 1 and 2: {speeds:?} m/s");
+    assert!(speeds.iter().all(|s| (25.0 / 3.6 - 1e-3..=35.0 / 3.6 + 1e-3).contains(s)), "{speeds:?}");
+    assert!((speeds[0] - speeds[1]).abs() > 1e-6, "the same speed for two seeds: {speeds:?}");
+}

@@ -8,7 +8,7 @@ use super::ego::EgoPlan;
 use super::groups::Resolved;
 use super::layout::Layout;
 use super::motion::starts_moving;
-use super::{Actor, Group, Place, kmh};
+use super::{Actor, Group, Place, Sampled};
 use crate::mapping::{self, Class};
 use crate::python::Names;
 
@@ -37,6 +37,12 @@ pub fn build(scenario: &Scenario, ego: &EgoPlan, groups: &[Resolved], layout: &L
         motion: ego.motion,
         target_speed: ego.speed,
         initial_speed: if starts_moving(ego.motion, Class::Car) { ego.speed } else { 0.0 },
+        params: Sampled {
+            tag: "Ego".into(),
+            speed: ego.speed_range,
+            motions: ego.motions.clone(),
+            ..Sampled::default()
+        },
     };
     let mut out = Vec::new();
     for (i, g) in groups.iter().enumerate() {
@@ -48,6 +54,14 @@ pub fn build(scenario: &Scenario, ego: &EgoPlan, groups: &[Resolved], layout: &L
                 names.fresh(&format!("{}_{}", g.name, k + 1))
             };
             let class = g.mapping.class;
+            let params = Sampled {
+                tag: (i + 1).to_string(),
+                speed: g.speed_range,
+                motions: g.motions.clone(),
+                shift: g.distance.filter(|(low, high)| low < high).map(|(low, high)| (high - low, -layout.steps[i])),
+                delay: g.delay,
+                trigger: g.trigger,
+            };
             actors.push(Actor {
                 ident,
                 class,
@@ -61,7 +75,8 @@ pub fn build(scenario: &Scenario, ego: &EgoPlan, groups: &[Resolved], layout: &L
                 across: g.across(),
                 motion: g.motion,
                 target_speed: g.speed,
-                initial_speed: if starts_moving(g.motion, class) { g.speed } else { 0.0 },
+                initial_speed: if starts_moving(g.motion, class) && !params.waits() { g.speed } else { 0.0 },
+                params,
             });
         }
         out.push(Group { summary: g.summary.clone(), actors });
@@ -73,10 +88,11 @@ pub fn build(scenario: &Scenario, ego: &EgoPlan, groups: &[Resolved], layout: &L
 fn ego_summary(scenario: &Scenario, lane: i64) -> String {
     let mut parts = Vec::new();
     if let Some(b) = scenario.ego.behavior.given() {
-        parts.push(scenario.entries.name(b).to_string());
+        let names: Vec<&str> = b.values().into_iter().map(|n| scenario.entries.name(n)).collect();
+        parts.push(names.join(" | "));
     }
-    if let Some(speed) = scenario.ego.speed.get() {
-        parts.push(kmh(speed.0));
+    if let Some(speed) = scenario.ego.speed.given() {
+        parts.push(super::groups::speed_text(speed));
     }
     parts.push(format!("lane {lane}"));
     format!("ego vehicle: {}", parts.join(", "))

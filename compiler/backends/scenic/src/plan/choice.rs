@@ -166,7 +166,7 @@ pub fn choose(
     let base = needs.clone();
     let minimal: Vec<usize> = groups.iter().map(|_| 1).collect();
     let extent = (ego.length, ego.speed);
-    layout::layout(groups, &minimal, ego.lane, extent, order, &mut needs, junction);
+    let _ = layout::layout(groups, &minimal, ego.lane, extent, order, &mut needs, junction);
     let (map, map_known) = match requested {
         Some(m) => match maps::known(m) {
             Some(k) => (k.to_string(), true),
@@ -236,7 +236,7 @@ pub fn choose(
                 g.lane = moved(g.lane, span, &format!("group `{}`", group.name));
             }
             lane_needs(groups, ego.lane, &mut needs);
-            layout::layout(groups, &minimal, ego.lane, extent, order, &mut needs, junction);
+            let _ = layout::layout(groups, &minimal, ego.lane, extent, order, &mut needs, junction);
             full = layout::full_windows(groups, ego.lane, extent, order, &needs);
             best = select(&needs, &full, &features, &[m], &preference);
         }

@@ -6,13 +6,13 @@ use tad_diagnostics::{Code, Span};
 use tad_ir::{ActorType, Entry, Motion, Scenario};
 
 use super::report::{Annotate, Report, unsupported};
-use super::{keyword, motion};
+use super::{ends, keyword, motion, nominal};
 use crate::mapping::Class;
 
 const WHO: &str = "the ego vehicle";
 
 /// The ego vehicle, resolved.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct EgoPlan {
     pub length: f64,
     pub width: f64,
@@ -25,6 +25,10 @@ pub struct EgoPlan {
     pub lane_span: Span,
     /// Where the behavior is written (else the `ego` section).
     pub behavior_span: Span,
+    /// A speed range (m/s), sampled by Scenic.
+    pub speed_range: Option<(f64, f64)>,
+    /// The motions of a choice of behaviors, sampled by Scenic (empty: no choice).
+    pub motions: Vec<Option<Motion>>,
 }
 
 /// The actor type the ego vehicle is: the first `reference` that declares one.
@@ -41,9 +45,13 @@ pub fn plan(scenario: &Scenario, scenario_span: Span, report: &mut Report) -> Eg
     let length = positive(kind.and_then(|k| k.length)).unwrap_or(4.5);
     let width = positive(kind.and_then(|k| k.width)).unwrap_or(1.8);
     let behavior_span = ego.behavior.span().unwrap_or(section);
-    let (motion, behavior) = motion::of(scenario, &ego.behavior, Class::Car, WHO, behavior_span, report);
+    let (motion, behavior) = motion::of(scenario, &nominal(&ego.behavior), Class::Car, WHO, behavior_span, report);
+    let motions = motion::choices(scenario, &ego.behavior, Class::Car, WHO, behavior_span, report);
     let typical = kind.and_then(|k| k.typical_speed).map_or(50.0 / 3.6, |s| s.0);
-    let speed = motion::speed(&ego.speed, typical, behavior, WHO, section, report);
+    let speed_range = ends(&ego.speed, |s| s.0.max(0.0)).filter(|(low, high)| low < high);
+    // the layout keeps room for the fastest
+    let fastest = ego.speed.clone().map(|p| p.max());
+    let speed = motion::speed(&fastest, typical, behavior, WHO, section, report);
     let lane_span = ego.lane.span().unwrap_or(section);
     let lanes = scenario.road.lanes.get().filter(|n| *n >= 1).map(|n| n.min(1000));
     let lane = match ego.lane.get() {
@@ -77,5 +85,5 @@ pub fn plan(scenario: &Scenario, scenario_span: Span, report: &mut Report) -> Eg
     } else {
         lane
     };
-    EgoPlan { length, width, speed, motion, lane, lane_span, behavior_span }
+    EgoPlan { length, width, speed, motion, lane, lane_span, behavior_span, speed_range, motions }
 }

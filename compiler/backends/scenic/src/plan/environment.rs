@@ -27,7 +27,40 @@ pub fn plan(scenario: &Scenario, road: &RoadRequest, simulator: Simulator, repor
     let environment = &scenario.environment;
     let mut parameters = Vec::new();
     let mut said = Vec::new();
-    if let (Some(written), Some(at)) = (environment.weather.given(), environment.weather.span()) {
+    let choices = [
+        (
+            "weather",
+            environment.weather.given().map(|p| p.values().into_iter().map(|n| entries.name(n)).collect::<Vec<_>>()),
+            environment.weather.span(),
+        ),
+        (
+            "time",
+            environment.time.given().map(|p| p.values().into_iter().map(|n| entries.name(n)).collect::<Vec<_>>()),
+            environment.time.span(),
+        ),
+    ];
+    for (field, values, at) in choices {
+        let (Some(values), Some(at)) = (values, at) else { continue };
+        if values.len() < 2 {
+            continue;
+        }
+        let first = values[0];
+        report
+            .warn(
+                Code::W0707,
+                format!(
+                    "the program does not sample the choice of {}",
+                    if field == "time" { "time of day" } else { "weather" }
+                ),
+                at,
+                format!("`{first}` in every scene"),
+                unsupported(format!("environment.{field}"), Some(format!("`{first}`, the first of the choice"))),
+            )
+            .note("CARLA's weather is one `param weather` of the whole program; a search varies it between programs");
+    }
+    let weather = environment.weather.clone().map(|p| p.nominal());
+    let time = environment.time.clone().map(|p| p.nominal());
+    if let (Some(written), Some(at)) = (weather.given(), weather.span()) {
         let name = entries.name(written);
         let p = entries.resolved(written).map(|e| weather_parameters(&e.attrs)).unwrap_or_default();
         if p.is_empty() {
@@ -45,7 +78,7 @@ pub fn plan(scenario: &Scenario, road: &RoadRequest, simulator: Simulator, repor
             said.push(name.to_string());
         }
     }
-    if let (Some(written), Some(at)) = (environment.time.given(), environment.time.span()) {
+    if let (Some(written), Some(at)) = (time.given(), time.span()) {
         let name = entries.name(written);
         let p = entries.resolved(written).map(|e| sun_parameters(&e.attrs)).unwrap_or_default();
         if p.is_empty() {

@@ -7,7 +7,7 @@ use tad_diagnostics::{Code, Span};
 use tad_ir::{ActorType, Entry, Field, Lane, Lateral, Longitudinal, Reference, Scenario};
 
 use super::report::{Annotate, Report, named, unsupported};
-use super::{MAX_GROUP, Place, kmh, motion};
+use super::{MAX_GROUP, Place, ends, kmh, motion, nominal};
 use crate::mapping::{self, Class};
 
 /// Where a group's position points.
@@ -49,6 +49,16 @@ pub struct Resolved {
     pub longitudinal: Longitudinal,
     pub lateral: Option<Lateral>,
     pub span: Span,
+    /// A speed range (m/s) Scenic samples; `speed` is then its upper end, for the layout.
+    pub speed_range: Option<(f64, f64)>,
+    /// The motions of a choice of behaviors (empty: no choice).
+    pub motions: Vec<Option<tad_ir::Motion>>,
+    /// The written gap to the reference, m: `(low, high)`.
+    pub distance: Option<(f64, f64)>,
+    /// Time before the group starts its behavior, s.
+    pub delay: Option<(f64, f64)>,
+    /// The ego's distance at which the group starts its behavior, m.
+    pub trigger: Option<(f64, f64)>,
 }
 
 impl Resolved {
@@ -78,8 +88,11 @@ impl Resolved {
         }
     }
 
-    /// Gap to the reference.
+    /// Gap to the reference: the written `distance` (its upper end), else from the speeds.
     pub fn lead_gap(&self, reference_speed: f64) -> f64 {
+        if let Some((_, high)) = self.distance {
+            return high;
+        }
         let base = if self.mapping.class == Class::Car { 2.0 } else { 1.0 };
         (base + self.speed.max(reference_speed)).min(30.0)
     }
@@ -149,7 +162,20 @@ pub fn resolve(scenario: &Scenario, report: &mut Report) -> Vec<Resolved> {
         let length = positive(entry.and_then(|e| e.attrs.length)).unwrap_or(default_length);
         let width = positive(entry.and_then(|e| e.attrs.width)).unwrap_or(default_width);
         let count_span = group.count.span().unwrap_or(group.name_span);
-        let count = match group.count() {
+        let count_param = group.count_param();
+        if let Some(tad_ir::Param::Range { min, max }) = &count_param {
+            let chosen = count_param.as_ref().map_or(1, tad_ir::Param::nominal);
+            report
+                .warn(
+                    Code::W0707,
+                    format!("Scenic cannot sample the number of actors of {who}"),
+                    count_span,
+                    format!("{chosen} in every scene"),
+                    unsupported("actor.count", Some(format!("{chosen} actors, the midpoint of {min}..{max}"))),
+                )
+                .note("a Scenic program creates a fixed set of objects: how many cannot depend on a sampled value");
+        }
+        let count = match count_param.as_ref().map(tad_ir::Param::nominal) {
             Some(n) if n >= 1 => usize::try_from(n).unwrap_or(usize::MAX),
             Some(_) => 1,
             None => {
@@ -177,12 +203,17 @@ pub fn resolve(scenario: &Scenario, report: &mut Report) -> Vec<Resolved> {
         } else {
             count
         };
-        let (motion, behavior) = motion::of(scenario, &group.behavior, mapping.class, &who, group.name_span, report);
+        let (motion, behavior) =
+            motion::of(scenario, &nominal(&group.behavior), mapping.class, &who, group.name_span, report);
+        let motions = motion::choices(scenario, &group.behavior, mapping.class, &who, group.name_span, report);
         let typical = entry.and_then(|e| e.attrs.typical_speed).map_or(0.0, |s| s.0);
-        let speed = if mapping.class == Class::Debris {
+        let debris = mapping.class == Class::Debris;
+        let speed_range = ends(&group.speed, |s| s.0.max(0.0)).filter(|(low, high)| low < high && !debris);
+        let speed = if debris {
             0.0
         } else {
-            motion::speed(&group.speed, typical, behavior, &who, group.name_span, report)
+            // the layout keeps room for the fastest
+            motion::speed(&group.speed.clone().map(|p| p.max()), typical, behavior, &who, group.name_span, report)
         };
         let (target, longitudinal, lateral) = match group.position.given() {
             None => {
@@ -239,6 +270,11 @@ pub fn resolve(scenario: &Scenario, report: &mut Report) -> Vec<Resolved> {
             longitudinal,
             lateral,
             span: group.span,
+            speed_range,
+            motions: if debris { Vec::new() } else { motions },
+            distance: ends(&group.distance, |m| m.0.max(0.0)),
+            delay: ends(&group.delay, |s| s.0.max(0.0)).filter(|_| !debris),
+            trigger: ends(&group.trigger, |m| m.0.max(0.0)).filter(|_| !debris),
         });
     }
     out
@@ -318,10 +354,11 @@ pub fn infer_lanes(
 fn summary(scenario: &Scenario, group: &tad_ir::Group, type_name: &str, count: usize) -> String {
     let mut parts = vec![format!("{count} {type_name}")];
     if let Some(b) = group.behavior.given() {
-        parts.push(scenario.entries.name(b).to_string());
+        let names: Vec<&str> = b.values().into_iter().map(|n| scenario.entries.name(n)).collect();
+        parts.push(names.join(" | "));
     }
-    if let Some(speed) = group.speed.get() {
-        parts.push(kmh(speed.0));
+    if let Some(speed) = group.speed.given() {
+        parts.push(speed_text(speed));
     }
     if let Some(p) = group.position.given() {
         let relation = scenario.entries.name(&p.relation.value);
@@ -331,4 +368,14 @@ fn summary(scenario: &Scenario, group: &tad_ir::Group, type_name: &str, count: u
         parts.push(format!("lane {}", lane.index()));
     }
     format!("group `{}`: {}", group.name, parts.join(", "))
+}
+
+/// `30 km/h`, or a range `30..40 km/h`, for a comment.
+pub fn speed_text(speed: &tad_ir::Param<tad_ir::MetresPerSecond>) -> String {
+    match speed {
+        tad_ir::Param::Range { min, max } => {
+            format!("{:.0}..{}", min.km_per_hour(), kmh(max.0))
+        }
+        other => kmh(other.nominal().0),
+    }
 }

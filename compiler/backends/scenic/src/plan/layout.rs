@@ -23,6 +23,9 @@ pub struct Layout {
     pub counts: Vec<usize>,
     /// Per group, each actor's offset.
     pub offsets: Vec<Vec<f64>>,
+    /// Per group, the way its actors follow each other along the ego's lane (1 or -1):
+    /// away from its reference.
+    pub steps: Vec<f64>,
     /// The chosen needs with the window of this layout.
     pub needs: Needs,
 }
@@ -50,7 +53,7 @@ pub fn fit(
     let extent = (ego.length, ego.speed);
     let mut needs = choice.needs.clone();
     let mut counts: Vec<usize> = groups.iter().map(|g| g.count).collect();
-    let mut offsets = layout(groups, &counts, ego.lane, extent, order, &mut needs, choice.junction);
+    let (mut offsets, mut steps) = layout(groups, &counts, ego.lane, extent, order, &mut needs, choice.junction);
     if choice.map_known && !needs.feasible(&choice.map) {
         let wanted = counts.clone();
         // the group taking the longest stretch of lane loses an actor first
@@ -60,7 +63,7 @@ pub fn fit(
             .max_by(|&a, &b| length(a, &counts).total_cmp(&length(b, &counts)))
         {
             counts[i] -= 1;
-            offsets = layout(groups, &counts, ego.lane, extent, order, &mut needs, choice.junction);
+            (offsets, steps) = layout(groups, &counts, ego.lane, extent, order, &mut needs, choice.junction);
             if needs.feasible(&choice.map) {
                 break;
             }
@@ -86,11 +89,13 @@ pub fn fit(
             }
         }
     }
-    Layout { counts, offsets, needs }
+    Layout { counts, offsets, steps, needs }
 }
 
-/// Place every actor: offsets along the ego's lane from its centre, per group. Sets the
-/// window (`ahead`, `behind`) and the junction approach of `needs`.
+/// Place every actor: offsets along the ego's lane from its centre, per group, and the
+/// way each group extends from its reference. Sets the window (`ahead`, `behind`) and the
+/// junction approach of `needs`. A group with a `distance` range is placed at its upper
+/// end, and the stretch down to its lower end is kept free: Scenic moves it nearer.
 pub fn layout(
     groups: &[Resolved],
     counts: &[usize],
@@ -99,11 +104,12 @@ pub fn layout(
     order: &[usize],
     needs: &mut Needs,
     junction: bool,
-) -> Vec<Vec<f64>> {
+) -> (Vec<Vec<f64>>, Vec<f64>) {
     const MARGIN: f64 = 0.5;
     let mut occupied: HashMap<(i64, bool), Vec<(f64, f64)>> = HashMap::new();
     occupied.entry((ego_lane, false)).or_default().push((-ego_length / 2.0, ego_length / 2.0));
     let mut offsets: Vec<Vec<f64>> = vec![Vec::new(); groups.len()];
+    let mut steps: Vec<f64> = vec![1.0; groups.len()];
     let mut approach = None;
     let mut ahead = ego_length / 2.0;
     for &i in order {
@@ -131,8 +137,8 @@ pub fn layout(
         let half = extent / 2.0;
         let lead = g.lead_gap(reference_speed);
         let (mut centre, step) = match (g.target, g.longitudinal) {
-            (Target::Junction, Longitudinal::Behind) => (low - 10.0 - half, -1.0),
-            (Target::Junction, _) => (low - 1.0 - half, -1.0),
+            (Target::Junction, Longitudinal::Behind) => (low - g.distance.map_or(10.0, |d| d.1) - half, -1.0),
+            (Target::Junction, _) => (low - g.distance.map_or(1.0, |d| d.1) - half, -1.0),
             (_, Longitudinal::Front) => {
                 let edge = if direction > 0.0 { high } else { low };
                 (edge + direction * (lead + half), direction)
@@ -143,8 +149,11 @@ pub fn layout(
             }
             (_, Longitudinal::Same) => ((low + high) / 2.0, direction),
         };
+        steps[i] = step;
         let key = (g.lane, g.place() == Place::Sidewalk);
         let lane = occupied.entry(key).or_default();
+        // the stretch a sampled distance may move the group into, kept free after placing it
+        let edge = centre - step * half;
         for k in 0..counts[i] {
             if k > 0 {
                 centre += step * (extent + g.gap());
@@ -158,6 +167,11 @@ pub fn layout(
             offsets[i].push(centre);
             ahead = ahead.max(centre + half);
         }
+        if let Some((near, far)) = g.distance.filter(|(near, far)| near < far && g.longitudinal != Longitudinal::Same) {
+            let edge = offsets[i].first().map_or(edge, |first| first - step * half);
+            let swept = (edge - step * (far - near), edge);
+            lane.push((swept.0.min(swept.1) + 1e-3, swept.0.max(swept.1) - 1e-3));
+        }
     }
     let mut behind: f64 = ego_length / 2.0;
     for (i, g) in groups.iter().enumerate() {
@@ -170,5 +184,5 @@ pub fn layout(
     needs.behind = (behind + 1.0).ceil();
     needs.approach =
         if junction { approach.unwrap_or((ahead + 3.0).max(12.0)).ceil().max(needs.ahead + 2.0) } else { 0.0 };
-    offsets
+    (offsets, steps)
 }

@@ -34,7 +34,7 @@ pub mod report;
 pub mod road;
 
 use tad_diagnostics::{Diagnostic, Span};
-use tad_ir::{Motion, Scenario, Signal};
+use tad_ir::{Field, Motion, Param, ParamValue, Scenario, Signal};
 
 use crate::EmitOptions;
 use crate::mapping::Class;
@@ -78,6 +78,45 @@ pub struct Actor {
     pub target_speed: f64,
     /// The speed it starts at, in m/s (0 for actors that start at rest).
     pub initial_speed: f64,
+    /// The parameters Scenic samples for it; shared by the actors of a group.
+    pub params: Sampled,
+}
+
+/// What a Scenic program samples for an actor (its group's ranges and choices), each
+/// `None` when fixed. Ranges are `(low, high)` in SI.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Sampled {
+    /// The name of the program's variables for this actor's group (`Ego`, `3`).
+    pub tag: String,
+    /// Speed range: its behavior keeps `tadSpeedTAG = Range(low, high)`.
+    pub speed: Option<(f64, f64)>,
+    /// The motions of a choice of behaviors (at least two), sampled with `DiscreteRange`.
+    pub motions: Vec<Option<Motion>>,
+    /// How much nearer its reference than `offset` it may be: `tadShiftTAG = Range(0, d)`,
+    /// and the sign of "nearer" along the ego's lane.
+    pub shift: Option<(f64, f64)>,
+    /// Time before it starts its behavior.
+    pub delay: Option<(f64, f64)>,
+    /// It starts its behavior when the ego is within this distance.
+    pub trigger: Option<(f64, f64)>,
+}
+
+impl Sampled {
+    /// Whether the actor starts at rest, waiting.
+    pub fn waits(&self) -> bool {
+        self.delay.is_some() || self.trigger.is_some()
+    }
+}
+
+/// A parameter's value as one value, for the steps that need one: its nominal value (the
+/// midpoint of a range, the first of a choice).
+pub(crate) fn nominal<T: ParamValue>(field: &Field<Param<T>>) -> Field<T> {
+    field.clone().map(|p| p.nominal())
+}
+
+/// A range's or a value's ends, in SI.
+pub(crate) fn ends<T: ParamValue + PartialOrd>(field: &Field<Param<T>>, si: impl Fn(&T) -> f64) -> Option<(f64, f64)> {
+    field.given().map(|p| (si(&p.min()), si(&p.max())))
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -150,7 +189,7 @@ pub fn plan(scenario: &Scenario, options: &EmitOptions) -> (Plan, Vec<Diagnostic
     groups::infer_lanes(scenario, &mut groups, &order, ego.lane, road.lanes, road.one_way, &mut report);
 
     let choice = choice::choose(scenario, &road, ego, &mut groups, &order, options.map.as_deref(), &mut report);
-    let ego = choice.ego;
+    let ego = choice.ego.clone();
     let layout = layout::fit(scenario, &groups, &order, &ego, &choice, &mut report);
 
     let actors = actors::build(scenario, &ego, &groups, &layout);

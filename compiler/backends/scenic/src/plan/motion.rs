@@ -3,7 +3,7 @@
 //! behavior's `max_speed`). Shared by the ego and the groups.
 
 use tad_diagnostics::{Code, Span};
-use tad_ir::{Behavior, ClosedSet, Entry, Field, Id, MetresPerSecond, Motion, Named, Scenario};
+use tad_ir::{Behavior, ClosedSet, Entry, Field, Id, MetresPerSecond, Motion, Named, Param, Scenario};
 
 use super::kmh;
 use super::report::{Annotate, Report, named, unsupported};
@@ -82,6 +82,26 @@ pub fn of<'s>(
         _ => {}
     }
     (motion, entry)
+}
+
+/// The motion of every behavior of a choice (`go_forward | turn_left`), each as [`of`]
+/// approximates it; empty when the behavior is not a choice.
+pub fn choices(
+    scenario: &Scenario,
+    behavior: &Field<Param<Named<Behavior>>>,
+    class: Class,
+    who: &str,
+    span: Span,
+    report: &mut Report,
+) -> Vec<Option<Motion>> {
+    let (Some(Param::Choice(options)), Some(at)) = (behavior.given(), behavior.span()) else { return Vec::new() };
+    // the first is the nominal behavior, already planned
+    let mut motions =
+        vec![of(scenario, &Field::Given(options[0].clone(), at), class, who, span, &mut Report::default()).0];
+    for option in &options[1..] {
+        motions.push(of(scenario, &Field::Given(option.clone(), at), class, who, span, report).0);
+    }
+    motions
 }
 
 /// The payload's construct for a field of the ego (`ego.speed`) or of a group (`actor.speed`).
