@@ -52,7 +52,7 @@ fn realistic_answers_get_their_class_without_false_errors() {
     assert!(total >= 40, "the set has {total} answers");
     // measured: 44 of 44 (before this checker: 14 of 38 YAML files, with 51 false errors)
     assert!(right * 100 >= total * 95, "{right} of {total} classes right: {confusion:?}");
-    assert!(false_errors.len() <= 1, "{false_errors:#?}");
+    assert!(false_errors.is_empty(), "{false_errors:#?}");
 }
 
 /// TrafficComposer's IR forms: a pedestrian going forward, a car crossing, a stationary
