@@ -138,3 +138,12 @@ fn awkward_names_and_texts_survive() {
     }
     round_trip("no scenario name", "scenario demo {\n  ego {\n  }\n}\n");
 }
+
+#[test]
+fn speed_and_count_ranges_survive() {
+    let src = "scenario ranged {\n  ego {\n    behavior: go_forward\n    speed: 25..30 km/h\n    lane: 1\n  }\n  actor walkers: 3..5 pedestrian {\n    behavior: cross\n    speed: 3.5..5 km/h\n    position: front of ego\n    lane: 1\n  }\n}\n";
+    round_trip("ranges", src);
+    let (model, _) = tad_syntax::analyze(src);
+    let yaml = tad_yaml::export(&model, src);
+    assert!(yaml.contains("speed: 25-30 km/h") && yaml.contains("number: 3-5"), "{yaml}");
+}
