@@ -4,35 +4,8 @@
 //! randomness). Each scenario also comes as an equivalent JSON document, so a benchmark
 //! can compare our front end with a production JSON parser on the same content.
 
-/// SplitMix64: small, fast, and good enough for test data.
-pub struct Rng(u64);
-
-impl Rng {
-    pub fn new(seed: u64) -> Self {
-        Rng(seed)
-    }
-
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in `0..n` (`n > 0`).
-    pub fn below(&mut self, n: usize) -> usize {
-        (self.next_u64() % n as u64) as usize
-    }
-
-    pub fn pick<'a, T>(&mut self, items: &'a [T]) -> &'a T {
-        &items[self.below(items.len())]
-    }
-
-    pub fn chance(&mut self, percent: usize) -> bool {
-        self.below(100) < percent
-    }
-}
+/// The seeded generator the IR samples parameters with (SplitMix64), with its helpers.
+pub use tad_ir::{Rng as _, SplitMix64 as Rng};
 
 const WEATHER: &[&str] = &["clear", "cloudy", "foggy", "rainy", "snowy", "wet"];
 const TIME: &[&str] = &["daytime", "nighttime", "dawn", "dusk"];

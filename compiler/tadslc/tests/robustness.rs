@@ -3,6 +3,7 @@
 //! UI fixtures; a failure names the seed and iteration, and saves the input.
 
 mod common;
+use tad_ir::Rng as _;
 use tad_test_support::mutate::{self, Rng};
 
 const SEED: u64 = 0x7AD5;

@@ -1,35 +1,8 @@
 //! Seeded mutations of TAD texts, for robustness tests: byte edits, token edits and word
-//! swaps. The same seed gives the same inputs on every machine (SplitMix64).
+//! swaps. The same seed gives the same inputs on every machine (the IR's SplitMix64).
 
-/// SplitMix64: small, fast, reproducible.
-pub struct Rng(u64);
-
-impl Rng {
-    pub fn new(seed: u64) -> Self {
-        Rng(seed)
-    }
-
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in `0..n` (`0` when `n` is 0).
-    pub fn below(&mut self, n: usize) -> usize {
-        (self.next_u64() % n.max(1) as u64) as usize
-    }
-
-    pub fn pick<'a, T>(&mut self, items: &'a [T]) -> &'a T {
-        &items[self.below(items.len())]
-    }
-
-    pub fn chance(&mut self, percent: usize) -> bool {
-        self.below(100) < percent
-    }
-}
+/// The IR's seeded generator (SplitMix64), with its helpers (`below`, `pick`, `chance`).
+pub use tad_ir::{Rng as _, SplitMix64 as Rng};
 
 /// Pieces that break TAD in telling ways: brackets, quotes, units, keywords, odd characters.
 pub const SNIPPETS: &[&str] = &[
