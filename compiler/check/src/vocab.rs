@@ -268,10 +268,6 @@ impl Vocabulary {
         self.elsewhere.iter().find(|l| l.kinds.get(kind).is_some_and(|t| t.find(name).is_some())).map(|l| l.module())
     }
 
-    pub fn layers(&self) -> &[Arc<Layer>] {
-        &self.layers
-    }
-
     /// A name of `kind` as declared, as an alias, or as the plural of either (`pedestrians`,
     /// `buses`, `bodies`: answers name a group by its plural); a plural is another spelling.
     pub fn lookup(&self, kind: &str, name: &str) -> Lookup<'_> {
@@ -348,12 +344,6 @@ impl Vocabulary {
             }
         }
         out
-    }
-
-    /// The closest name or alias of `kind` to `word`, as the canonical name. Candidates
-    /// are tried in declaration order, so ties resolve the same way every time.
-    pub fn suggest(&self, kind: &str, word: &str) -> Option<&str> {
-        self.candidates(kind, word, 1).into_iter().next()
     }
 }
 

@@ -64,12 +64,6 @@ pub enum Language {
 }
 
 impl Language {
-    /// The language a host assumes for a path: YAML for `.yaml`/`.yml`, else TAD.
-    pub fn of_path(path: &Path) -> Language {
-        let yaml = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("yaml") || e.eq_ignore_ascii_case("yml"));
-        if yaml { Language::Yaml } else { Language::Tad }
-    }
-
     /// The language of a file for a host that has only its path and text: `.tad` is TAD
     /// and `.yaml`/`.yml` YAML; another file (a model's answer saved as `.txt` or `.md`) is
     /// a YAML answer when it holds a YAML scenario and does not begin like TAD.
@@ -398,10 +392,11 @@ impl Database {
         self.log.as_ref().map(|l| l.lock().map(|mut l| std::mem::take(&mut *l)).unwrap_or_default()).unwrap_or_default()
     }
 
-    /// Register (or replace the text of) the file at `path`, in the language its extension
-    /// suggests, resolving its modules on the machine's file system.
+    /// Register (or replace the text of) the file at `path`, in the language its path and
+    /// text suggest ([`Language::guess`]), resolving its modules on the machine's file
+    /// system.
     pub fn set_file(&mut self, path: PathBuf, text: String) -> SourceFile {
-        let language = Language::of_path(&path);
+        let language = Language::guess(&path, &text);
         self.set_source(path, text, language, &RealFs)
     }
 
