@@ -1,0 +1,326 @@
+//! Plane geometry: points, poses, polyline paths, and oriented boxes (footprints) with
+//! overlap and distance by the separating axis theorem.
+//!
+//! The frame is right-handed with `y` to the left of `x`; a heading (yaw) is the angle
+//! from `+x`, counter-clockwise, in radians.
+
+use std::ops::{Add, Mul, Neg, Sub};
+
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Vec2 {
+    pub x: f64,
+    pub y: f64,
+}
+
+impl Vec2 {
+    pub const fn new(x: f64, y: f64) -> Vec2 {
+        Vec2 { x, y }
+    }
+
+    /// The unit vector of heading `yaw`.
+    pub fn from_yaw(yaw: f64) -> Vec2 {
+        Vec2::new(yaw.cos(), yaw.sin())
+    }
+
+    pub fn dot(self, o: Vec2) -> f64 {
+        self.x * o.x + self.y * o.y
+    }
+
+    pub fn cross(self, o: Vec2) -> f64 {
+        self.x * o.y - self.y * o.x
+    }
+
+    pub fn length(self) -> f64 {
+        self.x.hypot(self.y)
+    }
+
+    /// Rotated a quarter turn to the left.
+    pub fn left(self) -> Vec2 {
+        Vec2::new(-self.y, self.x)
+    }
+
+    /// Rotated a quarter turn to the right.
+    pub fn right(self) -> Vec2 {
+        Vec2::new(self.y, -self.x)
+    }
+
+    pub fn yaw(self) -> f64 {
+        self.y.atan2(self.x)
+    }
+
+    pub fn distance(self, o: Vec2) -> f64 {
+        (self - o).length()
+    }
+}
+
+impl Add for Vec2 {
+    type Output = Vec2;
+    fn add(self, o: Vec2) -> Vec2 {
+        Vec2::new(self.x + o.x, self.y + o.y)
+    }
+}
+
+impl Sub for Vec2 {
+    type Output = Vec2;
+    fn sub(self, o: Vec2) -> Vec2 {
+        Vec2::new(self.x - o.x, self.y - o.y)
+    }
+}
+
+impl Mul<f64> for Vec2 {
+    type Output = Vec2;
+    fn mul(self, k: f64) -> Vec2 {
+        Vec2::new(self.x * k, self.y * k)
+    }
+}
+
+impl Neg for Vec2 {
+    type Output = Vec2;
+    fn neg(self) -> Vec2 {
+        Vec2::new(-self.x, -self.y)
+    }
+}
+
+/// A position and a heading.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Pose {
+    pub position: Vec2,
+    pub yaw: f64,
+}
+
+impl Pose {
+    /// `p` in this pose's frame: `x` ahead, `y` to the left.
+    pub fn local(&self, p: Vec2) -> Vec2 {
+        let d = p - self.position;
+        let f = Vec2::from_yaw(self.yaw);
+        Vec2::new(d.dot(f), d.dot(f.left()))
+    }
+}
+
+/// An angle in `(-π, π]`.
+pub fn wrap(angle: f64) -> f64 {
+    let a = angle.rem_euclid(std::f64::consts::TAU);
+    if a > std::f64::consts::PI { a - std::f64::consts::TAU } else { a }
+}
+
+/// A path as a polyline with its cumulative arc lengths. Positions beyond either end
+/// continue straight along the end segments.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Path {
+    points: Vec<Vec2>,
+    arcs: Vec<f64>,
+}
+
+impl Path {
+    /// A path through `points`; repeated points are dropped. At least two distinct points
+    /// make a path; fewer give a degenerate one that stays at its point, facing `+x`.
+    pub fn new(points: impl IntoIterator<Item = Vec2>) -> Path {
+        let mut path = Path::default();
+        for p in points {
+            match path.points.last() {
+                Some(last) if last.distance(p) < 1e-6 => {}
+                Some(last) => {
+                    let arc = path.arcs.last().copied().unwrap_or(0.0) + last.distance(p);
+                    path.points.push(p);
+                    path.arcs.push(arc);
+                }
+                None => {
+                    path.points.push(p);
+                    path.arcs.push(0.0);
+                }
+            }
+        }
+        path
+    }
+
+    pub fn length(&self) -> f64 {
+        self.arcs.last().copied().unwrap_or(0.0)
+    }
+
+    pub fn points(&self) -> &[Vec2] {
+        &self.points
+    }
+
+    /// The segment holding arc `s`, clamped to the ends.
+    fn segment(&self, s: f64) -> usize {
+        if self.points.len() < 2 {
+            return 0;
+        }
+        let i = self.arcs.partition_point(|&a| a <= s);
+        i.clamp(1, self.points.len() - 1) - 1
+    }
+
+    /// The pose at arc length `s` (extrapolated straight beyond the ends).
+    pub fn pose(&self, s: f64) -> Pose {
+        match self.points.len() {
+            0 => Pose::default(),
+            1 => Pose { position: self.points[0], yaw: 0.0 },
+            _ => {
+                let i = self.segment(s);
+                let (a, b) = (self.points[i], self.points[i + 1]);
+                let along = (b - a) * (1.0 / (self.arcs[i + 1] - self.arcs[i]));
+                Pose { position: a + along * (s - self.arcs[i]), yaw: along.yaw() }
+            }
+        }
+    }
+
+    /// The arc length of the point of the path nearest `p`, and the distance to it.
+    pub fn project(&self, p: Vec2) -> (f64, f64) {
+        if self.points.len() < 2 {
+            return (0.0, self.points.first().map_or(f64::INFINITY, |q| q.distance(p)));
+        }
+        let mut best = (0.0, f64::INFINITY);
+        for i in 0..self.points.len() - 1 {
+            let (a, b) = (self.points[i], self.points[i + 1]);
+            let ab = b - a;
+            let t = ((p - a).dot(ab) / ab.dot(ab)).clamp(0.0, 1.0);
+            let d = (a + ab * t).distance(p);
+            if d < best.1 {
+                best = (self.arcs[i] + t * (self.arcs[i + 1] - self.arcs[i]), d);
+            }
+        }
+        best
+    }
+
+    /// The first arc length of this path at which it comes within `reach` of `other`,
+    /// with the arc length on `other`; sampled every `step` metres.
+    pub fn first_within(&self, other: &Path, reach: f64, step: f64) -> Option<(f64, f64)> {
+        let mut s = 0.0;
+        let end = self.length();
+        while s <= end {
+            let (o, d) = other.project(self.pose(s).position);
+            if d <= reach {
+                return Some((s, o));
+            }
+            s += step;
+        }
+        None
+    }
+}
+
+/// A cubic Bézier curve from `a` (leaving along `da`) to `b` (arriving along `db`),
+/// sampled every metre or so.
+pub fn bezier(a: Vec2, da: Vec2, b: Vec2, db: Vec2) -> Vec<Vec2> {
+    let chord = a.distance(b);
+    // a quarter circle of radius r has chord r·√2 and control arms of 0.552·r
+    let arm = chord * 0.39;
+    let (c1, c2) = (a + da * arm, b - db * arm);
+    let n = (chord.ceil() as usize).clamp(4, 400);
+    (0..=n)
+        .map(|k| {
+            let t = k as f64 / n as f64;
+            let u = 1.0 - t;
+            a * (u * u * u) + c1 * (3.0 * u * u * t) + c2 * (3.0 * u * t * t) + b * (t * t * t)
+        })
+        .collect()
+}
+
+/// A rectangle of `length` along its heading and `width` across, centred on its pose.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Footprint {
+    pub pose: Pose,
+    pub length: f64,
+    pub width: f64,
+}
+
+impl Footprint {
+    pub fn corners(&self) -> [Vec2; 4] {
+        let f = Vec2::from_yaw(self.pose.yaw) * (self.length / 2.0);
+        let l = Vec2::from_yaw(self.pose.yaw).left() * (self.width / 2.0);
+        let c = self.pose.position;
+        [c + f + l, c + f - l, c - f - l, c - f + l]
+    }
+
+    /// Whether the two rectangles share interior points (touching edges do not count).
+    pub fn overlaps(&self, other: &Footprint) -> bool {
+        let (a, b) = (self.corners(), other.corners());
+        let axes = [
+            Vec2::from_yaw(self.pose.yaw),
+            Vec2::from_yaw(self.pose.yaw).left(),
+            Vec2::from_yaw(other.pose.yaw),
+            Vec2::from_yaw(other.pose.yaw).left(),
+        ];
+        axes.iter().all(|axis| {
+            let (a0, a1) = extent(&a, *axis);
+            let (b0, b1) = extent(&b, *axis);
+            a0 < b1 - 1e-9 && b0 < a1 - 1e-9
+        })
+    }
+
+    /// The distance between the rectangles: 0 when they overlap or touch.
+    pub fn distance(&self, other: &Footprint) -> f64 {
+        if self.overlaps(other) {
+            return 0.0;
+        }
+        let (a, b) = (self.corners(), other.corners());
+        let mut best = f64::INFINITY;
+        for i in 0..4 {
+            for j in 0..4 {
+                best = best.min(point_segment(a[i], b[j], b[(j + 1) % 4]));
+                best = best.min(point_segment(b[j], a[i], a[(i + 1) % 4]));
+            }
+        }
+        best
+    }
+}
+
+fn extent(corners: &[Vec2; 4], axis: Vec2) -> (f64, f64) {
+    corners.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), c| {
+        let p = c.dot(axis);
+        (lo.min(p), hi.max(p))
+    })
+}
+
+fn point_segment(p: Vec2, a: Vec2, b: Vec2) -> f64 {
+    let ab = b - a;
+    let len2 = ab.dot(ab);
+    let t = if len2 > 0.0 { ((p - a).dot(ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
+    (a + ab * t).distance(p)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::FRAC_PI_2;
+
+    fn boxed(x: f64, y: f64, yaw: f64, length: f64, width: f64) -> Footprint {
+        Footprint { pose: Pose { position: Vec2::new(x, y), yaw }, length, width }
+    }
+
+    #[test]
+    fn boxes_overlap_by_their_rotated_sides() {
+        let car = boxed(0.0, 0.0, 0.0, 4.0, 2.0);
+        assert!(car.overlaps(&boxed(3.9, 0.0, 0.0, 4.0, 2.0)));
+        assert!(!car.overlaps(&boxed(4.1, 0.0, 0.0, 4.0, 2.0)));
+        assert!((car.distance(&boxed(5.0, 0.0, 0.0, 4.0, 2.0)) - 1.0).abs() < 1e-9);
+        // a box turned 45° whose corner reaches into the car
+        let turned = boxed(2.0 + 1.0, 0.0, std::f64::consts::FRAC_PI_4, 2.0, 2.0);
+        assert!(turned.overlaps(&car), "corner at x = {}", 3.0 - 2f64.sqrt());
+        // across, beside it
+        let across = boxed(0.0, 2.6, FRAC_PI_2, 1.0, 0.6);
+        assert!(!car.overlaps(&across));
+        assert!((car.distance(&across) - 1.1).abs() < 1e-9);
+    }
+
+    #[test]
+    fn paths_give_poses_and_projections() {
+        let path = Path::new([Vec2::new(0.0, 0.0), Vec2::new(10.0, 0.0), Vec2::new(10.0, 10.0)]);
+        assert_eq!(path.length(), 20.0);
+        let p = path.pose(15.0);
+        assert!((p.position.y - 5.0).abs() < 1e-9 && (p.yaw - FRAC_PI_2).abs() < 1e-9);
+        let before = path.pose(-5.0);
+        assert!((before.position.x + 5.0).abs() < 1e-9);
+        let (s, d) = path.project(Vec2::new(4.0, 2.0));
+        assert!((s - 4.0).abs() < 1e-9 && (d - 2.0).abs() < 1e-9);
+        let other = Path::new([Vec2::new(5.0, -5.0), Vec2::new(5.0, 5.0)]);
+        let (s, _) = path.first_within(&other, 1.0, 0.5).unwrap();
+        assert!((s - 4.0).abs() < 1e-9);
+        assert!(Path::new([Vec2::new(1.0, 1.0)]).pose(3.0).position == Vec2::new(1.0, 1.0));
+    }
+
+    #[test]
+    fn wrap_keeps_angles_in_one_turn() {
+        assert!((wrap(3.0 * std::f64::consts::PI) - std::f64::consts::PI).abs() < 1e-9);
+        assert!((wrap(-FRAC_PI_2 - std::f64::consts::TAU) + FRAC_PI_2).abs() < 1e-9);
+    }
+}

@@ -1,0 +1,163 @@
+//! The layout: where everything of a scenario is, target-neutral, for every backend (the
+//! Scenic printer, the runtime). Specified in `spec/layout.md`.
+//!
+//! ```text
+//! ir::Scenario ──facts──▶ bodies, counts, motions, speeds (+ the values chosen)
+//!              ──road───▶ Road: shape, lanes, arms, stop lines, crosswalks, the ego's approach
+//!              ──place──▶ every actor on an arm, a lane and a station, facing along or across
+//!              ──paths──▶ the path each one drives or walks (through the junction, a lane change)
+//!              ──timing─▶ each adversary started so it meets the ego at their conflict point
+//! ```
+//!
+//! Modules: `geom` (points, paths, footprints), `facts`, `road`, `place` (the steps above),
+//! `predict` (a kinematic roll-out of the layout: constant speeds, IDM following), and
+//! `fidelity` (what a simulated run must show: relations at the start, no overlap,
+//! adversaries reaching the ego; the same checks for the roll-out and for a simulator's
+//! trace).
+
+pub mod facts;
+pub mod fidelity;
+pub mod geom;
+mod place;
+pub mod predict;
+pub mod road;
+
+pub use facts::{Body, Chosen, Facts, MAX_GROUP};
+pub use place::lay_out;
+pub use road::{Arm, Road, Shape, Side, Station, Turn};
+
+use geom::{Footprint, Path, Pose};
+use tad_ir::{GroupId, Motion, Span};
+
+/// Where across its lane an actor stands.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Place {
+    /// The lane's centre.
+    Lane,
+    /// The curb side of an outermost lane.
+    Curb,
+    /// The sidewalk beside the road.
+    Sidewalk,
+}
+
+/// Which way an actor faces at the start.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Facing {
+    /// Along its lane's traffic.
+    Along,
+    /// Across the road, from the sidewalk of `from` towards the other side.
+    Across { from: Side },
+}
+
+/// When an actor starts doing its behavior.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Start {
+    /// Seconds it waits first (a written `delay`, or the layout's timing).
+    pub delay: f64,
+    /// It waits until the ego is within this distance, m (a written `trigger`).
+    pub trigger: Option<f64>,
+}
+
+/// One actor: the ego or one member of a group.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Agent {
+    /// `None` for the ego.
+    pub group: Option<GroupId>,
+    /// Its place in its group, from 0.
+    pub index: usize,
+    pub body: Body,
+    pub length: f64,
+    pub width: f64,
+    pub station: Station,
+    /// TAD lane index on its arm.
+    pub lane: i64,
+    pub place: Place,
+    /// Left of its arm's centre line (as the arm's incoming traffic sees it), m.
+    pub lateral: f64,
+    pub facing: Facing,
+    pub motion: Option<Motion>,
+    /// What it does at the junction ahead.
+    pub turn: Turn,
+    /// m/s: the speed it keeps once it moves.
+    pub speed: f64,
+    /// It is moving at the start (at `speed`).
+    pub moving: bool,
+    pub start: Start,
+    /// Its pose at the start.
+    pub pose: Pose,
+    /// What it drives or walks along, and the arc length of its start on it.
+    pub path: Path,
+    pub path_start: f64,
+}
+
+impl Agent {
+    pub fn footprint(&self) -> Footprint {
+        Footprint { pose: self.pose, length: self.length, width: self.width }
+    }
+
+    /// Whether it never moves by itself.
+    pub fn is_static(&self) -> bool {
+        self.speed <= 0.0 || self.body == Body::Object
+    }
+}
+
+/// A group's actors and the room the layout left around them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GroupLayout {
+    pub group: GroupId,
+    pub facts: Facts,
+    pub agents: Vec<Agent>,
+    /// How far the whole group may be sampled nearer its reference (m, along its lane
+    /// towards it) without touching anything: the free room the layout keeps.
+    pub slack: f64,
+}
+
+/// A group timed to meet the ego.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Conflict {
+    pub group: GroupId,
+    /// Where the first actor's path meets the ego's.
+    pub point: geom::Vec2,
+    /// When the ego reaches it at its stated speed, s.
+    pub time: f64,
+    /// How far (m, along its path) the adversary's start may vary either way and still meet
+    /// the ego within about a second.
+    pub spread: f64,
+}
+
+/// What the layout could not do as the scenario says.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Finding {
+    /// A value not stated, chosen.
+    Chosen(Chosen),
+    /// The group belongs on a junction arm the road does not have: it is on the ego's road.
+    NoArm { group: GroupId, arm: Arm, span: Span },
+    /// More actors than [`MAX_GROUP`].
+    Capped { group: GroupId, wanted: usize, placed: usize, span: Span },
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Layout {
+    pub road: Road,
+    pub ego: Agent,
+    pub ego_facts: Facts,
+    /// In the scenario's source order.
+    pub groups: Vec<GroupLayout>,
+    pub conflicts: Vec<Conflict>,
+    pub findings: Vec<Finding>,
+}
+
+impl Layout {
+    /// The ego and every actor, the ego first.
+    pub fn agents(&self) -> impl Iterator<Item = &Agent> {
+        std::iter::once(&self.ego).chain(self.groups.iter().flat_map(|g| &g.agents))
+    }
+
+    pub fn group(&self, id: GroupId) -> Option<&GroupLayout> {
+        self.groups.iter().find(|g| g.group == id)
+    }
+
+    pub fn conflict(&self, id: GroupId) -> Option<&Conflict> {
+        self.conflicts.iter().find(|c| c.group == id)
+    }
+}
