@@ -412,6 +412,29 @@ pub fn lay_out(scenario: &Scenario) -> Layout {
             }
         }
     }
+    if let Some(half) = road.junction.as_ref().filter(|j| j.arms.contains(&Arm::Opposite)).map(|j| j.half) {
+        // moving traffic ahead past the stop line is already across the junction
+        for (i, d) in decisions.iter().enumerate() {
+            let Some(d) = d.as_ref().filter(|d| d.arm == Arm::Ego && d.lane > 0 && !d.crosser) else { continue };
+            let f = &group_facts[i];
+            if f.is_static() || f.body != Body::Vehicle || turn_of(f.motion) != Turn::Straight {
+                continue;
+            }
+            let mut next = f.length / 2.0 + 0.5;
+            for (s, _) in &mut stations[i] {
+                if s.along + f.length / 2.0 > road.approach - 0.5 {
+                    let beyond = (s.along - road.approach - 2.0 * half).max(next);
+                    next = beyond + f.length + gap(f, f.speed);
+                    *s = Station { arm: Arm::Opposite, along: beyond };
+                    occupied.entry((Arm::Opposite, Key::Lane(-d.lane))).or_default().push((
+                        beyond - f.length / 2.0,
+                        beyond + f.length / 2.0,
+                        f.speed,
+                    ));
+                }
+            }
+        }
+    }
     place_arm(false, &road, &mut stations, &mut slack, &mut occupied);
     // --- agents, paths and timing; a walker that cannot reach a junction's crossing in
     // time moves the ego's start back
@@ -483,7 +506,10 @@ fn build(
             .iter()
             .enumerate()
             .map(|(k, &(station, lateral))| {
-                let lane = d.lane;
+                // moved across the junction: an outgoing lane of the opposite arm
+                let moved = station.arm != d.arm;
+                let lane = if moved { -d.lane } else { d.lane };
+                let lateral = if moved { road.lateral(lane) } else { lateral };
                 let yaw_of = |pose: Pose| match d.facing {
                     Facing::Along => pose.yaw,
                     Facing::Across { from } => {
@@ -648,6 +674,7 @@ fn place_group(
     let lead = if d.distance.is_some() { lead } else { lead + room };
     let edge = if step > 0.0 { reference.high } else { reference.low };
     let first = match d.longitudinal {
+        _ if reference.stop_line && across => -CROSSWALK,
         Longitudinal::Same if !reference.stop_line => (reference.low + reference.high) / 2.0,
         _ => edge + step * (lead + extent / 2.0),
     };
