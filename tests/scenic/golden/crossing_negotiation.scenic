@@ -238,24 +238,26 @@ behavior TadYield(speed):
 # Left out, as Town04 has no place with them and the rest: a stop sign at the junction ahead.
 # The ego is placed where the lane layout holds from `behind` metres behind it to `ahead` metres
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
-tadRoad = dict(same=1, other=1, minSame=1, minOther=1, index=1, sidewalk=False,
+tadRoad = dict(same=1, other=1, minSame=1, minOther=0, index=1, sidewalk=False,
                junction='4way', signalised=False, maneuver=None, signs=(),
-               shape=None, ahead=15.0, behind=4.0, approach=17.0)
+               shape=None, ahead=4.0, behind=4.0, approach=11.0, arms=('left', 'opposite'))
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
 # ego vehicle: move_forward, 10 km/h, lane 1
 tadEgoAt = tadSpot(tadAnchor, 0.0, 1)
 ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
-    with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 2.778, with behavior FollowLaneBehavior(target_speed=2.778)
+    with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 2.778, with behavior TadThrough(2.778, 'STRAIGHT')
 
 # group `adversary_suv`: 1 suv, turn_left, 15 km/h, left_front of ego, lane 1
-tadAt1 = tadSpot(tadAnchor, 10.817, 1)
+tadJitter1 = Range(-2.083, 2.083)
+tadAt1 = tadArmSpot(tadAnchor, 'left', 22.095 + tadJitter1, 1)
 adversary_suv = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.nissan.patrol', with width 1.95, with length 4.8,
-    with regionContainedIn None, with speed 4.167, with behavior TadTurn(4.167, 'LEFT_TURN')
+    with regionContainedIn None, with speed 4.167, with behavior TadThrough(4.167, 'LEFT_TURN')
 
 # group `waiting_car`: 1 car, stopped, 0 km/h, front of ego, lane -1
-tadAt2 = tadSpot(tadAnchor, 9.278, -1)
+tadShift2 = Range(0, 0.6)
+tadAt2 = tadArmSpot(tadAnchor, 'opposite', 4.35 - tadShift2, 1)
 waiting_car = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadStop()

@@ -234,12 +234,12 @@ behavior TadYield(speed):
         take SetThrottleAction(0), SetBrakeAction(1.0)
 # ---- end of the prelude ----
 
-# The road around the ego vehicle: 4 lanes in the ego's direction, 4 lanes in the other direction, a straight stretch of 79 m.
+# The road around the ego vehicle: 4 lanes in the ego's direction, 4 lanes in the other direction, a straight stretch of 67 m.
 # The ego is placed where the lane layout holds from `behind` metres behind it to `ahead` metres
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=4, other=4, minSame=3, minOther=0, index=3, sidewalk=False,
                junction=None, signalised=None, maneuver=None, signs=(),
-               shape='straight', ahead=40.0, behind=39.0, approach=None)
+               shape='straight', ahead=48.0, behind=19.0, approach=None, arms=())
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
 # ego vehicle: change_lane_left, 97 km/h, lane 3
@@ -248,19 +248,22 @@ ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 26.833, with behavior TadChangeLane(26.833, True)
 
 # group `slow_truck`: 1 truck, move_forward, 72 km/h, front of ego, lane 3
-tadAt1 = tadSpot(tadAnchor, 34.833, 3)
+tadShift1 = Range(0, 8.0)
+tadAt1 = tadSpot(tadAnchor, 42.833 - tadShift1, 3)
 slow_truck = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.carlamotors.carlacola', with width 2.5, with length 7.5,
-    with regionContainedIn None, with speed 20.111, with behavior FollowLaneBehavior(target_speed=20.111)
+    with regionContainedIn None, with speed 20.111, with behavior TadDrive(20.111)
 
 # group `merging_suv`: 1 suv, change_lane_right, 100 km/h, left_front of ego, lane 1
-tadAt2 = tadSpot(tadAnchor, 34.372, 1)
+tadJitter2 = Range(-5.0, 5.0)
+tadAt2 = tadSpot(tadAnchor, 5.15 + tadJitter2, 1)
 merging_suv = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.nissan.patrol', with width 1.95, with length 4.8,
     with regionContainedIn None, with speed 27.722, with behavior TadChangeLane(27.722, False)
 
 # group `fast_sedan`: 1 sedan, move_forward, 116 km/h, left_behind of ego, lane 2
-tadAt3 = tadSpot(tadAnchor, -34.65, 2)
+tadJitter3 = Range(-5.0, 5.0)
+tadAt3 = tadSpot(tadAnchor, -15.264 + tadJitter3, 2)
 fast_sedan = new Car at tadAt3[0], facing tadAt3[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
-    with regionContainedIn None, with speed 32.194, with behavior FollowLaneBehavior(target_speed=32.194)
+    with regionContainedIn None, with speed 32.194, with behavior TadDrive(32.194)

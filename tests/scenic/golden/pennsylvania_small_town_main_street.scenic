@@ -239,32 +239,34 @@ behavior TadYield(speed):
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=1, other=1, minSame=1, minOther=1, index=1, sidewalk=True,
                junction=None, signalised=None, maneuver=None, signs=(),
-               shape='straight', ahead=34.0, behind=4.0, approach=None)
+               shape='straight', ahead=28.0, behind=4.0, approach=None, arms=())
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
 # ego vehicle: move_forward, 35 km/h, lane 1
 tadEgoAt = tadSpot(tadAnchor, 0.0, 1)
 ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
-    with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 9.722, with behavior FollowLaneBehavior(target_speed=9.722)
+    with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 9.722, with behavior TadDrive(9.722)
 
 # group `pickup_truck`: 1 truck, move_forward, 35 km/h, front of ego, lane 1
-tadAt1 = tadSpot(tadAnchor, 17.722, 1)
+tadShift1 = Range(0, 4.689)
+tadAt1 = tadSpot(tadAnchor, 22.411 - tadShift1, 1)
 pickup_truck = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.carlamotors.carlacola', with width 2.5, with length 7.5,
-    with regionContainedIn None, with speed 9.722, with behavior FollowLaneBehavior(target_speed=9.722)
+    with regionContainedIn None, with speed 9.722, with behavior TadDrive(9.722)
 
 # group `parked_cars`: 2 car, parked, 0 km/h, right_front of ego, lane 1
-tadAt2 = tadSpot(tadAnchor, 24.722, 1, 'curb', 1.8)
+tadAt2 = tadSpot(tadAnchor, 5.9, 1, 'curb', 1.8)
 parked_cars_1 = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadParked()
-tadAt3 = tadSpot(tadAnchor, 30.222, 1, 'curb', 1.8)
+tadAt3 = tadSpot(tadAnchor, 11.4, 1, 'curb', 1.8)
 parked_cars_2 = new Car at tadAt3[0], facing tadAt3[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadParked()
 
 # group `oncoming_suv`: 1 suv, move_forward, 40 km/h, front of ego, lane -1
-tadAt4 = tadSpot(tadAnchor, 17.761, -1)
+tadShift3 = Range(0, 5.244)
+tadAt4 = tadSpot(tadAnchor, 23.006 - tadShift3, -1)
 oncoming_suv = new Car at tadAt4[0], facing tadAt4[1],
     with blueprint 'vehicle.nissan.patrol', with width 1.95, with length 4.8,
-    with regionContainedIn None, with speed 11.111, with behavior FollowLaneBehavior(target_speed=11.111)
+    with regionContainedIn None, with speed 11.111, with behavior TadDrive(11.111)

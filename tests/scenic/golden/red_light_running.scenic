@@ -239,37 +239,40 @@ behavior TadYield(speed):
 # Left out, as Town06 has no place with them and the rest: a sidewalk beside the ego's lane.
 # The ego is placed where the lane layout holds from `behind` metres behind it to `ahead` metres
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
-tadRoad = dict(same=3, other=3, minSame=3, minOther=2, index=2, sidewalk=False,
+tadRoad = dict(same=3, other=3, minSame=3, minOther=0, index=2, sidewalk=False,
                junction='4way', signalised=True, maneuver=None, signs=(),
-               shape=None, ahead=42.0, behind=4.0, approach=44.0)
+               shape=None, ahead=33.0, behind=4.0, approach=43.0, arms=('opposite', 'right'))
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
 # ego vehicle: move_forward, 50 km/h, lane 2
 tadEgoAt = tadSpot(tadAnchor, 0.0, 2)
 ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
-    with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 13.889, with behavior FollowLaneBehavior(target_speed=13.889)
+    with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 13.889, with behavior TadThrough(13.889, 'STRAIGHT')
 
 # group `red_light_runner`: 1 sedan, move_forward, 60 km/h, right_front of ego, lane 2
-tadAt1 = tadSpot(tadAnchor, 23.317, 2)
+tadJitter1 = Range(-5.0, 5.0)
+tadAt1 = tadArmSpot(tadAnchor, 'right', 67.233 + tadJitter1, 2)
 red_light_runner = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
-    with regionContainedIn None, with speed 16.667, with behavior FollowLaneBehavior(target_speed=16.667)
+    with regionContainedIn None, with speed 16.667, with behavior TadThrough(16.667, 'STRAIGHT')
 
 # group `box_truck`: 1 truck, move_forward, 40 km/h, right_front of ego, lane 3
-tadAt2 = tadSpot(tadAnchor, 21.889, 3)
+tadShift2 = Range(0, 6.356)
+tadAt2 = tadSpot(tadAnchor, 28.244 - tadShift2, 3)
 box_truck = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.carlamotors.carlacola', with width 2.5, with length 7.5,
-    with regionContainedIn None, with speed 11.111, with behavior FollowLaneBehavior(target_speed=11.111)
+    with regionContainedIn None, with speed 11.111, with behavior TadThrough(11.111, 'STRAIGHT')
 
 # group `oncoming_cars`: 2 car, move_forward, 45 km/h, front of ego, lane -2
-tadAt3 = tadSpot(tadAnchor, 20.389, -2)
+tadShift3 = Range(0, 8.0)
+tadAt3 = tadArmSpot(tadAnchor, 'opposite', 36.25 - tadShift3, 2)
 oncoming_cars_1 = new Car at tadAt3[0], facing tadAt3[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
-    with regionContainedIn None, with speed 12.5, with behavior FollowLaneBehavior(target_speed=12.5)
-tadAt4 = tadSpot(tadAnchor, 38.389, -2)
+    with regionContainedIn None, with speed 12.5, with behavior TadThrough(12.5, 'STRAIGHT')
+tadAt4 = tadArmSpot(tadAnchor, 'opposite', 55.25 - tadShift3, 2)
 oncoming_cars_2 = new Car at tadAt4[0], facing tadAt4[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
-    with regionContainedIn None, with speed 12.5, with behavior FollowLaneBehavior(target_speed=12.5)
+    with regionContainedIn None, with speed 12.5, with behavior TadThrough(12.5, 'STRAIGHT')
 
 # The traffic light facing the ego vehicle is `green`: hold the nearest one in that state.
 # (Without CARLA's model, as under Scenic's Newtonian simulator, the monitor does nothing.)

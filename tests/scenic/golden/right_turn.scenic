@@ -232,58 +232,77 @@ behavior TadYield(speed):
         do FollowLaneBehavior(target_speed=speed)
     interrupt when withinDistanceToAnyObjs(self, 10):
         take SetThrottleAction(0), SetBrakeAction(1.0)
+
+# Parameters: a choice of behaviors, a delay, a trigger.
+behavior TadOneOf(index, options):
+    """One of a choice of behaviors: the one at the sampled index."""
+    do options[index]
+
+behavior TadDelayed(delay, hold, then):
+    """Hold still for `delay` seconds, then behave."""
+    do hold for delay seconds
+    do then
+
+behavior TadTriggered(distance, hold, then):
+    """Hold still until the ego vehicle is within `distance` metres, then behave."""
+    do hold until (distance from self to ego) < distance
+    do then
 # ---- end of the prelude ----
 
 # The road around the ego vehicle: 2 lanes in the ego's direction, 2 lanes in the other direction, a four-way junction, a right turn at the junction ahead, a junction with traffic lights, a sidewalk beside the ego's lane.
 # The ego is placed where the lane layout holds from `behind` metres behind it to `ahead` metres
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
-tadRoad = dict(same=2, other=2, minSame=2, minOther=1, index=2, sidewalk=True,
+tadRoad = dict(same=2, other=2, minSame=2, minOther=0, index=2, sidewalk=True,
                junction='4way', signalised=True, maneuver='RIGHT_TURN', signs=(),
-               shape=None, ahead=42.0, behind=4.0, approach=44.0)
+               shape=None, ahead=4.0, behind=4.0, approach=13.0, arms=('opposite', 'right'))
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
 # ego vehicle: turn_right, 12 km/h, lane 2
 tadEgoAt = tadSpot(tadAnchor, 0.0, 2)
 ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
-    with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 3.333, with behavior TadTurn(3.333, 'RIGHT_TURN')
+    with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 3.333, with behavior TadThrough(3.333, 'RIGHT_TURN')
 
 # group `left_turning_taxi`: 1 taxi, turn_left, 30 km/h, front of ego, lane -1
-tadAt1 = tadSpot(tadAnchor, 14.983, -1)
+tadShift1 = Range(0, 7.067)
+tadAt1 = tadArmSpot(tadAnchor, 'opposite', 27.133 - tadShift1, 1)
 left_turning_taxi = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.ford.crown', with width 1.85, with length 4.8,
-    with regionContainedIn None, with speed 8.333, with behavior TadTurn(8.333, 'LEFT_TURN')
+    with regionContainedIn None, with speed 8.333, with behavior TadThrough(8.333, 'LEFT_TURN')
 
 # group `crossing_pedestrians`: 4 pedestrian, cross, 5 km/h, right_front of ego, lane 2
-tadAt2 = tadSpot(tadAnchor, 6.883, 2)
-crossing_pedestrians_1 = new Pedestrian at tadAt2[0], facing tadAt2[1] + 90 deg,
+tadDelay2 = 4.749
+tadJitter2 = Range(-0.5, 0.5)
+tadAt2 = tadCross(tadAnchor, 'right', -2.0 + tadJitter2, False, 0.0)
+crossing_pedestrians_1 = new Pedestrian at tadAt2[0], facing tadAt2[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
-    with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt3 = tadSpot(tadAnchor, 7.983, 2)
-crossing_pedestrians_2 = new Pedestrian at tadAt3[0], facing tadAt3[1] + 90 deg,
+    with regionContainedIn None, with behavior TadDelayed(tadDelay2, TadStand(), TadWalk(1.389))
+tadAt3 = tadCross(tadAnchor, 'right', -1.1 + tadJitter2, False, 0.0)
+crossing_pedestrians_2 = new Pedestrian at tadAt3[0], facing tadAt3[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
-    with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt4 = tadSpot(tadAnchor, 9.083, 2)
-crossing_pedestrians_3 = new Pedestrian at tadAt4[0], facing tadAt4[1] + 90 deg,
+    with regionContainedIn None, with behavior TadDelayed(tadDelay2, TadStand(), TadWalk(1.389))
+tadAt4 = tadCross(tadAnchor, 'right', -0.2 + tadJitter2, False, 0.0)
+crossing_pedestrians_3 = new Pedestrian at tadAt4[0], facing tadAt4[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
-    with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt5 = tadSpot(tadAnchor, 10.183, 2)
-crossing_pedestrians_4 = new Pedestrian at tadAt5[0], facing tadAt5[1] + 90 deg,
+    with regionContainedIn None, with behavior TadDelayed(tadDelay2, TadStand(), TadWalk(1.389))
+tadAt5 = tadCross(tadAnchor, 'right', 0.7 + tadJitter2, False, 0.0)
+crossing_pedestrians_4 = new Pedestrian at tadAt5[0], facing tadAt5[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
-    with regionContainedIn None, with behavior TadWalk(1.389)
+    with regionContainedIn None, with behavior TadDelayed(tadDelay2, TadStand(), TadWalk(1.389))
 
 # group `through_cars`: 3 car, move_forward, 25 km/h, left_front of ego, lane 1
-tadAt6 = tadSpot(tadAnchor, 13.444, 1)
+tadShift3 = Range(0, 3.578)
+tadAt6 = tadArmSpot(tadAnchor, 'opposite', 2.75 - tadShift3, -1)
 through_cars_1 = new Car at tadAt6[0], facing tadAt6[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
-    with regionContainedIn None, with speed 6.944, with behavior FollowLaneBehavior(target_speed=6.944)
-tadAt7 = tadSpot(tadAnchor, 25.889, 1)
+    with regionContainedIn None, with speed 6.944, with behavior TadDrive(6.944)
+tadAt7 = tadArmSpot(tadAnchor, 'opposite', 16.194 - tadShift3, -1)
 through_cars_2 = new Car at tadAt7[0], facing tadAt7[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
-    with regionContainedIn None, with speed 6.944, with behavior FollowLaneBehavior(target_speed=6.944)
-tadAt8 = tadSpot(tadAnchor, 38.333, 1)
+    with regionContainedIn None, with speed 6.944, with behavior TadDrive(6.944)
+tadAt8 = tadArmSpot(tadAnchor, 'opposite', 29.639 - tadShift3, -1)
 through_cars_3 = new Car at tadAt8[0], facing tadAt8[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
-    with regionContainedIn None, with speed 6.944, with behavior FollowLaneBehavior(target_speed=6.944)
+    with regionContainedIn None, with speed 6.944, with behavior TadDrive(6.944)
 
 # The traffic light facing the ego vehicle is `green`: hold the nearest one in that state.
 # (Without CARLA's model, as under Scenic's Newtonian simulator, the monitor does nothing.)

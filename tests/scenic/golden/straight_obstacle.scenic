@@ -232,61 +232,79 @@ behavior TadYield(speed):
         do FollowLaneBehavior(target_speed=speed)
     interrupt when withinDistanceToAnyObjs(self, 10):
         take SetThrottleAction(0), SetBrakeAction(1.0)
+
+# Parameters: a choice of behaviors, a delay, a trigger.
+behavior TadOneOf(index, options):
+    """One of a choice of behaviors: the one at the sampled index."""
+    do options[index]
+
+behavior TadDelayed(delay, hold, then):
+    """Hold still for `delay` seconds, then behave."""
+    do hold for delay seconds
+    do then
+
+behavior TadTriggered(distance, hold, then):
+    """Hold still until the ego vehicle is within `distance` metres, then behave."""
+    do hold until (distance from self to ego) < distance
+    do then
 # ---- end of the prelude ----
 
-# The road around the ego vehicle: 2 lanes in the ego's direction, 2 lanes in the other direction, a sidewalk beside the ego's lane, a straight stretch of 33 m.
+# The road around the ego vehicle: 2 lanes in the ego's direction, 2 lanes in the other direction, a sidewalk beside the ego's lane, a straight stretch of 55 m.
 # The ego is placed where the lane layout holds from `behind` metres behind it to `ahead` metres
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=2, other=2, minSame=2, minOther=1, index=1, sidewalk=True,
                junction=None, signalised=None, maneuver=None, signs=(),
-               shape='straight', ahead=52.0, behind=4.0, approach=None)
+               shape='straight', ahead=51.0, behind=4.0, approach=None, arms=())
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
 # ego vehicle: move_forward, 45 km/h, lane 1
 tadEgoAt = tadSpot(tadAnchor, 0.0, 1)
 ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
-    with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 12.5, with behavior FollowLaneBehavior(target_speed=12.5)
+    with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 12.5, with behavior TadDrive(12.5)
 
 # group `parked_sedans`: 5 sedan, parked, 0 km/h, right_front of ego, lane 2
-tadAt1 = tadSpot(tadAnchor, 19.15, 2, 'curb', 1.85)
+tadAt1 = tadSpot(tadAnchor, 6.05, 2, 'curb', 1.85)
 parked_sedans_1 = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt2 = tadSpot(tadAnchor, 24.95, 2, 'curb', 1.85)
+tadAt2 = tadSpot(tadAnchor, 11.85, 2, 'curb', 1.85)
 parked_sedans_2 = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt3 = tadSpot(tadAnchor, 30.75, 2, 'curb', 1.85)
+tadAt3 = tadSpot(tadAnchor, 17.65, 2, 'curb', 1.85)
 parked_sedans_3 = new Car at tadAt3[0], facing tadAt3[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt4 = tadSpot(tadAnchor, 36.55, 2, 'curb', 1.85)
+tadAt4 = tadSpot(tadAnchor, 23.45, 2, 'curb', 1.85)
 parked_sedans_4 = new Car at tadAt4[0], facing tadAt4[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt5 = tadSpot(tadAnchor, 42.35, 2, 'curb', 1.85)
+tadAt5 = tadSpot(tadAnchor, 29.25, 2, 'curb', 1.85)
 parked_sedans_5 = new Car at tadAt5[0], facing tadAt5[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
 
 # group `delivery_van`: 1 van, parked, 0 km/h, right_front of ego, lane 2
-tadAt6 = tadSpot(tadAnchor, 48.35, 2, 'curb', 2.0)
+tadAt6 = tadSpot(tadAnchor, 34.75, 2, 'curb', 2.0)
 delivery_van = new Car at tadAt6[0], facing tadAt6[1],
     with blueprint 'vehicle.mercedes.sprinter', with width 2.0, with length 5.2,
     with regionContainedIn None, with behavior TadParked()
 
 # group `darting_pedestrian`: 1 pedestrian, cross, 6 km/h, front of ego, lane 1
-tadAt7 = tadSpot(tadAnchor, 16.05, 1)
-darting_pedestrian = new Pedestrian at tadAt7[0], facing tadAt7[1] + 90 deg,
+tadDelay3 = 0.63
+tadJitter3 = Range(-0.5, 0.5)
+tadAt7 = tadCrossAt(tadAnchor, 49.125 + tadJitter3, True, 0.0)
+darting_pedestrian = new Pedestrian at tadAt7[0], facing tadAt7[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
-    with regionContainedIn None, with behavior TadWalk(1.667)
+    with regionContainedIn None, with behavior TadDelayed(tadDelay3, TadStand(), TadWalk(1.667))
 
 # group `oncoming_cars`: 2 car, move_forward, 40 km/h, front of ego, lane -1
-tadAt8 = tadSpot(tadAnchor, 19.0, -1)
+tadShift4 = Range(0, 5.8)
+tadAt8 = tadSpot(tadAnchor, 24.8 - tadShift4, -1)
 oncoming_cars_1 = new Car at tadAt8[0], facing tadAt8[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
-    with regionContainedIn None, with speed 11.111, with behavior FollowLaneBehavior(target_speed=11.111)
-tadAt9 = tadSpot(tadAnchor, 35.611, -1)
+    with regionContainedIn None, with speed 11.111, with behavior TadDrive(11.111)
+tadAt9 = tadSpot(tadAnchor, 42.411 - tadShift4, -1)
 oncoming_cars_2 = new Car at tadAt9[0], facing tadAt9[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
-    with regionContainedIn None, with speed 11.111, with behavior FollowLaneBehavior(target_speed=11.111)
+    with regionContainedIn None, with speed 11.111, with behavior TadDrive(11.111)

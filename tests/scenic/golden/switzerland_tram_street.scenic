@@ -235,53 +235,73 @@ behavior TadYield(speed):
         do FollowLaneBehavior(target_speed=speed)
     interrupt when withinDistanceToAnyObjs(self, 10):
         take SetThrottleAction(0), SetBrakeAction(1.0)
+
+# Parameters: a choice of behaviors, a delay, a trigger.
+behavior TadOneOf(index, options):
+    """One of a choice of behaviors: the one at the sampled index."""
+    do options[index]
+
+behavior TadDelayed(delay, hold, then):
+    """Hold still for `delay` seconds, then behave."""
+    do hold for delay seconds
+    do then
+
+behavior TadTriggered(distance, hold, then):
+    """Hold still until the ego vehicle is within `distance` metres, then behave."""
+    do hold until (distance from self to ego) < distance
+    do then
 # ---- end of the prelude ----
 
-# The road around the ego vehicle: 1 lane in the ego's direction, 1 lane in the other direction, a sidewalk beside the ego's lane, a straight stretch of 63 m.
+# The road around the ego vehicle: 1 lane in the ego's direction, 1 lane in the other direction, a sidewalk beside the ego's lane, a straight stretch of 83 m.
 # The ego is placed where the lane layout holds from `behind` metres behind it to `ahead` metres
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=1, other=1, minSame=1, minOther=1, index=1, sidewalk=True,
                junction=None, signalised=None, maneuver=None, signs=(),
-               shape='straight', ahead=73.0, behind=4.0, approach=None)
+               shape='straight', ahead=94.0, behind=4.0, approach=None, arms=())
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
 # ego vehicle: move_forward, 25 km/h, lane 1
 tadEgoAt = tadSpot(tadAnchor, 0.0, 1)
 ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
-    with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 6.944, with behavior FollowLaneBehavior(target_speed=6.944)
+    with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 6.944, with behavior TadDrive(6.944)
 
 # group `crossing_pedestrians`: 3 pedestrian, cross, 5 km/h, front of ego, lane 1
-tadAt1 = tadSpot(tadAnchor, 10.494, 1)
-crossing_pedestrians_1 = new Pedestrian at tadAt1[0], facing tadAt1[1] + 90 deg,
+tadDelay1 = 0.864
+tadJitter1 = Range(-0.5, 0.5)
+tadAt1 = tadCrossAt(tadAnchor, 16.0 + tadJitter1, True, 0.0)
+crossing_pedestrians_1 = new Pedestrian at tadAt1[0], facing tadAt1[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
-    with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt2 = tadSpot(tadAnchor, 11.594, 1)
-crossing_pedestrians_2 = new Pedestrian at tadAt2[0], facing tadAt2[1] + 90 deg,
+    with regionContainedIn None, with behavior TadDelayed(tadDelay1, TadStand(), TadWalk(1.389))
+tadAt2 = tadCrossAt(tadAnchor, 16.9 + tadJitter1, True, 0.0)
+crossing_pedestrians_2 = new Pedestrian at tadAt2[0], facing tadAt2[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
-    with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt3 = tadSpot(tadAnchor, 12.694, 1)
-crossing_pedestrians_3 = new Pedestrian at tadAt3[0], facing tadAt3[1] + 90 deg,
+    with regionContainedIn None, with behavior TadDelayed(tadDelay1, TadStand(), TadWalk(1.389))
+tadAt3 = tadCrossAt(tadAnchor, 17.8 + tadJitter1, True, 0.0)
+crossing_pedestrians_3 = new Pedestrian at tadAt3[0], facing tadAt3[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
-    with regionContainedIn None, with behavior TadWalk(1.389)
+    with regionContainedIn None, with behavior TadDelayed(tadDelay1, TadStand(), TadWalk(1.389))
 
 # group `cyclist`: 1 bicycle, move_forward, 18 km/h, right_front of ego, lane 1
-tadAt4 = tadSpot(tadAnchor, 17.694, 1)
+tadShift2 = Range(0, 3.578)
+tadAt4 = tadSpot(tadAnchor, 26.3 - tadShift2, 1, 'curb', 0.6)
 cyclist = new Car at tadAt4[0], facing tadAt4[1],
     with blueprint 'vehicle.diamondback.century', with width 0.6, with length 1.8,
-    with regionContainedIn None, with speed 5.0, with behavior FollowLaneBehavior(target_speed=5.0)
+    with regionContainedIn None, with speed 5.0, with behavior TadDrive(5.0)
 
 # group `oncoming_tram`: 1 tram, move_forward, 30 km/h, front of ego, lane -1
-tadAt5 = tadSpot(tadAnchor, 27.583, -1)
+tadShift3 = Range(0, 4.133)
+tadAt5 = tadSpot(tadAnchor, 43.733 - tadShift3, -1)
 oncoming_tram = new Car at tadAt5[0], facing tadAt5[1],
     with blueprint 'vehicle.mitsubishi.fusorosa', with width 2.4, with length 30.0,
-    with regionContainedIn None, with speed 8.333, with behavior FollowLaneBehavior(target_speed=8.333)
+    with regionContainedIn None, with speed 8.333, with behavior TadDrive(8.333)
 
 # group `cars_behind_tram`: 2 car, move_forward, 30 km/h, behind of oncoming_tram, lane -1
-tadAt6 = tadSpot(tadAnchor, 55.167, -1)
+tadShift4 = Range(0, 4.133)
+tadAt6 = tadSpot(tadAnchor, 75.45 - tadShift4, -1)
 cars_behind_tram_1 = new Car at tadAt6[0], facing tadAt6[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
-    with regionContainedIn None, with speed 8.333, with behavior FollowLaneBehavior(target_speed=8.333)
-tadAt7 = tadSpot(tadAnchor, 69.0, -1)
+    with regionContainedIn None, with speed 8.333, with behavior TadDrive(8.333)
+tadAt7 = tadSpot(tadAnchor, 90.283 - tadShift4, -1)
 cars_behind_tram_2 = new Car at tadAt7[0], facing tadAt7[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
-    with regionContainedIn None, with speed 8.333, with behavior FollowLaneBehavior(target_speed=8.333)
+    with regionContainedIn None, with speed 8.333, with behavior TadDrive(8.333)

@@ -236,6 +236,21 @@ behavior TadYield(speed):
         do FollowLaneBehavior(target_speed=speed)
     interrupt when withinDistanceToAnyObjs(self, 10):
         take SetThrottleAction(0), SetBrakeAction(1.0)
+
+# Parameters: a choice of behaviors, a delay, a trigger.
+behavior TadOneOf(index, options):
+    """One of a choice of behaviors: the one at the sampled index."""
+    do options[index]
+
+behavior TadDelayed(delay, hold, then):
+    """Hold still for `delay` seconds, then behave."""
+    do hold for delay seconds
+    do then
+
+behavior TadTriggered(distance, hold, then):
+    """Hold still until the ego vehicle is within `distance` metres, then behave."""
+    do hold until (distance from self to ego) < distance
+    do then
 # ---- end of the prelude ----
 
 # The road around the ego vehicle: 3 lanes in the ego's direction, a one-way road.
@@ -244,32 +259,35 @@ behavior TadYield(speed):
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=3, other=0, minSame=3, minOther=0, index=1, sidewalk=False,
                junction=None, signalised=None, maneuver=None, signs=(),
-               shape=None, ahead=22.0, behind=4.0, approach=None)
+               shape=None, ahead=24.0, behind=4.0, approach=None, arms=())
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
 # ego vehicle: turn_left, 15 km/h, lane 1
 tadEgoAt = tadSpot(tadAnchor, 0.0, 1)
 ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
-    with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 4.167, with behavior TadTurn(4.167, 'LEFT_TURN')
+    with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 4.167, with behavior TadThrough(4.167, 'LEFT_TURN')
 
 # group `crossing_cyclist`: 1 bicycle, cross, 14 km/h, left_front of ego, lane 1
-tadAt1 = tadSpot(tadAnchor, 8.717, 1)
-crossing_cyclist = new Car at tadAt1[0], facing tadAt1[1] + 90 deg,
+tadDelay1 = 9.157
+tadJitter1 = Range(-0.5, 0.5)
+tadAt1 = tadCrossAt(tadAnchor, 31.883 + tadJitter1, False, 0.0)
+crossing_cyclist = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.diamondback.century', with width 0.6, with length 1.8,
-    with regionContainedIn None, with speed 3.889, with behavior TadRide(3.889)
+    with regionContainedIn None, with behavior TadDelayed(tadDelay1, TadStop(), TadRide(3.889))
 
 # group `taxis`: 2 taxi, move_forward, 25 km/h, right of ego, lane 2
 tadAt2 = tadSpot(tadAnchor, 0.0, 2)
 taxis_1 = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.ford.crown', with width 1.85, with length 4.8,
-    with regionContainedIn None, with speed 6.944, with behavior FollowLaneBehavior(target_speed=6.944)
-tadAt3 = tadSpot(tadAnchor, 12.744, 2)
+    with regionContainedIn None, with speed 6.944, with behavior TadDrive(6.944)
+tadAt3 = tadSpot(tadAnchor, 13.744, 2)
 taxis_2 = new Car at tadAt3[0], facing tadAt3[1],
     with blueprint 'vehicle.ford.crown', with width 1.85, with length 4.8,
-    with regionContainedIn None, with speed 6.944, with behavior FollowLaneBehavior(target_speed=6.944)
+    with regionContainedIn None, with speed 6.944, with behavior TadDrive(6.944)
 
 # group `bus_at_stop`: 1 bus, stopped, 0 km/h, right_front of ego, lane 3
-tadAt4 = tadSpot(tadAnchor, 14.417, 3)
+tadShift3 = Range(0, 2.467)
+tadAt4 = tadSpot(tadAnchor, 16.883 - tadShift3, 3)
 bus_at_stop = new Car at tadAt4[0], facing tadAt4[1],
     with blueprint 'vehicle.mitsubishi.fusorosa', with width 2.55, with length 12.0,
     with regionContainedIn None, with behavior TadStop()

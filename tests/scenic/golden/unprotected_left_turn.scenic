@@ -235,27 +235,29 @@ behavior TadYield(speed):
 # The road around the ego vehicle: 1 lane in the ego's direction, 1 lane in the other direction, a four-way junction, a left turn at the junction ahead, a junction with traffic lights, a sidewalk beside the ego's lane.
 # The ego is placed where the lane layout holds from `behind` metres behind it to `ahead` metres
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
-tadRoad = dict(same=1, other=1, minSame=1, minOther=1, index=1, sidewalk=True,
+tadRoad = dict(same=1, other=1, minSame=1, minOther=0, index=1, sidewalk=True,
                junction='4way', signalised=True, maneuver='LEFT_TURN', signs=(),
-               shape=None, ahead=34.0, behind=4.0, approach=36.0)
+               shape=None, ahead=4.0, behind=4.0, approach=11.0, arms=('opposite',))
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
 # ego vehicle: turn_left, 10 km/h, lane 1
 tadEgoAt = tadSpot(tadAnchor, 0.0, 1)
 ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
-    with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 2.778, with behavior TadTurn(2.778, 'LEFT_TURN')
+    with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 2.778, with behavior TadThrough(2.778, 'LEFT_TURN')
 
 # group `turning_van`: 1 van, turn_left, 10 km/h, front of ego, lane -1
-tadAt1 = tadSpot(tadAnchor, 9.628, -1)
+tadShift1 = Range(0, 2.622)
+tadAt1 = tadArmSpot(tadAnchor, 'opposite', 11.778 - tadShift1, 1)
 turning_van = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.mercedes.sprinter', with width 2.0, with length 5.2,
-    with regionContainedIn None, with speed 2.778, with behavior TadTurn(2.778, 'LEFT_TURN')
+    with regionContainedIn None, with speed 2.778, with behavior TadThrough(2.778, 'LEFT_TURN')
 
 # group `oncoming_car`: 1 car, move_forward, 50 km/h, behind of turning_van, lane -1
-tadAt2 = tadSpot(tadAnchor, 30.367, -1)
+tadJitter2 = Range(-5.0, 5.0)
+tadAt2 = tadArmSpot(tadAnchor, 'opposite', 95.685 + tadJitter2, 1)
 oncoming_car = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
-    with regionContainedIn None, with speed 13.889, with behavior FollowLaneBehavior(target_speed=13.889)
+    with regionContainedIn None, with speed 13.889, with behavior TadThrough(13.889, 'STRAIGHT')
 
 # The traffic light facing the ego vehicle is `green`: hold the nearest one in that state.
 # (Without CARLA's model, as under Scenic's Newtonian simulator, the monitor does nothing.)

@@ -234,12 +234,12 @@ behavior TadYield(speed):
         take SetThrottleAction(0), SetBrakeAction(1.0)
 # ---- end of the prelude ----
 
-# The road around the ego vehicle: 1 lane in the ego's direction, 1 lane in the other direction, a sidewalk beside the ego's lane, a straight stretch of 26 m.
+# The road around the ego vehicle: 1 lane in the ego's direction, 1 lane in the other direction, a sidewalk beside the ego's lane, a straight stretch of 60 m.
 # The ego is placed where the lane layout holds from `behind` metres behind it to `ahead` metres
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=1, other=1, minSame=1, minOther=1, index=1, sidewalk=True,
                junction=None, signalised=None, maneuver=None, signs=(),
-               shape='straight', ahead=22.0, behind=4.0, approach=None)
+               shape='straight', ahead=56.0, behind=4.0, approach=None, arms=())
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
 # ego vehicle: overtake, 30 km/h, lane 1
@@ -248,13 +248,14 @@ ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 8.333, with behavior TadOvertake(8.333)
 
 # group `delivery_truck`: 1 truck, parked, 0 km/h, front of ego, lane 1
-tadAt1 = tadSpot(tadAnchor, 16.333, 1, 'curb', 2.5)
+tadAt1 = tadSpot(tadAnchor, 7.4, 1, 'curb', 2.5)
 delivery_truck = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.carlamotors.carlacola', with width 2.5, with length 7.5,
     with regionContainedIn None, with behavior TadParked()
 
 # group `oncoming_motorcycle`: 1 motorcycle, move_forward, 45 km/h, front of ego, lane -1
-tadAt2 = tadSpot(tadAnchor, 17.8, -1)
+tadJitter2 = Range(-5.0, 5.0)
+tadAt2 = tadSpot(tadAnchor, 53.944 + tadJitter2, -1)
 oncoming_motorcycle = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.yamaha.yzf', with width 0.8, with length 2.1,
-    with regionContainedIn None, with speed 12.5, with behavior FollowLaneBehavior(target_speed=12.5)
+    with regionContainedIn None, with speed 12.5, with behavior TadDrive(12.5)

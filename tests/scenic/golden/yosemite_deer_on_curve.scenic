@@ -234,43 +234,62 @@ behavior TadYield(speed):
         do FollowLaneBehavior(target_speed=speed)
     interrupt when withinDistanceToAnyObjs(self, 10):
         take SetThrottleAction(0), SetBrakeAction(1.0)
+
+# Parameters: a choice of behaviors, a delay, a trigger.
+behavior TadOneOf(index, options):
+    """One of a choice of behaviors: the one at the sampled index."""
+    do options[index]
+
+behavior TadDelayed(delay, hold, then):
+    """Hold still for `delay` seconds, then behave."""
+    do hold for delay seconds
+    do then
+
+behavior TadTriggered(distance, hold, then):
+    """Hold still until the ego vehicle is within `distance` metres, then behave."""
+    do hold until (distance from self to ego) < distance
+    do then
 # ---- end of the prelude ----
 
-# The road around the ego vehicle: 1 lane in the ego's direction, 1 lane in the other direction, a curved stretch of 42 m.
+# The road around the ego vehicle: 1 lane in the ego's direction, 1 lane in the other direction, a curved stretch of 51 m.
 # The ego is placed where the lane layout holds from `behind` metres behind it to `ahead` metres
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=1, other=1, minSame=1, minOther=1, index=1, sidewalk=False,
                junction=None, signalised=None, maneuver=None, signs=(),
-               shape='curved', ahead=24.0, behind=30.0, approach=None)
+               shape='curved', ahead=29.0, behind=36.0, approach=None, arms=())
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
 # ego vehicle: move_forward, 35 km/h, lane 1
 tadEgoAt = tadSpot(tadAnchor, 0.0, 1)
 ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
-    with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 9.722, with behavior FollowLaneBehavior(target_speed=9.722)
+    with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 9.722, with behavior TadDrive(9.722)
 
 # group `deer`: 2 deer, cross, 8 km/h, front of ego, lane 1
-tadAt1 = tadSpot(tadAnchor, 13.222, 1)
-deer_1 = new Pedestrian at tadAt1[0], facing tadAt1[1] + 90 deg,
+tadDelay1 = 0.387
+tadJitter1 = Range(-0.5, 0.5)
+tadAt1 = tadCrossAt(tadAnchor, 14.281 + tadJitter1, True, 0.0)
+deer_1 = new Pedestrian at tadAt1[0], facing tadAt1[1],
     with blueprint 'walker.pedestrian.0001', with width 0.5, with length 1.8,
-    with regionContainedIn None, with behavior TadWalk(2.222)
-tadAt2 = tadSpot(tadAnchor, 14.222, 1)
-deer_2 = new Pedestrian at tadAt2[0], facing tadAt2[1] + 90 deg,
+    with regionContainedIn None, with behavior TadDelayed(tadDelay1, TadStand(), TadWalk(2.222))
+tadAt2 = tadCrossAt(tadAnchor, 15.181 + tadJitter1, True, 0.0)
+deer_2 = new Pedestrian at tadAt2[0], facing tadAt2[1],
     with blueprint 'walker.pedestrian.0001', with width 0.5, with length 1.8,
-    with regionContainedIn None, with behavior TadWalk(2.222)
+    with regionContainedIn None, with behavior TadDelayed(tadDelay1, TadStand(), TadWalk(2.222))
 
 # group `oncoming_rv`: 1 rv, move_forward, 30 km/h, front of ego, lane -1
-tadAt3 = tadSpot(tadAnchor, 18.472, -1)
+tadShift2 = Range(0, 4.689)
+tadAt3 = tadSpot(tadAnchor, 23.161 - tadShift2, -1)
 oncoming_rv = new Car at tadAt3[0], facing tadAt3[1],
     with blueprint 'vehicle.volkswagen.t2', with width 2.5, with length 9.0,
-    with regionContainedIn None, with speed 8.333, with behavior FollowLaneBehavior(target_speed=8.333)
+    with regionContainedIn None, with speed 8.333, with behavior TadDrive(8.333)
 
 # group `following_motorcycles`: 2 motorcycle, move_forward, 35 km/h, behind of ego, lane 1
-tadAt4 = tadSpot(tadAnchor, -15.022, 1)
+tadShift3 = Range(0, 4.689)
+tadAt4 = tadSpot(tadAnchor, -19.711 + tadShift3, 1)
 following_motorcycles_1 = new Car at tadAt4[0], facing tadAt4[1],
     with blueprint 'vehicle.yamaha.yzf', with width 0.8, with length 2.1,
-    with regionContainedIn None, with speed 9.722, with behavior FollowLaneBehavior(target_speed=9.722)
-tadAt5 = tadSpot(tadAnchor, -27.844, 1)
+    with regionContainedIn None, with speed 9.722, with behavior TadDrive(9.722)
+tadAt5 = tadSpot(tadAnchor, -33.533 + tadShift3, 1)
 following_motorcycles_2 = new Car at tadAt5[0], facing tadAt5[1],
     with blueprint 'vehicle.yamaha.yzf', with width 0.8, with length 2.1,
-    with regionContainedIn None, with speed 9.722, with behavior FollowLaneBehavior(target_speed=9.722)
+    with regionContainedIn None, with speed 9.722, with behavior TadDrive(9.722)

@@ -101,6 +101,8 @@ pub struct Needs {
     pub behind: f64,
     /// With a junction: how far before it the ego starts.
     pub approach: f64,
+    /// With a junction: the arms actors stand on besides the ego's (`left`, `opposite`, ...).
+    pub arms: Vec<&'static str>,
 }
 
 impl Needs {

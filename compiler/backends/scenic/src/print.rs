@@ -15,6 +15,7 @@ use crate::maps;
 use crate::plan::{Actor, Light, Place, Plan, Sampled};
 use crate::python::{comment_lines, comment_text, number, string};
 use crate::{EmitOptions, PRELUDE_BEHAVIORS, PRELUDE_PARAMS, PRELUDE_PLACEMENT, Simulator};
+use tad_layout::Arm;
 
 /// The source section's fields as header lines: (label, value).
 fn source_lines(scenario: &Scenario) -> Vec<(&'static str, String)> {
@@ -164,11 +165,16 @@ pub fn program(scenario: &Scenario, plan: &Plan, diagnostics: &[Diagnostic], opt
         _ => "None",
     };
     let approach = if junction.is_some() { number(needs.approach) } else { "None".into() };
+    let arms = match needs.arms.len() {
+        0 => "()".to_string(),
+        1 => format!("({},)", string(needs.arms[0])),
+        _ => format!("({})", needs.arms.iter().map(|a| string(a)).collect::<Vec<_>>().join(", ")),
+    };
     let _ = writeln!(
         out,
         "tadRoad = dict(same={}, other={}, minSame={}, minOther={}, index={}, sidewalk={},\n               \
          junction={kind}, signalised={signalised}, maneuver={maneuver}, signs={signs},\n               \
-         shape={shape}, ahead={}, behind={}, approach={approach})",
+         shape={shape}, ahead={}, behind={}, approach={approach}, arms={arms})",
         opt_int(needs.same),
         opt_int(needs.other),
         needs.min_same,
@@ -183,7 +189,7 @@ pub fn program(scenario: &Scenario, plan: &Plan, diagnostics: &[Diagnostic], opt
     // --- actors
     out.push_str(&comment_lines(&plan.ego_summary, ""));
     params(&mut out, &plan.ego.params);
-    actor(&mut out, &plan.ego, "tadEgoAt");
+    actor(&mut out, &plan.ego, "tadEgoAt", needs);
     let mut spot = 0;
     for group in &plan.groups {
         out.push('\n');
@@ -193,7 +199,7 @@ pub fn program(scenario: &Scenario, plan: &Plan, diagnostics: &[Diagnostic], opt
         }
         for a in &group.actors {
             spot += 1;
-            actor(&mut out, a, &format!("tadAt{spot}"));
+            actor(&mut out, a, &format!("tadAt{spot}"), needs);
         }
     }
 
@@ -256,24 +262,51 @@ fn params(out: &mut String, p: &Sampled) {
     if let Some(trigger) = p.trigger {
         let _ = writeln!(out, "tadTrigger{tag} = {}", range(trigger));
     }
+    if let Some(jitter) = p.jitter {
+        let _ = writeln!(out, "tadJitter{tag} = Range({}, {})", number(-jitter), number(jitter));
+    }
 }
 
-/// `SPOT = tadSpot(...)` and `NAME = new CLASS at SPOT[0], facing SPOT[1], ...`.
-fn actor(out: &mut String, a: &Actor, spot: &str) {
+/// `SPOT = tadSpot(...)` (on the ego's road), `tadArmSpot(...)` (on another arm of the
+/// junction), `tadCrossAt(...)`/`tadCross(...)` (about to walk across), and `NAME = new CLASS
+/// at SPOT[0], facing SPOT[1], ...`.
+fn actor(out: &mut String, a: &Actor, spot: &str, needs: &maps::Needs) {
     let place = match a.place {
         Place::Centre => String::new(),
         Place::Curb => format!(", 'curb', {}", number(a.width)),
         Place::Sidewalk => ", 'sidewalk'".to_string(),
     };
     let p = &a.params;
-    let offset = match p.shift {
+    let mut offset = match p.shift {
         Some((_, sign)) if sign < 0.0 => format!("{} - tadShift{}", number(a.offset), p.tag),
         Some(_) => format!("{} + tadShift{}", number(a.offset), p.tag),
         None => number(a.offset),
     };
-    let speed = if p.speed.is_some() { format!("tadSpeed{}", p.tag) } else { number(a.target_speed) };
-    let _ = writeln!(out, "{spot} = tadSpot(tadAnchor, {offset}, {}{place})", a.lane);
-    let facing = if a.across { format!("{spot}[1] + 90 deg") } else { format!("{spot}[1]") };
+    if p.jitter.is_some() {
+        offset = format!("{offset} + tadJitter{}", p.tag);
+    }
+    let junction = needs.junction.is_some();
+    let call = match (a.arm, a.cross) {
+        (Arm::Ego, None) => format!("tadSpot(tadAnchor, {offset}, {}{place})", a.lane),
+        (Arm::Ego, Some((right, extra))) if junction => format!(
+            "tadCross(tadAnchor, 'ego', {} - ({offset}), {}, {})",
+            number(needs.approach),
+            python_bool(right),
+            number(extra)
+        ),
+        (Arm::Ego, Some((right, extra))) => {
+            format!("tadCrossAt(tadAnchor, {offset}, {}, {})", python_bool(right), number(extra))
+        }
+        (arm, None) => format!("tadArmSpot(tadAnchor, {}, {offset}, {}{place})", string(arm.as_str()), a.lane),
+        (arm, Some((right, extra))) => format!(
+            "tadCross(tadAnchor, {}, {offset}, {}, {})",
+            string(arm.as_str()),
+            python_bool(right),
+            number(extra)
+        ),
+    };
+    let _ = writeln!(out, "{spot} = {call}");
+    let facing = format!("{spot}[1]");
     let _ = write!(
         out,
         "{} = new {} at {spot}[0], facing {facing},\n    with blueprint {}",
@@ -292,15 +325,19 @@ fn actor(out: &mut String, a: &Actor, spot: &str) {
         // the Newtonian model's Debris is a plain object, which must be visible by default
         out.push_str(", with requireVisible False");
     }
+    // through a junction ahead, a vehicle takes the maneuver it is given (straight on too)
+    let through = junction && a.cross.is_none() && a.lane > 0;
+    let speed = if p.speed.is_some() { format!("tadSpeed{}", p.tag) } else { number(a.target_speed) };
     if a.initial_speed > 0.0 {
         let initial = if p.speed.is_some() { speed.clone() } else { number(a.initial_speed) };
         let _ = write!(out, ", with speed {initial}");
     }
     let call = if p.motions.len() > 1 {
-        let calls: Option<Vec<String>> = p.motions.iter().map(|m| behavior_call_with(*m, a.class, &speed)).collect();
+        let calls: Option<Vec<String>> =
+            p.motions.iter().map(|m| behavior_call_with(*m, a.class, &speed, through)).collect();
         calls.map(|calls| format!("TadOneOf(tadPick{}, [{}])", p.tag, calls.join(", ")))
     } else {
-        behavior_call_with(a.motion, a.class, &speed)
+        behavior_call_with(a.motion, a.class, &speed, through)
     };
     let hold = if a.class == Class::Pedestrian { "TadStand()" } else { "TadStop()" };
     let call = call.map(|call| match p.delay {
@@ -321,24 +358,32 @@ fn actor(out: &mut String, a: &Actor, spot: &str) {
 /// the prelude's `Tad...` behaviors and Scenic's `FollowLaneBehavior`; none for `Debris`.
 /// A behavior without a motion follows the lane (stands still at 0).
 pub fn behavior_call(motion: Option<Motion>, class: Class, speed: f64) -> Option<String> {
-    behavior_call_with(motion, class, &number(speed))
+    behavior_call_with(motion, class, &number(speed), false)
+}
+
+fn python_bool(b: bool) -> &'static str {
+    if b { "True" } else { "False" }
 }
 
 /// [`behavior_call`] with the speed as a Scenic expression (a number, or a sampled
 /// variable such as `tadSpeed2`, which is positive).
-fn behavior_call_with(motion: Option<Motion>, class: Class, v: &str) -> Option<String> {
+/// `through`: the vehicle drives into a junction, where it goes straight on unless it turns.
+fn behavior_call_with(motion: Option<Motion>, class: Class, v: &str, through: bool) -> Option<String> {
     let moving = v.parse::<f64>().map_or(true, |s| s > 0.0);
     match class {
         Class::Debris => None,
         Class::Car => Some(match motion {
-            Some(Motion::Follow | Motion::Walk | Motion::Graze) => format!("FollowLaneBehavior(target_speed={v})"),
-            None if moving => format!("FollowLaneBehavior(target_speed={v})"),
+            Some(Motion::Follow | Motion::Walk | Motion::Graze) | None if moving && through => {
+                format!("TadThrough({v}, '{}')", mapping::maneuver('S'))
+            }
+            Some(Motion::Follow | Motion::Walk | Motion::Graze) => format!("TadDrive({v})"),
+            None if moving => format!("TadDrive({v})"),
             None | Some(Motion::Stop | Motion::Stand) => "TadStop()".into(),
             Some(Motion::Parked) => "TadParked()".into(),
             Some(Motion::Cross) => format!("TadRide({v})"),
-            Some(Motion::TurnLeft) => format!("TadTurn({v}, '{}')", mapping::maneuver('L')),
-            Some(Motion::TurnRight) => format!("TadTurn({v}, '{}')", mapping::maneuver('R')),
-            Some(Motion::UTurn) => format!("TadTurn({v}, '{}')", mapping::maneuver('U')),
+            Some(Motion::TurnLeft) => format!("TadThrough({v}, '{}')", mapping::maneuver('L')),
+            Some(Motion::TurnRight) => format!("TadThrough({v}, '{}')", mapping::maneuver('R')),
+            Some(Motion::UTurn) => format!("TadThrough({v}, '{}')", mapping::maneuver('U')),
             Some(Motion::ChangeLaneLeft) => format!("TadChangeLane({v}, True)"),
             Some(Motion::ChangeLaneRight) => format!("TadChangeLane({v}, False)"),
             Some(Motion::Overtake) => format!("TadOvertake({v})"),

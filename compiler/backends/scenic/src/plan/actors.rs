@@ -1,13 +1,13 @@
 //! The objects of the program: the ego vehicle and one object per actor of every group,
-//! each with a safe identifier (`crate::python::Names`), its class, blueprint, size, lane,
-//! offset, place in the lane, motion and speeds.
+//! each with a safe identifier (`crate::python::Names`), its class, blueprint, size, and
+//! where the layout (`tad_layout`) put it: arm, lane, station, place in the lane or on the
+//! sidewalk, facing, speeds and timing.
 
 use tad_ir::Scenario;
+use tad_layout::{Arm, Facing, Layout, Side};
 
 use super::ego::EgoPlan;
 use super::groups::Resolved;
-use super::layout::Layout;
-use super::motion::starts_moving;
 use super::{Actor, Group, Place, Sampled};
 use crate::mapping::{self, Class};
 use crate::python::Names;
@@ -20,7 +20,24 @@ pub struct Actors {
     pub groups: Vec<Group>,
 }
 
-pub fn build(scenario: &Scenario, ego: &EgoPlan, groups: &[Resolved], layout: &Layout) -> Actors {
+fn place(p: tad_layout::Place) -> Place {
+    match p {
+        tad_layout::Place::Lane => Place::Centre,
+        tad_layout::Place::Curb => Place::Curb,
+        tad_layout::Place::Sidewalk => Place::Sidewalk,
+    }
+}
+
+/// `junction`: the map choice kept the junction (else actors of other arms stand on the
+/// ego's road beyond where the junction would be).
+pub fn build(
+    scenario: &Scenario,
+    ego: &EgoPlan,
+    groups: &[Resolved],
+    laid: &Layout,
+    kept: &[usize],
+    junction: bool,
+) -> Actors {
     let mut names = Names::default();
     names.reserve("ego");
     let ego_actor = Actor {
@@ -31,12 +48,13 @@ pub fn build(scenario: &Scenario, ego: &EgoPlan, groups: &[Resolved], layout: &L
         length: ego.length,
         width: ego.width,
         lane: ego.lane,
+        arm: Arm::Ego,
         offset: 0.0,
         place: Place::Centre,
-        across: false,
+        cross: None,
         motion: ego.motion,
         target_speed: ego.speed,
-        initial_speed: if starts_moving(ego.motion, Class::Car) { ego.speed } else { 0.0 },
+        initial_speed: if laid.ego.moving { ego.speed } else { 0.0 },
         params: Sampled {
             tag: "Ego".into(),
             speed: ego.speed_range,
@@ -46,21 +64,59 @@ pub fn build(scenario: &Scenario, ego: &EgoPlan, groups: &[Resolved], layout: &L
     };
     let mut out = Vec::new();
     for (i, g) in groups.iter().enumerate() {
+        let Some(gl) = laid.groups.iter().find(|l| l.group.index() == i) else {
+            out.push(Group { summary: g.summary.clone(), actors: Vec::new() });
+            continue;
+        };
+        let class = g.mapping.class;
+        let conflict = laid.conflict(gl.group);
+        let first = gl.agents.first();
+        // the way the group extends from its reference, to sample it nearer
+        let reference_along =
+            match scenario.group(gl.group).and_then(|s| s.position.given()).map(|p| &p.reference.value) {
+                Some(tad_ir::Reference::Group(r)) => laid
+                    .group(*r)
+                    .and_then(|r| r.agents.first())
+                    .filter(|r| first.is_some_and(|f| f.station.arm == r.station.arm))
+                    .map_or(0.0, |r| r.station.along),
+                _ => 0.0,
+            };
+        let away = first.map_or(1.0, |f| if f.station.along >= reference_along { 1.0 } else { -1.0 });
+        let params = Sampled {
+            tag: (i + 1).to_string(),
+            speed: g.speed_range,
+            motions: g.motions.clone(),
+            shift: if let Some((low, high)) = g.distance.filter(|(low, high)| low < high) {
+                Some((high - low, -away))
+            } else if gl.slack > 0.5 && conflict.is_none() {
+                Some((gl.slack, -away))
+            } else {
+                None
+            },
+            delay: g.delay.or_else(|| first.map(|f| f.start.delay).filter(|d| *d > 0.05).map(|d| (d, d))),
+            trigger: g.trigger,
+            jitter: conflict.map(|c| (c.spread * 0.5).clamp(0.5, 5.0)),
+        };
+        let row_start = first.map_or(0.0, |f| f.lateral);
         let mut actors = Vec::new();
-        for (k, &offset) in layout.offsets[i].iter().enumerate() {
-            let ident = if layout.counts[i] == 1 && g.count == 1 {
+        let n = kept.get(i).copied().unwrap_or(gl.agents.len());
+        for (k, a) in gl.agents.iter().take(n).enumerate() {
+            let ident = if n == 1 && g.count == 1 {
                 names.fresh(&g.name)
             } else {
                 names.fresh(&format!("{}_{}", g.name, k + 1))
             };
-            let class = g.mapping.class;
-            let params = Sampled {
-                tag: (i + 1).to_string(),
-                speed: g.speed_range,
-                motions: g.motions.clone(),
-                shift: g.distance.filter(|(low, high)| low < high).map(|(low, high)| (high - low, -layout.steps[i])),
-                delay: g.delay,
-                trigger: g.trigger,
+            let (arm, offset) = if junction || a.station.arm == Arm::Ego {
+                (a.station.arm, a.station.along)
+            } else {
+                // no junction on the map: beyond where it would be, on the ego's road
+                (Arm::Ego, laid.road.approach + a.station.along + 10.0)
+            };
+            let lane =
+                if a.station.arm == Arm::Ego && a.lane == first.map_or(a.lane, |f| f.lane) { g.lane } else { a.lane };
+            let cross = match a.facing {
+                Facing::Across { from } => Some((from == Side::Right, (a.lateral - row_start).abs())),
+                Facing::Along => None,
             };
             actors.push(Actor {
                 ident,
@@ -69,14 +125,15 @@ pub fn build(scenario: &Scenario, ego: &EgoPlan, groups: &[Resolved], layout: &L
                 is_ego: false,
                 length: g.length,
                 width: g.width,
-                lane: g.lane,
+                lane,
+                arm,
                 offset,
-                place: g.place(),
-                across: g.across(),
+                place: place(a.place),
+                cross,
                 motion: g.motion,
                 target_speed: g.speed,
-                initial_speed: if starts_moving(g.motion, class) && !params.waits() { g.speed } else { 0.0 },
-                params,
+                initial_speed: if a.moving && class == Class::Car && !params.waits() { g.speed } else { 0.0 },
+                params: params.clone(),
             });
         }
         out.push(Group { summary: g.summary.clone(), actors });

@@ -144,8 +144,9 @@ fn features(road: &RoadRequest, ego: &EgoPlan, groups: &[Resolved]) -> Vec<(Feat
 
 /// The lanes every actor uses as the base needs.
 fn lane_needs(groups: &[Resolved], ego_lane: i64, needs: &mut Needs) {
-    needs.min_same = groups.iter().map(|g| g.lane).chain([ego_lane]).max().unwrap_or(1).max(1) as u32;
-    needs.min_other = groups.iter().map(|g| -g.lane).max().unwrap_or(0).max(0) as u32;
+    let on_ego_road = || groups.iter().filter(|g| g.arm == tad_layout::Arm::Ego);
+    needs.min_same = on_ego_road().map(|g| g.lane).chain([ego_lane]).max().unwrap_or(1).max(1) as u32;
+    needs.min_other = on_ego_road().map(|g| -g.lane).max().unwrap_or(0).max(0) as u32;
     needs.index = ego_lane as u32;
 }
 
@@ -154,7 +155,7 @@ pub fn choose(
     road: &RoadRequest,
     mut ego: EgoPlan,
     groups: &mut [Resolved],
-    order: &[usize],
+    laid: &tad_layout::Layout,
     requested: Option<&str>,
     report: &mut Report,
 ) -> Choice {
@@ -164,9 +165,8 @@ pub fn choose(
     let mut needs = Needs::default();
     lane_needs(groups, ego.lane, &mut needs);
     let base = needs.clone();
-    let minimal: Vec<usize> = groups.iter().map(|_| 1).collect();
-    let extent = (ego.length, ego.speed);
-    let _ = layout::layout(groups, &minimal, ego.lane, extent, order, &mut needs, junction);
+    let first: Vec<usize> = laid.groups.iter().map(|g| g.agents.len().min(1)).collect();
+    layout::windows(laid, &mut needs, junction, Some(&first));
     let (map, map_known) = match requested {
         Some(m) => match maps::known(m) {
             Some(k) => (k.to_string(), true),
@@ -196,7 +196,13 @@ pub fn choose(
     } else {
         maps::KNOWN.to_vec()
     };
-    let mut full = layout::full_windows(groups, ego.lane, extent, order, &needs);
+    let full_windows = |needs: &Needs| {
+        let (mut away, mut before) = (needs.clone(), needs.clone());
+        layout::windows(laid, &mut away, false, None);
+        layout::windows(laid, &mut before, true, None);
+        [away, before]
+    };
+    let mut full = full_windows(&needs);
     let mut best = select(&needs, &full, &features, &candidates, &preference);
     if let Some((false, m, _)) = best
         && map_known
@@ -231,13 +237,13 @@ pub fn choose(
                 to
             };
             ego.lane = moved(ego.lane, ego.lane_span, "the ego vehicle");
-            for (g, group) in groups.iter_mut().zip(&scenario.groups) {
+            for (g, group) in groups.iter_mut().zip(&scenario.groups).filter(|(g, _)| g.arm == tad_layout::Arm::Ego) {
                 let span = group.lane.span().unwrap_or(group.name_span);
                 g.lane = moved(g.lane, span, &format!("group `{}`", group.name));
             }
             lane_needs(groups, ego.lane, &mut needs);
-            let _ = layout::layout(groups, &minimal, ego.lane, extent, order, &mut needs, junction);
-            full = layout::full_windows(groups, ego.lane, extent, order, &needs);
+            layout::windows(laid, &mut needs, junction, Some(&first));
+            full = full_windows(&needs);
             best = select(&needs, &full, &features, &[m], &preference);
         }
     }

@@ -43,8 +43,10 @@ pub struct Resolved {
     pub motion: Option<tad_ir::Motion>,
     /// m/s.
     pub speed: f64,
-    /// TAD lane index; 0 until [`infer_lanes`] when not written.
+    /// TAD lane index (on its arm); 0 until [`lanes_from`] when not written.
     pub lane: i64,
+    /// The junction arm its first actor stands on (`Ego` without a junction).
+    pub arm: tad_layout::Arm,
     pub target: Target,
     pub longitudinal: Longitudinal,
     pub lateral: Option<Lateral>,
@@ -266,6 +268,7 @@ pub fn resolve(scenario: &Scenario, report: &mut Report) -> Vec<Resolved> {
             motion,
             speed,
             lane: group.lane.get().map_or(0, Lane::index),
+            arm: tad_layout::Arm::Ego,
             target,
             longitudinal,
             lateral,
@@ -280,72 +283,42 @@ pub fn resolve(scenario: &Scenario, report: &mut Report) -> Vec<Resolved> {
     out
 }
 
-/// The IR's placement order (each group after its reference), with the groups that depend
-/// on the junction last: they are placed once the ego's approach to it is known.
-pub fn placement_order(scenario: &Scenario, groups: &[Resolved]) -> Vec<usize> {
-    let n = groups.len();
-    let depends_on_junction = |mut i: usize| {
-        for _ in 0..=n {
-            match groups[i].target {
-                Target::Junction => return true,
-                Target::Group(j) if j < n => i = j,
-                _ => return false,
+/// Lanes and arms from the layout; the lanes it chose are reported (W0706).
+pub fn lanes_from(scenario: &Scenario, laid: &tad_layout::Layout, groups: &mut [Resolved], report: &mut Report) {
+    for g in &laid.groups {
+        let Some(first) = g.agents.first() else { continue };
+        let Some(resolved) = groups.get_mut(g.group.index()) else { continue };
+        resolved.lane = first.lane;
+        resolved.arm = first.station.arm;
+    }
+    for finding in &laid.findings {
+        match finding {
+            tad_layout::Finding::Chosen(c) if c.field == "lane" => {
+                let Some(group) = c.group.and_then(|id| scenario.group(id)) else { continue };
+                report
+                    .warn(
+                        Code::W0706,
+                        format!("the lane of group `{}` is not given", group.name),
+                        c.span,
+                        format!("{} chosen", c.value),
+                        unsupported("actor.lane", Some(c.value.clone())),
+                    )
+                    .note(c.rule);
             }
-        }
-        false
-    };
-    let order: Vec<usize> = scenario.placement_order.iter().map(|id| id.index()).filter(|&i| i < n).collect();
-    let (mut early, late): (Vec<usize>, Vec<usize>) = order.into_iter().partition(|&i| !depends_on_junction(i));
-    early.extend(late);
-    early
-}
-
-/// The lanes not written: from the relation's `lateral` part and the reference's lane,
-/// clamped to the road (W0706).
-pub fn infer_lanes(
-    scenario: &Scenario,
-    groups: &mut [Resolved],
-    order: &[usize],
-    ego_lane: i64,
-    lanes: Option<u32>,
-    one_way: bool,
-    report: &mut Report,
-) {
-    for &i in order {
-        if groups[i].lane != 0 {
-            continue;
-        }
-        let reference_lane = match groups[i].target {
-            Target::Group(j) if groups[j].lane != 0 => groups[j].lane,
-            _ => ego_lane,
-        };
-        let shifted = |by: i64| Lane::new(reference_lane).map_or(reference_lane, |l| l.shift(by).index());
-        let mut lane = match groups[i].lateral {
-            Some(Lateral::Left) => shifted(-1),
-            Some(Lateral::Right) => shifted(1),
-            Some(Lateral::Opposite) => -reference_lane,
-            _ => reference_lane,
-        };
-        if let Some(n) = lanes {
-            lane = lane.clamp(-i64::from(n), i64::from(n));
-            if lane == 0 {
-                lane = reference_lane;
+            tad_layout::Finding::NoArm { group, arm, span } => {
+                let Some(group) = scenario.group(*group) else { continue };
+                report
+                    .warn(
+                        Code::W0701,
+                        format!("the junction has no {} arm for group `{}`", arm.as_str(), group.name),
+                        *span,
+                        "placed on the ego's road instead",
+                        unsupported("actor.position", Some("the ego's road".into())),
+                    )
+                    .note("a three-way junction keeps the arms the ego and most groups need");
             }
+            _ => {}
         }
-        if one_way && lane < 0 {
-            lane = reference_lane.max(1);
-        }
-        let group = &scenario.groups[i];
-        report
-            .warn(
-                Code::W0706,
-                format!("the lane of group `{}` is not given", group.name),
-                group.lane.span().unwrap_or(group.name_span),
-                format!("lane {lane} chosen"),
-                unsupported("actor.lane", Some(format!("lane {lane}"))),
-            )
-            .note("taken from the position's relation and the lane of its reference");
-        groups[i].lane = lane;
     }
 }
 

@@ -65,13 +65,17 @@ pub struct Actor {
     pub is_ego: bool,
     pub length: f64,
     pub width: f64,
-    /// TAD lane index.
+    /// TAD lane index on its arm.
     pub lane: i64,
-    /// Metres along the ego's lane from the ego's centre.
+    /// The junction arm it stands on (`Ego`: the ego's road).
+    pub arm: tad_layout::Arm,
+    /// On the ego's road: metres along the ego's lane from the ego's centre. On another
+    /// arm: metres before its stop line (outgoing lanes: after the junction).
     pub offset: f64,
     pub place: Place,
-    /// Facing across the road (to the left of its lane's direction) instead of along it.
-    pub across: bool,
+    /// About to walk across the road: from its right-hand side (as the arm's incoming
+    /// traffic, or the ego, sees it), and how much further from the road it stands.
+    pub cross: Option<(bool, f64)>,
     /// What it does; `None` for a behavior that declares no motion.
     pub motion: Option<Motion>,
     /// The speed its behavior keeps, in m/s.
@@ -99,6 +103,9 @@ pub struct Sampled {
     pub delay: Option<(f64, f64)>,
     /// It starts its behavior when the ego is within this distance.
     pub trigger: Option<(f64, f64)>,
+    /// An adversary timed to meet the ego: its place varies by up to this much either way
+    /// (`tadJitterTAG = Range(-j, j)`).
+    pub jitter: Option<f64>,
 }
 
 impl Sampled {
@@ -184,22 +191,28 @@ pub fn plan(scenario: &Scenario, options: &EmitOptions) -> (Plan, Vec<Diagnostic
 
     let ego = ego::plan(scenario, scenario_span, &mut report);
     let road = road::request(scenario, road_span, &mut report);
+    let laid = tad_layout::lay_out(scenario);
     let mut groups = groups::resolve(scenario, &mut report);
-    let order = groups::placement_order(scenario, &groups);
-    groups::infer_lanes(scenario, &mut groups, &order, ego.lane, road.lanes, road.one_way, &mut report);
+    groups::lanes_from(scenario, &laid, &mut groups, &mut report);
 
-    let choice = choice::choose(scenario, &road, ego, &mut groups, &order, options.map.as_deref(), &mut report);
+    let choice = choice::choose(scenario, &road, ego, &mut groups, &laid, options.map.as_deref(), &mut report);
     let ego = choice.ego.clone();
-    let layout = layout::fit(scenario, &groups, &order, &ego, &choice, &mut report);
 
-    let actors = actors::build(scenario, &ego, &groups, &layout);
+    let kept = if choice.map_known {
+        layout::fit(scenario, &laid, &choice.needs, &choice.map, choice.junction, &mut report)
+    } else {
+        laid.groups.iter().map(|g| g.agents.len()).collect()
+    };
+    let mut needs = choice.needs.clone();
+    layout::windows(&laid, &mut needs, choice.junction, Some(&kept));
+    let actors = actors::build(scenario, &ego, &groups, &laid, &kept, choice.junction);
     let environment = environment::plan(scenario, &road, options.simulator, &mut report);
 
     let plan = Plan {
         scenario: scenario.name.as_ref().map_or_else(|| "scenario".to_string(), |n| n.value.clone()),
         map: choice.map,
         map_known: choice.map_known,
-        needs: layout.needs,
+        needs,
         ego: actors.ego,
         ego_summary: actors.ego_summary,
         groups: actors.groups,
