@@ -132,7 +132,14 @@ pub fn lay_out(scenario: &Scenario) -> Layout {
         _ if at_junction => Shape::Junction { arms: 4, roundabout: false },
         _ => Shape::Straight,
     };
-    let junction_road = matches!(shape, Shape::Junction { .. });
+    // a light that shows something stands at a junction ahead, whatever the road's shape
+    let lit = scenario
+        .road
+        .light
+        .given()
+        .and_then(|l| scenario.entries.resolved(l))
+        .is_some_and(|e| e.attrs.present && e.attrs.signal.is_some());
+    let junction_road = matches!(shape, Shape::Junction { .. }) || lit;
 
     // --- decisions: arm, lane, place, facing, in placement order
     let ids: Vec<GroupId> = scenario.groups().map(|(id, _)| id).collect();
@@ -273,8 +280,13 @@ pub fn lay_out(scenario: &Scenario) -> Layout {
 
     // --- the junction's arms
     let ego_turn = turn_of(ego_facts.motion);
-    let junction = match shape {
-        Shape::Junction { arms, roundabout } => {
+    let junction_shape = match shape {
+        Shape::Junction { arms, roundabout } => Some((arms, roundabout)),
+        _ if junction_road => Some((4, false)),
+        _ => None,
+    };
+    let junction = match junction_shape {
+        Some((arms, roundabout)) => {
             let mut needed: Vec<Arm> = decisions.iter().flatten().map(|d| d.arm).collect();
             needed.push(ego_turn.exit(Arm::Ego));
             let arms_of = if arms == 3 {
@@ -300,7 +312,7 @@ pub fn lay_out(scenario: &Scenario) -> Layout {
                 }),
             })
         }
-        _ => None,
+        None => None,
     };
     for (i, d) in decisions.iter_mut().enumerate() {
         let Some(d) = d else { continue };
@@ -413,25 +425,35 @@ pub fn lay_out(scenario: &Scenario) -> Layout {
         }
     }
     if let Some(half) = road.junction.as_ref().filter(|j| j.arms.contains(&Arm::Opposite)).map(|j| j.half) {
-        // moving traffic ahead past the stop line is already across the junction
-        for (i, d) in decisions.iter().enumerate() {
-            let Some(d) = d.as_ref().filter(|d| d.arm == Arm::Ego && d.lane > 0 && !d.crosser) else { continue };
+        // moving traffic ahead past the stop line is already across the junction: all of it
+        // moves on by the same distance, so that none is inside the junction and their
+        // relations hold
+        let beyond = |i: usize| {
             let f = &group_facts[i];
-            if f.is_static() || f.body != Body::Vehicle || turn_of(f.motion) != Turn::Straight {
-                continue;
+            decisions[i].as_ref().is_some_and(|d| d.arm == Arm::Ego && d.lane > 0 && !d.crosser)
+                && !f.is_static()
+                && f.body == Body::Vehicle
+                && turn_of(f.motion) == Turn::Straight
+        };
+        let exit = road.approach + 2.0 * half;
+        let mut push: f64 = 0.0;
+        for i in (0..stations.len()).filter(|&i| beyond(i)) {
+            let len = group_facts[i].length;
+            for (s, _) in stations[i].iter().filter(|(s, _)| s.along + len / 2.0 > road.approach - 0.5) {
+                push = push.max(exit + len / 2.0 + 0.5 - s.along);
             }
-            let mut next = f.length / 2.0 + 0.5;
-            for (s, _) in &mut stations[i] {
-                if s.along + f.length / 2.0 > road.approach - 0.5 {
-                    let beyond = (s.along - road.approach - 2.0 * half).max(next);
-                    next = beyond + f.length + gap(f, f.speed);
-                    *s = Station { arm: Arm::Opposite, along: beyond };
-                    occupied.entry((Arm::Opposite, Key::Lane(-d.lane))).or_default().push((
-                        beyond - f.length / 2.0,
-                        beyond + f.length / 2.0,
-                        f.speed,
-                    ));
-                }
+        }
+        for i in (0..stations.len()).filter(|&i| beyond(i)) {
+            let f = &group_facts[i];
+            let lane = decisions[i].as_ref().map_or(1, |d| d.lane);
+            for (s, _) in stations[i].iter_mut().filter(|(s, _)| s.along + f.length / 2.0 > road.approach - 0.5) {
+                let along = s.along + push - exit;
+                *s = Station { arm: Arm::Opposite, along };
+                occupied.entry((Arm::Opposite, Key::Lane(-lane))).or_default().push((
+                    along - f.length / 2.0,
+                    along + f.length / 2.0,
+                    f.speed,
+                ));
             }
         }
     }

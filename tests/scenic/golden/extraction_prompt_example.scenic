@@ -240,9 +240,9 @@ behavior TadYield(speed):
 # Left out, as Town06 has no place with them and the rest: a sidewalk beside the ego's lane.
 # The ego is placed where the lane layout holds from `behind` metres behind it to `ahead` metres
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
-tadRoad = dict(same=3, other=3, minSame=3, minOther=3, index=2, sidewalk=False,
+tadRoad = dict(same=3, other=3, minSame=3, minOther=0, index=2, sidewalk=False,
                junction=None, signalised=True, maneuver=None, signs=(),
-               shape=None, ahead=62.0, behind=4.0, approach=6.0, arms=())
+               shape=None, ahead=62.0, behind=4.0, approach=62.0, arms=('opposite',))
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
 # ego vehicle: move_forward, 38 km/h, lane 2
@@ -300,41 +300,41 @@ parked_sedans_10 = new Car at tadAt11[0], facing tadAt11[1],
     with regionContainedIn None, with behavior TadParked()
 
 # group `parked_sedans_opposite`: 7 sedan, parked, 0 km/h, left_front of ego, lane -3
-tadAt12 = tadSpot(tadAnchor, 6.05, -3, 'curb', 1.85)
+tadAt12 = tadArmSpot(tadAnchor, 'opposite', 3.8, 3, 'curb', 1.85)
 parked_sedans_opposite_1 = new Car at tadAt12[0], facing tadAt12[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt13 = tadSpot(tadAnchor, 11.85, -3, 'curb', 1.85)
+tadAt13 = tadArmSpot(tadAnchor, 'opposite', 9.6, 3, 'curb', 1.85)
 parked_sedans_opposite_2 = new Car at tadAt13[0], facing tadAt13[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt14 = tadSpot(tadAnchor, 17.65, -3, 'curb', 1.85)
+tadAt14 = tadArmSpot(tadAnchor, 'opposite', 15.4, 3, 'curb', 1.85)
 parked_sedans_opposite_3 = new Car at tadAt14[0], facing tadAt14[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt15 = tadSpot(tadAnchor, 23.45, -3, 'curb', 1.85)
+tadAt15 = tadArmSpot(tadAnchor, 'opposite', 21.2, 3, 'curb', 1.85)
 parked_sedans_opposite_4 = new Car at tadAt15[0], facing tadAt15[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt16 = tadSpot(tadAnchor, 29.25, -3, 'curb', 1.85)
+tadAt16 = tadArmSpot(tadAnchor, 'opposite', 27.0, 3, 'curb', 1.85)
 parked_sedans_opposite_5 = new Car at tadAt16[0], facing tadAt16[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt17 = tadSpot(tadAnchor, 35.05, -3, 'curb', 1.85)
+tadAt17 = tadArmSpot(tadAnchor, 'opposite', 32.8, 3, 'curb', 1.85)
 parked_sedans_opposite_6 = new Car at tadAt17[0], facing tadAt17[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt18 = tadSpot(tadAnchor, 40.85, -3, 'curb', 1.85)
+tadAt18 = tadArmSpot(tadAnchor, 'opposite', 38.6, 3, 'curb', 1.85)
 parked_sedans_opposite_7 = new Car at tadAt18[0], facing tadAt18[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
 
 # group `oncoming_truck`: 1 truck, move_forward, 40 km/h, front of ego, lane -2
-tadShift4 = Range(0, 5.244)
-tadAt19 = tadSpot(tadAnchor, 24.356 - tadShift4, -2)
+tadShift4 = Range(0, 8.0)
+tadAt19 = tadArmSpot(tadAnchor, 'opposite', 34.972 - tadShift4, 2)
 oncoming_truck = new Car at tadAt19[0], facing tadAt19[1],
     with blueprint 'vehicle.carlamotors.carlacola', with width 2.5, with length 7.5,
-    with regionContainedIn None, with speed 11.111, with behavior TadDrive(11.111)
+    with regionContainedIn None, with speed 11.111, with behavior TadThrough(11.111, 'STRAIGHT')
 
 # The traffic light facing the ego vehicle is `green`: hold the nearest one in that state.
 # (Without CARLA's model, as under Scenic's Newtonian simulator, the monitor does nothing.)
