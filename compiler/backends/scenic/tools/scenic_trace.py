@@ -7,7 +7,8 @@ each seed samples a scene and simulates it, recording every object's state at ev
 Prints one JSON line per (file, seed):
 
   {"file", "seed", "ok", "error", "dt", "steps", "termination", "iterations",
-   "compile_s", "sample_s", "sim_s",
+   "compile_s", "sample_s", "sim_s",   (steps: the states recorded after step 0;
+                                        iterations: Scenic's rejection-sampling tries)
    "objects": [{"index", "name", "group", "group_index", "class", "length", "width",
                 "is_ego"}, ...],
    "states": [[[x, y, heading, speed], ... one per object], ... one per step]}
@@ -277,7 +278,7 @@ def trace_file(path, args, seeds):
                     ran = sink[-1]
                     rec["dt"] = ran.timestep
                     rec["states"] = [list(s) for s in ran.trajectory]
-                    rec["steps"] = ran.currentTime
+                    rec["steps"] = max(len(rec["states"]) - 1, 0)
             if simulation is None:
                 ran = sink[-1] if sink else None
                 why = ran.traceError if ran is not None else None
