@@ -1,13 +1,16 @@
 //! What TADSL's tests share: where the repository and `../shared` are, the files of a
 //! directory, the examples, a scratch directory, seeded mutations of TAD texts, and the
-//! Scenic oracle (the real Scenic 3.1.1 in a Python venv).
+//! Scenic oracle (the real Scenic 3.1.1 in a Python venv), traces of programs in Scenic's
+//! Newtonian simulator, and the footprint geometry to judge them by.
 //!
 //! No machine paths: everything is found from this crate's own location, or from an
 //! environment variable a user or CI sets (`TADSL_SHARED`, `TADSL_SCENIC_PYTHON`,
-//! `TADSL_SCENIC_CHECK`, `TADSL_SCENIC_MAPS`).
+//! `TADSL_SCENIC_CHECK`, `TADSL_SCENIC_MAPS`, `TADSL_SCENIC_TRACE`).
 
+pub mod geometry;
 pub mod mutate;
 pub mod scenic;
+pub mod trace;
 
 use std::path::{Path, PathBuf};
 

@@ -63,27 +63,38 @@ pub fn map_dir(base: &Path) -> Option<PathBuf> {
 pub fn oracle(base: &Path) -> Option<(PathBuf, PathBuf, PathBuf)> {
     let found = (|| Some((python()?, check_script()?, map_dir(base)?)))();
     if found.is_none() {
-        let why = "the Scenic oracle is not available (set TADSL_SCENIC_PYTHON to a python with scenic 3.1.1, \
-                   or run `bash ../shared/scenic/setup.sh .venv-scenic`; ../shared/scenic/scenic_check.py and \
-                   ../shared/maps/CARLA must exist)";
-        if std::env::var_os("TAD_REQUIRE_SCENIC").is_some_and(|v| v == "1") {
-            panic!("{why}");
-        }
-        // `cargo test` shows what a passing test prints with `println!`/`eprintln!` only
-        // with --nocapture; a direct write to the process's stderr always reaches the
-        // terminal, so the skip is seen
-        use std::io::Write;
-        let _ = writeln!(std::io::stderr().lock(), "warning: SKIPPED: {why}");
+        unavailable(
+            "the Scenic oracle is not available (set TADSL_SCENIC_PYTHON to a python with scenic 3.1.1, \
+             or run `bash ../shared/scenic/setup.sh .venv-scenic`; ../shared/scenic/scenic_check.py and \
+             ../shared/maps/CARLA must exist)",
+        );
     }
     found
 }
 
+/// Say `why` Scenic is missing where a user sees it (a skip), or panic with it when
+/// `TAD_REQUIRE_SCENIC=1`.
+pub fn unavailable(why: &str) {
+    if std::env::var_os("TAD_REQUIRE_SCENIC").is_some_and(|v| v == "1") {
+        panic!("{why}");
+    }
+    // `cargo test` shows what a passing test prints with `println!`/`eprintln!` only
+    // with --nocapture; a direct write to the process's stderr always reaches the
+    // terminal, so the skip is seen
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr().lock(), "warning: SKIPPED: {why}");
+}
+
+/// This test process's turn to run Scenic: one run at a time, as Scenic processes share
+/// the map cache (`.snet`), which the first compile of a map writes.
+pub fn turn() -> std::sync::MutexGuard<'static, ()> {
+    static SCENIC: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    SCENIC.lock().unwrap_or_else(|e| e.into_inner())
+}
+
 /// Run the oracle on `files` in one process; one JSON object per file.
 pub fn run(python: &Path, check: &Path, args: &[&str], files: &[PathBuf]) -> Vec<serde_json::Value> {
-    // One Scenic process at a time: they share the map cache (`.snet`), which the first
-    // compile of a map writes.
-    static ORACLE: std::sync::Mutex<()> = std::sync::Mutex::new(());
-    let _turn = ORACLE.lock().unwrap_or_else(|e| e.into_inner());
+    let _turn = turn();
     let output = Command::new(python)
         .arg(check)
         .args(args)
