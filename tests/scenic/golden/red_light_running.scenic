@@ -94,12 +94,257 @@ def tadJunctionOk(lane, junction, signalised, maneuver, signs):
     kinds = {signal.type for signal in crossing.signals}
     return all(sign in kinds for sign in signs)
 
+TAD_ARMS = {'left': -90.0, 'right': 90.0, 'opposite': 180.0}
+
+def tadWrap(angle):
+    """An angle in degrees brought into [-180, 180)."""
+    return (angle + 180.0) % 360.0 - 180.0
+
+def tadEndHeading(lane, atStart=False):
+    """The heading (radians) of a lane over its last 4 metres (over its first 4 with
+    `atStart`): a chord, so that the curve of a road just before a junction does not count."""
+    line = lane.centerline
+    span = min(4.0, line.length)
+    if atStart:
+        return line.pointAlongBy(0).angleTo(line.pointAlongBy(span))
+    return line.pointAlongBy(line.length - span).angleTo(line.pointAlongBy(line.length))
+
+def tadArms(lane):
+    """The arms of the junction `lane` ends at, by name: 'ego' (the road of `lane`), and
+    'left', 'right', 'opposite', classified by the heading of the traffic entering the junction
+    from the arm (over its last 4 m) relative to the heading of `lane` at its end: about -90
+    degrees (it drives towards the ego's right) is 'left', about +90 'right', about 180
+    'opposite' (each within 45 degrees; of two roads in one class, the nearer to the ideal
+    angle). An arm whose road only leaves the junction is classified by its outgoing lanes,
+    reversed. Each arm is (incoming lanes, outgoing lanes), both ordered from the centre line
+    outwards (TAD 1, 2, ... and -1, -2, ...). Empty if `lane` ends at no junction."""
+    if not lane.maneuvers or lane.maneuvers[0].intersection is None:
+        return {}
+    crossing = lane.maneuvers[0].intersection
+    base = tadMath.degrees(tadEndHeading(lane))
+    found = {}
+    for road in crossing.roads:
+        ins = [l for l in crossing.incomingLanes if l.road == road]
+        outs = [l for l in crossing.outgoingLanes if l.road == road]
+        ins.sort(key=lambda l: abs(l.sections[-1].openDriveID))
+        outs.sort(key=lambda l: abs(l.sections[0].openDriveID))
+        if road == lane.road:
+            found['ego'] = (0.0, ins, outs)
+            continue
+        if ins:
+            heading = tadMath.degrees(tadEndHeading(ins[0]))
+        elif outs:
+            heading = tadMath.degrees(tadEndHeading(outs[0], atStart=True)) + 180.0
+        else:
+            continue
+        turn = tadWrap(heading - base)
+        for name, ideal in TAD_ARMS.items():
+            miss = abs(tadWrap(turn - ideal))
+            if miss < 45.0 and (name not in found or miss < found[name][0]):
+                found[name] = (miss, ins, outs)
+    return {name: (ins, outs) for name, (miss, ins, outs) in found.items()}
+
+def tadArmLanes(anchor, arm):
+    """(incoming, outgoing) lanes of an arm of the junction ahead of the anchor, as in
+    `tadArms`; for 'ego' without a junction, the lanes of the ego's road at the end of its
+    lane (those of its direction, then none). Raises TadRejection if there is no such arm."""
+    if arm not in TAD_ARMS and arm != 'ego':
+        raise ValueError(f'TADSL: unknown junction arm {arm!r}')
+    lane, arc = anchor
+    arms = tadArms(lane)
+    if arm == 'ego' and arm not in arms:
+        same, other = tadLanes(lane.sections[-1])
+        return ([s.lane for s in same], [])
+    if arm not in arms:
+        raise TadRejection(f'the junction has no {arm} arm')
+    return arms[arm]
+
+@tadLazy
+def tadArm(anchor, arm):
+    """The lane (Scenic `Lane`) entering the junction ahead of the anchor's lane from arm `arm`
+    ('left', 'right', 'opposite': see `tadArms`), the one nearest the centre line (TAD lane 1
+    of that arm); for 'ego', the anchor's own lane. Raises TadRejection if the junction has no
+    such arm (a three-way junction lacks one of them) or the arm has no lane into it."""
+    if arm == 'ego':
+        return anchor[0]
+    ins, outs = tadArmLanes(anchor, arm)
+    if not ins:
+        raise TadRejection(f'no lane enters the junction from its {arm} arm')
+    return ins[0]
+
+def tadOrdinary(lane):
+    """Whether `lane` is a lane of an ordinary road (not of a junction's connecting road)."""
+    return lane is not None and lane.road in lane.network.roads
+
+def tadBack(lane, before):
+    """The point `before` metres before the end of `lane`, walking back over the lanes leading
+    into it while they are lanes of ordinary roads: (lane, arc). TadRejection if they end
+    (at another junction) sooner."""
+    arc = lane.centerline.length - before
+    seen = {lane.uid}
+    while arc < 0:
+        prev = lane._predecessor
+        if prev is None or not hasattr(prev, 'centerline') or prev.uid in seen or not tadOrdinary(prev) \
+                or prev.centerline[-1].distanceTo(lane.centerline[0]) > 1.0:
+            raise TadRejection('the arm is too short for the actor')
+        seen.add(prev.uid)
+        lane = prev
+        arc += lane.centerline.length
+    return (lane, arc)
+
+def tadOnward(lane, after):
+    """The point `after` metres from the start of `lane`, walking on over the lanes it leads
+    into while they are lanes of ordinary roads: (lane, arc). TadRejection if they end sooner."""
+    arc = after
+    seen = {lane.uid}
+    while arc > lane.centerline.length:
+        nxt = lane._successor
+        if nxt is None or not hasattr(nxt, 'centerline') or nxt.uid in seen or not tadOrdinary(nxt) \
+                or nxt.centerline[0].distanceTo(lane.centerline[-1]) > 1.0:
+            raise TadRejection('the arm is too short for the actor')
+        seen.add(nxt.uid)
+        arc -= lane.centerline.length
+        lane = nxt
+    return (lane, arc)
+
+def tadReach(lane, onward=False, limit=500.0):
+    """How many metres of ordinary road lanes lead into `lane`'s end (with `onward`: lead on
+    from its start), up to `limit`: how far `tadBack` (`tadOnward`) can go."""
+    total, seen = lane.centerline.length, {lane.uid}
+    while total < limit:
+        nxt = lane._successor if onward else lane._predecessor
+        if nxt is None or not hasattr(nxt, 'centerline') or nxt.uid in seen or not tadOrdinary(nxt):
+            break
+        gap = nxt.centerline[0].distanceTo(lane.centerline[-1]) if onward \
+            else nxt.centerline[-1].distanceTo(lane.centerline[0])
+        if gap > 1.0:
+            break
+        seen.add(nxt.uid)
+        lane = nxt
+        total += lane.centerline.length
+    return min(total, limit)
+
+@tadLazy
+def tadArmSpot(anchor, arm, before, index, place='centre', width=0.0):
+    """Where an actor on an arm of the junction ahead of the ego stands: (position, heading of
+    its lane there). `arm` is 'ego', 'left', 'right' or 'opposite' (see `tadArms`). `index` > 0:
+    TAD lane `index` of the lanes driving into the junction on that arm (1 = the one nearest
+    the centre line), `before` metres before the arm's stop line (the end of its lane), going
+    back over the lanes leading into it on ordinary roads if needed. `index` < 0: lane -`index`
+    of the lanes driving away from the junction on that arm (-1 = nearest the centre line),
+    `before` metres after the junction exit, heading away. The index counts the lanes where the
+    actor stands. `place` and `width` as in `tadSpot` ('curb'/'sidewalk' only move an actor in
+    the outermost lane). Raises TadRejection if the junction has no such arm or the lanes are
+    too short; ValueError for index 0 or a negative `before`."""
+    if index == 0 or before < 0:
+        raise ValueError('TADSL: tadArmSpot needs index != 0 and before >= 0')
+    ins, outs = tadArmLanes(anchor, arm)
+    if index > 0:
+        if not ins:
+            raise TadRejection(f'no lane enters the junction from its {arm} arm')
+        lane, arc = tadBack(ins[0], before)
+    else:
+        if not outs:
+            raise TadRejection(f'no lane leaves the junction on its {arm} arm')
+        lane, arc = tadOnward(outs[0], before)
+    return tadPlace(lane, arc, abs(index), place, width)
+
+def tadCrossing(lane, arc, beyond, fromRight, extra):
+    """The start of a walk across the road of `lane` at `arc` metres along it (and `beyond`
+    metres further, straight on past its end): on the sidewalk of that side, 0.5 m in from its
+    edge next to the road, else 0.5 m outside the curb; `extra` metres further out; heading
+    straight across the road."""
+    point = lane.centerline.pointAlongBy(arc)
+    heading = tadHeading(lane.centerline, arc)
+    right = Vector(1, 0).rotatedBy(heading)
+    section = lane.sectionAt(point) or min(lane.sections, key=lambda s: s.distanceTo(point))
+    same, other = tadLanes(section)
+    side = 1 if fromRight else -1
+    outer = same[-1] if fromRight else (other[-1] if other else same[0])
+    lateral = lambda q: side * (q - point).dot(right)
+    edges = [outer.leftEdge, outer.rightEdge]
+    if fromRight or other:
+        edges.append(outer.group.curb)
+    edge = max(lateral(e.project(point)) for e in edges)
+    offset = edge + 0.5
+    best = None
+    for walk in section.road.sidewalks or ():
+        middle = walk.centerline.project(point)
+        if abs((middle - point).dot(Vector(0, 1).rotatedBy(heading))) > 2.0 or lateral(middle) < edge:
+            continue
+        inner = min(lateral(walk.leftEdge.project(point)), lateral(walk.rightEdge.project(point)))
+        spot = min(max(inner, edge) + 0.5, lateral(middle))
+        if best is None or spot < best:
+            best = spot
+    if best is not None:
+        offset = best
+    position = point + Vector(0, beyond).rotatedBy(heading) + right * (side * (offset + extra))
+    return (position, heading + side * tadMath.pi / 2)
+
+@tadLazy
+def tadCross(anchor, arm, before, fromRight, extra=0.0):
+    """Where a pedestrian (or cyclist) who walks across the road of arm `arm` of the junction
+    ahead of the ego starts: (position, heading straight across the road). `before` metres
+    before that arm's stop line (measured along its lane 1, going back over the lanes leading
+    into it if needed; a negative `before` is that many metres past the stop line, straight
+    on into the junction). `fromRight`: on the right-hand side of the road as seen by the
+    arm's incoming traffic, else on the far left side beyond its outgoing lanes. The spot is
+    on the sidewalk there, 0.5 m in from its edge next to the road (at most at its middle),
+    else 0.5 m outside the curb (the road's edge, shoulders and parking lanes included);
+    `extra` metres further from the road (the 2nd, 3rd ... of a group standing side by side).
+    For 'ego' the stop line is the end of the ego's lane (with or without a junction; for a
+    spot relative to the ego see `tadCrossAt`). Raises TadRejection if the junction has no
+    such arm or its lanes are too short."""
+    ins, outs = tadArmLanes(anchor, arm)
+    if not ins:
+        raise TadRejection(f'no lane enters the junction from its {arm} arm')
+    if before >= 0:
+        lane, arc = tadBack(ins[0], before)
+        return tadCrossing(lane, arc, 0.0, fromRight, extra)
+    return tadCrossing(ins[0], ins[0].centerline.length, -before, fromRight, extra)
+
+@tadLazy
+def tadCrossAt(anchor, offset, fromRight, extra=0.0):
+    """Like `tadCross`, on the ego's road `offset` metres ahead of the ego (negative: behind),
+    along its lane as in `tadSpot`: `fromRight` is the ego's right-hand side. Raises
+    TadRejection beyond the ends of the ego's lane."""
+    lane, arc = anchor
+    arc = arc + offset
+    if arc < 0 or arc > lane.centerline.length:
+        raise TadRejection('crossing beyond the end of the lane')
+    return tadCrossing(lane, arc, 0.0, fromRight, extra)
+
+def tadArmsOk(lane, arms, armLanes, armReach):
+    """Whether the junction `lane` ends at has the arms `arms`, at least the (incoming,
+    outgoing) lanes `armLanes[arm]` and the (incoming, outgoing) metres `armReach[arm]`."""
+    if not arms and not armLanes and not armReach:
+        return True
+    found = tadArms(lane)
+    for arm in tuple(arms) + tuple(armLanes or ()) + tuple(armReach or ()):
+        if arm not in found or not (found[arm][0] or found[arm][1]):
+            return False
+    for arm, (nIn, nOut) in (armLanes or {}).items():
+        if len(found[arm][0]) < nIn or len(found[arm][1]) < nOut:
+            return False
+    for arm, (mIn, mOut) in (armReach or {}).items():
+        ins, outs = found[arm]
+        if mIn > 0 and (not ins or tadReach(ins[0]) < mIn):
+            return False
+        if mOut > 0 and (not outs or tadReach(outs[0], onward=True) < mOut):
+            return False
+    return True
+
 def tadAnchors(network, same=None, other=None, minSame=0, minOther=0, index=1, sidewalk=False,
                junction=None, signalised=None, maneuver=None, signs=(), shape=None, ahead=10.0,
-               behind=10.0, approach=None, step=4.0):
+               behind=10.0, approach=None, step=4.0, arms=(), armLanes=None, armReach=None):
     """Where the ego vehicle can be: (lane, arc) pairs such that the lane layout is the one asked
     for from `behind` metres behind the ego to `ahead` metres in front of it, and, with an
-    `approach`, the lane ends `approach` metres ahead at a junction of the kind asked for."""
+    `approach`, the lane ends `approach` metres ahead at a junction of the kind asked for.
+    With an `approach`, the junction can also be asked to have the arms `arms` (names as in
+    `tadArms`: 'ego', 'left', 'right', 'opposite'), at least `armLanes[arm] = (incoming,
+    outgoing)` lanes on an arm at the junction, and `armReach[arm] = (incoming, outgoing)`
+    metres of ordinary road on the arm before its stop line and after its exit (how far
+    `tadArmSpot` and `tadCross` can go). All three are optional."""
     found = []
     for lane, start, end, n, m, i, walk in tadRuns(network):
         if (same is not None and n != same) or (other is not None and m != other):
@@ -110,7 +355,8 @@ def tadAnchors(network, same=None, other=None, minSame=0, minOther=0, index=1, s
         if approach is not None:
             arc = length - approach
             if end >= length - 0.5 and arc - behind >= start and arc >= 0 and \
-                    tadJunctionOk(lane, junction, signalised, maneuver, signs):
+                    tadJunctionOk(lane, junction, signalised, maneuver, signs) and \
+                    tadArmsOk(lane, arms, armLanes, armReach):
                 found.append((lane, arc))
             continue
         arc = start + behind
@@ -123,7 +369,7 @@ def tadAnchors(network, same=None, other=None, minSame=0, minOther=0, index=1, s
 def tadRequire(anchors, wanted):
     if not anchors:
         raise RuntimeError('TADSL: no place on this map has the road the scenario needs ('
-                           + ', '.join(f'{k}={v!r}' for k, v in wanted.items() if v is not None)
+                           + ', '.join(f'{k}={v!r}' for k, v in wanted.items() if v is not None and v != () and v != {})
                            + '); build for another map (--map) or relax the road section')
     return anchors
 
@@ -136,6 +382,12 @@ def tadSpot(anchor, offset, index, place='centre', width=0.0):
     arc = arc + offset
     if arc < 0 or arc > lane.centerline.length:
         raise TadRejection('actor beyond the end of the lane')
+    return tadPlace(lane, arc, index, place, width)
+
+def tadPlace(lane, arc, index, place='centre', width=0.0):
+    """The spot `arc` metres along `lane` in TAD lane `index` counted from `lane`'s direction
+    (positive: lanes of its direction from the left, negative: the others from the centre line
+    outwards): (position, heading of that lane there). `place` as in `tadSpot`."""
     point = lane.centerline.pointAlongBy(arc)
     section = lane.sectionAt(point) or min(lane.sections, key=lambda s: s.distanceTo(point))
     same, other = tadLanes(section)
@@ -200,6 +452,69 @@ behavior TadTurn(speed, maneuver):
         path = [lane, turn.endLane] if turn.connectingLane is None else [lane, turn.connectingLane, turn.endLane]
         do FollowTrajectoryBehavior(target_speed=speed, trajectory=path)
     do TadFollow(speed)
+
+def tadGapAhead(car, reach):
+    """The free distance (metres, bumper to bumper) from `car` to the nearest object ahead of
+    it in its path within `reach`, else None. In its path: ahead of its front, and overlapping
+    the band of its width (plus 0.3 m each side) along its heading, or in the same lane."""
+    forward = Vector(0, 1).rotatedBy(car.heading)
+    right = Vector(1, 0).rotatedBy(car.heading)
+    best = None
+    for obj in simulation().objects:
+        if obj is car:
+            continue
+        offset = obj.position - car.position
+        along = offset.dot(forward)
+        if along <= 0 or along > reach + car.length + 10:
+            continue
+        turn = obj.heading - car.heading
+        cos, sin = abs(tadMath.cos(turn)), abs(tadMath.sin(turn))
+        gap = along - car.length / 2 - (obj.length * cos + obj.width * sin) / 2
+        if gap > reach or (best is not None and gap >= best):
+            continue
+        aside = abs(offset.dot(right)) - (obj.width * cos + obj.length * sin) / 2
+        if aside > car.width / 2 + 0.3:
+            lane = car._lane
+            if lane is None or getattr(obj, '_lane', None) != lane:
+                continue
+        best = max(gap, 0.0)
+    return best
+
+def tadHeadway(car):
+    """The gap `car` keeps to what is ahead of it: 2 m plus 1.5 s at its speed."""
+    return 2.0 + 1.5 * (car.speed or 0.0)
+
+def tadTooClose(car):
+    """Whether something is ahead of `car` in its path closer than its headway."""
+    gap = tadGapAhead(car, tadHeadway(car))
+    return gap is not None and gap < tadHeadway(car)
+
+def tadBraking(car):
+    """The brake that stops `car` 1.5 m short of what is ahead of it (0.2 to 1)."""
+    gap = tadGapAhead(car, tadHeadway(car))
+    if gap is None:
+        return 0.2
+    speed = car.speed or 0.0
+    need = speed * speed / (2 * max(gap - 1.5, 0.1))
+    return min(1.0, max(0.2, need / 6.8 + 0.1))
+
+behavior TadDrive(speed):
+    """Follow the lane at `speed` (straight on through junctions, as `TadFollow`), slowing down
+    and stopping behind whatever is ahead in its path (a vehicle, a pedestrian): it keeps a gap
+    of 2 m plus 1.5 s at its speed, and drives on when the way is clear."""
+    try:
+        do TadFollow(speed)
+    interrupt when tadTooClose(self):
+        take SetThrottleAction(0), SetBrakeAction(tadBraking(self))
+
+behavior TadThrough(speed, maneuver):
+    """Follow the lane at `speed`, then take a maneuver of the given type ('STRAIGHT',
+    'LEFT_TURN', 'RIGHT_TURN', 'U_TURN') at the junction it ends at (as `TadTurn`), with the
+    car following of `TadDrive`."""
+    try:
+        do TadTurn(speed, maneuver)
+    interrupt when tadTooClose(self):
+        take SetThrottleAction(0), SetBrakeAction(tadBraking(self))
 
 behavior TadChangeLane(speed, toLeft):
     """Follow the lane for a moment, then change to the adjacent lane of the same direction."""
