@@ -12,6 +12,7 @@
 #   rightmost lane of the other direction. An oncoming truck approaches at about 40 km/h
 #   in the middle lane of the opposite carriageway.
 # Left out or approximated (the build's warnings say where):
+#   W0701 Town06 has no place with a straight stretch of 66 m
 #   W0700 traffic density `light` has no Scenic mapping
 #   W0700 `buildings`, `trees` and `parked_cars` (road roadside) have no Scenic mapping
 #   W0701 Town06 has no place with a sidewalk beside the ego's lane
@@ -345,7 +346,8 @@ def tadAnchors(network, same=None, other=None, minSame=0, minOther=0, index=1, s
     `tadArms`: 'ego', 'left', 'right', 'opposite'), at least `armLanes[arm] = (incoming,
     outgoing)` lanes on an arm at the junction, and `armReach[arm] = (incoming, outgoing)`
     metres of ordinary road on the arm before its stop line and after its exit (how far
-    `tadArmSpot` and `tadCross` can go). All three are optional."""
+    `tadArmSpot` and `tadCross` can go). All three are optional. A `shape` holds over the
+    whole stretch: with an approach, from `behind` the ego to the junction."""
     found = []
     for lane, start, end, n, m, i, walk in tadRuns(network):
         if (same is not None and n != same) or (other is not None and m != other):
@@ -357,7 +359,8 @@ def tadAnchors(network, same=None, other=None, minSame=0, minOther=0, index=1, s
             arc = length - approach
             if end >= length - 0.5 and arc - behind >= start and arc >= 0 and \
                     tadJunctionOk(lane, junction, signalised, maneuver, signs) and \
-                    tadArmsOk(lane, arms, armLanes, armReach):
+                    tadArmsOk(lane, arms, armLanes, armReach) and \
+                    tadShapeOk(lane.centerline, arc - behind, length, shape):
                 found.append((lane, arc))
             continue
         arc = start + behind
@@ -551,8 +554,8 @@ behavior TadYield(speed):
         take SetThrottleAction(0), SetBrakeAction(1.0)
 # ---- end of the prelude ----
 
-# The road around the ego vehicle: 3 lanes in the ego's direction, 3 lanes in the other direction, a junction with traffic lights, a straight stretch of 37 m.
-# Left out, as Town06 has no place with them and the rest: a sidewalk beside the ego's lane.
+# The road around the ego vehicle: 3 lanes in the ego's direction, 3 lanes in the other direction, a junction with traffic lights.
+# Left out, as Town06 has no place with them and the rest: a sidewalk beside the ego's lane, a straight stretch of 66 m.
 # The ego is placed where the lane layout holds from `behind` metres behind it to `ahead` metres
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=3, other=3, minSame=3, minOther=0, index=2, sidewalk=False,

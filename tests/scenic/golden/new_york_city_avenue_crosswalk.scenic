@@ -12,6 +12,7 @@
 #   sedans are parked along the left curb. High-rise buildings and shopfronts line both
 #   sidewalks.
 # Left out or approximated (the build's warnings say where):
+#   W0701 Town06 has no place with a straight stretch of 53 m
 #   W0700 `parking_lane` and `bus_lane` (road special_lanes) have no Scenic mapping
 #   W0700 traffic density `heavy` has no Scenic mapping
 #   W0700 `buildings`, `shops` and `parked_cars` (road roadside) have no Scenic mapping
@@ -346,7 +347,8 @@ def tadAnchors(network, same=None, other=None, minSame=0, minOther=0, index=1, s
     `tadArms`: 'ego', 'left', 'right', 'opposite'), at least `armLanes[arm] = (incoming,
     outgoing)` lanes on an arm at the junction, and `armReach[arm] = (incoming, outgoing)`
     metres of ordinary road on the arm before its stop line and after its exit (how far
-    `tadArmSpot` and `tadCross` can go). All three are optional."""
+    `tadArmSpot` and `tadCross` can go). All three are optional. A `shape` holds over the
+    whole stretch: with an approach, from `behind` the ego to the junction."""
     found = []
     for lane, start, end, n, m, i, walk in tadRuns(network):
         if (same is not None and n != same) or (other is not None and m != other):
@@ -358,7 +360,8 @@ def tadAnchors(network, same=None, other=None, minSame=0, minOther=0, index=1, s
             arc = length - approach
             if end >= length - 0.5 and arc - behind >= start and arc >= 0 and \
                     tadJunctionOk(lane, junction, signalised, maneuver, signs) and \
-                    tadArmsOk(lane, arms, armLanes, armReach):
+                    tadArmsOk(lane, arms, armLanes, armReach) and \
+                    tadShapeOk(lane.centerline, arc - behind, length, shape):
                 found.append((lane, arc))
             continue
         arc = start + behind
@@ -552,8 +555,8 @@ behavior TadYield(speed):
         take SetThrottleAction(0), SetBrakeAction(1.0)
 # ---- end of the prelude ----
 
-# The road around the ego vehicle: 5 lanes in the ego's direction, a one-way road, a junction with traffic lights, a straight stretch of 50 m.
-# Left out, as Town06 has no place with them and the rest: a sidewalk beside the ego's lane.
+# The road around the ego vehicle: 5 lanes in the ego's direction, a one-way road, a junction with traffic lights.
+# Left out, as Town06 has no place with them and the rest: a sidewalk beside the ego's lane, a straight stretch of 53 m.
 # The ego is placed where the lane layout holds from `behind` metres behind it to `ahead` metres
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=5, other=0, minSame=5, minOther=0, index=3, sidewalk=False,

@@ -11,6 +11,7 @@
 #   lane at about 25 km/h. A car drives ahead of the ego and an SUV drives just ahead of
 #   the bus, both at roughly 30 km/h.
 # Left out or approximated (the build's warnings say where):
+#   W0701 Town04 has no place with a straight stretch of 27 m
 #   W0700 traffic density `free_flow` has no Scenic mapping
 #   W0700 `buildings` (road roadside) has no Scenic mapping
 #   W0701 Town04 has no place with a sidewalk beside the ego's lane
@@ -344,7 +345,8 @@ def tadAnchors(network, same=None, other=None, minSame=0, minOther=0, index=1, s
     `tadArms`: 'ego', 'left', 'right', 'opposite'), at least `armLanes[arm] = (incoming,
     outgoing)` lanes on an arm at the junction, and `armReach[arm] = (incoming, outgoing)`
     metres of ordinary road on the arm before its stop line and after its exit (how far
-    `tadArmSpot` and `tadCross` can go). All three are optional."""
+    `tadArmSpot` and `tadCross` can go). All three are optional. A `shape` holds over the
+    whole stretch: with an approach, from `behind` the ego to the junction."""
     found = []
     for lane, start, end, n, m, i, walk in tadRuns(network):
         if (same is not None and n != same) or (other is not None and m != other):
@@ -356,7 +358,8 @@ def tadAnchors(network, same=None, other=None, minSame=0, minOther=0, index=1, s
             arc = length - approach
             if end >= length - 0.5 and arc - behind >= start and arc >= 0 and \
                     tadJunctionOk(lane, junction, signalised, maneuver, signs) and \
-                    tadArmsOk(lane, arms, armLanes, armReach):
+                    tadArmsOk(lane, arms, armLanes, armReach) and \
+                    tadShapeOk(lane.centerline, arc - behind, length, shape):
                 found.append((lane, arc))
             continue
         arc = start + behind
@@ -550,8 +553,8 @@ behavior TadYield(speed):
         take SetThrottleAction(0), SetBrakeAction(1.0)
 # ---- end of the prelude ----
 
-# The road around the ego vehicle: 2 lanes in the ego's direction, a one-way road, a junction with traffic lights, a straight stretch of 27 m.
-# Left out, as Town04 has no place with them and the rest: a sidewalk beside the ego's lane.
+# The road around the ego vehicle: 2 lanes in the ego's direction, a one-way road, a junction with traffic lights.
+# Left out, as Town04 has no place with them and the rest: a sidewalk beside the ego's lane, a straight stretch of 27 m.
 # The ego is placed where the lane layout holds from `behind` metres behind it to `ahead` metres
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=2, other=0, minSame=2, minOther=0, index=2, sidewalk=False,

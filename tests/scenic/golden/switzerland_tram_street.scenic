@@ -346,7 +346,8 @@ def tadAnchors(network, same=None, other=None, minSame=0, minOther=0, index=1, s
     `tadArms`: 'ego', 'left', 'right', 'opposite'), at least `armLanes[arm] = (incoming,
     outgoing)` lanes on an arm at the junction, and `armReach[arm] = (incoming, outgoing)`
     metres of ordinary road on the arm before its stop line and after its exit (how far
-    `tadArmSpot` and `tadCross` can go). All three are optional."""
+    `tadArmSpot` and `tadCross` can go). All three are optional. A `shape` holds over the
+    whole stretch: with an approach, from `behind` the ego to the junction."""
     found = []
     for lane, start, end, n, m, i, walk in tadRuns(network):
         if (same is not None and n != same) or (other is not None and m != other):
@@ -358,7 +359,8 @@ def tadAnchors(network, same=None, other=None, minSame=0, minOther=0, index=1, s
             arc = length - approach
             if end >= length - 0.5 and arc - behind >= start and arc >= 0 and \
                     tadJunctionOk(lane, junction, signalised, maneuver, signs) and \
-                    tadArmsOk(lane, arms, armLanes, armReach):
+                    tadArmsOk(lane, arms, armLanes, armReach) and \
+                    tadShapeOk(lane.centerline, arc - behind, length, shape):
                 found.append((lane, arc))
             continue
         arc = start + behind

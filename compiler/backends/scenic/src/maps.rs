@@ -124,6 +124,12 @@ impl Needs {
                     && need.turn.is_none_or(|t| junction.turns.contains(t))
                     && need.signs.iter().all(|t| sign_name(*t).is_some_and(|s| junction.signs.contains(&s)))
                     && run.length >= self.approach + self.behind + SLACK
+                    && match self.shape {
+                        None => true,
+                        // the table knows a run's straight and curved windows, not where they end
+                        Some(Shape::Straight) => run.straight >= self.approach + self.behind,
+                        Some(Shape::Curved) => run.curved.is_some(),
+                    }
             }
             (None, None) => {
                 let window = self.ahead + self.behind;

@@ -159,10 +159,10 @@ pub fn program(scenario: &Scenario, plan: &Plan, diagnostics: &[Diagnostic], opt
         1 => format!("({},)", signs[0]),
         _ => format!("({})", signs.join(", ")),
     };
-    let shape = match (junction, needs.shape) {
-        (None, Some(maps::Shape::Straight)) => "'straight'",
-        (None, Some(maps::Shape::Curved)) => "'curved'",
-        _ => "None",
+    let shape = match needs.shape {
+        Some(maps::Shape::Straight) => "'straight'",
+        Some(maps::Shape::Curved) => "'curved'",
+        None => "None",
     };
     let approach = if junction.is_some() { number(needs.approach) } else { "None".into() };
     let arms = match needs.arms.len() {
