@@ -49,6 +49,8 @@ struct Decision {
     target: Target,
     longitudinal: Longitudinal,
     crosser: bool,
+    /// At the curb on the road's left (past its leftmost lane) rather than its right.
+    curb_left: bool,
     /// A written `distance`: (low, high).
     distance: Option<(f64, f64)>,
     span: Span,
@@ -139,7 +141,12 @@ pub fn lay_out(scenario: &Scenario) -> Layout {
         .given()
         .and_then(|l| scenario.entries.resolved(l))
         .is_some_and(|e| e.attrs.present && e.attrs.signal.is_some());
-    let junction_road = matches!(shape, Shape::Junction { .. }) || lit;
+    // so do signs that belong to a junction, and the ego's turn
+    let junction_sign = scenario.road.signs.given().is_some_and(|signs| {
+        signs.iter().any(|s| scenario.entries.resolved(&s.value).is_some_and(|e| e.attrs.opendrive_type.is_some()))
+    });
+    let turning = matches!(ego_facts.motion, Some(Motion::TurnLeft | Motion::TurnRight | Motion::UTurn));
+    let junction_road = matches!(shape, Shape::Junction { .. }) || lit || junction_sign || turning;
 
     // --- decisions: arm, lane, place, facing, in placement order
     let ids: Vec<GroupId> = scenario.groups().map(|(id, _)| id).collect();
@@ -188,6 +195,7 @@ pub fn lay_out(scenario: &Scenario) -> Layout {
         let mut arm = ref_arm;
         let mut lane;
         let mut place = Place::Lane;
+        let mut curb_left = false;
         if junction_road
             && ref_arm == Arm::Ego
             && side_arm.is_some()
@@ -228,12 +236,14 @@ pub fn lay_out(scenario: &Scenario) -> Layout {
                 lane = i64::from(incoming);
                 place = Place::Curb;
             } else if lane < 0 && lane < -i64::from(outgoing) {
+                curb_left = outgoing == 0;
                 lane = if outgoing == 0 { 1 } else { -i64::from(outgoing) };
                 place = Place::Curb;
             }
             if one_way && arm == Arm::Ego && lane < 0 {
                 lane = 1;
                 place = Place::Curb;
+                curb_left = true;
             }
         }
         if written.is_none() {
@@ -250,7 +260,11 @@ pub fn lay_out(scenario: &Scenario) -> Layout {
             lane == i64::from(incoming) || lane == -i64::from(outgoing) || (outgoing == 0 && lane == 1)
         };
         match f.motion {
-            Some(Motion::Parked) if f.body != Body::Object && outermost(arm, lane) => place = Place::Curb,
+            Some(Motion::Parked) if f.body != Body::Object && outermost(arm, lane) => {
+                place = Place::Curb;
+                // lane 1 of a one-way road of several lanes has its curb on the left
+                curb_left |= one_way && arm == Arm::Ego && lane == 1 && lanes > 1;
+            }
             Some(Motion::Walk) if f.body == Body::Walker => place = Place::Sidewalk,
             Some(Motion::Graze) if outermost(arm, lane) => place = Place::Curb,
             _ => {}
@@ -273,6 +287,7 @@ pub fn lay_out(scenario: &Scenario) -> Layout {
             target,
             longitudinal,
             crosser,
+            curb_left,
             distance,
             span: group.position.given().map_or(group.name_span, |p| p.relation.span),
         });
@@ -397,21 +412,27 @@ pub fn lay_out(scenario: &Scenario) -> Layout {
     place_arm(true, &road, &mut stations, &mut slack, &mut occupied);
     if road.junction.is_some() {
         // a queue ahead waits at the stop line; a moving ego is a few seconds away
-        let ahead: Vec<(f64, bool)> = decisions
+        let ahead: Vec<(f64, bool, bool)> = decisions
             .iter()
             .enumerate()
             .filter(|(_, d)| d.as_ref().is_some_and(|d| d.arm == Arm::Ego && d.lane > 0 && !d.crosser))
             .flat_map(|(i, _)| {
                 let f = &group_facts[i];
-                stations[i].iter().map(move |(s, _)| (s.along + f.length / 2.0, f.is_static()))
+                let queued = f.is_static() && f.motion != Some(Motion::Parked) && f.body == Body::Vehicle;
+                stations[i].iter().map(move |(s, _)| (s.along + f.length / 2.0, f.is_static(), queued))
             })
-            .filter(|(front, _)| *front > 0.0)
+            .filter(|(front, _, _)| *front > 0.0)
             .collect();
         // moving traffic ahead drives on through the junction; what stands waits before it
-        let front = ahead.iter().filter(|(_, stopped)| *stopped).map(|(x, _)| *x).fold(ego_len / 2.0, f64::max);
-        let queue = ahead.iter().any(|(_, stopped)| *stopped);
+        // a queue of stopped vehicles ends at the stop line; what stands elsewhere stays
+        // before it
+        let front = |which: fn(&(f64, bool, bool)) -> bool| {
+            ahead.iter().filter(|a| which(a)).map(|a| a.0).fold(ego_len / 2.0, f64::max)
+        };
+        let queue = ahead.iter().any(|a| a.2);
+        let standing = front(|a| a.1) + 1.0;
         let base = (ego_facts.speed * APPROACH_TIME).clamp(6.0, 40.0) + ego_len / 2.0;
-        road.approach = if queue { front + 1.0 } else { base.max(front + 3.0) };
+        road.approach = if queue { front(|a| a.2) + 1.0 } else { base }.max(standing).max(6.0);
         // crossers on the ego's road near the junction use its crosswalk
         for (i, d) in decisions.iter().enumerate() {
             let Some(d) = d.as_ref().filter(|d| d.arm == Arm::Ego && d.crosser) else { continue };
@@ -465,7 +486,16 @@ pub fn lay_out(scenario: &Scenario) -> Layout {
         if road.junction.is_none() || built.late <= 0.05 {
             break;
         }
-        road.approach += built.late * ego_facts.speed + 1.0;
+        let delta = built.late * ego_facts.speed + 1.0;
+        road.approach += delta;
+        // walkers at the ego's crosswalk stay at it
+        for (i, d) in decisions.iter().enumerate() {
+            if d.as_ref().is_some_and(|d| d.arm == Arm::Ego && d.crosser) {
+                for (s, _) in &mut stations[i] {
+                    s.along += delta;
+                }
+            }
+        }
         built = build(scenario, &road, &decisions, &group_facts, &stations, &slack, &ids, ego_lane, &ego_facts);
     }
     let Built { ego, groups, conflicts, .. } = built;
@@ -510,7 +540,7 @@ fn build(
         facing: Facing::Along,
         motion: ego_facts.motion,
         turn: ego_turn,
-        speed: ego_facts.speed,
+        speed: if ego_facts.is_static() { 0.0 } else { ego_facts.speed },
         moving: !ego_facts.is_static(),
         start: Start::default(),
         pose: road.lane_pose(ego_station, ego_lane),
@@ -719,7 +749,7 @@ fn place_group(
             Place::Curb => {
                 let shift = (road.lane_width / 2.0 - f.width / 2.0 - 0.2).max(0.0);
                 // the curb is to the right of a lane's own traffic
-                let outward = if d.lane > 0 { -1.0 } else { 1.0 };
+                let outward = if d.lane > 0 && !d.curb_left { -1.0 } else { 1.0 };
                 centre + outward * shift
             }
             Place::Sidewalk => side_lateral(if d.lane > 0 { Side::Right } else { Side::Left }, 0),

@@ -16,7 +16,6 @@ use std::process::Command;
 
 use serde_json::Value;
 
-use crate::geometry::Footprint;
 use crate::{repo, scenic};
 
 /// One object's state at one step.
@@ -140,53 +139,6 @@ impl Trace {
     /// The index of the ego in `objects`.
     pub fn ego(&self) -> Option<usize> {
         self.objects.iter().position(|o| o.is_ego)
-    }
-
-    /// The footprint of object `object` at `step`.
-    pub fn footprint(&self, step: usize, object: usize) -> Footprint {
-        let pose = self.states[step][object];
-        let o = &self.objects[object];
-        Footprint::new(pose.x, pose.y, pose.heading, o.length, o.width)
-    }
-
-    /// The pairs `(i, j)`, `i < j`, of objects whose footprints overlap at `step`.
-    pub fn overlapping_pairs(&self, step: usize) -> Vec<(usize, usize)> {
-        let footprints: Vec<Footprint> = (0..self.objects.len()).map(|i| self.footprint(step, i)).collect();
-        let mut pairs = Vec::new();
-        for i in 0..footprints.len() {
-            for j in i + 1..footprints.len() {
-                if footprints[i].overlaps(&footprints[j]) {
-                    pairs.push((i, j));
-                }
-            }
-        }
-        pairs
-    }
-
-    /// The first step of `steps` (clamped to those recorded) at which two objects overlap
-    /// for which `pair(i, j)` holds, with the pair: `(step, i, j)`.
-    pub fn first_overlap(
-        &self,
-        steps: std::ops::Range<usize>,
-        pair: impl Fn(usize, usize) -> bool,
-    ) -> Option<(usize, usize, usize)> {
-        let steps = steps.start..steps.end.min(self.states.len());
-        steps.into_iter().find_map(|step| {
-            self.overlapping_pairs(step).into_iter().find(|&(i, j)| pair(i, j)).map(|(i, j)| (step, i, j))
-        })
-    }
-
-    /// The least distance between the footprints of objects `a` and `b` over the trace, and
-    /// the first step it occurs at; `None` without a state with finite poses.
-    pub fn closest_approach(&self, a: usize, b: usize) -> Option<(f64, usize)> {
-        let mut best: Option<(f64, usize)> = None;
-        for step in 0..self.states.len() {
-            let d = self.footprint(step, a).distance(&self.footprint(step, b));
-            if d.is_finite() && best.is_none_or(|(least, _)| d < least) {
-                best = Some((d, step));
-            }
-        }
-        best
     }
 }
 
@@ -413,49 +365,7 @@ mod tests {
         assert!(t.states[0][1].speed.is_nan());
         assert_eq!(t.states[1][1], Pose { x: 0.0, y: 21.0, heading: 0.5, speed: 0.0 });
         assert!((t.time(1) - 0.1).abs() < 1e-12);
-        let f = t.footprint(1, 1);
-        assert_eq!((f.length, f.width, f.y), (12.0, 2.5, 21.0));
-    }
-
-    #[test]
-    fn overlaps_and_closest_approach() {
-        // two cars 4.5 m long heading +y; the second starts 10 m ahead (5.5 m between them)
-        // and comes back 2 m per step: 1.5 m apart at step 2, overlapping by 0.5 m at step 3
-        let car = || TraceObject {
-            name: None,
-            group: None,
-            index: None,
-            class: "Car".into(),
-            length: 4.5,
-            width: 1.8,
-            is_ego: false,
-        };
-        let states = (0..6)
-            .map(|k| {
-                let k = f64::from(k);
-                vec![
-                    Pose { x: 0.0, y: 0.0, heading: 0.0, speed: 0.0 },
-                    Pose { x: 0.0, y: 10.0 - 2.0 * k, heading: 0.0, speed: 20.0 },
-                ]
-            })
-            .collect();
-        let t = Trace {
-            file: "x".into(),
-            seed: 0,
-            ok: true,
-            error: None,
-            dt: 0.1,
-            termination: None,
-            objects: vec![car(), car()],
-            states,
-        };
-        assert_eq!(t.overlapping_pairs(0), []);
-        assert_eq!(t.overlapping_pairs(3), [(0, 1)]);
-        assert_eq!(t.first_overlap(0..100, |_, _| true), Some((3, 0, 1)));
-        assert_eq!(t.first_overlap(0..3, |_, _| true), None);
-        assert_eq!(t.first_overlap(0..100, |i, _| i != 0), None);
-        let (d, step) = t.closest_approach(0, 1).unwrap();
-        assert_eq!((d, step), (0.0, 3));
+        assert_eq!((t.objects[1].length, t.objects[1].width), (12.0, 2.5));
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! The printer: a [`Plan`] as the text of a Scenic 3 program. Everything Scenic-specific
 //! in the output is written here, from the plan's typed data: the header comments, the
 //! parameters, the prelude, the road requirements (`tadRoad`), each object with its
-//! behavior call (`FollowLaneBehavior(target_speed=..)`, `TadTurn(.., 'LEFT_TURN')`, ...),
+//! behavior call (`TadDrive(..)`, `TadThrough(.., 'LEFT_TURN')`, ...),
 //! and the traffic-light monitor. Strings, identifiers and comments go through
 //! `crate::python`, so scenario text cannot break out of them.
 
@@ -355,7 +355,7 @@ fn actor(out: &mut String, a: &Actor, spot: &str, needs: &maps::Needs) {
 }
 
 /// The Scenic behavior call for a motion, for an actor of `class` keeping `speed` (m/s):
-/// the prelude's `Tad...` behaviors and Scenic's `FollowLaneBehavior`; none for `Debris`.
+/// the prelude's `Tad...` behaviors; none for `Debris`.
 /// A behavior without a motion follows the lane (stands still at 0).
 pub fn behavior_call(motion: Option<Motion>, class: Class, speed: f64) -> Option<String> {
     behavior_call_with(motion, class, &number(speed), false)

@@ -7,7 +7,7 @@ use tad_diagnostics::{Code, Span};
 use tad_ir::{ActorType, Entry, Field, Lane, Lateral, Longitudinal, Reference, Scenario};
 
 use super::report::{Annotate, Report, named, unsupported};
-use super::{MAX_GROUP, Place, ends, kmh, motion, nominal};
+use super::{MAX_GROUP, ends, kmh, motion, nominal};
 use crate::mapping::{self, Class};
 
 /// Where a group's position points.
@@ -61,43 +61,6 @@ pub struct Resolved {
     pub delay: Option<(f64, f64)>,
     /// The ego's distance at which the group starts its behavior, m.
     pub trigger: Option<(f64, f64)>,
-}
-
-impl Resolved {
-    pub fn across(&self) -> bool {
-        self.motion == Some(tad_ir::Motion::Cross)
-    }
-
-    /// Length along the lane: crossing actors stand across it.
-    pub fn extent(&self) -> f64 {
-        if self.across() { self.width } else { self.length }
-    }
-
-    pub fn place(&self) -> Place {
-        match self.motion {
-            Some(tad_ir::Motion::Parked) => Place::Curb,
-            Some(tad_ir::Motion::Walk) => Place::Sidewalk,
-            _ => Place::Centre,
-        }
-    }
-
-    /// Bumper-to-bumper gap inside the group.
-    pub fn gap(&self) -> f64 {
-        match self.mapping.class {
-            Class::Car => 1.0 + self.speed.min(25.0),
-            Class::Pedestrian => 0.5,
-            Class::Debris => 1.0,
-        }
-    }
-
-    /// Gap to the reference: the written `distance` (its upper end), else from the speeds.
-    pub fn lead_gap(&self, reference_speed: f64) -> f64 {
-        if let Some((_, high)) = self.distance {
-            return high;
-        }
-        let base = if self.mapping.class == Class::Car { 2.0 } else { 1.0 };
-        (base + self.speed.max(reference_speed)).min(30.0)
-    }
 }
 
 /// What stands for an actor type: its own declared simulation, else its kind's (W0703 with

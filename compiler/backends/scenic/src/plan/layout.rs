@@ -26,7 +26,7 @@ pub fn windows(layout: &Layout, needs: &mut Needs, junction: bool, kept: Option<
     }
     needs.ahead = (ahead + 1.0).ceil();
     needs.behind = (behind + 1.0).ceil();
-    needs.approach = if junction { layout.road.approach.ceil().max(6.0) } else { 0.0 };
+    needs.approach = if junction { (layout.road.approach * 1000.0).round() / 1000.0 } else { 0.0 };
     needs.arms = if junction {
         let mut arms: Vec<&'static str> =
             layout.agents().map(|a| a.station.arm).filter(|arm| *arm != Arm::Ego).map(Arm::as_str).collect();

@@ -3,20 +3,20 @@
 //! size, lane, place along the lane, motion and speeds. The plan holds typed data only;
 //! `crate::print` writes it as Scenic.
 //!
-//! Placement is decided here, not sampled: every actor gets a TAD lane index and an offset
-//! in metres along the ego's lane from the ego's centre, so actors never overlap and the
-//! stretch of road the scenario needs is known before the map is chosen. Only the ego's
-//! place on the map is left to Scenic, among places the map table says exist.
+//! Where everything stands is the layout's (`tad_layout`, `spec/layout.md`): its arm, lane,
+//! station, facing, path and timing. This plan renders it on a CARLA map: only the ego's
+//! place on the map is left to Scenic, among places the map table says have the road the
+//! layout needs, and the room the layout keeps (its slack, an adversary's spread) is sampled.
 //!
 //! [`plan`] runs the steps in order, each in its own module with a typed result:
 //!
 //! 1. [`road`]: what the road section asks of the map ([`road::RoadRequest`]);
 //! 2. [`ego`]: the ego vehicle's size, motion, speed and lane ([`ego::EgoPlan`]);
-//! 3. [`groups`]: every actor group's mapping, count, motion, speed, reference and lane
-//!    ([`groups::Resolved`]), and the order they are placed in;
+//! 3. [`groups`]: every actor group's mapping, count, motion, speed, reference, and its lane
+//!    and arm from the layout ([`groups::Resolved`]);
 //! 4. [`choice`]: the road features in priority order and the map that keeps the most
 //!    important ones ([`choice::Choice`]), moving actors into lanes the map has;
-//! 5. [`layout`]: offsets along the lane, capping groups to the stretch the map has;
+//! 5. [`layout`]: the stretch of road the layout needs, and capping groups to what the map has;
 //! 6. [`actors`]: the objects of the program, with their identifiers;
 //! 7. [`environment`]: CARLA's weather parameters, and the traffic light.
 //!
