@@ -160,4 +160,15 @@ impl Layout {
     pub fn conflict(&self, id: GroupId) -> Option<&Conflict> {
         self.conflicts.iter().find(|c| c.group == id)
     }
+
+    /// How far an agent's start may be sampled either way: half its group's conflict
+    /// spread (at most 5 m), never into the junction; 0 for an agent not timed.
+    pub fn conflict_spread(&self, agent: &Agent) -> f64 {
+        let Some(c) = agent.group.and_then(|g| self.conflict(g)) else { return 0.0 };
+        let half = (c.spread * 0.5).clamp(0.5, 5.0);
+        match agent.station.arm {
+            Arm::Ego => half,
+            _ => half.min(agent.station.along - agent.length / 2.0 - 0.5).max(0.0),
+        }
+    }
 }

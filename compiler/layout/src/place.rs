@@ -27,7 +27,7 @@ use crate::road::{self, Arm, Junction, Road, Shape, Side, Station, Turn};
 use crate::{Agent, Conflict, Facing, Finding, GroupLayout, Layout, Place, Start};
 
 /// How long a moving ego takes to reach its stop line, s.
-const APPROACH_TIME: f64 = 3.0;
+const APPROACH_TIME: f64 = 2.0;
 /// Where crosswalks are: metres past an arm's stop line, towards the junction.
 const CROSSWALK: f64 = 2.0;
 /// Spacing of walkers standing side by side.
@@ -430,7 +430,9 @@ pub fn lay_out(scenario: &Scenario) -> Layout {
             ahead.iter().filter(|a| which(a)).map(|a| a.0).fold(ego_len / 2.0, f64::max)
         };
         let queue = ahead.iter().any(|a| a.2);
-        let standing = front(|a| a.1) + 1.0;
+        // on a one-way road the road across the junction may not go on: all of it waits
+        let standing = if road.opposite == 0 { front(|_| true) + 1.0 } else { 0.0 };
+        let standing = standing.max(front(|a| a.1) + 1.0);
         let base = (ego_facts.speed * APPROACH_TIME).clamp(6.0, 40.0) + ego_len / 2.0;
         road.approach = if queue { front(|a| a.2) + 1.0 } else { base }.max(standing).max(6.0);
         // crossers on the ego's road near the junction use its crosswalk
@@ -445,7 +447,9 @@ pub fn lay_out(scenario: &Scenario) -> Layout {
             }
         }
     }
-    if let Some(half) = road.junction.as_ref().filter(|j| j.arms.contains(&Arm::Opposite)).map(|j| j.half) {
+    if let Some(half) =
+        road.junction.as_ref().filter(|j| j.arms.contains(&Arm::Opposite) && road.opposite > 0).map(|j| j.half)
+    {
         // moving traffic ahead past the stop line is already across the junction: all of it
         // moves on by the same distance, so that none is inside the junction and their
         // relations hold

@@ -560,7 +560,8 @@ behavior TadYield(speed):
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=3, other=3, minSame=3, minOther=0, index=2, sidewalk=False,
                junction=None, signalised=True, maneuver=None, signs=(),
-               shape=None, ahead=62.0, behind=4.0, approach=62.0, arms=('opposite',))
+               shape=None, ahead=62.0, behind=4.0, approach=61.65, arms=('opposite',),
+               armReach={'opposite': (43.0, 0.0)})
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
 # ego vehicle: move_forward, 38 km/h, lane 2

@@ -559,7 +559,8 @@ behavior TadYield(speed):
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=3, other=3, minSame=3, minOther=0, index=2, sidewalk=False,
                junction='4way', signalised=True, maneuver=None, signs=(),
-               shape=None, ahead=39.0, behind=4.0, approach=33.0, arms=())
+               shape=None, ahead=39.0, behind=4.0, approach=32.65, arms=(),
+               armReach=None)
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
 # ego vehicle: stopped, 0 km/h, lane 2
@@ -618,27 +619,27 @@ parked_sedans_5 = new Car at tadAt10[0], facing tadAt10[1],
     with regionContainedIn None, with behavior TadParked()
 
 # group `crossing_pedestrians`: 6 pedestrian, cross, 5 km/h, front of lead_suv, lane 2
-tadAt11 = tadCross(tadAnchor, 'ego', 33.0 - (34.65), True, 0.0)
+tadAt11 = tadCross(tadAnchor, 'ego', 32.65 - (34.65), True, 0.0)
 crossing_pedestrians_1 = new Pedestrian at tadAt11[0], facing tadAt11[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt12 = tadCross(tadAnchor, 'ego', 33.0 - (35.55), True, 0.0)
+tadAt12 = tadCross(tadAnchor, 'ego', 32.65 - (35.55), True, 0.0)
 crossing_pedestrians_2 = new Pedestrian at tadAt12[0], facing tadAt12[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt13 = tadCross(tadAnchor, 'ego', 33.0 - (36.45), True, 0.0)
+tadAt13 = tadCross(tadAnchor, 'ego', 32.65 - (36.45), True, 0.0)
 crossing_pedestrians_3 = new Pedestrian at tadAt13[0], facing tadAt13[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt14 = tadCross(tadAnchor, 'ego', 33.0 - (37.35), True, 0.0)
+tadAt14 = tadCross(tadAnchor, 'ego', 32.65 - (37.35), True, 0.0)
 crossing_pedestrians_4 = new Pedestrian at tadAt14[0], facing tadAt14[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt15 = tadCross(tadAnchor, 'ego', 33.0 - (34.65), True, 0.8)
+tadAt15 = tadCross(tadAnchor, 'ego', 32.65 - (34.65), True, 0.8)
 crossing_pedestrians_5 = new Pedestrian at tadAt15[0], facing tadAt15[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt16 = tadCross(tadAnchor, 'ego', 33.0 - (35.55), True, 0.8)
+tadAt16 = tadCross(tadAnchor, 'ego', 32.65 - (35.55), True, 0.8)
 crossing_pedestrians_6 = new Pedestrian at tadAt16[0], facing tadAt16[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)

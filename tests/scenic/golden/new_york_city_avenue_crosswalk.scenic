@@ -561,7 +561,8 @@ behavior TadYield(speed):
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=5, other=0, minSame=5, minOther=0, index=3, sidewalk=False,
                junction=None, signalised=True, maneuver=None, signs=(),
-               shape=None, ahead=49.0, behind=4.0, approach=43.0, arms=())
+               shape=None, ahead=49.0, behind=4.0, approach=42.55, arms=(),
+               armReach=None)
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
 # ego vehicle: stopped, 0 km/h, lane 3
@@ -570,51 +571,51 @@ ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with behavior TadStop()
 
 # group `crossing_pedestrians`: 12 pedestrian, cross, 5 km/h, front of ego, lane 3
-tadAt1 = tadCross(tadAnchor, 'ego', 43.0 - (44.55), True, 0.0)
+tadAt1 = tadCross(tadAnchor, 'ego', 42.55 - (44.55), True, 0.0)
 crossing_pedestrians_1 = new Pedestrian at tadAt1[0], facing tadAt1[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt2 = tadCross(tadAnchor, 'ego', 43.0 - (45.45), True, 0.0)
+tadAt2 = tadCross(tadAnchor, 'ego', 42.55 - (45.45), True, 0.0)
 crossing_pedestrians_2 = new Pedestrian at tadAt2[0], facing tadAt2[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt3 = tadCross(tadAnchor, 'ego', 43.0 - (46.35), True, 0.0)
+tadAt3 = tadCross(tadAnchor, 'ego', 42.55 - (46.35), True, 0.0)
 crossing_pedestrians_3 = new Pedestrian at tadAt3[0], facing tadAt3[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt4 = tadCross(tadAnchor, 'ego', 43.0 - (47.25), True, 0.0)
+tadAt4 = tadCross(tadAnchor, 'ego', 42.55 - (47.25), True, 0.0)
 crossing_pedestrians_4 = new Pedestrian at tadAt4[0], facing tadAt4[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt5 = tadCross(tadAnchor, 'ego', 43.0 - (44.55), True, 0.8)
+tadAt5 = tadCross(tadAnchor, 'ego', 42.55 - (44.55), True, 0.8)
 crossing_pedestrians_5 = new Pedestrian at tadAt5[0], facing tadAt5[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt6 = tadCross(tadAnchor, 'ego', 43.0 - (45.45), True, 0.8)
+tadAt6 = tadCross(tadAnchor, 'ego', 42.55 - (45.45), True, 0.8)
 crossing_pedestrians_6 = new Pedestrian at tadAt6[0], facing tadAt6[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt7 = tadCross(tadAnchor, 'ego', 43.0 - (46.35), True, 0.8)
+tadAt7 = tadCross(tadAnchor, 'ego', 42.55 - (46.35), True, 0.8)
 crossing_pedestrians_7 = new Pedestrian at tadAt7[0], facing tadAt7[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt8 = tadCross(tadAnchor, 'ego', 43.0 - (47.25), True, 0.8)
+tadAt8 = tadCross(tadAnchor, 'ego', 42.55 - (47.25), True, 0.8)
 crossing_pedestrians_8 = new Pedestrian at tadAt8[0], facing tadAt8[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt9 = tadCross(tadAnchor, 'ego', 43.0 - (44.55), True, 1.6)
+tadAt9 = tadCross(tadAnchor, 'ego', 42.55 - (44.55), True, 1.6)
 crossing_pedestrians_9 = new Pedestrian at tadAt9[0], facing tadAt9[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt10 = tadCross(tadAnchor, 'ego', 43.0 - (45.45), True, 1.6)
+tadAt10 = tadCross(tadAnchor, 'ego', 42.55 - (45.45), True, 1.6)
 crossing_pedestrians_10 = new Pedestrian at tadAt10[0], facing tadAt10[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt11 = tadCross(tadAnchor, 'ego', 43.0 - (46.35), True, 1.6)
+tadAt11 = tadCross(tadAnchor, 'ego', 42.55 - (46.35), True, 1.6)
 crossing_pedestrians_11 = new Pedestrian at tadAt11[0], facing tadAt11[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt12 = tadCross(tadAnchor, 'ego', 43.0 - (47.25), True, 1.6)
+tadAt12 = tadCross(tadAnchor, 'ego', 42.55 - (47.25), True, 1.6)
 crossing_pedestrians_12 = new Pedestrian at tadAt12[0], facing tadAt12[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)

@@ -11,7 +11,7 @@
 #   lane at about 25 km/h. A car drives ahead of the ego and an SUV drives just ahead of
 #   the bus, both at roughly 30 km/h.
 # Left out or approximated (the build's warnings say where):
-#   W0701 Town04 has no place with a straight stretch of 27 m
+#   W0701 Town04 has no place with a straight stretch of 53 m
 #   W0700 traffic density `free_flow` has no Scenic mapping
 #   W0700 `buildings` (road roadside) has no Scenic mapping
 #   W0701 Town04 has no place with a sidewalk beside the ego's lane
@@ -554,12 +554,13 @@ behavior TadYield(speed):
 # ---- end of the prelude ----
 
 # The road around the ego vehicle: 2 lanes in the ego's direction, a one-way road, a junction with traffic lights.
-# Left out, as Town04 has no place with them and the rest: a sidewalk beside the ego's lane, a straight stretch of 27 m.
+# Left out, as Town04 has no place with them and the rest: a sidewalk beside the ego's lane, a straight stretch of 53 m.
 # The ego is placed where the lane layout holds from `behind` metres behind it to `ahead` metres
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=2, other=0, minSame=2, minOther=0, index=2, sidewalk=False,
                junction=None, signalised=True, maneuver=None, signs=(),
-               shape=None, ahead=23.0, behind=4.0, approach=28.0, arms=('opposite',))
+               shape=None, ahead=49.0, behind=4.0, approach=48.983, arms=(),
+               armReach=None)
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
 # ego vehicle: move_forward, 30 km/h, lane 2
@@ -569,10 +570,10 @@ ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
 
 # group `bus`: 1 bus, move_forward, 25 km/h, left_front of ego, lane 1
 tadShift1 = Range(0, 4.133)
-tadAt1 = tadArmSpot(tadAnchor, 'opposite', 6.5 - tadShift1, -1)
+tadAt1 = tadSpot(tadAnchor, 22.717 - tadShift1, 1)
 bus = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.mitsubishi.fusorosa', with width 2.55, with length 12.0,
-    with regionContainedIn None, with speed 6.944, with behavior TadDrive(6.944)
+    with regionContainedIn None, with speed 6.944, with behavior TadThrough(6.944, 'STRAIGHT')
 
 # group `car_ahead`: 1 car, move_forward, 30 km/h, front of ego, lane 2
 tadShift2 = Range(0, 4.133)
@@ -583,10 +584,10 @@ car_ahead = new Car at tadAt2[0], facing tadAt2[1],
 
 # group `suv_ahead_of_bus`: 1 suv, move_forward, 30 km/h, front of bus, lane 1
 tadShift3 = Range(0, 4.133)
-tadAt3 = tadArmSpot(tadAnchor, 'opposite', 29.367 - tadShift3, -1)
+tadAt3 = tadSpot(tadAnchor, 45.583 - tadShift3, 1)
 suv_ahead_of_bus = new Car at tadAt3[0], facing tadAt3[1],
     with blueprint 'vehicle.nissan.patrol', with width 1.95, with length 4.8,
-    with regionContainedIn None, with speed 8.333, with behavior TadDrive(8.333)
+    with regionContainedIn None, with speed 8.333, with behavior TadThrough(8.333, 'STRAIGHT')
 
 # The traffic light facing the ego vehicle is `green`: hold the nearest one in that state.
 # (Without CARLA's model, as under Scenic's Newtonian simulator, the monitor does nothing.)

@@ -556,9 +556,10 @@ behavior TadYield(speed):
 # Left out, as Town06 has no place with them and the rest: a sidewalk beside the ego's lane.
 # The ego is placed where the lane layout holds from `behind` metres behind it to `ahead` metres
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
-tadRoad = dict(same=3, other=3, minSame=3, minOther=0, index=2, sidewalk=False,
+tadRoad = dict(same=3, other=3, minSame=2, minOther=0, index=2, sidewalk=False,
                junction='4way', signalised=True, maneuver=None, signs=(),
-               shape=None, ahead=33.0, behind=4.0, approach=43.0, arms=('opposite', 'right'))
+               shape=None, ahead=4.0, behind=4.0, approach=30.028, arms=('opposite', 'right'),
+               armReach={'opposite': (60.0, 10.0), 'right': (62.0, 0.0)})
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
 # ego vehicle: move_forward, 50 km/h, lane 2
@@ -568,17 +569,16 @@ ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
 
 # group `red_light_runner`: 1 sedan, move_forward, 60 km/h, right_front of ego, lane 2
 tadJitter1 = Range(-5.0, 5.0)
-tadAt1 = tadArmSpot(tadAnchor, 'right', 67.233 + tadJitter1, 2)
+tadAt1 = tadArmSpot(tadAnchor, 'right', 52.567 + tadJitter1, 2)
 red_light_runner = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with speed 16.667, with behavior TadThrough(16.667, 'STRAIGHT')
 
 # group `box_truck`: 1 truck, move_forward, 40 km/h, right_front of ego, lane 3
-tadShift2 = Range(0, 6.356)
-tadAt2 = tadSpot(tadAnchor, 28.244 - tadShift2, 3)
+tadAt2 = tadArmSpot(tadAnchor, 'opposite', 4.25, -3)
 box_truck = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.carlamotors.carlacola', with width 2.5, with length 7.5,
-    with regionContainedIn None, with speed 11.111, with behavior TadThrough(11.111, 'STRAIGHT')
+    with regionContainedIn None, with speed 11.111, with behavior TadDrive(11.111)
 
 # group `oncoming_cars`: 2 car, move_forward, 45 km/h, front of ego, lane -2
 tadShift3 = Range(0, 8.0)

@@ -571,7 +571,8 @@ behavior TadTriggered(distance, hold, then):
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=2, other=2, minSame=2, minOther=0, index=2, sidewalk=True,
                junction='4way', signalised=True, maneuver='RIGHT_TURN', signs=(),
-               shape=None, ahead=4.0, behind=4.0, approach=13.0, arms=('opposite', 'right'))
+               shape=None, ahead=4.0, behind=4.0, approach=8.917, arms=('opposite', 'right'),
+               armReach={'opposite': (32.0, 34.0), 'right': (3.0, 0.0)})
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
 # ego vehicle: turn_right, 12 km/h, lane 2
@@ -587,36 +588,34 @@ left_turning_taxi = new Car at tadAt1[0], facing tadAt1[1],
     with regionContainedIn None, with speed 8.333, with behavior TadThrough(8.333, 'LEFT_TURN')
 
 # group `crossing_pedestrians`: 4 pedestrian, cross, 5 km/h, right_front of ego, lane 2
-tadDelay2 = 4.749
-tadJitter2 = Range(-0.5, 0.5)
-tadAt2 = tadCross(tadAnchor, 'right', -2.0 + tadJitter2, False, 0.0)
+tadDelay2 = 3.776
+tadAt2 = tadCross(tadAnchor, 'right', -2.0, False, 0.0)
 crossing_pedestrians_1 = new Pedestrian at tadAt2[0], facing tadAt2[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadDelayed(tadDelay2, TadStand(), TadWalk(1.389))
-tadAt3 = tadCross(tadAnchor, 'right', -1.1 + tadJitter2, False, 0.0)
+tadAt3 = tadCross(tadAnchor, 'right', -1.1, False, 0.0)
 crossing_pedestrians_2 = new Pedestrian at tadAt3[0], facing tadAt3[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadDelayed(tadDelay2, TadStand(), TadWalk(1.389))
-tadAt4 = tadCross(tadAnchor, 'right', -0.2 + tadJitter2, False, 0.0)
+tadAt4 = tadCross(tadAnchor, 'right', -0.2, False, 0.0)
 crossing_pedestrians_3 = new Pedestrian at tadAt4[0], facing tadAt4[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadDelayed(tadDelay2, TadStand(), TadWalk(1.389))
-tadAt5 = tadCross(tadAnchor, 'right', 0.7 + tadJitter2, False, 0.0)
+tadAt5 = tadCross(tadAnchor, 'right', 0.7, False, 0.0)
 crossing_pedestrians_4 = new Pedestrian at tadAt5[0], facing tadAt5[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadDelayed(tadDelay2, TadStand(), TadWalk(1.389))
 
 # group `through_cars`: 3 car, move_forward, 25 km/h, left_front of ego, lane 1
-tadShift3 = Range(0, 3.578)
-tadAt6 = tadArmSpot(tadAnchor, 'opposite', 2.75 - tadShift3, -1)
+tadAt6 = tadArmSpot(tadAnchor, 'opposite', 2.75, -1)
 through_cars_1 = new Car at tadAt6[0], facing tadAt6[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with speed 6.944, with behavior TadDrive(6.944)
-tadAt7 = tadArmSpot(tadAnchor, 'opposite', 16.194 - tadShift3, -1)
+tadAt7 = tadArmSpot(tadAnchor, 'opposite', 16.194, -1)
 through_cars_2 = new Car at tadAt7[0], facing tadAt7[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with speed 6.944, with behavior TadDrive(6.944)
-tadAt8 = tadArmSpot(tadAnchor, 'opposite', 29.639 - tadShift3, -1)
+tadAt8 = tadArmSpot(tadAnchor, 'opposite', 29.639, -1)
 through_cars_3 = new Car at tadAt8[0], facing tadAt8[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with speed 6.944, with behavior TadDrive(6.944)

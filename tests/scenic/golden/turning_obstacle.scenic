@@ -576,7 +576,8 @@ behavior TadTriggered(distance, hold, then):
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=3, other=0, minSame=3, minOther=0, index=1, sidewalk=False,
                junction=None, signalised=None, maneuver=None, signs=(),
-               shape=None, ahead=24.0, behind=4.0, approach=None, arms=())
+               shape=None, ahead=24.0, behind=4.0, approach=None, arms=(),
+               armReach=None)
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
 # ego vehicle: turn_left, 15 km/h, lane 1
@@ -586,8 +587,7 @@ ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
 
 # group `crossing_cyclist`: 1 bicycle, cross, 14 km/h, left_front of ego, lane 1
 tadDelay1 = 9.157
-tadJitter1 = Range(-0.5, 0.5)
-tadAt1 = tadCrossAt(tadAnchor, 31.883 + tadJitter1, False, 0.0)
+tadAt1 = tadCrossAt(tadAnchor, 31.883, False, 0.0)
 crossing_cyclist = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.diamondback.century', with width 0.6, with length 1.8,
     with regionContainedIn None, with behavior TadDelayed(tadDelay1, TadStop(), TadRide(3.889))

@@ -554,7 +554,8 @@ behavior TadYield(speed):
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=1, other=1, minSame=1, minOther=0, index=1, sidewalk=True,
                junction='4way', signalised=True, maneuver='LEFT_TURN', signs=(),
-               shape=None, ahead=4.0, behind=4.0, approach=11.0, arms=('opposite',))
+               shape=None, ahead=4.0, behind=4.0, approach=8.25, arms=('opposite',),
+               armReach={'opposite': (93.0, 0.0)})
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
 # ego vehicle: turn_left, 10 km/h, lane 1
@@ -571,7 +572,7 @@ turning_van = new Car at tadAt1[0], facing tadAt1[1],
 
 # group `oncoming_car`: 1 car, move_forward, 50 km/h, behind of turning_van, lane -1
 tadJitter2 = Range(-5.0, 5.0)
-tadAt2 = tadArmSpot(tadAnchor, 'opposite', 95.685 + tadJitter2, 1)
+tadAt2 = tadArmSpot(tadAnchor, 'opposite', 83.685 + tadJitter2, 1)
 oncoming_car = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with speed 13.889, with behavior TadThrough(13.889, 'STRAIGHT')

@@ -558,7 +558,8 @@ behavior TadYield(speed):
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=1, other=1, minSame=1, minOther=1, index=1, sidewalk=False,
                junction=None, signalised=None, maneuver=None, signs=(),
-               shape='straight', ahead=21.0, behind=4.0, approach=None, arms=())
+               shape='straight', ahead=21.0, behind=4.0, approach=None, arms=(),
+               armReach=None)
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
 # ego vehicle: stopped, 0 km/h, lane 1

@@ -103,6 +103,8 @@ pub struct Needs {
     pub approach: f64,
     /// With a junction: the arms actors stand on besides the ego's (`left`, `opposite`, ...).
     pub arms: Vec<&'static str>,
+    /// Per arm of `arms`: metres of road it needs before its stop line and after the junction.
+    pub arm_reach: Vec<(&'static str, f64, f64)>,
 }
 
 impl Needs {

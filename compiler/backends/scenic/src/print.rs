@@ -165,6 +165,16 @@ pub fn program(scenario: &Scenario, plan: &Plan, diagnostics: &[Diagnostic], opt
         None => "None",
     };
     let approach = if junction.is_some() { number(needs.approach) } else { "None".into() };
+    let arm_reach = if needs.arm_reach.is_empty() {
+        "None".to_string()
+    } else {
+        let entries: Vec<String> = needs
+            .arm_reach
+            .iter()
+            .map(|(arm, before, after)| format!("{}: ({}, {})", string(arm), number(*before), number(*after)))
+            .collect();
+        format!("{{{}}}", entries.join(", "))
+    };
     let arms = match needs.arms.len() {
         0 => "()".to_string(),
         1 => format!("({},)", string(needs.arms[0])),
@@ -174,7 +184,8 @@ pub fn program(scenario: &Scenario, plan: &Plan, diagnostics: &[Diagnostic], opt
         out,
         "tadRoad = dict(same={}, other={}, minSame={}, minOther={}, index={}, sidewalk={},\n               \
          junction={kind}, signalised={signalised}, maneuver={maneuver}, signs={signs},\n               \
-         shape={shape}, ahead={}, behind={}, approach={approach}, arms={arms})",
+         shape={shape}, ahead={}, behind={}, approach={approach}, arms={arms},\n               \
+         armReach={arm_reach})",
         opt_int(needs.same),
         opt_int(needs.other),
         needs.min_same,

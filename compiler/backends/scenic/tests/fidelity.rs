@@ -121,7 +121,8 @@ fn every_example_keeps_its_meaning_in_scenic() {
     let programs = emit(&examples, &dir, &tracer);
     let files: Vec<PathBuf> = programs.iter().map(|p| p.file.clone()).collect();
     let started = Instant::now();
-    let traces = tracer.run(&files, &TraceOptions { seeds: (0..seeds).collect(), steps: STEPS, ..TraceOptions::default() });
+    let traces =
+        tracer.run(&files, &TraceOptions { seeds: (0..seeds).collect(), steps: STEPS, ..TraceOptions::default() });
     let seconds = started.elapsed().as_secs_f64();
     let mut table = String::new();
     let _ = writeln!(
@@ -149,7 +150,10 @@ fn every_example_keeps_its_meaning_in_scenic() {
                     format!("{name} {:.1} m ({:.1} s)", x.distance, x.time)
                 })
                 .collect();
-            let contact = a.first_contact.as_ref().map_or("-".to_string(), |o| format!("{}×{} {:.1} s", who(o.a), who(o.b), o.time));
+            let contact = a
+                .first_contact
+                .as_ref()
+                .map_or("-".to_string(), |o| format!("{}×{} {:.1} s", who(o.a), who(o.b), o.time));
             let _ = writeln!(
                 table,
                 "| {} | {} | {} | {relations} | {} | {} | {contact} |",

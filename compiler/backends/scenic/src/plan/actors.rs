@@ -88,14 +88,18 @@ pub fn build(
             motions: g.motions.clone(),
             shift: if let Some((low, high)) = g.distance.filter(|(low, high)| low < high) {
                 Some((high - low, -away))
-            } else if gl.slack > 0.5 && conflict.is_none() {
-                Some((gl.slack, -away))
+            } else if conflict.is_none() {
+                // never into the junction on another arm
+                let room = first
+                    .filter(|f| f.station.arm != Arm::Ego && away > 0.0)
+                    .map_or(f64::INFINITY, |f| f.station.along - f.length / 2.0 - 0.5);
+                Some((gl.slack.min(room), -away)).filter(|(s, _)| *s >= 0.5)
             } else {
                 None
             },
             delay: g.delay.or_else(|| first.map(|f| f.start.delay).filter(|d| *d > 0.05).map(|d| (d, d))),
             trigger: g.trigger,
-            jitter: conflict.map(|c| (c.spread * 0.5).clamp(0.5, 5.0)),
+            jitter: first.map(|f| laid.conflict_spread(f)).filter(|j| *j >= 0.3),
         };
         let row_start = first.map_or(0.0, |f| f.lateral);
         let mut actors = Vec::new();

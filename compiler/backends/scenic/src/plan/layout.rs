@@ -36,6 +36,19 @@ pub fn windows(layout: &Layout, needs: &mut Needs, junction: bool, kept: Option<
     } else {
         Vec::new()
     };
+    needs.arm_reach = needs
+        .arms
+        .iter()
+        .map(|&name| {
+            let on = layout.agents().filter(|a| a.station.arm.as_str() == name);
+            let (mut incoming, mut outgoing): (f64, f64) = (0.0, 0.0);
+            for a in on {
+                let far = a.station.along + a.length / 2.0 + layout.conflict_spread(a) + 2.0;
+                if a.lane > 0 { incoming = incoming.max(far) } else { outgoing = outgoing.max(far) }
+            }
+            (name, incoming.ceil(), outgoing.ceil())
+        })
+        .collect();
 }
 
 /// How many actors of each group the chosen map has room for: the whole layout when its
