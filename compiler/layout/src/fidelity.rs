@@ -105,6 +105,17 @@ impl Assessment {
     }
 }
 
+/// Where `b` is seen from `a`: `x` ahead, `y` to the left, in a frame midway between their
+/// headings (one turned half round when they face opposite ways), so that a bend of the road
+/// between them shifts neither side.
+fn between(a: Pose, b: Pose) -> crate::geom::Vec2 {
+    let delta = wrap(b.yaw - a.yaw);
+    let along = if delta.abs() > std::f64::consts::FRAC_PI_2 { wrap(delta - std::f64::consts::PI) } else { delta };
+    // only for actors along the same road: one crossing it is seen from `a` itself
+    let turn = if along.abs() < 0.6 { along / 2.0 } else { 0.0 };
+    Pose { position: a.position, yaw: a.yaw + turn }.local(b.position)
+}
+
 /// Check a trace of `scenario` laid out as `layout`.
 pub fn assess(scenario: &Scenario, layout: &Layout, trace: &Trace) -> Assessment {
     let mut out = Assessment::default();
@@ -128,9 +139,9 @@ pub fn assess(scenario: &Scenario, layout: &Layout, trace: &Trace) -> Assessment
         };
         let relation = scenario.entries.resolved(&position.relation.value).map(|e| e.attrs);
         let (pr, pg) = (trace.states[0][r], trace.states[0][k]);
-        let local = pr.local(pg.position);
+        let local = between(pr, pg);
         let heading = wrap(pg.yaw - pr.yaw);
-        let expected_local = reference_agent.pose.local(first.pose.position);
+        let expected_local = between(reference_agent.pose, first.pose);
         let expected_heading = wrap(first.pose.yaw - reference_agent.pose.yaw);
         let mut failures = Vec::new();
         let half = (trace.objects[r].length + trace.objects[k].length) / 2.0;

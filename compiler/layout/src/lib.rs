@@ -36,6 +36,8 @@ pub enum Place {
     Lane,
     /// The curb side of an outermost lane.
     Curb,
+    /// Just outside the outermost lane: on the shoulder or in a parking strip.
+    Shoulder,
     /// The sidewalk beside the road.
     Sidewalk,
 }

@@ -30,6 +30,9 @@ use crate::{Agent, Conflict, Facing, Finding, GroupLayout, Layout, Place, Start}
 const APPROACH_TIME: f64 = 2.0;
 /// Where crosswalks are: metres past an arm's stop line, towards the junction.
 const CROSSWALK: f64 = 2.0;
+/// The farthest a timed adversary starts from its arm's stop line, m; one that would need
+/// more waits there and starts late.
+const MAX_ARM_START: f64 = 150.0;
 /// Spacing of walkers standing side by side.
 const WALKER_SPACING: f64 = 0.9;
 
@@ -234,15 +237,15 @@ pub fn lay_out(scenario: &Scenario) -> Layout {
             };
             if lane > i64::from(incoming) {
                 lane = i64::from(incoming);
-                place = Place::Curb;
+                place = Place::Shoulder;
             } else if lane < 0 && lane < -i64::from(outgoing) {
                 curb_left = outgoing == 0;
                 lane = if outgoing == 0 { 1 } else { -i64::from(outgoing) };
-                place = Place::Curb;
+                place = Place::Shoulder;
             }
             if one_way && arm == Arm::Ego && lane < 0 {
                 lane = 1;
-                place = Place::Curb;
+                place = Place::Shoulder;
                 curb_left = true;
             }
         }
@@ -686,6 +689,10 @@ fn extent_of(stations: &[(Station, f64)], half: f64, speed: f64, lane: i64, arm:
 /// The gap kept in front of a vehicle moving at `speed` (IDM's jam distance and one second
 /// of headway), or between standing actors.
 fn gap(f: &Facts, other_speed: f64) -> f64 {
+    if other_speed > 0.0 && f.is_static() {
+        // standing in front of something moving: room to see it and brake
+        return (2.0 + 1.5 * other_speed).min(40.0);
+    }
     match f.body {
         Body::Walker => WALKER_SPACING - f.length.min(0.5),
         Body::Object => 1.0,
@@ -719,7 +726,7 @@ fn place_group(
         Some((_, high)) => high,
         None if reference.speed <= 0.0 && f.is_static() => gap(f, 0.0),
         None if across => 1.0,
-        None if reference.stop_line && !f.is_static() => 1.0 + 2.0 * f.speed,
+        None if reference.stop_line && !f.is_static() => 1.0 + 0.5 * f.speed,
         None if reference.stop_line => 1.0,
         None => gap(f, reference.speed),
     };
@@ -750,8 +757,12 @@ fn place_group(
         let centre = road.lateral(d.lane);
         match place {
             Place::Lane => centre,
-            Place::Curb => {
-                let shift = (road.lane_width / 2.0 - f.width / 2.0 - 0.2).max(0.0);
+            Place::Curb | Place::Shoulder => {
+                let shift = if place == Place::Shoulder {
+                    road.lane_width / 2.0 + f.width / 2.0 + 0.2
+                } else {
+                    (road.lane_width / 2.0 - f.width / 2.0 - 0.2).max(0.0)
+                };
                 // the curb is to the right of a lane's own traffic
                 let outward = if d.lane > 0 && !d.curb_left { -1.0 } else { 1.0 };
                 centre + outward * shift
@@ -800,20 +811,35 @@ fn place_group(
     for k in 0..f.count {
         let (row, column) = if across { (k / 4, k % 4) } else { (0, k) };
         let along = if across { first + step * column as f64 * spacing } else { centre };
-        let mut along = along;
-        // never on top of what is already there: move on, away from the reference
-        for _ in 0..200 {
-            let (lo, hi) = (along - extent / 2.0 - 0.25, along + extent / 2.0 + 0.25);
-            match list.iter().find(|(a, b, _)| lo < *b && *a < hi) {
-                Some(&(a, b, speed)) if !across || row == 0 => {
-                    let keep = if f.body == Body::Vehicle && (speed > 0.0 || f.speed > 0.0) {
+        // never on top of what is already there: move on, away from the reference (beside
+        // it, whichever way is nearer)
+        let free = |start: f64, way: f64| {
+            let mut along = start;
+            for _ in 0..200 {
+                // a vehicle keeps its headway to what it shares the lane with, moving or not
+                let keep = |speed: f64| {
+                    if f.body == Body::Vehicle && (speed > 0.0 || f.speed > 0.0) {
                         2.0 + speed.max(f.speed)
                     } else {
                         0.5
-                    };
-                    along = if step > 0.0 { b + extent / 2.0 + keep } else { a - extent / 2.0 - keep };
+                    }
+                };
+                let (lo, hi) = (along - extent / 2.0, along + extent / 2.0);
+                match list.iter().find(|(a, b, speed)| lo - keep(*speed) + 0.25 < *b && *a < hi + keep(*speed) - 0.25) {
+                    Some(&(a, b, speed)) if !across || row == 0 => {
+                        let keep = keep(speed);
+                        along = if way > 0.0 { b + extent / 2.0 + keep } else { a - extent / 2.0 - keep };
+                    }
+                    _ => break,
                 }
-                _ => break,
+            }
+            along
+        };
+        let mut along = free(along, step);
+        if d.longitudinal == Longitudinal::Same && k == 0 {
+            let back = free(first, -step);
+            if (back - first).abs() < (along - first).abs() {
+                along = back;
             }
         }
         let lateral = match d.facing {
@@ -974,13 +1000,14 @@ fn time_group(
             }
         }
         Arm::Ego => (f64::NEG_INFINITY, f64::INFINITY),
-        _ => (f64::NEG_INFINITY, first.station.along - first.length / 2.0 - 0.5),
+        // never past the junction; never farther out than MAX_ARM_START (it waits instead)
+        _ => (first.station.along - MAX_ARM_START, first.station.along - first.length / 2.0 - 0.5),
     };
     shift = shift.clamp(floor.min(limit), limit);
-    // clamped: it reaches the point early (it waits) or late (the ego must start further back)
+    // clamped: it reaches the point early (it waits, on another arm) or late (the ego must
+    // start further back)
     let arrival = (s_own - shift) / v;
-    let wait = if shift < s_own - v * time - 1e-6 { arrival - time } else { 0.0 };
-    let wait = if wait > 0.0 { wait } else { -(time - arrival).max(0.0) };
+    let early = time - arrival;
     for a in &mut g.agents {
         let along = match (a.station.arm, a.lane < 0) {
             (Arm::Ego, false) => a.station.along + shift,
@@ -993,12 +1020,12 @@ fn time_group(
         a.station = station;
         a.pose = Pose { yaw: a.pose.yaw, ..pose };
         a.path_start = a.path.project(a.pose.position).0;
-        if wait < 0.0 && d.arm != Arm::Ego {
-            a.start.delay = -wait;
+        if early > 0.05 && d.arm != Arm::Ego {
+            a.start.delay = early;
             a.moving = false;
         }
     }
-    Some((Conflict { group: g.group, point, time, spread: v }, wait.max(0.0)))
+    Some((Conflict { group: g.group, point, time, spread: v }, (-early).max(0.0)))
 }
 
 fn sample_path(path: &Path, from: f64, to: f64) -> Vec<Vec2> {

@@ -246,7 +246,7 @@ def tadArmSpot(anchor, arm, before, index, place='centre', width=0.0):
         if not outs:
             raise TadRejection(f'no lane leaves the junction on its {arm} arm')
         lane, arc = tadOnward(outs[0], before)
-    return tadPlace(lane, arc, abs(index), place, width)
+    return tadPlace(lane, arc, abs(index), place, width, clamp=True)
 
 def tadCrossing(lane, arc, beyond, fromRight, extra):
     """The start of a walk across the road of `lane` at `arc` metres along it (and `beyond`
@@ -385,16 +385,20 @@ def tadSpot(anchor, offset, index, place='centre', width=0.0):
         raise TadRejection('actor beyond the end of the lane')
     return tadPlace(lane, arc, index, place, width)
 
-def tadPlace(lane, arc, index, place='centre', width=0.0):
+def tadPlace(lane, arc, index, place='centre', width=0.0, clamp=False):
     """The spot `arc` metres along `lane` in TAD lane `index` counted from `lane`'s direction
     (positive: lanes of its direction from the left, negative: the others from the centre line
-    outwards): (position, heading of that lane there). `place` as in `tadSpot`."""
+    outwards): (position, heading of that lane there). `place` as in `tadSpot`, or 'shoulder'
+    (just outside the outermost lane's edge). With `clamp`, an index beyond the lanes there is
+    the outermost lane (a crossing road narrower than the scenario's)."""
     point = lane.centerline.pointAlongBy(arc)
     section = lane.sectionAt(point) or min(lane.sections, key=lambda s: s.distanceTo(point))
     same, other = tadLanes(section)
     lanes = same if index > 0 else other
     if abs(index) > len(lanes):
-        raise TadRejection('no lane with this index here')
+        if not clamp or not lanes:
+            raise TadRejection('no lane with this index here')
+        index = len(lanes) if index > 0 else -len(lanes)
     target = lanes[abs(index) - 1]
     position = target.centerline.project(point)
     start, end = target.centerline.nearestSegmentTo(position)
@@ -403,7 +407,12 @@ def tadPlace(lane, arc, index, place='centre', width=0.0):
         if place == 'sidewalk' and target.group._sidewalk is not None:
             return (target.group._sidewalk.centerline.project(position), heading)
         half = (target.leftEdge.distanceTo(position) + target.rightEdge.distanceTo(position)) / 2
-        shift = half + 0.6 if place == 'sidewalk' else max(half - width / 2 - 0.2, 0.0)
+        if place == 'sidewalk':
+            shift = half + 0.6
+        elif place == 'shoulder':
+            shift = half + width / 2 + 0.2
+        else:
+            shift = max(half - width / 2 - 0.2, 0.0)
         position = position + Vector(shift, 0).rotatedBy(heading)
     return (position, heading)
 
@@ -551,12 +560,12 @@ behavior TadYield(speed):
         take SetThrottleAction(0), SetBrakeAction(1.0)
 # ---- end of the prelude ----
 
-# The road around the ego vehicle: 1 lane in the ego's direction, 1 lane in the other direction, a sidewalk beside the ego's lane, a straight stretch of 32 m.
+# The road around the ego vehicle: 1 lane in the ego's direction, 1 lane in the other direction, a sidewalk beside the ego's lane, a straight stretch of 48 m.
 # The ego is placed where the lane layout holds from `behind` metres behind it to `ahead` metres
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=1, other=1, minSame=1, minOther=1, index=1, sidewalk=True,
                junction=None, signalised=None, maneuver=None, signs=(),
-               shape='straight', ahead=28.0, behind=4.0, approach=None, arms=(),
+               shape='straight', ahead=49.0, behind=4.0, approach=None, arms=(),
                armReach=None)
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
@@ -573,11 +582,12 @@ pickup_truck = new Car at tadAt1[0], facing tadAt1[1],
     with regionContainedIn None, with speed 9.722, with behavior TadDrive(9.722)
 
 # group `parked_cars`: 2 car, parked, 0 km/h, right_front of ego, lane 1
-tadAt2 = tadSpot(tadAnchor, 5.9, 1, 'curb', 1.8)
+tadShift2 = Range(0, 6.633)
+tadAt2 = tadSpot(tadAnchor, 40.133 - tadShift2, 1, 'curb', 1.8)
 parked_cars_1 = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadParked()
-tadAt3 = tadSpot(tadAnchor, 11.4, 1, 'curb', 1.8)
+tadAt3 = tadSpot(tadAnchor, 45.633 - tadShift2, 1, 'curb', 1.8)
 parked_cars_2 = new Car at tadAt3[0], facing tadAt3[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadParked()

@@ -247,7 +247,7 @@ def tadArmSpot(anchor, arm, before, index, place='centre', width=0.0):
         if not outs:
             raise TadRejection(f'no lane leaves the junction on its {arm} arm')
         lane, arc = tadOnward(outs[0], before)
-    return tadPlace(lane, arc, abs(index), place, width)
+    return tadPlace(lane, arc, abs(index), place, width, clamp=True)
 
 def tadCrossing(lane, arc, beyond, fromRight, extra):
     """The start of a walk across the road of `lane` at `arc` metres along it (and `beyond`
@@ -386,16 +386,20 @@ def tadSpot(anchor, offset, index, place='centre', width=0.0):
         raise TadRejection('actor beyond the end of the lane')
     return tadPlace(lane, arc, index, place, width)
 
-def tadPlace(lane, arc, index, place='centre', width=0.0):
+def tadPlace(lane, arc, index, place='centre', width=0.0, clamp=False):
     """The spot `arc` metres along `lane` in TAD lane `index` counted from `lane`'s direction
     (positive: lanes of its direction from the left, negative: the others from the centre line
-    outwards): (position, heading of that lane there). `place` as in `tadSpot`."""
+    outwards): (position, heading of that lane there). `place` as in `tadSpot`, or 'shoulder'
+    (just outside the outermost lane's edge). With `clamp`, an index beyond the lanes there is
+    the outermost lane (a crossing road narrower than the scenario's)."""
     point = lane.centerline.pointAlongBy(arc)
     section = lane.sectionAt(point) or min(lane.sections, key=lambda s: s.distanceTo(point))
     same, other = tadLanes(section)
     lanes = same if index > 0 else other
     if abs(index) > len(lanes):
-        raise TadRejection('no lane with this index here')
+        if not clamp or not lanes:
+            raise TadRejection('no lane with this index here')
+        index = len(lanes) if index > 0 else -len(lanes)
     target = lanes[abs(index) - 1]
     position = target.centerline.project(point)
     start, end = target.centerline.nearestSegmentTo(position)
@@ -404,7 +408,12 @@ def tadPlace(lane, arc, index, place='centre', width=0.0):
         if place == 'sidewalk' and target.group._sidewalk is not None:
             return (target.group._sidewalk.centerline.project(position), heading)
         half = (target.leftEdge.distanceTo(position) + target.rightEdge.distanceTo(position)) / 2
-        shift = half + 0.6 if place == 'sidewalk' else max(half - width / 2 - 0.2, 0.0)
+        if place == 'sidewalk':
+            shift = half + 0.6
+        elif place == 'shoulder':
+            shift = half + width / 2 + 0.2
+        else:
+            shift = max(half - width / 2 - 0.2, 0.0)
         position = position + Vector(shift, 0).rotatedBy(heading)
     return (position, heading)
 
@@ -559,7 +568,7 @@ behavior TadYield(speed):
 tadRoad = dict(same=3, other=3, minSame=2, minOther=0, index=2, sidewalk=False,
                junction='4way', signalised=True, maneuver=None, signs=(),
                shape=None, ahead=4.0, behind=4.0, approach=30.028, arms=('opposite', 'right'),
-               armReach={'opposite': (60.0, 10.0), 'right': (62.0, 0.0)})
+               armReach={'opposite': (36.0, 10.0), 'right': (62.0, 0.0)})
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
 # ego vehicle: move_forward, 50 km/h, lane 2
@@ -569,7 +578,7 @@ ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
 
 # group `red_light_runner`: 1 sedan, move_forward, 60 km/h, right_front of ego, lane 2
 tadJitter1 = Range(-5.0, 5.0)
-tadAt1 = tadArmSpot(tadAnchor, 'right', 52.567 + tadJitter1, 2)
+tadAt1 = tadArmSpot(tadAnchor, 'right', 52.3 + tadJitter1, 2)
 red_light_runner = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with speed 16.667, with behavior TadThrough(16.667, 'STRAIGHT')
@@ -581,12 +590,12 @@ box_truck = new Car at tadAt2[0], facing tadAt2[1],
     with regionContainedIn None, with speed 11.111, with behavior TadDrive(11.111)
 
 # group `oncoming_cars`: 2 car, move_forward, 45 km/h, front of ego, lane -2
-tadShift3 = Range(0, 8.0)
-tadAt3 = tadArmSpot(tadAnchor, 'opposite', 36.25 - tadShift3, 2)
+tadShift3 = Range(0, 2.9)
+tadAt3 = tadArmSpot(tadAnchor, 'opposite', 12.4 - tadShift3, 2)
 oncoming_cars_1 = new Car at tadAt3[0], facing tadAt3[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with speed 12.5, with behavior TadThrough(12.5, 'STRAIGHT')
-tadAt4 = tadArmSpot(tadAnchor, 'opposite', 55.25 - tadShift3, 2)
+tadAt4 = tadArmSpot(tadAnchor, 'opposite', 31.4 - tadShift3, 2)
 oncoming_cars_2 = new Car at tadAt4[0], facing tadAt4[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with speed 12.5, with behavior TadThrough(12.5, 'STRAIGHT')

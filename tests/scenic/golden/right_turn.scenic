@@ -246,7 +246,7 @@ def tadArmSpot(anchor, arm, before, index, place='centre', width=0.0):
         if not outs:
             raise TadRejection(f'no lane leaves the junction on its {arm} arm')
         lane, arc = tadOnward(outs[0], before)
-    return tadPlace(lane, arc, abs(index), place, width)
+    return tadPlace(lane, arc, abs(index), place, width, clamp=True)
 
 def tadCrossing(lane, arc, beyond, fromRight, extra):
     """The start of a walk across the road of `lane` at `arc` metres along it (and `beyond`
@@ -385,16 +385,20 @@ def tadSpot(anchor, offset, index, place='centre', width=0.0):
         raise TadRejection('actor beyond the end of the lane')
     return tadPlace(lane, arc, index, place, width)
 
-def tadPlace(lane, arc, index, place='centre', width=0.0):
+def tadPlace(lane, arc, index, place='centre', width=0.0, clamp=False):
     """The spot `arc` metres along `lane` in TAD lane `index` counted from `lane`'s direction
     (positive: lanes of its direction from the left, negative: the others from the centre line
-    outwards): (position, heading of that lane there). `place` as in `tadSpot`."""
+    outwards): (position, heading of that lane there). `place` as in `tadSpot`, or 'shoulder'
+    (just outside the outermost lane's edge). With `clamp`, an index beyond the lanes there is
+    the outermost lane (a crossing road narrower than the scenario's)."""
     point = lane.centerline.pointAlongBy(arc)
     section = lane.sectionAt(point) or min(lane.sections, key=lambda s: s.distanceTo(point))
     same, other = tadLanes(section)
     lanes = same if index > 0 else other
     if abs(index) > len(lanes):
-        raise TadRejection('no lane with this index here')
+        if not clamp or not lanes:
+            raise TadRejection('no lane with this index here')
+        index = len(lanes) if index > 0 else -len(lanes)
     target = lanes[abs(index) - 1]
     position = target.centerline.project(point)
     start, end = target.centerline.nearestSegmentTo(position)
@@ -403,7 +407,12 @@ def tadPlace(lane, arc, index, place='centre', width=0.0):
         if place == 'sidewalk' and target.group._sidewalk is not None:
             return (target.group._sidewalk.centerline.project(position), heading)
         half = (target.leftEdge.distanceTo(position) + target.rightEdge.distanceTo(position)) / 2
-        shift = half + 0.6 if place == 'sidewalk' else max(half - width / 2 - 0.2, 0.0)
+        if place == 'sidewalk':
+            shift = half + 0.6
+        elif place == 'shoulder':
+            shift = half + width / 2 + 0.2
+        else:
+            shift = max(half - width / 2 - 0.2, 0.0)
         position = position + Vector(shift, 0).rotatedBy(heading)
     return (position, heading)
 
@@ -572,7 +581,7 @@ behavior TadTriggered(distance, hold, then):
 tadRoad = dict(same=2, other=2, minSame=2, minOther=0, index=2, sidewalk=True,
                junction='4way', signalised=True, maneuver='RIGHT_TURN', signs=(),
                shape=None, ahead=4.0, behind=4.0, approach=8.917, arms=('opposite', 'right'),
-               armReach={'opposite': (32.0, 34.0), 'right': (3.0, 0.0)})
+               armReach={'opposite': (15.0, 34.0), 'right': (3.0, 0.0)})
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
 # ego vehicle: turn_right, 12 km/h, lane 2
@@ -581,8 +590,8 @@ ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 3.333, with behavior TadThrough(3.333, 'RIGHT_TURN')
 
 # group `left_turning_taxi`: 1 taxi, turn_left, 30 km/h, front of ego, lane -1
-tadShift1 = Range(0, 7.067)
-tadAt1 = tadArmSpot(tadAnchor, 'opposite', 27.133 - tadShift1, 1)
+tadShift1 = Range(0, 2.067)
+tadAt1 = tadArmSpot(tadAnchor, 'opposite', 9.633 - tadShift1, 1)
 left_turning_taxi = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.ford.crown', with width 1.85, with length 4.8,
     with regionContainedIn None, with speed 8.333, with behavior TadThrough(8.333, 'LEFT_TURN')

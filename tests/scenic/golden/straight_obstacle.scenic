@@ -10,6 +10,7 @@
 #   van and walks into its path, stopping in the middle of the lane. Two cars approach in
 #   the opposite direction, so swerving left is not an option.
 # Left out or approximated (the build's warnings say where):
+#   W0701 Town10HD has no place with a straight stretch of 71 m
 #   W0700 `speed_limit_sign` (road signs) has no Scenic mapping
 #   W0700 traffic density `light` has no Scenic mapping
 #   W0700 `shops`, `trees` and `parked_cars` (road roadside) have no Scenic mapping
@@ -246,7 +247,7 @@ def tadArmSpot(anchor, arm, before, index, place='centre', width=0.0):
         if not outs:
             raise TadRejection(f'no lane leaves the junction on its {arm} arm')
         lane, arc = tadOnward(outs[0], before)
-    return tadPlace(lane, arc, abs(index), place, width)
+    return tadPlace(lane, arc, abs(index), place, width, clamp=True)
 
 def tadCrossing(lane, arc, beyond, fromRight, extra):
     """The start of a walk across the road of `lane` at `arc` metres along it (and `beyond`
@@ -385,16 +386,20 @@ def tadSpot(anchor, offset, index, place='centre', width=0.0):
         raise TadRejection('actor beyond the end of the lane')
     return tadPlace(lane, arc, index, place, width)
 
-def tadPlace(lane, arc, index, place='centre', width=0.0):
+def tadPlace(lane, arc, index, place='centre', width=0.0, clamp=False):
     """The spot `arc` metres along `lane` in TAD lane `index` counted from `lane`'s direction
     (positive: lanes of its direction from the left, negative: the others from the centre line
-    outwards): (position, heading of that lane there). `place` as in `tadSpot`."""
+    outwards): (position, heading of that lane there). `place` as in `tadSpot`, or 'shoulder'
+    (just outside the outermost lane's edge). With `clamp`, an index beyond the lanes there is
+    the outermost lane (a crossing road narrower than the scenario's)."""
     point = lane.centerline.pointAlongBy(arc)
     section = lane.sectionAt(point) or min(lane.sections, key=lambda s: s.distanceTo(point))
     same, other = tadLanes(section)
     lanes = same if index > 0 else other
     if abs(index) > len(lanes):
-        raise TadRejection('no lane with this index here')
+        if not clamp or not lanes:
+            raise TadRejection('no lane with this index here')
+        index = len(lanes) if index > 0 else -len(lanes)
     target = lanes[abs(index) - 1]
     position = target.centerline.project(point)
     start, end = target.centerline.nearestSegmentTo(position)
@@ -403,7 +408,12 @@ def tadPlace(lane, arc, index, place='centre', width=0.0):
         if place == 'sidewalk' and target.group._sidewalk is not None:
             return (target.group._sidewalk.centerline.project(position), heading)
         half = (target.leftEdge.distanceTo(position) + target.rightEdge.distanceTo(position)) / 2
-        shift = half + 0.6 if place == 'sidewalk' else max(half - width / 2 - 0.2, 0.0)
+        if place == 'sidewalk':
+            shift = half + 0.6
+        elif place == 'shoulder':
+            shift = half + width / 2 + 0.2
+        else:
+            shift = max(half - width / 2 - 0.2, 0.0)
         position = position + Vector(shift, 0).rotatedBy(heading)
     return (position, heading)
 
@@ -566,12 +576,13 @@ behavior TadTriggered(distance, hold, then):
     do then
 # ---- end of the prelude ----
 
-# The road around the ego vehicle: 2 lanes in the ego's direction, 2 lanes in the other direction, a sidewalk beside the ego's lane, a straight stretch of 55 m.
+# The road around the ego vehicle: 2 lanes in the ego's direction, 2 lanes in the other direction, a sidewalk beside the ego's lane.
+# Left out, as Town10HD has no place with them and the rest: a straight stretch of 71 m.
 # The ego is placed where the lane layout holds from `behind` metres behind it to `ahead` metres
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=2, other=2, minSame=2, minOther=1, index=1, sidewalk=True,
                junction=None, signalised=None, maneuver=None, signs=(),
-               shape='straight', ahead=51.0, behind=4.0, approach=None, arms=(),
+               shape=None, ahead=67.0, behind=4.0, approach=None, arms=(),
                armReach=None)
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
@@ -581,37 +592,39 @@ ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 12.5, with behavior TadDrive(12.5)
 
 # group `parked_sedans`: 5 sedan, parked, 0 km/h, right_front of ego, lane 2
-tadAt1 = tadSpot(tadAnchor, 6.05, 2, 'curb', 1.85)
+tadShift1 = Range(0, 8.0)
+tadAt1 = tadSpot(tadAnchor, 33.4 - tadShift1, 2, 'curb', 1.85)
 parked_sedans_1 = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt2 = tadSpot(tadAnchor, 11.85, 2, 'curb', 1.85)
+tadAt2 = tadSpot(tadAnchor, 39.2 - tadShift1, 2, 'curb', 1.85)
 parked_sedans_2 = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt3 = tadSpot(tadAnchor, 17.65, 2, 'curb', 1.85)
+tadAt3 = tadSpot(tadAnchor, 45.0 - tadShift1, 2, 'curb', 1.85)
 parked_sedans_3 = new Car at tadAt3[0], facing tadAt3[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt4 = tadSpot(tadAnchor, 23.45, 2, 'curb', 1.85)
+tadAt4 = tadSpot(tadAnchor, 50.8 - tadShift1, 2, 'curb', 1.85)
 parked_sedans_4 = new Car at tadAt4[0], facing tadAt4[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt5 = tadSpot(tadAnchor, 29.25, 2, 'curb', 1.85)
+tadAt5 = tadSpot(tadAnchor, 56.6 - tadShift1, 2, 'curb', 1.85)
 parked_sedans_5 = new Car at tadAt5[0], facing tadAt5[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
 
 # group `delivery_van`: 1 van, parked, 0 km/h, right_front of ego, lane 2
-tadAt6 = tadSpot(tadAnchor, 34.75, 2, 'curb', 2.0)
+tadShift2 = Range(0, 8.0)
+tadAt6 = tadSpot(tadAnchor, 62.1 - tadShift2, 2, 'curb', 2.0)
 delivery_van = new Car at tadAt6[0], facing tadAt6[1],
     with blueprint 'vehicle.mercedes.sprinter', with width 2.0, with length 5.2,
     with regionContainedIn None, with behavior TadParked()
 
 # group `darting_pedestrian`: 1 pedestrian, cross, 6 km/h, front of ego, lane 1
-tadDelay3 = 0.63
+tadDelay3 = 1.948
 tadJitter3 = Range(-0.5, 0.5)
-tadAt7 = tadCrossAt(tadAnchor, 49.125 + tadJitter3, True, 0.0)
+tadAt7 = tadCrossAt(tadAnchor, 65.6 + tadJitter3, True, 0.0)
 darting_pedestrian = new Pedestrian at tadAt7[0], facing tadAt7[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadDelayed(tadDelay3, TadStand(), TadWalk(1.667))

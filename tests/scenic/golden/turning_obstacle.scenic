@@ -250,7 +250,7 @@ def tadArmSpot(anchor, arm, before, index, place='centre', width=0.0):
         if not outs:
             raise TadRejection(f'no lane leaves the junction on its {arm} arm')
         lane, arc = tadOnward(outs[0], before)
-    return tadPlace(lane, arc, abs(index), place, width)
+    return tadPlace(lane, arc, abs(index), place, width, clamp=True)
 
 def tadCrossing(lane, arc, beyond, fromRight, extra):
     """The start of a walk across the road of `lane` at `arc` metres along it (and `beyond`
@@ -389,16 +389,20 @@ def tadSpot(anchor, offset, index, place='centre', width=0.0):
         raise TadRejection('actor beyond the end of the lane')
     return tadPlace(lane, arc, index, place, width)
 
-def tadPlace(lane, arc, index, place='centre', width=0.0):
+def tadPlace(lane, arc, index, place='centre', width=0.0, clamp=False):
     """The spot `arc` metres along `lane` in TAD lane `index` counted from `lane`'s direction
     (positive: lanes of its direction from the left, negative: the others from the centre line
-    outwards): (position, heading of that lane there). `place` as in `tadSpot`."""
+    outwards): (position, heading of that lane there). `place` as in `tadSpot`, or 'shoulder'
+    (just outside the outermost lane's edge). With `clamp`, an index beyond the lanes there is
+    the outermost lane (a crossing road narrower than the scenario's)."""
     point = lane.centerline.pointAlongBy(arc)
     section = lane.sectionAt(point) or min(lane.sections, key=lambda s: s.distanceTo(point))
     same, other = tadLanes(section)
     lanes = same if index > 0 else other
     if abs(index) > len(lanes):
-        raise TadRejection('no lane with this index here')
+        if not clamp or not lanes:
+            raise TadRejection('no lane with this index here')
+        index = len(lanes) if index > 0 else -len(lanes)
     target = lanes[abs(index) - 1]
     position = target.centerline.project(point)
     start, end = target.centerline.nearestSegmentTo(position)
@@ -407,7 +411,12 @@ def tadPlace(lane, arc, index, place='centre', width=0.0):
         if place == 'sidewalk' and target.group._sidewalk is not None:
             return (target.group._sidewalk.centerline.project(position), heading)
         half = (target.leftEdge.distanceTo(position) + target.rightEdge.distanceTo(position)) / 2
-        shift = half + 0.6 if place == 'sidewalk' else max(half - width / 2 - 0.2, 0.0)
+        if place == 'sidewalk':
+            shift = half + 0.6
+        elif place == 'shoulder':
+            shift = half + width / 2 + 0.2
+        else:
+            shift = max(half - width / 2 - 0.2, 0.0)
         position = position + Vector(shift, 0).rotatedBy(heading)
     return (position, heading)
 
@@ -576,7 +585,7 @@ behavior TadTriggered(distance, hold, then):
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=3, other=0, minSame=3, minOther=0, index=1, sidewalk=False,
                junction=None, signalised=None, maneuver=None, signs=(),
-               shape=None, ahead=24.0, behind=4.0, approach=None, arms=(),
+               shape=None, ahead=27.0, behind=4.0, approach=None, arms=(),
                armReach=None)
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
@@ -586,8 +595,8 @@ ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 4.167, with behavior TadThrough(4.167, 'LEFT_TURN')
 
 # group `crossing_cyclist`: 1 bicycle, cross, 14 km/h, left_front of ego, lane 1
-tadDelay1 = 9.157
-tadAt1 = tadCrossAt(tadAnchor, 31.883, False, 0.0)
+tadDelay1 = 9.855
+tadAt1 = tadCrossAt(tadAnchor, 34.8, False, 0.0)
 crossing_cyclist = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.diamondback.century', with width 0.6, with length 1.8,
     with regionContainedIn None, with behavior TadDelayed(tadDelay1, TadStop(), TadRide(3.889))
@@ -603,8 +612,8 @@ taxis_2 = new Car at tadAt3[0], facing tadAt3[1],
     with regionContainedIn None, with speed 6.944, with behavior TadDrive(6.944)
 
 # group `bus_at_stop`: 1 bus, stopped, 0 km/h, right_front of ego, lane 3
-tadShift3 = Range(0, 2.467)
-tadAt4 = tadSpot(tadAnchor, 16.883 - tadShift3, 3)
+tadShift3 = Range(0, 3.3)
+tadAt4 = tadSpot(tadAnchor, 19.8 - tadShift3, 3)
 bus_at_stop = new Car at tadAt4[0], facing tadAt4[1],
     with blueprint 'vehicle.mitsubishi.fusorosa', with width 2.55, with length 12.0,
     with regionContainedIn None, with behavior TadStop()

@@ -244,7 +244,7 @@ def tadArmSpot(anchor, arm, before, index, place='centre', width=0.0):
         if not outs:
             raise TadRejection(f'no lane leaves the junction on its {arm} arm')
         lane, arc = tadOnward(outs[0], before)
-    return tadPlace(lane, arc, abs(index), place, width)
+    return tadPlace(lane, arc, abs(index), place, width, clamp=True)
 
 def tadCrossing(lane, arc, beyond, fromRight, extra):
     """The start of a walk across the road of `lane` at `arc` metres along it (and `beyond`
@@ -383,16 +383,20 @@ def tadSpot(anchor, offset, index, place='centre', width=0.0):
         raise TadRejection('actor beyond the end of the lane')
     return tadPlace(lane, arc, index, place, width)
 
-def tadPlace(lane, arc, index, place='centre', width=0.0):
+def tadPlace(lane, arc, index, place='centre', width=0.0, clamp=False):
     """The spot `arc` metres along `lane` in TAD lane `index` counted from `lane`'s direction
     (positive: lanes of its direction from the left, negative: the others from the centre line
-    outwards): (position, heading of that lane there). `place` as in `tadSpot`."""
+    outwards): (position, heading of that lane there). `place` as in `tadSpot`, or 'shoulder'
+    (just outside the outermost lane's edge). With `clamp`, an index beyond the lanes there is
+    the outermost lane (a crossing road narrower than the scenario's)."""
     point = lane.centerline.pointAlongBy(arc)
     section = lane.sectionAt(point) or min(lane.sections, key=lambda s: s.distanceTo(point))
     same, other = tadLanes(section)
     lanes = same if index > 0 else other
     if abs(index) > len(lanes):
-        raise TadRejection('no lane with this index here')
+        if not clamp or not lanes:
+            raise TadRejection('no lane with this index here')
+        index = len(lanes) if index > 0 else -len(lanes)
     target = lanes[abs(index) - 1]
     position = target.centerline.project(point)
     start, end = target.centerline.nearestSegmentTo(position)
@@ -401,7 +405,12 @@ def tadPlace(lane, arc, index, place='centre', width=0.0):
         if place == 'sidewalk' and target.group._sidewalk is not None:
             return (target.group._sidewalk.centerline.project(position), heading)
         half = (target.leftEdge.distanceTo(position) + target.rightEdge.distanceTo(position)) / 2
-        shift = half + 0.6 if place == 'sidewalk' else max(half - width / 2 - 0.2, 0.0)
+        if place == 'sidewalk':
+            shift = half + 0.6
+        elif place == 'shoulder':
+            shift = half + width / 2 + 0.2
+        else:
+            shift = max(half - width / 2 - 0.2, 0.0)
         position = position + Vector(shift, 0).rotatedBy(heading)
     return (position, heading)
 
@@ -555,7 +564,7 @@ behavior TadYield(speed):
 tadRoad = dict(same=1, other=1, minSame=1, minOther=0, index=1, sidewalk=True,
                junction='4way', signalised=True, maneuver='LEFT_TURN', signs=(),
                shape=None, ahead=4.0, behind=4.0, approach=8.25, arms=('opposite',),
-               armReach={'opposite': (93.0, 0.0)})
+               armReach={'opposite': (94.0, 0.0)})
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
 # ego vehicle: turn_left, 10 km/h, lane 1
@@ -564,15 +573,15 @@ ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 2.778, with behavior TadThrough(2.778, 'LEFT_TURN')
 
 # group `turning_van`: 1 van, turn_left, 10 km/h, front of ego, lane -1
-tadShift1 = Range(0, 2.622)
-tadAt1 = tadArmSpot(tadAnchor, 'opposite', 11.778 - tadShift1, 1)
+tadShift1 = Range(0, 0.956)
+tadAt1 = tadArmSpot(tadAnchor, 'opposite', 5.944 - tadShift1, 1)
 turning_van = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.mercedes.sprinter', with width 2.0, with length 5.2,
     with regionContainedIn None, with speed 2.778, with behavior TadThrough(2.778, 'LEFT_TURN')
 
 # group `oncoming_car`: 1 car, move_forward, 50 km/h, behind of turning_van, lane -1
 tadJitter2 = Range(-5.0, 5.0)
-tadAt2 = tadArmSpot(tadAnchor, 'opposite', 83.685 + tadJitter2, 1)
+tadAt2 = tadArmSpot(tadAnchor, 'opposite', 84.267 + tadJitter2, 1)
 oncoming_car = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with speed 13.889, with behavior TadThrough(13.889, 'STRAIGHT')

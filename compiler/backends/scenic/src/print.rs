@@ -286,6 +286,7 @@ fn actor(out: &mut String, a: &Actor, spot: &str, needs: &maps::Needs) {
         Place::Centre => String::new(),
         Place::Curb => format!(", 'curb', {}", number(a.width)),
         Place::Sidewalk => ", 'sidewalk'".to_string(),
+        Place::Shoulder => format!(", 'shoulder', {}", number(a.width)),
     };
     let p = &a.params;
     let mut offset = match p.shift {

@@ -25,6 +25,7 @@ fn place(p: tad_layout::Place) -> Place {
         tad_layout::Place::Lane => Place::Centre,
         tad_layout::Place::Curb => Place::Curb,
         tad_layout::Place::Sidewalk => Place::Sidewalk,
+        tad_layout::Place::Shoulder => Place::Shoulder,
     }
 }
 

@@ -52,6 +52,8 @@ pub enum Place {
     Curb,
     /// The sidewalk beside the lane, when it is the outermost lane and has one.
     Sidewalk,
+    /// Just outside the outermost lane (a shoulder or parking strip).
+    Shoulder,
 }
 
 /// One object of the Scenic program.
