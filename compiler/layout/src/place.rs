@@ -211,6 +211,7 @@ pub fn lay_out(scenario: &Scenario) -> Layout {
             lane = written.map_or(1, i64::abs).min(i64::from(lanes));
         } else if junction_road
             && ref_arm == Arm::Ego
+            && moving_vehicle
             && longitudinal == Longitudinal::Front
             && (lateral == Lateral::Opposite || written.is_some_and(|l| l < 0))
         {
@@ -363,8 +364,14 @@ pub fn lay_out(scenario: &Scenario) -> Layout {
     occupied.entry((Arm::Ego, Key::Lane(ego_lane))).or_default().push((-ego_len / 2.0, ego_len / 2.0, ego_facts.speed));
     let mut stations: Vec<Vec<(Station, f64)>> = vec![Vec::new(); scenario.groups.len()];
     let mut slack = vec![0.0; scenario.groups.len()];
-    let ego_extent =
-        Extent { stop_line: false, low: -ego_len / 2.0, high: ego_len / 2.0, forward: 1.0, speed: ego_facts.speed };
+    let ego_extent = Extent {
+        lane: ego_lane,
+        stop_line: false,
+        low: -ego_len / 2.0,
+        high: ego_len / 2.0,
+        forward: 1.0,
+        speed: ego_facts.speed,
+    };
     let place_arm = |on_ego: bool,
                      road: &Road,
                      stations: &mut Vec<Vec<(Station, f64)>>,
@@ -658,6 +665,8 @@ enum Key {
 /// What a group is placed relative to: an interval of stations on an arm.
 #[derive(Clone, Copy, Debug)]
 struct Extent {
+    /// The lane it is in (what stands in another lane needs no room to brake for it).
+    lane: i64,
     /// It is an arm's stop line: groups extend from it away from the junction.
     stop_line: bool,
     low: f64,
@@ -671,7 +680,7 @@ impl Extent {
     /// An arm's stop line: its incoming traffic's front is towards smaller stations.
     fn stop_line(arm: Arm) -> Extent {
         let _ = arm;
-        Extent { stop_line: true, low: 0.0, high: 0.0, forward: 1.0, speed: 0.0 }
+        Extent { lane: 0, stop_line: true, low: 0.0, high: 0.0, forward: 1.0, speed: 0.0 }
     }
 }
 
@@ -683,7 +692,7 @@ fn forward_of(arm: Arm, lane: i64) -> f64 {
 fn extent_of(stations: &[(Station, f64)], half: f64, speed: f64, lane: i64, arm: Arm) -> Extent {
     let low = stations.iter().map(|(s, _)| s.along).fold(f64::INFINITY, f64::min);
     let high = stations.iter().map(|(s, _)| s.along).fold(f64::NEG_INFINITY, f64::max);
-    Extent { stop_line: false, low: low - half, high: high + half, forward: forward_of(arm, lane), speed }
+    Extent { lane, stop_line: false, low: low - half, high: high + half, forward: forward_of(arm, lane), speed }
 }
 
 /// The gap kept in front of a vehicle moving at `speed` (IDM's jam distance and one second
@@ -724,7 +733,7 @@ fn place_group(
     let spacing = if across { WALKER_SPACING.max(f.width + 0.3) } else { f.length + gap(f, f.speed) };
     let lead = match d.distance {
         Some((_, high)) => high,
-        None if reference.speed <= 0.0 && f.is_static() => gap(f, 0.0),
+        None if (reference.speed <= 0.0 || reference.lane != d.lane) && f.is_static() => gap(f, 0.0),
         None if across => 1.0,
         None if reference.stop_line && !f.is_static() => 1.0 + 0.5 * f.speed,
         None if reference.stop_line => 1.0,

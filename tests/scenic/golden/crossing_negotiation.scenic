@@ -564,10 +564,10 @@ behavior TadYield(speed):
 # Left out, as Town04 has no place with them and the rest: a stop sign at the junction ahead.
 # The ego is placed where the lane layout holds from `behind` metres behind it to `ahead` metres
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
-tadRoad = dict(same=1, other=1, minSame=1, minOther=0, index=1, sidewalk=False,
+tadRoad = dict(same=1, other=1, minSame=1, minOther=1, index=1, sidewalk=False,
                junction='4way', signalised=False, maneuver=None, signs=(),
-               shape=None, ahead=4.0, behind=4.0, approach=8.25, arms=('left', 'opposite'),
-               armReach={'left': (26.0, 0.0), 'opposite': (9.0, 0.0)})
+               shape=None, ahead=10.0, behind=4.0, approach=8.25, arms=('left',),
+               armReach={'left': (26.0, 0.0)})
 tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
 
 # ego vehicle: move_forward, 10 km/h, lane 1
@@ -584,7 +584,7 @@ adversary_suv = new Car at tadAt1[0], facing tadAt1[1],
 
 # group `waiting_car`: 1 car, stopped, 0 km/h, front of ego, lane -1
 tadShift2 = Range(0, 0.6)
-tadAt2 = tadArmSpot(tadAnchor, 'opposite', 4.35 - tadShift2, 1)
+tadAt2 = tadSpot(tadAnchor, 6.6 - tadShift2, -1)
 waiting_car = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadStop()

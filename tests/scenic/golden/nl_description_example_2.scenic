@@ -638,51 +638,49 @@ taxis_2 = new Car at tadAt9[0], facing tadAt9[1],
     with regionContainedIn None, with speed 8.333, with behavior TadDrive(8.333)
 
 # group `curbside_vehicles`: 10 car, parked, 0 km/h, right_front of ego, lane 4
-tadShift3 = Range(0, 6.633)
-tadAt10 = tadSpot(tadAnchor, 51.178 - tadShift3, 4, 'curb', 1.8)
+tadAt10 = tadSpot(tadAnchor, 51.178, 4, 'curb', 1.8)
 curbside_vehicles_1 = new Car at tadAt10[0], facing tadAt10[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadParked()
-tadAt11 = tadSpot(tadAnchor, 56.678 - tadShift3, 4, 'curb', 1.8)
+tadAt11 = tadSpot(tadAnchor, 56.678, 4, 'curb', 1.8)
 curbside_vehicles_2 = new Car at tadAt11[0], facing tadAt11[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadParked()
-tadAt12 = tadSpot(tadAnchor, 62.178 - tadShift3, 4, 'curb', 1.8)
+tadAt12 = tadSpot(tadAnchor, 62.178, 4, 'curb', 1.8)
 curbside_vehicles_3 = new Car at tadAt12[0], facing tadAt12[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadParked()
-tadAt13 = tadSpot(tadAnchor, 67.678 - tadShift3, 4, 'curb', 1.8)
+tadAt13 = tadSpot(tadAnchor, 67.678, 4, 'curb', 1.8)
 curbside_vehicles_4 = new Car at tadAt13[0], facing tadAt13[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadParked()
-tadAt14 = tadSpot(tadAnchor, 73.178 - tadShift3, 4, 'curb', 1.8)
+tadAt14 = tadSpot(tadAnchor, 73.178, 4, 'curb', 1.8)
 curbside_vehicles_5 = new Car at tadAt14[0], facing tadAt14[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadParked()
-tadAt15 = tadSpot(tadAnchor, 78.678 - tadShift3, 4, 'curb', 1.8)
+tadAt15 = tadSpot(tadAnchor, 78.678, 4, 'curb', 1.8)
 curbside_vehicles_6 = new Car at tadAt15[0], facing tadAt15[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadParked()
-tadAt16 = tadSpot(tadAnchor, 84.178 - tadShift3, 4, 'curb', 1.8)
+tadAt16 = tadSpot(tadAnchor, 84.178, 4, 'curb', 1.8)
 curbside_vehicles_7 = new Car at tadAt16[0], facing tadAt16[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadParked()
-tadAt17 = tadSpot(tadAnchor, 89.678 - tadShift3, 4, 'curb', 1.8)
+tadAt17 = tadSpot(tadAnchor, 89.678, 4, 'curb', 1.8)
 curbside_vehicles_8 = new Car at tadAt17[0], facing tadAt17[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadParked()
-tadAt18 = tadSpot(tadAnchor, 95.178 - tadShift3, 4, 'curb', 1.8)
+tadAt18 = tadSpot(tadAnchor, 95.178, 4, 'curb', 1.8)
 curbside_vehicles_9 = new Car at tadAt18[0], facing tadAt18[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadParked()
-tadAt19 = tadSpot(tadAnchor, 100.678 - tadShift3, 4, 'curb', 1.8)
+tadAt19 = tadSpot(tadAnchor, 100.678, 4, 'curb', 1.8)
 curbside_vehicles_10 = new Car at tadAt19[0], facing tadAt19[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadParked()
 
 # group `empty_bus`: 1 bus, parked, 0 km/h, right_front of ego, lane 4
-tadShift4 = Range(0, 6.633)
-tadAt20 = tadSpot(tadAnchor, 109.428 - tadShift4, 4, 'curb', 2.55)
+tadAt20 = tadSpot(tadAnchor, 109.428, 4, 'curb', 2.55)
 empty_bus = new Car at tadAt20[0], facing tadAt20[1],
     with blueprint 'vehicle.mitsubishi.fusorosa', with width 2.55, with length 12.0,
     with regionContainedIn None, with behavior TadParked()
