@@ -976,8 +976,10 @@ fn time_group(
     let ego_ahead = Path::new(sample_path(&ego.path, ego.path_start, ego.path.length()));
     let own_ahead = Path::new(sample_path(&first.path, first.path_start, first.path.length()));
     let (s_own, s_ego) = own_ahead.first_within(&ego_ahead, reach, 0.5)?;
-    // in the ego's lane from the start (a leader or a follower): not a conflict
-    if s_own < 1.0 || s_ego < ego.length / 2.0 {
+    // on the ego's path from the start and going its way (a leader or a follower), or
+    // meeting it where the ego already is: not a conflict; head-on on its path is one
+    let same_way = Vec2::from_yaw(own_ahead.pose(s_own).yaw).dot(Vec2::from_yaw(ego_ahead.pose(s_ego).yaw)) > 0.7;
+    if (s_own < 1.0 && same_way) || s_ego < ego.length / 2.0 {
         return None;
     }
     let time = s_ego / ego.speed;

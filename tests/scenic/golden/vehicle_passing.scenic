@@ -177,15 +177,15 @@ def tadOrdinary(lane):
 
 def tadBack(lane, before):
     """The point `before` metres before the end of `lane`, walking back over the lanes leading
-    into it while they are lanes of ordinary roads: (lane, arc). TadRejection if they end
-    (at another junction) sooner."""
+    into it while they are lanes of ordinary roads: (lane, arc); where they end (at another
+    junction) sooner, that end: as far out as the arm goes."""
     arc = lane.centerline.length - before
     seen = {lane.uid}
     while arc < 0:
         prev = lane._predecessor
         if prev is None or not hasattr(prev, 'centerline') or prev.uid in seen or not tadOrdinary(prev) \
                 or prev.centerline[-1].distanceTo(lane.centerline[0]) > 1.0:
-            raise TadRejection('the arm is too short for the actor')
+            return (lane, 0.0)
         seen.add(prev.uid)
         lane = prev
         arc += lane.centerline.length
@@ -193,14 +193,14 @@ def tadBack(lane, before):
 
 def tadOnward(lane, after):
     """The point `after` metres from the start of `lane`, walking on over the lanes it leads
-    into while they are lanes of ordinary roads: (lane, arc). TadRejection if they end sooner."""
+    into while they are lanes of ordinary roads: (lane, arc); where they end sooner, that end."""
     arc = after
     seen = {lane.uid}
     while arc > lane.centerline.length:
         nxt = lane._successor
         if nxt is None or not hasattr(nxt, 'centerline') or nxt.uid in seen or not tadOrdinary(nxt) \
                 or nxt.centerline[0].distanceTo(lane.centerline[-1]) > 1.0:
-            raise TadRejection('the arm is too short for the actor')
+            return (lane, lane.centerline.length)
         seen.add(nxt.uid)
         arc -= lane.centerline.length
         lane = nxt
@@ -366,6 +366,15 @@ def tadAnchors(network, same=None, other=None, minSame=0, minOther=0, index=1, s
                 found.append((lane, arc))
             arc += step
     return found
+
+def tadFind(network, wanted):
+    """The anchors for the road `wanted` (the keywords of `tadAnchors`); when no junction has
+    the reach its arms should have (`armReach`), the junctions with those arms at all, where
+    far actors stand as far out as the arm goes."""
+    anchors = tadAnchors(network, **wanted)
+    if not anchors and wanted.get('armReach'):
+        anchors = tadAnchors(network, **dict(wanted, armReach=None))
+    return tadRequire(anchors, wanted)
 
 def tadRequire(anchors, wanted):
     if not anchors:
@@ -560,14 +569,14 @@ behavior TadYield(speed):
         take SetThrottleAction(0), SetBrakeAction(1.0)
 # ---- end of the prelude ----
 
-# The road around the ego vehicle: 1 lane in the ego's direction, 1 lane in the other direction, a sidewalk beside the ego's lane, a straight stretch of 36 m.
+# The road around the ego vehicle: 1 lane in the ego's direction, 1 lane in the other direction, a sidewalk beside the ego's lane, a straight stretch of 66 m.
 # The ego is placed where the lane layout holds from `behind` metres behind it to `ahead` metres
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=1, other=1, minSame=1, minOther=1, index=1, sidewalk=True,
                junction=None, signalised=None, maneuver=None, signs=(),
-               shape='straight', ahead=32.0, behind=4.0, approach=None, arms=(),
+               shape='straight', ahead=62.0, behind=4.0, approach=None, arms=(),
                armReach=None)
-tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))
+tadAnchor = Uniform(*tadFind(network, tadRoad))
 
 # ego vehicle: overtake, 30 km/h, lane 1
 tadEgoAt = tadSpot(tadAnchor, 0.0, 1)
@@ -582,8 +591,8 @@ delivery_truck = new Car at tadAt1[0], facing tadAt1[1],
     with regionContainedIn None, with behavior TadParked()
 
 # group `oncoming_motorcycle`: 1 motorcycle, move_forward, 45 km/h, front of ego, lane -1
-tadShift2 = Range(0, 5.8)
-tadAt2 = tadSpot(tadAnchor, 23.6 - tadShift2, -1)
+tadJitter2 = Range(-5.0, 5.0)
+tadAt2 = tadSpot(tadAnchor, 59.709 + tadJitter2, -1)
 oncoming_motorcycle = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.yamaha.yzf', with width 0.8, with length 2.1,
     with regionContainedIn None, with speed 12.5, with behavior TadDrive(12.5)

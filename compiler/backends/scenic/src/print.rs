@@ -195,7 +195,7 @@ pub fn program(scenario: &Scenario, plan: &Plan, diagnostics: &[Diagnostic], opt
         number(needs.ahead),
         number(needs.behind),
     );
-    out.push_str("tadAnchor = Uniform(*tadRequire(tadAnchors(network, **tadRoad), tadRoad))\n\n");
+    out.push_str("tadAnchor = Uniform(*tadFind(network, tadRoad))\n\n");
 
     // --- actors
     out.push_str(&comment_lines(&plan.ego_summary, ""));
@@ -346,10 +346,10 @@ fn actor(out: &mut String, a: &Actor, spot: &str, needs: &maps::Needs) {
     }
     let call = if p.motions.len() > 1 {
         let calls: Option<Vec<String>> =
-            p.motions.iter().map(|m| behavior_call_with(*m, a.class, &speed, through)).collect();
+            p.motions.iter().map(|m| behavior_call_with(*m, a.class, &speed, through, a.is_ego)).collect();
         calls.map(|calls| format!("TadOneOf(tadPick{}, [{}])", p.tag, calls.join(", ")))
     } else {
-        behavior_call_with(a.motion, a.class, &speed, through)
+        behavior_call_with(a.motion, a.class, &speed, through, a.is_ego)
     };
     let hold = if a.class == Class::Pedestrian { "TadStand()" } else { "TadStop()" };
     let call = call.map(|call| match p.delay {
@@ -370,7 +370,7 @@ fn actor(out: &mut String, a: &Actor, spot: &str, needs: &maps::Needs) {
 /// the prelude's `Tad...` behaviors; none for `Debris`.
 /// A behavior without a motion follows the lane (stands still at 0).
 pub fn behavior_call(motion: Option<Motion>, class: Class, speed: f64) -> Option<String> {
-    behavior_call_with(motion, class, &number(speed), false)
+    behavior_call_with(motion, class, &number(speed), false, false)
 }
 
 fn python_bool(b: bool) -> &'static str {
@@ -380,7 +380,21 @@ fn python_bool(b: bool) -> &'static str {
 /// [`behavior_call`] with the speed as a Scenic expression (a number, or a sampled
 /// variable such as `tadSpeed2`, which is positive).
 /// `through`: the vehicle drives into a junction, where it goes straight on unless it turns.
-fn behavior_call_with(motion: Option<Motion>, class: Class, v: &str, through: bool) -> Option<String> {
+/// `ego`: the vehicle under test keeps its speed (no car following: a driving model drives it
+/// in CARLA, and the scenario's timing assumes it keeps its speed).
+fn behavior_call_with(motion: Option<Motion>, class: Class, v: &str, through: bool, ego: bool) -> Option<String> {
+    let moving = v.parse::<f64>().map_or(true, |s| s > 0.0);
+    if ego && class == Class::Car && moving {
+        let turn = |letter: char| format!("TadTurn({v}, '{}')", mapping::maneuver(letter));
+        match motion {
+            Some(Motion::Follow | Motion::Walk | Motion::Graze) | None if through => return Some(turn('S')),
+            Some(Motion::Follow | Motion::Walk | Motion::Graze) | None => return Some(format!("TadFollow({v})")),
+            Some(Motion::TurnLeft) => return Some(turn('L')),
+            Some(Motion::TurnRight) => return Some(turn('R')),
+            Some(Motion::UTurn) => return Some(turn('U')),
+            _ => {}
+        }
+    }
     let moving = v.parse::<f64>().map_or(true, |s| s > 0.0);
     match class {
         Class::Debris => None,

@@ -154,15 +154,15 @@ def tadOrdinary(lane):
 
 def tadBack(lane, before):
     """The point `before` metres before the end of `lane`, walking back over the lanes leading
-    into it while they are lanes of ordinary roads: (lane, arc). TadRejection if they end
-    (at another junction) sooner."""
+    into it while they are lanes of ordinary roads: (lane, arc); where they end (at another
+    junction) sooner, that end: as far out as the arm goes."""
     arc = lane.centerline.length - before
     seen = {lane.uid}
     while arc < 0:
         prev = lane._predecessor
         if prev is None or not hasattr(prev, 'centerline') or prev.uid in seen or not tadOrdinary(prev) \
                 or prev.centerline[-1].distanceTo(lane.centerline[0]) > 1.0:
-            raise TadRejection('the arm is too short for the actor')
+            return (lane, 0.0)
         seen.add(prev.uid)
         lane = prev
         arc += lane.centerline.length
@@ -170,14 +170,14 @@ def tadBack(lane, before):
 
 def tadOnward(lane, after):
     """The point `after` metres from the start of `lane`, walking on over the lanes it leads
-    into while they are lanes of ordinary roads: (lane, arc). TadRejection if they end sooner."""
+    into while they are lanes of ordinary roads: (lane, arc); where they end sooner, that end."""
     arc = after
     seen = {lane.uid}
     while arc > lane.centerline.length:
         nxt = lane._successor
         if nxt is None or not hasattr(nxt, 'centerline') or nxt.uid in seen or not tadOrdinary(nxt) \
                 or nxt.centerline[0].distanceTo(lane.centerline[-1]) > 1.0:
-            raise TadRejection('the arm is too short for the actor')
+            return (lane, lane.centerline.length)
         seen.add(nxt.uid)
         arc -= lane.centerline.length
         lane = nxt
@@ -343,6 +343,15 @@ def tadAnchors(network, same=None, other=None, minSame=0, minOther=0, index=1, s
                 found.append((lane, arc))
             arc += step
     return found
+
+def tadFind(network, wanted):
+    """The anchors for the road `wanted` (the keywords of `tadAnchors`); when no junction has
+    the reach its arms should have (`armReach`), the junctions with those arms at all, where
+    far actors stand as far out as the arm goes."""
+    anchors = tadAnchors(network, **wanted)
+    if not anchors and wanted.get('armReach'):
+        anchors = tadAnchors(network, **dict(wanted, armReach=None))
+    return tadRequire(anchors, wanted)
 
 def tadRequire(anchors, wanted):
     if not anchors:
