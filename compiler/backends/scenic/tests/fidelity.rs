@@ -20,6 +20,11 @@ use tad_test_support::trace::{self, Group, Label, Trace, TraceOptions, Tracer};
 /// Steps simulated: 15 s, long enough for the slowest conflict of the examples.
 const STEPS: u32 = 150;
 
+/// What does not hold yet on the CARLA maps, with why: (example, property, reason). These
+/// are printed, not failed; everything else must hold for every seed. A property listed
+/// here that holds is printed too, so the list only shrinks.
+const KNOWN: &[(&str, &str, &str)] = &[];
+
 /// An emitted example: its stem, program file and actor groups.
 struct Program {
     stem: String,
@@ -130,7 +135,7 @@ fn every_example_keeps_its_meaning_in_scenic() {
         "| scenario | seed | ran | relations at start | overlaps in 3 s (not the ego) | adversaries: least distance to the ego (time) | first contact |"
     );
     let _ = writeln!(table, "|---|---|---|---|---|---|---|");
-    let mut failures = Vec::new();
+    let mut failures: Vec<(String, &str, String)> = Vec::new();
     for (program, example) in programs.iter().zip(&examples) {
         let scenario = resolved(example);
         let layout = tad_layout::lay_out(&scenario);
@@ -164,19 +169,22 @@ fn every_example_keeps_its_meaning_in_scenic() {
                 if adversaries.is_empty() { "-".into() } else { adversaries.join(", ") },
             );
             let at = format!("{} seed {}", program.stem, t.seed);
+            let stem = program.stem.clone();
             if !t.ok {
-                failures.push(format!("{at}: {}", t.error.clone().unwrap_or_default()));
+                failures.push((stem.clone(), "ran", format!("{at}: {}", t.error.clone().unwrap_or_default())));
             }
             for r in a.relations.iter().filter(|r| !r.holds) {
                 let name = scenario.group(r.group).map_or("?", |g| g.name.as_str());
-                failures.push(format!("{at}: {name}: {} — {}", r.measured, r.failure.clone().unwrap_or_default()));
+                let what = format!("{at}: {name}: {} — {}", r.measured, r.failure.clone().unwrap_or_default());
+                failures.push((stem.clone(), "relations", what));
             }
             if !a.overlaps.is_empty() {
-                failures.push(format!("{at}: overlaps {}", overlaps.join(", ")));
+                failures.push((stem.clone(), "overlaps", format!("{at}: overlaps {}", overlaps.join(", "))));
             }
             for x in a.adversaries.iter().filter(|x| x.distance > tad_layout::fidelity::ADVERSARY_REACH) {
                 let name = scenario.group(x.group).map_or("?", |g| g.name.as_str());
-                failures.push(format!("{at}: adversary {name} comes only within {:.1} m", x.distance));
+                let what = format!("{at}: adversary {name} comes only within {:.1} m", x.distance);
+                failures.push((stem.clone(), "adversaries", what));
             }
         }
     }
@@ -184,5 +192,12 @@ fn every_example_keeps_its_meaning_in_scenic() {
     if let Some(path) = std::env::var_os("TADSL_FIDELITY_REPORT") {
         std::fs::write(path, &table).unwrap();
     }
-    assert!(failures.is_empty(), "{} failures:\n{}", failures.len(), failures.join("\n"));
+    let known = |stem: &str, property: &str| KNOWN.iter().find(|(s, p, _)| *s == stem && *p == property);
+    for (stem, property, why) in KNOWN {
+        let seen = failures.iter().filter(|(s, p, _)| s == stem && p == property).count();
+        println!("known: {stem} {property} ({why}): {seen} of the runs fail it");
+    }
+    let unexpected: Vec<&String> =
+        failures.iter().filter(|(stem, property, _)| known(stem, property).is_none()).map(|(_, _, what)| what).collect();
+    assert!(unexpected.is_empty(), "{} failures:\n{}", unexpected.len(), unexpected.iter().map(|s| s.as_str()).collect::<Vec<_>>().join("\n"));
 }
