@@ -41,13 +41,18 @@ impl Class {
         }
     }
 
-    /// The length and width of an actor of this class whose type states none.
-    pub fn default_size(self) -> (f64, f64) {
+    /// The layout's body of an actor of this class.
+    pub fn body(self) -> tad_layout::Body {
         match self {
-            Class::Car => (4.5, 1.8),
-            Class::Pedestrian => (0.5, 0.6),
-            Class::Debris => (0.5, 0.5),
+            Class::Car => tad_layout::Body::Vehicle,
+            Class::Pedestrian => tad_layout::Body::Walker,
+            Class::Debris => tad_layout::Body::Object,
         }
+    }
+
+    /// The length and width of an actor of this class whose type states none (the layout's).
+    pub fn default_size(self) -> (f64, f64) {
+        self.body().default_size()
     }
 
     /// The CARLA blueprint of an actor of this class when neither its type nor its kind
