@@ -33,6 +33,7 @@ const KNOWN: &[(&str, &str, &str)] = &[
     ("red_light_running", "adversaries", "the map's junction is larger than the layout's: with some seeds the runner crosses up to 8 m ahead of the ego"),
     ("straight_obstacle", "relations", "with some seeds the chosen stretch of the map bends ahead of the ego"),
     ("turning_obstacle", "relations", "the one-way road's junction on the map: its bus stop lane and cross road do not run as the layout's"),
+    ("pennsylvania_small_town_main_street", "overlaps", "with some seeds the map's shoulder is narrower than a car, and the pickup truck brushes the first parked car"),
     ("unprotected_left_turn", "relations", "the oncoming car starts 78 m out, past the next junction of the map's opposite arm, on another road"),
 ];
 
