@@ -24,17 +24,57 @@ const STEPS: u32 = 150;
 /// are printed, not failed; everything else must hold for every seed. A property listed
 /// here that holds is printed too, so the list only shrinks.
 const KNOWN: &[(&str, &str, &str)] = &[
-    ("nl_to_dsl_example_2", "relations", "a curved road: the layout's bend (60 m radius, to the left) is not the map's"),
-    ("yosemite_deer_on_curve", "relations", "a curved road: the layout's bend (60 m radius, to the left) is not the map's"),
-    ("yosemite_deer_on_curve", "overlaps", "on the map's bend the oncoming RV reaches the deer's crossing sooner than on the layout's"),
-    ("extraction_prompt_example", "relations", "the map's road has a median: its third opposite lane is 4.5 m further out than three lanes"),
-    ("lane_changing", "overlaps", "two adversaries timed into one gap: Scenic's lane change takes longer than the layout's, so they meet each other"),
-    ("lane_changing", "adversaries", "the merging SUV is kept in front of the ego (its relation) and passes 7 m ahead of it"),
-    ("red_light_running", "adversaries", "the map's junction is larger than the layout's: with some seeds the runner crosses up to 8 m ahead of the ego"),
+    (
+        "nl_to_dsl_example_2",
+        "relations",
+        "a curved road: the layout's bend (60 m radius, to the left) is not the map's",
+    ),
+    (
+        "yosemite_deer_on_curve",
+        "relations",
+        "a curved road: the layout's bend (60 m radius, to the left) is not the map's",
+    ),
+    (
+        "yosemite_deer_on_curve",
+        "overlaps",
+        "on the map's bend the oncoming RV reaches the deer's crossing sooner than on the layout's",
+    ),
+    (
+        "extraction_prompt_example",
+        "relations",
+        "the map's road has a median: its third opposite lane is 4.5 m further out than three lanes",
+    ),
+    (
+        "lane_changing",
+        "overlaps",
+        "two adversaries timed into one gap: Scenic's lane change takes longer than the layout's, so they meet each other",
+    ),
+    (
+        "lane_changing",
+        "adversaries",
+        "the merging SUV is kept in front of the ego (its relation) and passes 7 m ahead of it",
+    ),
+    (
+        "red_light_running",
+        "adversaries",
+        "the map's junction is larger than the layout's: with some seeds the runner crosses up to 8 m ahead of the ego",
+    ),
     ("straight_obstacle", "relations", "with some seeds the chosen stretch of the map bends ahead of the ego"),
-    ("turning_obstacle", "relations", "the one-way road's junction on the map: its bus stop lane and cross road do not run as the layout's"),
-    ("pennsylvania_small_town_main_street", "overlaps", "with some seeds the map's shoulder is narrower than a car, and the pickup truck brushes the first parked car"),
-    ("unprotected_left_turn", "relations", "the oncoming car starts 78 m out, past the next junction of the map's opposite arm, on another road"),
+    (
+        "turning_obstacle",
+        "relations",
+        "the one-way road's junction on the map: its bus stop lane and cross road do not run as the layout's",
+    ),
+    (
+        "pennsylvania_small_town_main_street",
+        "overlaps",
+        "with some seeds the map's shoulder is narrower than a car, and the pickup truck brushes the first parked car",
+    ),
+    (
+        "unprotected_left_turn",
+        "relations",
+        "the oncoming car starts 78 m out, past the next junction of the map's opposite arm, on another road",
+    ),
 ];
 
 /// An emitted example: its stem, program file and actor groups.
@@ -209,7 +249,15 @@ fn every_example_keeps_its_meaning_in_scenic() {
         let seen = failures.iter().filter(|(s, p, _)| s == stem && p == property).count();
         println!("known: {stem} {property} ({why}): {seen} of the runs fail it");
     }
-    let unexpected: Vec<&String> =
-        failures.iter().filter(|(stem, property, _)| known(stem, property).is_none()).map(|(_, _, what)| what).collect();
-    assert!(unexpected.is_empty(), "{} failures:\n{}", unexpected.len(), unexpected.iter().map(|s| s.as_str()).collect::<Vec<_>>().join("\n"));
+    let unexpected: Vec<&String> = failures
+        .iter()
+        .filter(|(stem, property, _)| known(stem, property).is_none())
+        .map(|(_, _, what)| what)
+        .collect();
+    assert!(
+        unexpected.is_empty(),
+        "{} failures:\n{}",
+        unexpected.len(),
+        unexpected.iter().map(|s| s.as_str()).collect::<Vec<_>>().join("\n")
+    );
 }
