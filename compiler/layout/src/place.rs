@@ -26,6 +26,8 @@ use crate::geom::{Path, Pose, Vec2};
 use crate::road::{self, Arm, Junction, Road, Shape, Side, Station, Turn};
 use crate::{Agent, Conflict, Facing, Finding, GroupLayout, Layout, Place, Start};
 
+/// The farthest from the ego anything is put by timing or a late walker, m.
+const MAX_REACH: f64 = 150.0;
 /// How long a moving ego takes to reach its stop line, s.
 const APPROACH_TIME: f64 = 2.0;
 /// Where crosswalks are: metres past an arm's stop line, towards the junction.
@@ -412,7 +414,7 @@ pub fn lay_out(scenario: &Scenario) -> Layout {
                     _ => Side::Right,
                 });
                 let walk = ((start - road.lateral(ego_lane)).abs() + 1.0) / f.speed;
-                min_first = ego_facts.speed * walk + ego_len / 2.0;
+                min_first = (ego_facts.speed * walk + ego_len / 2.0).min(MAX_REACH);
             }
             let (placed, room) = place_group(road, d, f, reference, min_first, occupied);
             stations[i] = placed;
@@ -425,11 +427,17 @@ pub fn lay_out(scenario: &Scenario) -> Layout {
         let ahead: Vec<(f64, bool, bool)> = decisions
             .iter()
             .enumerate()
-            .filter(|(_, d)| d.as_ref().is_some_and(|d| d.arm == Arm::Ego && d.lane > 0 && !d.crosser))
-            .flat_map(|(i, _)| {
+            .filter(|(_, d)| d.as_ref().is_some_and(|d| d.arm == Arm::Ego && !d.crosser))
+            .flat_map(|(i, d)| {
                 let f = &group_facts[i];
-                let queued = f.is_static() && f.motion != Some(Motion::Parked) && f.body == Body::Vehicle;
-                stations[i].iter().map(move |(s, _)| (s.along + f.length / 2.0, f.is_static(), queued))
+                // moving traffic in the opposite lanes comes from the opposite arm; what stands
+                // there is before the junction too
+                let incoming = d.as_ref().is_some_and(|d| d.lane > 0);
+                if !incoming && !f.is_static() {
+                    return Vec::new();
+                }
+                let queued = incoming && f.is_static() && f.motion != Some(Motion::Parked) && f.body == Body::Vehicle;
+                stations[i].iter().map(|(s, _)| (s.along + f.length / 2.0, f.is_static(), queued)).collect()
             })
             .filter(|(front, _, _)| *front > 0.0)
             .collect();
@@ -500,7 +508,10 @@ pub fn lay_out(scenario: &Scenario) -> Layout {
         if road.junction.is_none() || built.late <= 0.05 {
             break;
         }
-        let delta = built.late * ego_facts.speed + 1.0;
+        let delta = (built.late * ego_facts.speed + 1.0).min(MAX_REACH - road.approach);
+        if delta <= 0.0 {
+            break;
+        }
         road.approach += delta;
         // walkers at the ego's crosswalk stay at it
         for (i, d) in decisions.iter().enumerate() {
@@ -749,6 +760,12 @@ fn place_group(
         _ if reference.stop_line && across => -CROSSWALK,
         Longitudinal::Same if !reference.stop_line => (reference.low + reference.high) / 2.0,
         _ => edge + step * (lead + extent / 2.0),
+    };
+    // on another arm nothing stands inside the junction: what would, goes behind its reference
+    let (first, step) = if d.arm != Arm::Ego && !across && first - extent / 2.0 < 0.5 {
+        (reference.high.max(0.0) + lead + extent / 2.0, 1.0)
+    } else {
+        (first, step)
     };
     // walkers across stand in rows of four along the sidewalk, further back row by row
     let side_lateral = |side: Side, row: usize| {
@@ -1010,7 +1027,9 @@ fn time_group(
                 (false, false) => (-room, f64::INFINITY),
             }
         }
-        Arm::Ego => (f64::NEG_INFINITY, f64::INFINITY),
+        // never farther than MAX_REACH from the ego
+        Arm::Ego if first.lane > 0 => (-MAX_REACH - first.station.along, MAX_REACH - first.station.along),
+        Arm::Ego => (first.station.along - MAX_REACH, first.station.along + MAX_REACH),
         // never past the junction; never farther out than MAX_ARM_START (it waits instead)
         _ => (first.station.along - MAX_ARM_START, first.station.along - first.length / 2.0 - 0.5),
     };

@@ -575,8 +575,8 @@ behavior TadYield(speed):
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=1, other=1, minSame=1, minOther=1, index=1, sidewalk=False,
                junction='4way', signalised=False, maneuver=None, signs=(),
-               shape=None, ahead=10.0, behind=4.0, approach=8.25, arms=('left',),
-               armReach={'left': (26.0, 0.0)})
+               shape=None, ahead=10.0, behind=4.0, approach=9.85, arms=('left',),
+               armReach={'left': (28.0, 0.0)})
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
 # ego vehicle: move_forward, 10 km/h, lane 1
@@ -586,7 +586,7 @@ ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
 
 # group `adversary_suv`: 1 suv, turn_left, 15 km/h, left_front of ego, lane 1
 tadJitter1 = Range(-2.083, 2.083)
-tadAt1 = tadArmSpot(tadAnchor, 'left', 18.554 + tadJitter1, 1)
+tadAt1 = tadArmSpot(tadAnchor, 'left', 20.954 + tadJitter1, 1)
 adversary_suv = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.nissan.patrol', with width 1.95, with length 4.8,
     with regionContainedIn None, with speed 4.167, with behavior TadThrough(4.167, 'LEFT_TURN')

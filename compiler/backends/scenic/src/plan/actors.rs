@@ -112,7 +112,9 @@ pub fn build(
                 names.fresh(&format!("{}_{}", g.name, k + 1))
             };
             let (arm, offset) = if junction || a.station.arm == Arm::Ego {
-                (a.station.arm, a.station.along)
+                // on another arm a spot is never inside the junction (a walker's may be)
+                let inside = a.station.arm != Arm::Ego && a.facing == Facing::Along;
+                (a.station.arm, if inside { a.station.along.max(0.0) } else { a.station.along })
             } else {
                 // no junction on the map: beyond where it would be, on the ego's road
                 (Arm::Ego, laid.road.approach + a.station.along + 10.0)
