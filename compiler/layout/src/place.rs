@@ -437,7 +437,9 @@ pub fn lay_out(scenario: &Scenario) -> Layout {
                     return Vec::new();
                 }
                 let queued = incoming && f.is_static() && f.motion != Some(Motion::Parked) && f.body == Body::Vehicle;
-                stations[i].iter().map(|(s, _)| (s.along + f.length / 2.0, f.is_static(), queued)).collect()
+                // what turns at the junction is before it too (only straight traffic moves across)
+                let before = f.is_static() || turn_of(f.motion) != Turn::Straight || road.opposite == 0;
+                stations[i].iter().map(|(s, _)| (s.along + f.length / 2.0, before, queued)).collect()
             })
             .filter(|(front, _, _)| *front > 0.0)
             .collect();

@@ -575,7 +575,7 @@ behavior TadYield(speed):
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=1, other=1, minSame=1, minOther=1, index=1, sidewalk=False,
                junction='4way', signalised=False, maneuver=None, signs=(),
-               shape=None, ahead=10.0, behind=4.0, approach=9.85, arms=('left',),
+               shape=None, ahead=11.0, behind=4.0, approach=9.85, arms=('left',),
                armReach={'left': (28.0, 0.0)})
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 

@@ -574,7 +574,7 @@ behavior TadYield(speed):
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=4, other=4, minSame=3, minOther=0, index=3, sidewalk=False,
                junction=None, signalised=None, maneuver=None, signs=(),
-               shape='straight', ahead=48.0, behind=19.0, approach=None, arms=(),
+               shape='straight', ahead=56.0, behind=24.0, approach=None, arms=(),
                armReach=None)
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 

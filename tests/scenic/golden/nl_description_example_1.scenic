@@ -577,7 +577,7 @@ behavior TadYield(speed):
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=2, other=0, minSame=2, minOther=0, index=2, sidewalk=False,
                junction=None, signalised=True, maneuver=None, signs=(),
-               shape=None, ahead=49.0, behind=4.0, approach=48.983, arms=(),
+               shape=None, ahead=54.0, behind=4.0, approach=48.983, arms=(),
                armReach=None)
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 

@@ -591,7 +591,7 @@ behavior TadTriggered(distance, hold, then):
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=2, other=2, minSame=2, minOther=1, index=1, sidewalk=True,
                junction=None, signalised=None, maneuver=None, signs=(),
-               shape=None, ahead=69.0, behind=4.0, approach=None, arms=(),
+               shape=None, ahead=75.0, behind=4.0, approach=None, arms=(),
                armReach=None)
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 

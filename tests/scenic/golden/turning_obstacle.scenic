@@ -594,7 +594,7 @@ behavior TadTriggered(distance, hold, then):
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=3, other=0, minSame=3, minOther=0, index=1, sidewalk=False,
                junction=None, signalised=None, maneuver=None, signs=(),
-               shape=None, ahead=18.0, behind=4.0, approach=None, arms=(),
+               shape=None, ahead=28.0, behind=4.0, approach=None, arms=(),
                armReach=None)
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 

@@ -591,7 +591,7 @@ behavior TadTriggered(distance, hold, then):
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=1, other=1, minSame=1, minOther=1, index=1, sidewalk=False,
                junction=None, signalised=None, maneuver=None, signs=(),
-               shape='curved', ahead=37.0, behind=36.0, approach=None, arms=(),
+               shape='curved', ahead=41.0, behind=41.0, approach=None, arms=(),
                armReach=None)
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 

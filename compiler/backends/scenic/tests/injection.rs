@@ -102,8 +102,12 @@ fn is_identifier(s: &str) -> bool {
 /// The structure of a generated program: comments, the statements the backend writes, and
 /// nothing else.
 fn check_structure(name: &str, text: &str) {
-    let prelude: Vec<&str> =
-        tad_scenic::PRELUDE_PLACEMENT.lines().chain(tad_scenic::PRELUDE_BEHAVIORS.lines()).collect();
+    let prelude: Vec<&str> = tad_scenic::PRELUDE_PLACEMENT
+        .lines()
+        .chain(tad_scenic::PRELUDE_BEHAVIORS.lines())
+        .chain(tad_scenic::PRELUDE_PARAMS.lines())
+        .chain(["# Parameters: a choice of behaviors, a delay, a trigger."])
+        .collect();
     for c in text.chars() {
         assert!(
             c == '\n'

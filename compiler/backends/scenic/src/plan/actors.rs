@@ -91,9 +91,12 @@ pub fn build(
                 Some((high - low, -away))
             } else if conflict.is_none() {
                 // never into the junction on another arm
-                let room = first
-                    .filter(|f| f.station.arm != Arm::Ego && away > 0.0)
-                    .map_or(f64::INFINITY, |f| f.station.along - f.length / 2.0 - 0.5);
+                let room = gl
+                    .agents
+                    .iter()
+                    .filter(|a| a.station.arm != Arm::Ego && a.facing == Facing::Along)
+                    .map(|a| a.station.along - a.length / 2.0 - 0.5)
+                    .fold(f64::INFINITY, f64::min);
                 Some((gl.slack.min(room), -away)).filter(|(s, _)| *s >= 0.5)
             } else {
                 None

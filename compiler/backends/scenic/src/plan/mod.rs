@@ -208,6 +208,13 @@ pub fn plan(scenario: &Scenario, options: &EmitOptions) -> (Plan, Vec<Diagnostic
     let mut needs = choice.needs.clone();
     layout::windows(&laid, &mut needs, choice.junction, Some(&kept));
     let actors = actors::build(scenario, &ego, &groups, &laid, &kept, choice.junction);
+    // the window holds every actor the program places on the ego's road, sampled either way
+    for a in actors.groups.iter().flat_map(|g| &g.actors).filter(|a| a.arm == tad_layout::Arm::Ego) {
+        let reach = a.length.max(a.width) / 2.0 + a.params.jitter.unwrap_or(0.0) + 1.0;
+        let shift = a.params.shift.map_or(0.0, |(s, _)| s);
+        needs.ahead = needs.ahead.max((a.offset + reach + shift).ceil());
+        needs.behind = needs.behind.max((reach + shift - a.offset).ceil());
+    }
     let environment = environment::plan(scenario, &road, options.simulator, &mut report);
 
     let plan = Plan {
