@@ -754,7 +754,7 @@ fn place_group(
     };
     let room = match d.distance {
         Some((low, high)) => high - low,
-        None => (lead * 0.4).min(8.0),
+        None => (lead * 0.25).min(5.0),
     };
     let lead = if d.distance.is_some() { lead } else { lead + room };
     let edge = if step > 0.0 { reference.high } else { reference.low };

@@ -575,7 +575,7 @@ behavior TadYield(speed):
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=1, other=1, minSame=1, minOther=1, index=1, sidewalk=False,
                junction='4way', signalised=False, maneuver=None, signs=(),
-               shape=None, ahead=11.0, behind=4.0, approach=9.85, arms=('left',),
+               shape=None, ahead=10.0, behind=4.0, approach=9.625, arms=('left',),
                armReach={'left': (28.0, 0.0)})
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
@@ -586,14 +586,13 @@ ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
 
 # group `adversary_suv`: 1 suv, turn_left, 15 km/h, left_front of ego, lane 1
 tadJitter1 = Range(-2.083, 2.083)
-tadAt1 = tadArmSpot(tadAnchor, 'left', 20.954 + tadJitter1, 1)
+tadAt1 = tadArmSpot(tadAnchor, 'left', 20.588 + tadJitter1, 1)
 adversary_suv = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.nissan.patrol', with width 1.95, with length 4.8,
     with regionContainedIn None, with speed 4.167, with behavior TadThrough(4.167, 'LEFT_TURN')
 
 # group `waiting_car`: 1 car, stopped, 0 km/h, front of ego, lane -1
-tadShift2 = Range(0, 0.6)
-tadAt2 = tadSpot(tadAnchor, 6.6 - tadShift2, -1)
+tadAt2 = tadSpot(tadAnchor, 6.375, -1)
 waiting_car = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadStop()

@@ -578,8 +578,8 @@ behavior TadYield(speed):
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=3, other=3, minSame=3, minOther=3, index=2, sidewalk=False,
                junction=None, signalised=True, maneuver=None, signs=(),
-               shape=None, ahead=62.0, behind=4.0, approach=61.65, arms=('opposite',),
-               armReach={'opposite': (19.0, 0.0)})
+               shape=None, ahead=62.0, behind=4.0, approach=61.5, arms=('opposite',),
+               armReach={'opposite': (18.0, 0.0)})
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
 # ego vehicle: move_forward, 38 km/h, lane 2
@@ -588,87 +588,87 @@ ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 10.556, with behavior TadTurn(10.556, 'STRAIGHT')
 
 # group `bus_ahead`: 1 bus, move_forward, 35 km/h, front of ego
-tadShift1 = Range(0, 5.022)
-tadAt1 = tadSpot(tadAnchor, 25.828 - tadShift1, 2)
+tadShift1 = Range(0, 3.139)
+tadAt1 = tadSpot(tadAnchor, 23.944 - tadShift1, 2)
 bus_ahead = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.mitsubishi.fusorosa', with width 2.55, with length 12.0,
     with regionContainedIn None, with speed 9.722, with behavior TadThrough(9.722, 'STRAIGHT')
 
 # group `parked_sedans`: 10 sedan, parked, 0 km/h, right_front of ego, lane 3
-tadAt2 = tadSpot(tadAnchor, 6.05, 3, 'curb', 1.85)
+tadAt2 = tadSpot(tadAnchor, 5.9, 3, 'curb', 1.85)
 parked_sedans_1 = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt3 = tadSpot(tadAnchor, 11.85, 3, 'curb', 1.85)
+tadAt3 = tadSpot(tadAnchor, 11.7, 3, 'curb', 1.85)
 parked_sedans_2 = new Car at tadAt3[0], facing tadAt3[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt4 = tadSpot(tadAnchor, 17.65, 3, 'curb', 1.85)
+tadAt4 = tadSpot(tadAnchor, 17.5, 3, 'curb', 1.85)
 parked_sedans_3 = new Car at tadAt4[0], facing tadAt4[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt5 = tadSpot(tadAnchor, 23.45, 3, 'curb', 1.85)
+tadAt5 = tadSpot(tadAnchor, 23.3, 3, 'curb', 1.85)
 parked_sedans_4 = new Car at tadAt5[0], facing tadAt5[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt6 = tadSpot(tadAnchor, 29.25, 3, 'curb', 1.85)
+tadAt6 = tadSpot(tadAnchor, 29.1, 3, 'curb', 1.85)
 parked_sedans_5 = new Car at tadAt6[0], facing tadAt6[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt7 = tadSpot(tadAnchor, 35.05, 3, 'curb', 1.85)
+tadAt7 = tadSpot(tadAnchor, 34.9, 3, 'curb', 1.85)
 parked_sedans_6 = new Car at tadAt7[0], facing tadAt7[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt8 = tadSpot(tadAnchor, 40.85, 3, 'curb', 1.85)
+tadAt8 = tadSpot(tadAnchor, 40.7, 3, 'curb', 1.85)
 parked_sedans_7 = new Car at tadAt8[0], facing tadAt8[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt9 = tadSpot(tadAnchor, 46.65, 3, 'curb', 1.85)
+tadAt9 = tadSpot(tadAnchor, 46.5, 3, 'curb', 1.85)
 parked_sedans_8 = new Car at tadAt9[0], facing tadAt9[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt10 = tadSpot(tadAnchor, 52.45, 3, 'curb', 1.85)
+tadAt10 = tadSpot(tadAnchor, 52.3, 3, 'curb', 1.85)
 parked_sedans_9 = new Car at tadAt10[0], facing tadAt10[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt11 = tadSpot(tadAnchor, 58.25, 3, 'curb', 1.85)
+tadAt11 = tadSpot(tadAnchor, 58.1, 3, 'curb', 1.85)
 parked_sedans_10 = new Car at tadAt11[0], facing tadAt11[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
 
 # group `parked_sedans_opposite`: 7 sedan, parked, 0 km/h, left_front of ego, lane -3
-tadAt12 = tadSpot(tadAnchor, 6.05, -3, 'curb', 1.85)
+tadAt12 = tadSpot(tadAnchor, 5.9, -3, 'curb', 1.85)
 parked_sedans_opposite_1 = new Car at tadAt12[0], facing tadAt12[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt13 = tadSpot(tadAnchor, 11.85, -3, 'curb', 1.85)
+tadAt13 = tadSpot(tadAnchor, 11.7, -3, 'curb', 1.85)
 parked_sedans_opposite_2 = new Car at tadAt13[0], facing tadAt13[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt14 = tadSpot(tadAnchor, 17.65, -3, 'curb', 1.85)
+tadAt14 = tadSpot(tadAnchor, 17.5, -3, 'curb', 1.85)
 parked_sedans_opposite_3 = new Car at tadAt14[0], facing tadAt14[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt15 = tadSpot(tadAnchor, 23.45, -3, 'curb', 1.85)
+tadAt15 = tadSpot(tadAnchor, 23.3, -3, 'curb', 1.85)
 parked_sedans_opposite_4 = new Car at tadAt15[0], facing tadAt15[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt16 = tadSpot(tadAnchor, 29.25, -3, 'curb', 1.85)
+tadAt16 = tadSpot(tadAnchor, 29.1, -3, 'curb', 1.85)
 parked_sedans_opposite_5 = new Car at tadAt16[0], facing tadAt16[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt17 = tadSpot(tadAnchor, 35.05, -3, 'curb', 1.85)
+tadAt17 = tadSpot(tadAnchor, 34.9, -3, 'curb', 1.85)
 parked_sedans_opposite_6 = new Car at tadAt17[0], facing tadAt17[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt18 = tadSpot(tadAnchor, 40.85, -3, 'curb', 1.85)
+tadAt18 = tadSpot(tadAnchor, 40.7, -3, 'curb', 1.85)
 parked_sedans_opposite_7 = new Car at tadAt18[0], facing tadAt18[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
 
 # group `oncoming_truck`: 1 truck, move_forward, 40 km/h, front of ego, lane -2
-tadShift4 = Range(0, 2.622)
-tadAt19 = tadArmSpot(tadAnchor, 'opposite', 12.928 - tadShift4, 2)
+tadShift4 = Range(0, 1.639)
+tadAt19 = tadArmSpot(tadAnchor, 'opposite', 11.944 - tadShift4, 2)
 oncoming_truck = new Car at tadAt19[0], facing tadAt19[1],
     with blueprint 'vehicle.carlamotors.carlacola', with width 2.5, with length 7.5,
     with regionContainedIn None, with speed 11.111, with behavior TadThrough(11.111, 'STRAIGHT')

@@ -569,12 +569,12 @@ behavior TadYield(speed):
         take SetThrottleAction(0), SetBrakeAction(1.0)
 # ---- end of the prelude ----
 
-# The road around the ego vehicle: 4 lanes in the ego's direction, 4 lanes in the other direction, a straight stretch of 67 m.
+# The road around the ego vehicle: 4 lanes in the ego's direction, 4 lanes in the other direction, a straight stretch of 79 m.
 # The ego is placed where the lane layout holds from `behind` metres behind it to `ahead` metres
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=4, other=4, minSame=3, minOther=0, index=3, sidewalk=False,
                junction=None, signalised=None, maneuver=None, signs=(),
-               shape='straight', ahead=56.0, behind=24.0, approach=None, arms=(),
+               shape='straight', ahead=50.0, behind=29.0, approach=None, arms=(),
                armReach=None)
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
@@ -584,8 +584,8 @@ ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 26.833, with behavior TadChangeLane(26.833, True)
 
 # group `slow_truck`: 1 truck, move_forward, 72 km/h, front of ego, lane 3
-tadShift1 = Range(0, 8.0)
-tadAt1 = tadSpot(tadAnchor, 42.833 - tadShift1, 3)
+tadShift1 = Range(0, 5.0)
+tadAt1 = tadSpot(tadAnchor, 39.833 - tadShift1, 3)
 slow_truck = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.carlamotors.carlacola', with width 2.5, with length 7.5,
     with regionContainedIn None, with speed 20.111, with behavior TadDrive(20.111)

@@ -577,7 +577,7 @@ behavior TadYield(speed):
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=3, other=3, minSame=3, minOther=0, index=2, sidewalk=False,
                junction='4way', signalised=True, maneuver=None, signs=(),
-               shape=None, ahead=39.0, behind=5.0, approach=32.65, arms=(),
+               shape=None, ahead=39.0, behind=6.0, approach=32.5, arms=(),
                armReach=None)
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
@@ -587,77 +587,75 @@ ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with behavior TadStop()
 
 # group `lead_suv`: 1 suv, stopped, 0 km/h, front of ego, lane 2
-tadShift1 = Range(0, 0.6)
-tadAt1 = tadSpot(tadAnchor, 6.75 - tadShift1, 2)
+tadAt1 = tadSpot(tadAnchor, 6.525, 2)
 lead_suv = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.nissan.patrol', with width 1.95, with length 4.8,
     with regionContainedIn None, with behavior TadStop()
 
 # group `left_lane_queue`: 3 car, stopped, 0 km/h, left_front of ego, lane 1
-tadShift2 = Range(0, 0.6)
-tadAt2 = tadSpot(tadAnchor, 6.6 - tadShift2, 1)
+tadAt2 = tadSpot(tadAnchor, 6.375, 1)
 left_lane_queue_1 = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadStop()
-tadAt3 = tadSpot(tadAnchor, 12.6 - tadShift2, 1)
+tadAt3 = tadSpot(tadAnchor, 12.375, 1)
 left_lane_queue_2 = new Car at tadAt3[0], facing tadAt3[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadStop()
-tadAt4 = tadSpot(tadAnchor, 18.6 - tadShift2, 1)
+tadAt4 = tadSpot(tadAnchor, 18.375, 1)
 left_lane_queue_3 = new Car at tadAt4[0], facing tadAt4[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadStop()
 
 # group `lane_splitting_motorcycle`: 1 motorcycle, move_forward, 15 km/h, left of ego, lane 1
-tadAt5 = tadSpot(tadAnchor, -2.867, 1)
+tadAt5 = tadSpot(tadAnchor, -3.092, 1)
 lane_splitting_motorcycle = new Car at tadAt5[0], facing tadAt5[1],
     with blueprint 'vehicle.yamaha.yzf', with width 0.8, with length 2.1,
     with regionContainedIn None, with speed 4.167, with behavior TadThrough(4.167, 'STRAIGHT')
 
 # group `parked_sedans`: 5 sedan, parked, 0 km/h, right_front of ego, lane 3
-tadAt6 = tadSpot(tadAnchor, 6.05, 3, 'curb', 1.85)
+tadAt6 = tadSpot(tadAnchor, 5.9, 3, 'curb', 1.85)
 parked_sedans_1 = new Car at tadAt6[0], facing tadAt6[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt7 = tadSpot(tadAnchor, 11.85, 3, 'curb', 1.85)
+tadAt7 = tadSpot(tadAnchor, 11.7, 3, 'curb', 1.85)
 parked_sedans_2 = new Car at tadAt7[0], facing tadAt7[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt8 = tadSpot(tadAnchor, 17.65, 3, 'curb', 1.85)
+tadAt8 = tadSpot(tadAnchor, 17.5, 3, 'curb', 1.85)
 parked_sedans_3 = new Car at tadAt8[0], facing tadAt8[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt9 = tadSpot(tadAnchor, 23.45, 3, 'curb', 1.85)
+tadAt9 = tadSpot(tadAnchor, 23.3, 3, 'curb', 1.85)
 parked_sedans_4 = new Car at tadAt9[0], facing tadAt9[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt10 = tadSpot(tadAnchor, 29.25, 3, 'curb', 1.85)
+tadAt10 = tadSpot(tadAnchor, 29.1, 3, 'curb', 1.85)
 parked_sedans_5 = new Car at tadAt10[0], facing tadAt10[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
 
 # group `crossing_pedestrians`: 6 pedestrian, cross, 5 km/h, front of lead_suv, lane 2
-tadAt11 = tadCross(tadAnchor, 'ego', 32.65 - (34.65), True, 0.0)
+tadAt11 = tadCross(tadAnchor, 'ego', 32.5 - (34.5), True, 0.0)
 crossing_pedestrians_1 = new Pedestrian at tadAt11[0], facing tadAt11[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt12 = tadCross(tadAnchor, 'ego', 32.65 - (35.55), True, 0.0)
+tadAt12 = tadCross(tadAnchor, 'ego', 32.5 - (35.4), True, 0.0)
 crossing_pedestrians_2 = new Pedestrian at tadAt12[0], facing tadAt12[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt13 = tadCross(tadAnchor, 'ego', 32.65 - (36.45), True, 0.0)
+tadAt13 = tadCross(tadAnchor, 'ego', 32.5 - (36.3), True, 0.0)
 crossing_pedestrians_3 = new Pedestrian at tadAt13[0], facing tadAt13[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt14 = tadCross(tadAnchor, 'ego', 32.65 - (37.35), True, 0.0)
+tadAt14 = tadCross(tadAnchor, 'ego', 32.5 - (37.2), True, 0.0)
 crossing_pedestrians_4 = new Pedestrian at tadAt14[0], facing tadAt14[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt15 = tadCross(tadAnchor, 'ego', 32.65 - (34.65), True, 0.8)
+tadAt15 = tadCross(tadAnchor, 'ego', 32.5 - (34.5), True, 0.8)
 crossing_pedestrians_5 = new Pedestrian at tadAt15[0], facing tadAt15[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt16 = tadCross(tadAnchor, 'ego', 32.65 - (35.55), True, 0.8)
+tadAt16 = tadCross(tadAnchor, 'ego', 32.5 - (35.4), True, 0.8)
 crossing_pedestrians_6 = new Pedestrian at tadAt16[0], facing tadAt16[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)

@@ -579,7 +579,7 @@ behavior TadYield(speed):
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=5, other=0, minSame=5, minOther=0, index=3, sidewalk=False,
                junction=None, signalised=True, maneuver=None, signs=(),
-               shape=None, ahead=49.0, behind=4.0, approach=42.55, arms=(),
+               shape=None, ahead=49.0, behind=4.0, approach=42.4, arms=(),
                armReach=None)
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
@@ -589,51 +589,51 @@ ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with behavior TadStop()
 
 # group `crossing_pedestrians`: 12 pedestrian, cross, 5 km/h, front of ego, lane 3
-tadAt1 = tadCross(tadAnchor, 'ego', 42.55 - (44.55), True, 0.0)
+tadAt1 = tadCross(tadAnchor, 'ego', 42.4 - (44.4), True, 0.0)
 crossing_pedestrians_1 = new Pedestrian at tadAt1[0], facing tadAt1[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt2 = tadCross(tadAnchor, 'ego', 42.55 - (45.45), True, 0.0)
+tadAt2 = tadCross(tadAnchor, 'ego', 42.4 - (45.3), True, 0.0)
 crossing_pedestrians_2 = new Pedestrian at tadAt2[0], facing tadAt2[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt3 = tadCross(tadAnchor, 'ego', 42.55 - (46.35), True, 0.0)
+tadAt3 = tadCross(tadAnchor, 'ego', 42.4 - (46.2), True, 0.0)
 crossing_pedestrians_3 = new Pedestrian at tadAt3[0], facing tadAt3[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt4 = tadCross(tadAnchor, 'ego', 42.55 - (47.25), True, 0.0)
+tadAt4 = tadCross(tadAnchor, 'ego', 42.4 - (47.1), True, 0.0)
 crossing_pedestrians_4 = new Pedestrian at tadAt4[0], facing tadAt4[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt5 = tadCross(tadAnchor, 'ego', 42.55 - (44.55), True, 0.8)
+tadAt5 = tadCross(tadAnchor, 'ego', 42.4 - (44.4), True, 0.8)
 crossing_pedestrians_5 = new Pedestrian at tadAt5[0], facing tadAt5[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt6 = tadCross(tadAnchor, 'ego', 42.55 - (45.45), True, 0.8)
+tadAt6 = tadCross(tadAnchor, 'ego', 42.4 - (45.3), True, 0.8)
 crossing_pedestrians_6 = new Pedestrian at tadAt6[0], facing tadAt6[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt7 = tadCross(tadAnchor, 'ego', 42.55 - (46.35), True, 0.8)
+tadAt7 = tadCross(tadAnchor, 'ego', 42.4 - (46.2), True, 0.8)
 crossing_pedestrians_7 = new Pedestrian at tadAt7[0], facing tadAt7[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt8 = tadCross(tadAnchor, 'ego', 42.55 - (47.25), True, 0.8)
+tadAt8 = tadCross(tadAnchor, 'ego', 42.4 - (47.1), True, 0.8)
 crossing_pedestrians_8 = new Pedestrian at tadAt8[0], facing tadAt8[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt9 = tadCross(tadAnchor, 'ego', 42.55 - (44.55), True, 1.6)
+tadAt9 = tadCross(tadAnchor, 'ego', 42.4 - (44.4), True, 1.6)
 crossing_pedestrians_9 = new Pedestrian at tadAt9[0], facing tadAt9[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt10 = tadCross(tadAnchor, 'ego', 42.55 - (45.45), True, 1.6)
+tadAt10 = tadCross(tadAnchor, 'ego', 42.4 - (45.3), True, 1.6)
 crossing_pedestrians_10 = new Pedestrian at tadAt10[0], facing tadAt10[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt11 = tadCross(tadAnchor, 'ego', 42.55 - (46.35), True, 1.6)
+tadAt11 = tadCross(tadAnchor, 'ego', 42.4 - (46.2), True, 1.6)
 crossing_pedestrians_11 = new Pedestrian at tadAt11[0], facing tadAt11[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
-tadAt12 = tadCross(tadAnchor, 'ego', 42.55 - (47.25), True, 1.6)
+tadAt12 = tadCross(tadAnchor, 'ego', 42.4 - (47.1), True, 1.6)
 crossing_pedestrians_12 = new Pedestrian at tadAt12[0], facing tadAt12[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadWalk(1.389)
@@ -643,7 +643,7 @@ tadAt13 = tadSpot(tadAnchor, 0.0, 2)
 taxis_1 = new Car at tadAt13[0], facing tadAt13[1],
     with blueprint 'vehicle.ford.crown', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadStop()
-tadAt14 = tadSpot(tadAnchor, 10.15, 2)
+tadAt14 = tadSpot(tadAnchor, 10.0, 2)
 taxis_2 = new Car at tadAt14[0], facing tadAt14[1],
     with blueprint 'vehicle.ford.crown', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadStop()
@@ -655,34 +655,33 @@ delivery_van = new Car at tadAt15[0], facing tadAt15[1],
     with regionContainedIn None, with behavior TadStop()
 
 # group `city_bus`: 1 bus, stopped, 0 km/h, right_front of ego, lane 5
-tadShift4 = Range(0, 0.6)
-tadAt16 = tadSpot(tadAnchor, 13.75 - tadShift4, 5)
+tadAt16 = tadSpot(tadAnchor, 13.6, 5)
 city_bus = new Car at tadAt16[0], facing tadAt16[1],
     with blueprint 'vehicle.mitsubishi.fusorosa', with width 2.55, with length 12.0,
     with regionContainedIn None, with behavior TadStop()
 
 # group `parked_sedans`: 6 sedan, parked, 0 km/h, left_front of ego, lane 1
-tadAt17 = tadSpot(tadAnchor, 10.15, 1, 'curb', 1.85)
+tadAt17 = tadSpot(tadAnchor, 10.0, 1, 'curb', 1.85)
 parked_sedans_1 = new Car at tadAt17[0], facing tadAt17[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt18 = tadSpot(tadAnchor, 15.95, 1, 'curb', 1.85)
+tadAt18 = tadSpot(tadAnchor, 15.8, 1, 'curb', 1.85)
 parked_sedans_2 = new Car at tadAt18[0], facing tadAt18[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt19 = tadSpot(tadAnchor, 21.75, 1, 'curb', 1.85)
+tadAt19 = tadSpot(tadAnchor, 21.6, 1, 'curb', 1.85)
 parked_sedans_3 = new Car at tadAt19[0], facing tadAt19[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt20 = tadSpot(tadAnchor, 27.55, 1, 'curb', 1.85)
+tadAt20 = tadSpot(tadAnchor, 27.4, 1, 'curb', 1.85)
 parked_sedans_4 = new Car at tadAt20[0], facing tadAt20[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt21 = tadSpot(tadAnchor, 33.35, 1, 'curb', 1.85)
+tadAt21 = tadSpot(tadAnchor, 33.2, 1, 'curb', 1.85)
 parked_sedans_5 = new Car at tadAt21[0], facing tadAt21[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt22 = tadSpot(tadAnchor, 39.15, 1, 'curb', 1.85)
+tadAt22 = tadSpot(tadAnchor, 39.0, 1, 'curb', 1.85)
 parked_sedans_6 = new Car at tadAt22[0], facing tadAt22[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()

@@ -577,7 +577,7 @@ behavior TadYield(speed):
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=2, other=0, minSame=2, minOther=0, index=2, sidewalk=False,
                junction=None, signalised=True, maneuver=None, signs=(),
-               shape=None, ahead=54.0, behind=4.0, approach=48.983, arms=(),
+               shape=None, ahead=49.0, behind=4.0, approach=45.883, arms=(),
                armReach=None)
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
@@ -587,22 +587,22 @@ ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 8.333, with behavior TadTurn(8.333, 'STRAIGHT')
 
 # group `bus`: 1 bus, move_forward, 25 km/h, left_front of ego, lane 1
-tadShift1 = Range(0, 4.133)
-tadAt1 = tadSpot(tadAnchor, 22.717 - tadShift1, 1)
+tadShift1 = Range(0, 2.583)
+tadAt1 = tadSpot(tadAnchor, 21.167 - tadShift1, 1)
 bus = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.mitsubishi.fusorosa', with width 2.55, with length 12.0,
     with regionContainedIn None, with speed 6.944, with behavior TadThrough(6.944, 'STRAIGHT')
 
 # group `car_ahead`: 1 car, move_forward, 30 km/h, front of ego, lane 2
-tadShift2 = Range(0, 4.133)
-tadAt2 = tadSpot(tadAnchor, 18.967 - tadShift2, 2)
+tadShift2 = Range(0, 2.583)
+tadAt2 = tadSpot(tadAnchor, 17.417 - tadShift2, 2)
 car_ahead = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with speed 8.333, with behavior TadThrough(8.333, 'STRAIGHT')
 
 # group `suv_ahead_of_bus`: 1 suv, move_forward, 30 km/h, front of bus, lane 1
-tadShift3 = Range(0, 4.133)
-tadAt3 = tadSpot(tadAnchor, 45.583 - tadShift3, 1)
+tadShift3 = Range(0, 2.583)
+tadAt3 = tadSpot(tadAnchor, 42.483 - tadShift3, 1)
 suv_ahead_of_bus = new Car at tadAt3[0], facing tadAt3[1],
     with blueprint 'vehicle.nissan.patrol', with width 1.95, with length 4.8,
     with regionContainedIn None, with speed 8.333, with behavior TadThrough(8.333, 'STRAIGHT')

@@ -588,13 +588,13 @@ behavior TadTriggered(distance, hold, then):
     do then
 # ---- end of the prelude ----
 
-# The road around the ego vehicle: 4 lanes in the ego's direction, a one-way road, a junction without traffic lights, a straight stretch of 124 m.
+# The road around the ego vehicle: 4 lanes in the ego's direction, a one-way road, a junction without traffic lights, a straight stretch of 123 m.
 # Left out, as Town06 has no place with them and the rest: a stop sign at the junction ahead, a sidewalk beside the ego's lane.
 # The ego is placed where the lane layout holds from `behind` metres behind it to `ahead` metres
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=4, other=0, minSame=4, minOther=0, index=3, sidewalk=False,
                junction=None, signalised=None, maneuver=None, signs=(),
-               shape='straight', ahead=123.0, behind=4.0, approach=None, arms=(),
+               shape='straight', ahead=122.0, behind=4.0, approach=None, arms=(),
                armReach=None)
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
@@ -604,92 +604,92 @@ ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 9.722, with behavior TadFollow(9.722)
 
 # group `pedestrians`: 7 pedestrian, cross, front of ego
-tadDelay1 = 8.221
+tadDelay1 = 8.095
 tadJitter1 = Range(-0.5, 0.5)
-tadAt1 = tadCrossAt(tadAnchor, 118.428 + tadJitter1, True, 0.0)
+tadAt1 = tadCrossAt(tadAnchor, 117.2 + tadJitter1, True, 0.0)
 pedestrians_1 = new Pedestrian at tadAt1[0], facing tadAt1[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadDelayed(tadDelay1, TadStand(), TadWalk(1.389))
-tadAt2 = tadCrossAt(tadAnchor, 119.328 + tadJitter1, True, 0.0)
+tadAt2 = tadCrossAt(tadAnchor, 118.1 + tadJitter1, True, 0.0)
 pedestrians_2 = new Pedestrian at tadAt2[0], facing tadAt2[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadDelayed(tadDelay1, TadStand(), TadWalk(1.389))
-tadAt3 = tadCrossAt(tadAnchor, 120.228 + tadJitter1, True, 0.0)
+tadAt3 = tadCrossAt(tadAnchor, 119.0 + tadJitter1, True, 0.0)
 pedestrians_3 = new Pedestrian at tadAt3[0], facing tadAt3[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadDelayed(tadDelay1, TadStand(), TadWalk(1.389))
-tadAt4 = tadCrossAt(tadAnchor, 121.128 + tadJitter1, True, 0.0)
+tadAt4 = tadCrossAt(tadAnchor, 119.9 + tadJitter1, True, 0.0)
 pedestrians_4 = new Pedestrian at tadAt4[0], facing tadAt4[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadDelayed(tadDelay1, TadStand(), TadWalk(1.389))
-tadAt5 = tadCrossAt(tadAnchor, 118.428 + tadJitter1, True, 0.8)
+tadAt5 = tadCrossAt(tadAnchor, 117.2 + tadJitter1, True, 0.8)
 pedestrians_5 = new Pedestrian at tadAt5[0], facing tadAt5[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadDelayed(tadDelay1, TadStand(), TadWalk(1.389))
-tadAt6 = tadCrossAt(tadAnchor, 119.328 + tadJitter1, True, 0.8)
+tadAt6 = tadCrossAt(tadAnchor, 118.1 + tadJitter1, True, 0.8)
 pedestrians_6 = new Pedestrian at tadAt6[0], facing tadAt6[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadDelayed(tadDelay1, TadStand(), TadWalk(1.389))
-tadAt7 = tadCrossAt(tadAnchor, 120.228 + tadJitter1, True, 0.8)
+tadAt7 = tadCrossAt(tadAnchor, 119.0 + tadJitter1, True, 0.8)
 pedestrians_7 = new Pedestrian at tadAt7[0], facing tadAt7[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadDelayed(tadDelay1, TadStand(), TadWalk(1.389))
 
 # group `taxis`: 2 taxi, move_forward, 30 km/h, right_front of ego, lane 4
-tadShift2 = Range(0, 4.689)
-tadAt8 = tadSpot(tadAnchor, 21.061 - tadShift2, 4)
+tadShift2 = Range(0, 2.931)
+tadAt8 = tadSpot(tadAnchor, 19.833 - tadShift2, 4)
 taxis_1 = new Car at tadAt8[0], facing tadAt8[1],
     with blueprint 'vehicle.ford.crown', with width 1.85, with length 4.8,
     with regionContainedIn None, with speed 8.333, with behavior TadDrive(8.333)
-tadAt9 = tadSpot(tadAnchor, 36.194 - tadShift2, 4)
+tadAt9 = tadSpot(tadAnchor, 34.967 - tadShift2, 4)
 taxis_2 = new Car at tadAt9[0], facing tadAt9[1],
     with blueprint 'vehicle.ford.crown', with width 1.85, with length 4.8,
     with regionContainedIn None, with speed 8.333, with behavior TadDrive(8.333)
 
 # group `curbside_vehicles`: 10 car, parked, 0 km/h, right_front of ego, lane 4
-tadAt10 = tadSpot(tadAnchor, 51.178, 4, 'curb', 1.8)
+tadAt10 = tadSpot(tadAnchor, 49.95, 4, 'curb', 1.8)
 curbside_vehicles_1 = new Car at tadAt10[0], facing tadAt10[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadParked()
-tadAt11 = tadSpot(tadAnchor, 56.678, 4, 'curb', 1.8)
+tadAt11 = tadSpot(tadAnchor, 55.45, 4, 'curb', 1.8)
 curbside_vehicles_2 = new Car at tadAt11[0], facing tadAt11[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadParked()
-tadAt12 = tadSpot(tadAnchor, 62.178, 4, 'curb', 1.8)
+tadAt12 = tadSpot(tadAnchor, 60.95, 4, 'curb', 1.8)
 curbside_vehicles_3 = new Car at tadAt12[0], facing tadAt12[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadParked()
-tadAt13 = tadSpot(tadAnchor, 67.678, 4, 'curb', 1.8)
+tadAt13 = tadSpot(tadAnchor, 66.45, 4, 'curb', 1.8)
 curbside_vehicles_4 = new Car at tadAt13[0], facing tadAt13[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadParked()
-tadAt14 = tadSpot(tadAnchor, 73.178, 4, 'curb', 1.8)
+tadAt14 = tadSpot(tadAnchor, 71.95, 4, 'curb', 1.8)
 curbside_vehicles_5 = new Car at tadAt14[0], facing tadAt14[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadParked()
-tadAt15 = tadSpot(tadAnchor, 78.678, 4, 'curb', 1.8)
+tadAt15 = tadSpot(tadAnchor, 77.45, 4, 'curb', 1.8)
 curbside_vehicles_6 = new Car at tadAt15[0], facing tadAt15[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadParked()
-tadAt16 = tadSpot(tadAnchor, 84.178, 4, 'curb', 1.8)
+tadAt16 = tadSpot(tadAnchor, 82.95, 4, 'curb', 1.8)
 curbside_vehicles_7 = new Car at tadAt16[0], facing tadAt16[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadParked()
-tadAt17 = tadSpot(tadAnchor, 89.678, 4, 'curb', 1.8)
+tadAt17 = tadSpot(tadAnchor, 88.45, 4, 'curb', 1.8)
 curbside_vehicles_8 = new Car at tadAt17[0], facing tadAt17[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadParked()
-tadAt18 = tadSpot(tadAnchor, 95.178, 4, 'curb', 1.8)
+tadAt18 = tadSpot(tadAnchor, 93.95, 4, 'curb', 1.8)
 curbside_vehicles_9 = new Car at tadAt18[0], facing tadAt18[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadParked()
-tadAt19 = tadSpot(tadAnchor, 100.678, 4, 'curb', 1.8)
+tadAt19 = tadSpot(tadAnchor, 99.45, 4, 'curb', 1.8)
 curbside_vehicles_10 = new Car at tadAt19[0], facing tadAt19[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadParked()
 
 # group `empty_bus`: 1 bus, parked, 0 km/h, right_front of ego, lane 4
-tadAt20 = tadSpot(tadAnchor, 109.428, 4, 'curb', 2.55)
+tadAt20 = tadSpot(tadAnchor, 108.2, 4, 'curb', 2.55)
 empty_bus = new Car at tadAt20[0], facing tadAt20[1],
     with blueprint 'vehicle.mitsubishi.fusorosa', with width 2.55, with length 12.0,
     with regionContainedIn None, with behavior TadParked()

@@ -569,12 +569,12 @@ behavior TadYield(speed):
         take SetThrottleAction(0), SetBrakeAction(1.0)
 # ---- end of the prelude ----
 
-# The road around the ego vehicle: 1 lane in the ego's direction, 1 lane in the other direction, a sidewalk beside the ego's lane, a straight stretch of 43 m.
+# The road around the ego vehicle: 1 lane in the ego's direction, 1 lane in the other direction, a sidewalk beside the ego's lane, a straight stretch of 44 m.
 # The ego is placed where the lane layout holds from `behind` metres behind it to `ahead` metres
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=1, other=1, minSame=1, minOther=1, index=1, sidewalk=True,
                junction=None, signalised=None, maneuver=None, signs=(),
-               shape='straight', ahead=78.0, behind=4.0, approach=None, arms=(),
+               shape='straight', ahead=74.0, behind=4.0, approach=None, arms=(),
                armReach=None)
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
@@ -584,34 +584,34 @@ ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 7.778, with behavior TadFollow(7.778)
 
 # group `vehicle_in_front_1`: 1 sedan, move_forward, 30 km/h, front of ego, lane 1
-tadShift1 = Range(0, 4.133)
-tadAt1 = tadSpot(tadAnchor, 19.117 - tadShift1, 1)
+tadShift1 = Range(0, 2.583)
+tadAt1 = tadSpot(tadAnchor, 17.567 - tadShift1, 1)
 vehicle_in_front_1 = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with speed 8.333, with behavior TadDrive(8.333)
 
 # group `vehicle_in_front_2`: 1 suv, move_forward, 32 km/h, front of ego, lane 1
-tadShift2 = Range(0, 4.356)
-tadAt2 = tadSpot(tadAnchor, 34.806 - tadShift2, 1)
+tadShift2 = Range(0, 2.722)
+tadAt2 = tadSpot(tadAnchor, 33.256 - tadShift2, 1)
 vehicle_in_front_2 = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.nissan.patrol', with width 1.95, with length 4.8,
     with regionContainedIn None, with speed 8.889, with behavior TadDrive(8.889)
 
 # group `vehicles_opposite_direction`: 4 car, move_forward, 35 km/h, front of ego, lane -1
-tadShift3 = Range(0, 4.689)
-tadAt3 = tadSpot(tadAnchor, 20.911 - tadShift3, -1)
+tadShift3 = Range(0, 2.931)
+tadAt3 = tadSpot(tadAnchor, 19.153 - tadShift3, -1)
 vehicles_opposite_direction_1 = new Car at tadAt3[0], facing tadAt3[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with speed 9.722, with behavior TadDrive(9.722)
-tadAt4 = tadSpot(tadAnchor, 37.133 - tadShift3, -1)
+tadAt4 = tadSpot(tadAnchor, 35.375 - tadShift3, -1)
 vehicles_opposite_direction_2 = new Car at tadAt4[0], facing tadAt4[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with speed 9.722, with behavior TadDrive(9.722)
-tadAt5 = tadSpot(tadAnchor, 53.356 - tadShift3, -1)
+tadAt5 = tadSpot(tadAnchor, 51.597 - tadShift3, -1)
 vehicles_opposite_direction_3 = new Car at tadAt5[0], facing tadAt5[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with speed 9.722, with behavior TadDrive(9.722)
-tadAt6 = tadSpot(tadAnchor, 69.578 - tadShift3, -1)
+tadAt6 = tadSpot(tadAnchor, 67.819 - tadShift3, -1)
 vehicles_opposite_direction_4 = new Car at tadAt6[0], facing tadAt6[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with speed 9.722, with behavior TadDrive(9.722)

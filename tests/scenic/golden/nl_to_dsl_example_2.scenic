@@ -570,12 +570,12 @@ behavior TadYield(speed):
         take SetThrottleAction(0), SetBrakeAction(1.0)
 # ---- end of the prelude ----
 
-# The road around the ego vehicle: 1 lane in the ego's direction, 1 lane in the other direction, a curved stretch of 37 m.
+# The road around the ego vehicle: 1 lane in the ego's direction, 1 lane in the other direction, a curved stretch of 39 m.
 # The ego is placed where the lane layout holds from `behind` metres behind it to `ahead` metres
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=1, other=1, minSame=1, minOther=1, index=1, sidewalk=False,
                junction=None, signalised=None, maneuver=None, signs=(),
-               shape='curved', ahead=49.0, behind=4.0, approach=None, arms=(),
+               shape='curved', ahead=44.0, behind=4.0, approach=None, arms=(),
                armReach=None)
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
@@ -585,19 +585,19 @@ ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 12.5, with behavior TadFollow(12.5)
 
 # group `construction_vehicles`: 2 construction_vehicle, move_forward, 3 km/h, front of ego, lane -1
-tadShift1 = Range(0, 5.8)
-tadAt1 = tadSpot(tadAnchor, 26.55 - tadShift1, -1)
+tadShift1 = Range(0, 3.625)
+tadAt1 = tadSpot(tadAnchor, 24.375 - tadShift1, -1)
 construction_vehicles_1 = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.carlamotors.european_hgv', with width 2.5, with length 8.0,
     with regionContainedIn None, with speed 0.833, with behavior TadDrive(0.833)
-tadAt2 = tadSpot(tadAnchor, 37.383 - tadShift1, -1)
+tadAt2 = tadSpot(tadAnchor, 35.208 - tadShift1, -1)
 construction_vehicles_2 = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.carlamotors.european_hgv', with width 2.5, with length 8.0,
     with regionContainedIn None, with speed 0.833, with behavior TadDrive(0.833)
 
 # group `traffic_worker`: 1 construction_worker, stopped, 0 km/h, front of ego, lane 1
-tadShift2 = Range(0, 8.0)
-tadAt3 = tadSpot(tadAnchor, 31.25 - tadShift2, 1)
+tadShift2 = Range(0, 5.0)
+tadAt3 = tadSpot(tadAnchor, 28.25 - tadShift2, 1)
 traffic_worker = new Pedestrian at tadAt3[0], facing tadAt3[1],
     with blueprint 'walker.pedestrian.0030', with width 0.6, with length 0.5,
     with regionContainedIn None, with behavior TadStand()

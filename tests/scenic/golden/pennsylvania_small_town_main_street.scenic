@@ -569,12 +569,12 @@ behavior TadYield(speed):
         take SetThrottleAction(0), SetBrakeAction(1.0)
 # ---- end of the prelude ----
 
-# The road around the ego vehicle: 1 lane in the ego's direction, 1 lane in the other direction, a sidewalk beside the ego's lane, a straight stretch of 48 m.
+# The road around the ego vehicle: 1 lane in the ego's direction, 1 lane in the other direction, a sidewalk beside the ego's lane, a straight stretch of 50 m.
 # The ego is placed where the lane layout holds from `behind` metres behind it to `ahead` metres
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=1, other=1, minSame=1, minOther=1, index=1, sidewalk=True,
                junction=None, signalised=None, maneuver=None, signs=(),
-               shape='straight', ahead=56.0, behind=4.0, approach=None, arms=(),
+               shape='straight', ahead=52.0, behind=4.0, approach=None, arms=(),
                armReach=None)
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
@@ -584,26 +584,26 @@ ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 9.722, with behavior TadFollow(9.722)
 
 # group `pickup_truck`: 1 truck, move_forward, 35 km/h, front of ego, lane 1
-tadShift1 = Range(0, 4.689)
-tadAt1 = tadSpot(tadAnchor, 22.411 - tadShift1, 1)
+tadShift1 = Range(0, 2.931)
+tadAt1 = tadSpot(tadAnchor, 20.653 - tadShift1, 1)
 pickup_truck = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.carlamotors.carlacola', with width 2.5, with length 7.5,
     with regionContainedIn None, with speed 9.722, with behavior TadDrive(9.722)
 
 # group `parked_cars`: 2 car, parked, 0 km/h, right_front of ego, lane 1
-tadShift2 = Range(0, 6.633)
-tadAt2 = tadSpot(tadAnchor, 40.133 - tadShift2, 1, 'curb', 1.8)
+tadShift2 = Range(0, 4.146)
+tadAt2 = tadSpot(tadAnchor, 38.375 - tadShift2, 1, 'curb', 1.8)
 parked_cars_1 = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadParked()
-tadAt3 = tadSpot(tadAnchor, 45.633 - tadShift2, 1, 'curb', 1.8)
+tadAt3 = tadSpot(tadAnchor, 43.875 - tadShift2, 1, 'curb', 1.8)
 parked_cars_2 = new Car at tadAt3[0], facing tadAt3[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with behavior TadParked()
 
 # group `oncoming_suv`: 1 suv, move_forward, 40 km/h, front of ego, lane -1
-tadShift3 = Range(0, 5.244)
-tadAt4 = tadSpot(tadAnchor, 23.006 - tadShift3, -1)
+tadShift3 = Range(0, 3.278)
+tadAt4 = tadSpot(tadAnchor, 21.039 - tadShift3, -1)
 oncoming_suv = new Car at tadAt4[0], facing tadAt4[1],
     with blueprint 'vehicle.nissan.patrol', with width 1.95, with length 4.8,
     with regionContainedIn None, with speed 11.111, with behavior TadDrive(11.111)

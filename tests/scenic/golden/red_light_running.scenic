@@ -577,7 +577,7 @@ behavior TadYield(speed):
 tadRoad = dict(same=3, other=3, minSame=2, minOther=0, index=2, sidewalk=False,
                junction='4way', signalised=True, maneuver=None, signs=(),
                shape=None, ahead=4.0, behind=4.0, approach=30.028, arms=('opposite', 'right'),
-               armReach={'opposite': (36.0, 10.0), 'right': (62.0, 0.0)})
+               armReach={'opposite': (35.0, 10.0), 'right': (62.0, 0.0)})
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
 # ego vehicle: move_forward, 50 km/h, lane 2
@@ -587,7 +587,7 @@ ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
 
 # group `red_light_runner`: 1 sedan, move_forward, 60 km/h, right_front of ego, lane 2
 tadJitter1 = Range(-5.0, 5.0)
-tadAt1 = tadArmSpot(tadAnchor, 'right', 52.3 + tadJitter1, 2)
+tadAt1 = tadArmSpot(tadAnchor, 'right', 52.4 + tadJitter1, 2)
 red_light_runner = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with speed 16.667, with behavior TadThrough(16.667, 'STRAIGHT')
@@ -599,12 +599,12 @@ box_truck = new Car at tadAt2[0], facing tadAt2[1],
     with regionContainedIn None, with speed 11.111, with behavior TadDrive(11.111)
 
 # group `oncoming_cars`: 2 car, move_forward, 45 km/h, front of ego, lane -2
-tadShift3 = Range(0, 2.9)
-tadAt3 = tadArmSpot(tadAnchor, 'opposite', 12.4 - tadShift3, 2)
+tadShift3 = Range(0, 1.813)
+tadAt3 = tadArmSpot(tadAnchor, 'opposite', 11.313 - tadShift3, 2)
 oncoming_cars_1 = new Car at tadAt3[0], facing tadAt3[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with speed 12.5, with behavior TadThrough(12.5, 'STRAIGHT')
-tadAt4 = tadArmSpot(tadAnchor, 'opposite', 31.4 - tadShift3, 2)
+tadAt4 = tadArmSpot(tadAnchor, 'opposite', 30.313 - tadShift3, 2)
 oncoming_cars_2 = new Car at tadAt4[0], facing tadAt4[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with speed 12.5, with behavior TadThrough(12.5, 'STRAIGHT')

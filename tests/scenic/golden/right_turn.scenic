@@ -590,7 +590,7 @@ behavior TadTriggered(distance, hold, then):
 tadRoad = dict(same=2, other=2, minSame=2, minOther=0, index=2, sidewalk=True,
                junction='4way', signalised=True, maneuver='RIGHT_TURN', signs=(),
                shape=None, ahead=4.0, behind=4.0, approach=8.917, arms=('opposite', 'right'),
-               armReach={'opposite': (15.0, 34.0), 'right': (3.0, 0.0)})
+               armReach={'opposite': (14.0, 34.0), 'right': (3.0, 0.0)})
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
 # ego vehicle: turn_right, 12 km/h, lane 2
@@ -599,8 +599,8 @@ ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 3.333, with behavior TadTurn(3.333, 'RIGHT_TURN')
 
 # group `left_turning_taxi`: 1 taxi, turn_left, 30 km/h, front of ego, lane -1
-tadShift1 = Range(0, 2.067)
-tadAt1 = tadArmSpot(tadAnchor, 'opposite', 9.633 - tadShift1, 1)
+tadShift1 = Range(0, 1.292)
+tadAt1 = tadArmSpot(tadAnchor, 'opposite', 8.858 - tadShift1, 1)
 left_turning_taxi = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.ford.crown', with width 1.85, with length 4.8,
     with regionContainedIn None, with speed 8.333, with behavior TadThrough(8.333, 'LEFT_TURN')

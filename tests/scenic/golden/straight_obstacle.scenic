@@ -10,7 +10,7 @@
 #   van and walks into its path, stopping in the middle of the lane. Two cars approach in
 #   the opposite direction, so swerving left is not an option.
 # Left out or approximated (the build's warnings say where):
-#   W0701 Town10HD has no place with a straight stretch of 73 m
+#   W0701 Town10HD has no place with a straight stretch of 76 m
 #   W0700 `speed_limit_sign` (road signs) has no Scenic mapping
 #   W0700 traffic density `light` has no Scenic mapping
 #   W0700 `shops`, `trees` and `parked_cars` (road roadside) have no Scenic mapping
@@ -586,12 +586,12 @@ behavior TadTriggered(distance, hold, then):
 # ---- end of the prelude ----
 
 # The road around the ego vehicle: 2 lanes in the ego's direction, 2 lanes in the other direction, a sidewalk beside the ego's lane.
-# Left out, as Town10HD has no place with them and the rest: a straight stretch of 73 m.
+# Left out, as Town10HD has no place with them and the rest: a straight stretch of 76 m.
 # The ego is placed where the lane layout holds from `behind` metres behind it to `ahead` metres
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=2, other=2, minSame=2, minOther=1, index=1, sidewalk=True,
                junction=None, signalised=None, maneuver=None, signs=(),
-               shape=None, ahead=75.0, behind=4.0, approach=None, arms=(),
+               shape=None, ahead=72.0, behind=4.0, approach=None, arms=(),
                armReach=None)
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
@@ -601,29 +601,29 @@ ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 12.5, with behavior TadFollow(12.5)
 
 # group `parked_sedans`: 5 sedan, parked, 0 km/h, right_front of ego, lane 2
-tadAt1 = tadSpot(tadAnchor, 6.05, 2, 'curb', 1.85)
+tadAt1 = tadSpot(tadAnchor, 5.9, 2, 'curb', 1.85)
 parked_sedans_1 = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt2 = tadSpot(tadAnchor, 11.85, 2, 'curb', 1.85)
+tadAt2 = tadSpot(tadAnchor, 11.7, 2, 'curb', 1.85)
 parked_sedans_2 = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt3 = tadSpot(tadAnchor, 17.65, 2, 'curb', 1.85)
+tadAt3 = tadSpot(tadAnchor, 17.5, 2, 'curb', 1.85)
 parked_sedans_3 = new Car at tadAt3[0], facing tadAt3[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt4 = tadSpot(tadAnchor, 23.45, 2, 'curb', 1.85)
+tadAt4 = tadSpot(tadAnchor, 23.3, 2, 'curb', 1.85)
 parked_sedans_4 = new Car at tadAt4[0], facing tadAt4[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
-tadAt5 = tadSpot(tadAnchor, 29.25, 2, 'curb', 1.85)
+tadAt5 = tadSpot(tadAnchor, 29.1, 2, 'curb', 1.85)
 parked_sedans_5 = new Car at tadAt5[0], facing tadAt5[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with behavior TadParked()
 
 # group `delivery_van`: 1 van, parked, 0 km/h, right_front of ego, lane 2
-tadAt6 = tadSpot(tadAnchor, 34.75, 2, 'curb', 2.0)
+tadAt6 = tadSpot(tadAnchor, 34.6, 2, 'curb', 2.0)
 delivery_van = new Car at tadAt6[0], facing tadAt6[1],
     with blueprint 'vehicle.mercedes.sprinter', with width 2.0, with length 5.2,
     with regionContainedIn None, with behavior TadParked()
@@ -637,8 +637,8 @@ darting_pedestrian = new Pedestrian at tadAt7[0], facing tadAt7[1],
     with regionContainedIn None, with behavior TadDelayed(tadDelay3, TadStand(), TadWalk(1.667))
 
 # group `oncoming_cars`: 2 car, move_forward, 40 km/h, front of ego, lane -1
-tadShift4 = Range(0, 5.8)
-tadAt8 = tadSpot(tadAnchor, 24.8 - tadShift4, -1)
+tadShift4 = Range(0, 3.625)
+tadAt8 = tadSpot(tadAnchor, 22.625 - tadShift4, -1)
 oncoming_cars_1 = new Car at tadAt8[0], facing tadAt8[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with speed 11.111, with behavior TadDrive(11.111)

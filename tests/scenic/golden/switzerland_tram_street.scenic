@@ -587,12 +587,12 @@ behavior TadTriggered(distance, hold, then):
     do then
 # ---- end of the prelude ----
 
-# The road around the ego vehicle: 1 lane in the ego's direction, 1 lane in the other direction, a sidewalk beside the ego's lane, a straight stretch of 83 m.
+# The road around the ego vehicle: 1 lane in the ego's direction, 1 lane in the other direction, a sidewalk beside the ego's lane, a straight stretch of 84 m.
 # The ego is placed where the lane layout holds from `behind` metres behind it to `ahead` metres
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=1, other=1, minSame=1, minOther=1, index=1, sidewalk=True,
                junction=None, signalised=None, maneuver=None, signs=(),
-               shape='straight', ahead=98.0, behind=4.0, approach=None, arms=(),
+               shape='straight', ahead=95.0, behind=4.0, approach=None, arms=(),
                armReach=None)
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
@@ -618,26 +618,26 @@ crossing_pedestrians_3 = new Pedestrian at tadAt3[0], facing tadAt3[1],
     with regionContainedIn None, with behavior TadDelayed(tadDelay1, TadStand(), TadWalk(1.389))
 
 # group `cyclist`: 1 bicycle, move_forward, 18 km/h, right_front of ego, lane 1
-tadShift2 = Range(0, 3.578)
+tadShift2 = Range(0, 2.236)
 tadAt4 = tadSpot(tadAnchor, 26.3 - tadShift2, 1, 'shoulder', 0.6)
 cyclist = new Car at tadAt4[0], facing tadAt4[1],
     with blueprint 'vehicle.diamondback.century', with width 0.6, with length 1.8,
     with regionContainedIn None, with speed 5.0, with behavior TadDrive(5.0)
 
 # group `oncoming_tram`: 1 tram, move_forward, 30 km/h, front of ego, lane -1
-tadShift3 = Range(0, 4.133)
+tadShift3 = Range(0, 2.583)
 tadAt5 = tadSpot(tadAnchor, 43.733 - tadShift3, -1)
 oncoming_tram = new Car at tadAt5[0], facing tadAt5[1],
     with blueprint 'vehicle.mitsubishi.fusorosa', with width 2.4, with length 30.0,
     with regionContainedIn None, with speed 8.333, with behavior TadDrive(8.333)
 
 # group `cars_behind_tram`: 2 car, move_forward, 30 km/h, behind of oncoming_tram, lane -1
-tadShift4 = Range(0, 4.133)
-tadAt6 = tadSpot(tadAnchor, 75.45 - tadShift4, -1)
+tadShift4 = Range(0, 2.583)
+tadAt6 = tadSpot(tadAnchor, 73.9 - tadShift4, -1)
 cars_behind_tram_1 = new Car at tadAt6[0], facing tadAt6[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with speed 8.333, with behavior TadDrive(8.333)
-tadAt7 = tadSpot(tadAnchor, 90.283 - tadShift4, -1)
+tadAt7 = tadSpot(tadAnchor, 88.733 - tadShift4, -1)
 cars_behind_tram_2 = new Car at tadAt7[0], facing tadAt7[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with speed 8.333, with behavior TadDrive(8.333)

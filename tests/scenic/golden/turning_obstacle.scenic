@@ -604,8 +604,8 @@ ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 4.167, with behavior TadTurn(4.167, 'LEFT_TURN')
 
 # group `crossing_cyclist`: 1 bicycle, cross, 14 km/h, left_front of ego, lane 1
-tadDelay1 = 7.597
-tadAt1 = tadCrossAt(tadAnchor, 25.35, False, 0.0)
+tadDelay1 = 7.544
+tadAt1 = tadCrossAt(tadAnchor, 25.144, False, 0.0)
 crossing_cyclist = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.diamondback.century', with width 0.6, with length 1.8,
     with regionContainedIn None, with behavior TadDelayed(tadDelay1, TadStop(), TadRide(3.889))
@@ -621,8 +621,7 @@ taxis_2 = new Car at tadAt3[0], facing tadAt3[1],
     with regionContainedIn None, with speed 6.944, with behavior TadDrive(6.944)
 
 # group `bus_at_stop`: 1 bus, stopped, 0 km/h, right_front of ego, lane 3
-tadShift3 = Range(0, 0.6)
-tadAt4 = tadSpot(tadAnchor, 10.35 - tadShift3, 3)
+tadAt4 = tadSpot(tadAnchor, 10.125, 3)
 bus_at_stop = new Car at tadAt4[0], facing tadAt4[1],
     with blueprint 'vehicle.mitsubishi.fusorosa', with width 2.55, with length 12.0,
     with regionContainedIn None, with behavior TadStop()

@@ -573,7 +573,7 @@ behavior TadYield(speed):
 tadRoad = dict(same=1, other=1, minSame=1, minOther=0, index=1, sidewalk=True,
                junction='4way', signalised=True, maneuver='LEFT_TURN', signs=(),
                shape=None, ahead=4.0, behind=4.0, approach=8.25, arms=('opposite',),
-               armReach={'opposite': (94.0, 0.0)})
+               armReach={'opposite': (93.0, 0.0)})
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
 # ego vehicle: turn_left, 10 km/h, lane 1
@@ -582,15 +582,15 @@ ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 2.778, with behavior TadTurn(2.778, 'LEFT_TURN')
 
 # group `turning_van`: 1 van, turn_left, 10 km/h, front of ego, lane -1
-tadShift1 = Range(0, 0.956)
-tadAt1 = tadArmSpot(tadAnchor, 'opposite', 5.944 - tadShift1, 1)
+tadShift1 = Range(0, 0.597)
+tadAt1 = tadArmSpot(tadAnchor, 'opposite', 5.586 - tadShift1, 1)
 turning_van = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.mercedes.sprinter', with width 2.0, with length 5.2,
     with regionContainedIn None, with speed 2.778, with behavior TadThrough(2.778, 'LEFT_TURN')
 
 # group `oncoming_car`: 1 car, move_forward, 50 km/h, behind of turning_van, lane -1
 tadJitter2 = Range(-5.0, 5.0)
-tadAt2 = tadArmSpot(tadAnchor, 'opposite', 84.267 + tadJitter2, 1)
+tadAt2 = tadArmSpot(tadAnchor, 'opposite', 83.577 + tadJitter2, 1)
 oncoming_car = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.toyota.prius', with width 1.8, with length 4.5,
     with regionContainedIn None, with speed 13.889, with behavior TadThrough(13.889, 'STRAIGHT')

@@ -569,12 +569,12 @@ behavior TadYield(speed):
         take SetThrottleAction(0), SetBrakeAction(1.0)
 # ---- end of the prelude ----
 
-# The road around the ego vehicle: 1 lane in the ego's direction, 1 lane in the other direction, a sidewalk beside the ego's lane, a straight stretch of 66 m.
+# The road around the ego vehicle: 1 lane in the ego's direction, 1 lane in the other direction, a sidewalk beside the ego's lane, a straight stretch of 69 m.
 # The ego is placed where the lane layout holds from `behind` metres behind it to `ahead` metres
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=1, other=1, minSame=1, minOther=1, index=1, sidewalk=True,
                junction=None, signalised=None, maneuver=None, signs=(),
-               shape='straight', ahead=67.0, behind=4.0, approach=None, arms=(),
+               shape='straight', ahead=65.0, behind=4.0, approach=None, arms=(),
                armReach=None)
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
@@ -584,15 +584,15 @@ ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 8.333, with behavior TadOvertake(8.333)
 
 # group `delivery_truck`: 1 truck, parked, 0 km/h, front of ego, lane 1
-tadShift1 = Range(0, 5.8)
-tadAt1 = tadSpot(tadAnchor, 26.3 - tadShift1, 1, 'curb', 2.5)
+tadShift1 = Range(0, 3.625)
+tadAt1 = tadSpot(tadAnchor, 24.125 - tadShift1, 1, 'curb', 2.5)
 delivery_truck = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.carlamotors.carlacola', with width 2.5, with length 7.5,
     with regionContainedIn None, with behavior TadParked()
 
 # group `oncoming_motorcycle`: 1 motorcycle, move_forward, 45 km/h, front of ego, lane -1
 tadJitter2 = Range(-5.0, 5.0)
-tadAt2 = tadSpot(tadAnchor, 59.709 + tadJitter2, -1)
+tadAt2 = tadSpot(tadAnchor, 54.272 + tadJitter2, -1)
 oncoming_motorcycle = new Car at tadAt2[0], facing tadAt2[1],
     with blueprint 'vehicle.yamaha.yzf', with width 0.8, with length 2.1,
     with regionContainedIn None, with speed 12.5, with behavior TadDrive(12.5)

@@ -571,7 +571,7 @@ behavior TadYield(speed):
         take SetThrottleAction(0), SetBrakeAction(1.0)
 # ---- end of the prelude ----
 
-# The road around the ego vehicle: 1 lane in the ego's direction, 1 lane in the other direction, a straight stretch of 21 m.
+# The road around the ego vehicle: 1 lane in the ego's direction, 1 lane in the other direction, a straight stretch of 22 m.
 # The ego is placed where the lane layout holds from `behind` metres behind it to `ahead` metres
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=1, other=1, minSame=1, minOther=1, index=1, sidewalk=False,
@@ -586,37 +586,35 @@ ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with behavior TadStop()
 
 # group `rv_ahead`: 1 rv, stopped, 0 km/h, front of ego, lane 1
-tadShift1 = Range(0, 0.6)
-tadAt1 = tadSpot(tadAnchor, 8.85 - tadShift1, 1)
+tadAt1 = tadSpot(tadAnchor, 8.625, 1)
 rv_ahead = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.volkswagen.t2', with width 2.5, with length 9.0,
     with regionContainedIn None, with behavior TadStop()
 
 # group `bison_herd`: 5 bison, cross, 3 km/h, front of rv_ahead, lane 1
-tadAt2 = tadCrossAt(tadAnchor, 15.25, True, 0.0)
+tadAt2 = tadCrossAt(tadAnchor, 14.875, True, 0.0)
 bison_herd_1 = new Pedestrian at tadAt2[0], facing tadAt2[1],
     with blueprint 'walker.pedestrian.0001', with width 1.0, with length 3.2,
     with regionContainedIn None, with behavior TadWalk(0.833)
-tadAt3 = tadCrossAt(tadAnchor, 16.55, True, 0.0)
+tadAt3 = tadCrossAt(tadAnchor, 16.175, True, 0.0)
 bison_herd_2 = new Pedestrian at tadAt3[0], facing tadAt3[1],
     with blueprint 'walker.pedestrian.0001', with width 1.0, with length 3.2,
     with regionContainedIn None, with behavior TadWalk(0.833)
-tadAt4 = tadCrossAt(tadAnchor, 17.85, True, 0.0)
+tadAt4 = tadCrossAt(tadAnchor, 17.475, True, 0.0)
 bison_herd_3 = new Pedestrian at tadAt4[0], facing tadAt4[1],
     with blueprint 'walker.pedestrian.0001', with width 1.0, with length 3.2,
     with regionContainedIn None, with behavior TadWalk(0.833)
-tadAt5 = tadCrossAt(tadAnchor, 19.15, True, 0.0)
+tadAt5 = tadCrossAt(tadAnchor, 18.775, True, 0.0)
 bison_herd_4 = new Pedestrian at tadAt5[0], facing tadAt5[1],
     with blueprint 'walker.pedestrian.0001', with width 1.0, with length 3.2,
     with regionContainedIn None, with behavior TadWalk(0.833)
-tadAt6 = tadCrossAt(tadAnchor, 15.25, True, 3.5)
+tadAt6 = tadCrossAt(tadAnchor, 14.875, True, 3.5)
 bison_herd_5 = new Pedestrian at tadAt6[0], facing tadAt6[1],
     with blueprint 'walker.pedestrian.0001', with width 1.0, with length 3.2,
     with regionContainedIn None, with behavior TadWalk(0.833)
 
 # group `oncoming_tractor`: 1 tractor, stopped, 0 km/h, front of ego, lane -1
-tadShift3 = Range(0, 0.6)
-tadAt7 = tadSpot(tadAnchor, 6.6 - tadShift3, -1)
+tadAt7 = tadSpot(tadAnchor, 6.375, -1)
 oncoming_tractor = new Car at tadAt7[0], facing tadAt7[1],
     with blueprint 'vehicle.carlamotors.european_hgv', with width 2.4, with length 4.5,
     with regionContainedIn None, with behavior TadStop()

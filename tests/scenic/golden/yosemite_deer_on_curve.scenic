@@ -586,12 +586,12 @@ behavior TadTriggered(distance, hold, then):
     do then
 # ---- end of the prelude ----
 
-# The road around the ego vehicle: 1 lane in the ego's direction, 1 lane in the other direction, a curved stretch of 59 m.
+# The road around the ego vehicle: 1 lane in the ego's direction, 1 lane in the other direction, a curved stretch of 62 m.
 # The ego is placed where the lane layout holds from `behind` metres behind it to `ahead` metres
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=1, other=1, minSame=1, minOther=1, index=1, sidewalk=False,
                junction=None, signalised=None, maneuver=None, signs=(),
-               shape='curved', ahead=41.0, behind=41.0, approach=None, arms=(),
+               shape='curved', ahead=39.0, behind=37.0, approach=None, arms=(),
                armReach=None)
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
@@ -613,19 +613,19 @@ deer_2 = new Pedestrian at tadAt2[0], facing tadAt2[1],
     with regionContainedIn None, with behavior TadDelayed(tadDelay1, TadStand(), TadWalk(2.222))
 
 # group `oncoming_rv`: 1 rv, move_forward, 30 km/h, front of ego, lane -1
-tadShift2 = Range(0, 4.689)
+tadShift2 = Range(0, 2.931)
 tadAt3 = tadSpot(tadAnchor, 30.565 - tadShift2, -1)
 oncoming_rv = new Car at tadAt3[0], facing tadAt3[1],
     with blueprint 'vehicle.volkswagen.t2', with width 2.5, with length 9.0,
     with regionContainedIn None, with speed 8.333, with behavior TadDrive(8.333)
 
 # group `following_motorcycles`: 2 motorcycle, move_forward, 35 km/h, behind of ego, lane 1
-tadShift3 = Range(0, 4.689)
-tadAt4 = tadSpot(tadAnchor, -19.711 + tadShift3, 1)
+tadShift3 = Range(0, 2.931)
+tadAt4 = tadSpot(tadAnchor, -17.953 + tadShift3, 1)
 following_motorcycles_1 = new Car at tadAt4[0], facing tadAt4[1],
     with blueprint 'vehicle.yamaha.yzf', with width 0.8, with length 2.1,
     with regionContainedIn None, with speed 9.722, with behavior TadDrive(9.722)
-tadAt5 = tadSpot(tadAnchor, -33.533 + tadShift3, 1)
+tadAt5 = tadSpot(tadAnchor, -31.775 + tadShift3, 1)
 following_motorcycles_2 = new Car at tadAt5[0], facing tadAt5[1],
     with blueprint 'vehicle.yamaha.yzf', with width 0.8, with length 2.1,
     with regionContainedIn None, with speed 9.722, with behavior TadDrive(9.722)

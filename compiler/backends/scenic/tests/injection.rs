@@ -174,8 +174,9 @@ fn check_structure(name: &str, text: &str) {
         let numbered = |prefix: &str| {
             target.strip_prefix(prefix).is_some_and(|n| !n.is_empty() && n.chars().all(|c| c.is_ascii_digit()))
         };
-        if numbered("tadShift") || numbered("tadJitter") {
-            assert!(value.starts_with("Range("), "{name}: {line}");
+        if ["tadShift", "tadJitter", "tadSpeed", "tadPick", "tadDelay", "tadTrigger"].iter().any(|p| numbered(p)) {
+            let number = value.parse::<f64>().is_ok();
+            assert!(number || value.starts_with("Range(") || value.starts_with("DiscreteRange("), "{name}: {line}");
             continue;
         }
         assert!(is_identifier(target), "{name}: bad identifier `{target}`");

@@ -15,14 +15,14 @@ use crate::maps::Needs;
 /// of the first `kept[g]` actors of each group (all with `None`).
 pub fn windows(layout: &Layout, needs: &mut Needs, junction: bool, kept: Option<&[usize]>) {
     let (mut ahead, mut behind) = (layout.ego.length / 2.0, layout.ego.length / 2.0);
-    let agents = layout.groups.iter().enumerate().flat_map(|(i, g)| {
+    for (i, g) in layout.groups.iter().enumerate() {
         let n = kept.map_or(g.agents.len(), |k| k.get(i).copied().unwrap_or(0));
-        g.agents.iter().take(n)
-    });
-    for a in agents.filter(|a| a.station.arm == Arm::Ego) {
-        let half = if matches!(a.facing, tad_layout::Facing::Across { .. }) { a.width } else { a.length } / 2.0;
-        ahead = ahead.max(a.station.along + half);
-        behind = behind.max(-(a.station.along - half));
+        for a in g.agents.iter().take(n).filter(|a| a.station.arm == Arm::Ego) {
+            // what the program may sample: the group's shift, an adversary's spread
+            let half = a.length.max(a.width) / 2.0 + g.slack + layout.conflict_spread(a);
+            ahead = ahead.max(a.station.along + half);
+            behind = behind.max(half - a.station.along);
+        }
     }
     needs.ahead = (ahead + 1.0).ceil();
     needs.behind = (behind + 1.0).ceil();
@@ -78,8 +78,10 @@ pub fn fit(
             .filter(|a| a.station.arm == Arm::Ego)
             .map_or(0.0, |a| a.station.along.abs())
     };
-    while let Some(i) =
-        (0..kept.len()).filter(|&i| kept[i] > 1).max_by(|&a, &b| reach(a, &kept).total_cmp(&reach(b, &kept)))
+    // the actor reaching farthest along the ego's road goes first, even a group's last
+    while let Some(i) = (0..kept.len())
+        .filter(|&i| kept[i] > 0 && reach(i, &kept) > 0.0)
+        .max_by(|&a, &b| reach(a, &kept).total_cmp(&reach(b, &kept)))
     {
         kept[i] -= 1;
         if fits(&kept) {
