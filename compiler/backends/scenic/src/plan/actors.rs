@@ -49,6 +49,7 @@ pub fn build(
         length: ego.length,
         width: ego.width,
         lane: ego.lane,
+        moved: false,
         arm: Arm::Ego,
         offset: 0.0,
         place: Place::Centre,
@@ -124,6 +125,7 @@ pub fn build(
             };
             let lane =
                 if a.station.arm == Arm::Ego && a.lane == first.map_or(a.lane, |f| f.lane) { g.lane } else { a.lane };
+            let moved = a.station.arm == Arm::Ego && lane != a.lane;
             let cross = match a.facing {
                 Facing::Across { from } => Some((from == Side::Right, (a.lateral - row_start).abs())),
                 Facing::Along => None,
@@ -136,6 +138,7 @@ pub fn build(
                 length: g.length,
                 width: g.width,
                 lane,
+                moved,
                 arm,
                 offset,
                 place: place(a.place),
@@ -148,7 +151,30 @@ pub fn build(
         }
         out.push(Group { summary: g.summary.clone(), actors });
     }
+    moved_clear(&ego_actor, &mut out);
     Actors { ego: ego_actor, ego_summary: ego_summary(scenario, ego.lane), groups: out }
+}
+
+/// Actors the map choice moved into another lane (W0701) are placed ahead of everything
+/// already in it, one after the other, so a lane the map lacks never puts two in one place.
+fn moved_clear(ego: &Actor, groups: &mut [Group]) {
+    let mut fronts: std::collections::HashMap<i64, f64> = std::collections::HashMap::new();
+    fronts.insert(ego.lane, ego.length / 2.0);
+    for a in groups.iter().flat_map(|g| &g.actors).filter(|a| a.arm == Arm::Ego && a.cross.is_none() && !a.moved) {
+        let front = fronts.entry(a.lane).or_insert(f64::NEG_INFINITY);
+        *front = front.max(a.offset + a.length / 2.0);
+    }
+    for g in groups.iter_mut() {
+        for a in g.actors.iter_mut().filter(|a| a.moved) {
+            let front = fronts.entry(a.lane).or_insert(f64::NEG_INFINITY);
+            let at = front.max(a.offset - a.length / 2.0 - 2.0)
+                + 2.0
+                + a.length / 2.0
+                + a.params.shift.map_or(0.0, |(s, _)| s);
+            a.offset = at;
+            *front = at + a.length / 2.0;
+        }
+    }
 }
 
 /// `ego vehicle: BEHAVIOR, SPEED, lane N`, for a comment.

@@ -69,6 +69,8 @@ pub struct Actor {
     pub width: f64,
     /// TAD lane index on its arm.
     pub lane: i64,
+    /// Moved by the map choice into another lane than the layout's (W0701).
+    pub moved: bool,
     /// The junction arm it stands on (`Ego`: the ego's road).
     pub arm: tad_layout::Arm,
     /// On the ego's road: metres along the ego's lane from the ego's centre. On another
