@@ -158,6 +158,13 @@ pub fn build(
 /// Actors the map choice moved into another lane (W0701) are placed ahead of everything
 /// already in it, one after the other, so a lane the map lacks never puts two in one place.
 fn moved_clear(ego: &Actor, groups: &mut [Group]) {
+    // the ego moved too: whatever now shares its place moves on as well
+    for a in groups.iter_mut().flat_map(|g| &mut g.actors) {
+        let beside = (a.offset.abs() - a.length / 2.0) < ego.length / 2.0 + 1.0;
+        if a.arm == Arm::Ego && a.cross.is_none() && a.lane == ego.lane && beside {
+            a.moved = true;
+        }
+    }
     let mut fronts: std::collections::HashMap<i64, f64> = std::collections::HashMap::new();
     fronts.insert(ego.lane, ego.length / 2.0);
     for a in groups.iter().flat_map(|g| &g.actors).filter(|a| a.arm == Arm::Ego && a.cross.is_none() && !a.moved) {
