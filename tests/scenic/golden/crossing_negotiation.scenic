@@ -576,7 +576,7 @@ behavior TadYield(speed):
 tadRoad = dict(same=1, other=1, minSame=1, minOther=1, index=1, sidewalk=False,
                junction='4way', signalised=False, maneuver=None, signs=(),
                shape=None, ahead=10.0, behind=4.0, approach=9.625, arms=('left',),
-               armReach={'left': (28.0, 0.0)})
+               armLanes={'left': (1, 0)}, armReach={'left': (28.0, 0.0)})
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
 # ego vehicle: move_forward, 10 km/h, lane 1

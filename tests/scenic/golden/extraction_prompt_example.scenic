@@ -579,7 +579,7 @@ behavior TadYield(speed):
 tadRoad = dict(same=3, other=3, minSame=3, minOther=3, index=2, sidewalk=False,
                junction=None, signalised=True, maneuver=None, signs=(),
                shape=None, ahead=62.0, behind=4.0, approach=61.5, arms=('opposite',),
-               armReach={'opposite': (18.0, 0.0)})
+               armLanes={'opposite': (1, 0)}, armReach={'opposite': (18.0, 0.0)})
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
 # ego vehicle: move_forward, 38 km/h, lane 2

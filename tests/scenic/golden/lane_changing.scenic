@@ -575,7 +575,7 @@ behavior TadYield(speed):
 tadRoad = dict(same=4, other=4, minSame=3, minOther=0, index=3, sidewalk=False,
                junction=None, signalised=None, maneuver=None, signs=(),
                shape='straight', ahead=50.0, behind=29.0, approach=None, arms=(),
-               armReach=None)
+               armLanes=None, armReach=None)
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
 # ego vehicle: change_lane_left, 97 km/h, lane 3

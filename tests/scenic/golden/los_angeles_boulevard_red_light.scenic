@@ -578,7 +578,7 @@ behavior TadYield(speed):
 tadRoad = dict(same=3, other=3, minSame=3, minOther=0, index=2, sidewalk=False,
                junction='4way', signalised=True, maneuver=None, signs=(),
                shape=None, ahead=39.0, behind=6.0, approach=32.5, arms=(),
-               armReach=None)
+               armLanes=None, armReach=None)
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
 # ego vehicle: stopped, 0 km/h, lane 2

@@ -580,7 +580,7 @@ behavior TadYield(speed):
 tadRoad = dict(same=5, other=0, minSame=5, minOther=0, index=3, sidewalk=False,
                junction=None, signalised=True, maneuver=None, signs=(),
                shape=None, ahead=49.0, behind=4.0, approach=42.4, arms=(),
-               armReach=None)
+               armLanes=None, armReach=None)
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
 # ego vehicle: stopped, 0 km/h, lane 3

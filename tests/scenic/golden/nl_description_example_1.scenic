@@ -578,7 +578,7 @@ behavior TadYield(speed):
 tadRoad = dict(same=2, other=0, minSame=2, minOther=0, index=2, sidewalk=False,
                junction=None, signalised=True, maneuver=None, signs=(),
                shape=None, ahead=49.0, behind=4.0, approach=45.883, arms=(),
-               armReach=None)
+               armLanes=None, armReach=None)
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
 # ego vehicle: move_forward, 30 km/h, lane 2

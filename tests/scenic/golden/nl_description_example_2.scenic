@@ -595,7 +595,7 @@ behavior TadTriggered(distance, hold, then):
 tadRoad = dict(same=4, other=0, minSame=4, minOther=0, index=3, sidewalk=False,
                junction=None, signalised=None, maneuver=None, signs=(),
                shape='straight', ahead=122.0, behind=4.0, approach=None, arms=(),
-               armReach=None)
+               armLanes=None, armReach=None)
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
 # ego vehicle: move_forward, 35 km/h, lane 3

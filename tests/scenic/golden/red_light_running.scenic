@@ -577,7 +577,7 @@ behavior TadYield(speed):
 tadRoad = dict(same=3, other=3, minSame=2, minOther=0, index=2, sidewalk=False,
                junction='4way', signalised=True, maneuver=None, signs=(),
                shape=None, ahead=4.0, behind=4.0, approach=30.028, arms=('opposite', 'right'),
-               armReach={'opposite': (35.0, 10.0), 'right': (62.0, 0.0)})
+               armLanes={'opposite': (1, 1), 'right': (1, 0)}, armReach={'opposite': (35.0, 10.0), 'right': (62.0, 0.0)})
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
 # ego vehicle: move_forward, 50 km/h, lane 2

@@ -590,7 +590,7 @@ behavior TadTriggered(distance, hold, then):
 tadRoad = dict(same=2, other=2, minSame=2, minOther=0, index=2, sidewalk=True,
                junction='4way', signalised=True, maneuver='RIGHT_TURN', signs=(),
                shape=None, ahead=4.0, behind=4.0, approach=8.917, arms=('opposite', 'right'),
-               armReach={'opposite': (14.0, 34.0), 'right': (3.0, 0.0)})
+               armLanes={'opposite': (1, 1), 'right': (1, 0)}, armReach={'opposite': (14.0, 34.0), 'right': (3.0, 0.0)})
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
 # ego vehicle: turn_right, 12 km/h, lane 2

@@ -592,7 +592,7 @@ behavior TadTriggered(distance, hold, then):
 tadRoad = dict(same=2, other=2, minSame=2, minOther=1, index=1, sidewalk=True,
                junction=None, signalised=None, maneuver=None, signs=(),
                shape=None, ahead=72.0, behind=4.0, approach=None, arms=(),
-               armReach=None)
+               armLanes=None, armReach=None)
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
 # ego vehicle: move_forward, 45 km/h, lane 1

@@ -593,7 +593,7 @@ behavior TadTriggered(distance, hold, then):
 tadRoad = dict(same=1, other=1, minSame=1, minOther=1, index=1, sidewalk=True,
                junction=None, signalised=None, maneuver=None, signs=(),
                shape='straight', ahead=95.0, behind=4.0, approach=None, arms=(),
-               armReach=None)
+               armLanes=None, armReach=None)
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
 # ego vehicle: move_forward, 25 km/h, lane 1

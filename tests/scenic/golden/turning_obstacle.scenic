@@ -595,7 +595,7 @@ behavior TadTriggered(distance, hold, then):
 tadRoad = dict(same=3, other=0, minSame=3, minOther=0, index=1, sidewalk=False,
                junction=None, signalised=None, maneuver=None, signs=(),
                shape=None, ahead=28.0, behind=4.0, approach=None, arms=(),
-               armReach=None)
+               armLanes=None, armReach=None)
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
 # ego vehicle: turn_left, 15 km/h, lane 1

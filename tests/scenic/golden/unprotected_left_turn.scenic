@@ -573,7 +573,7 @@ behavior TadYield(speed):
 tadRoad = dict(same=1, other=1, minSame=1, minOther=0, index=1, sidewalk=True,
                junction='4way', signalised=True, maneuver='LEFT_TURN', signs=(),
                shape=None, ahead=4.0, behind=4.0, approach=8.25, arms=('opposite',),
-               armReach={'opposite': (93.0, 0.0)})
+               armLanes={'opposite': (1, 0)}, armReach={'opposite': (93.0, 0.0)})
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
 # ego vehicle: turn_left, 10 km/h, lane 1

@@ -577,7 +577,7 @@ behavior TadYield(speed):
 tadRoad = dict(same=1, other=1, minSame=1, minOther=1, index=1, sidewalk=False,
                junction=None, signalised=None, maneuver=None, signs=(),
                shape='straight', ahead=22.0, behind=4.0, approach=None, arms=(),
-               armReach=None)
+               armLanes=None, armReach=None)
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
 # ego vehicle: stopped, 0 km/h, lane 1

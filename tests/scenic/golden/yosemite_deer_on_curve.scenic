@@ -592,7 +592,7 @@ behavior TadTriggered(distance, hold, then):
 tadRoad = dict(same=1, other=1, minSame=1, minOther=1, index=1, sidewalk=False,
                junction=None, signalised=None, maneuver=None, signs=(),
                shape='curved', ahead=39.0, behind=37.0, approach=None, arms=(),
-               armReach=None)
+               armLanes=None, armReach=None)
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
 # ego vehicle: move_forward, 35 km/h, lane 1

@@ -175,6 +175,19 @@ pub fn program(scenario: &Scenario, plan: &Plan, diagnostics: &[Diagnostic], opt
             .collect();
         format!("{{{}}}", entries.join(", "))
     };
+    // an arm with actors in its incoming (outgoing) lanes has at least one such lane
+    let arm_lanes = if needs.arm_reach.is_empty() {
+        "None".to_string()
+    } else {
+        let entries: Vec<String> = needs
+            .arm_reach
+            .iter()
+            .map(|(arm, before, after)| {
+                format!("{}: ({}, {})", string(arm), u8::from(*before > 0.0), u8::from(*after > 0.0))
+            })
+            .collect();
+        format!("{{{}}}", entries.join(", "))
+    };
     let arms = match needs.arms.len() {
         0 => "()".to_string(),
         1 => format!("({},)", string(needs.arms[0])),
@@ -185,7 +198,7 @@ pub fn program(scenario: &Scenario, plan: &Plan, diagnostics: &[Diagnostic], opt
         "tadRoad = dict(same={}, other={}, minSame={}, minOther={}, index={}, sidewalk={},\n               \
          junction={kind}, signalised={signalised}, maneuver={maneuver}, signs={signs},\n               \
          shape={shape}, ahead={}, behind={}, approach={approach}, arms={arms},\n               \
-         armReach={arm_reach})",
+         armLanes={arm_lanes}, armReach={arm_reach})",
         opt_int(needs.same),
         opt_int(needs.other),
         needs.min_same,
