@@ -164,6 +164,20 @@ impl Path {
         }
     }
 
+    /// The path moved `left` metres to the left of its direction (negative: to the right),
+    /// point by point, each along the segment that starts at it.
+    pub fn offset(&self, left: f64) -> Path {
+        let n = self.points.len();
+        if n < 2 {
+            return self.clone();
+        }
+        Path::new((0..n).map(|k| {
+            let i = k.min(n - 2);
+            let along = self.points[i + 1] - self.points[i];
+            self.points[k] + along.left() * (left / along.length())
+        }))
+    }
+
     /// The arc length of the point of the path nearest `p`, and the distance to it.
     pub fn project(&self, p: Vec2) -> (f64, f64) {
         if self.points.len() < 2 {
@@ -316,6 +330,10 @@ mod tests {
         let (s, _) = path.first_within(&other, 1.0, 0.5).unwrap();
         assert!((s - 4.0).abs() < 1e-9);
         assert!(Path::new([Vec2::new(1.0, 1.0)]).pose(3.0).position == Vec2::new(1.0, 1.0));
+        // moved left of its direction: up on the first leg, left (−x) on the second
+        let left = path.offset(2.0);
+        assert_eq!(left.points()[0], Vec2::new(0.0, 2.0));
+        assert_eq!(left.points()[2], Vec2::new(8.0, 10.0));
     }
 
     #[test]

@@ -396,7 +396,7 @@ pub fn lay_out(scenario: &Scenario) -> Layout {
                     extent_of(&stations[j], half, rf.speed, r.map_or(1, |r| r.lane), d.arm)
                 }
                 _ if d.arm == Arm::Ego => ego_extent,
-                _ => Extent::stop_line(d.arm),
+                _ => Extent::stop_line(),
             };
             // a crossing ahead of a moving ego, on a road without a junction, is where the
             // walkers reach the ego's lane when the ego does
@@ -652,7 +652,7 @@ fn build(
             if written_timing || g.facts.is_static() || g.agents.is_empty() {
                 continue;
             }
-            if let Some((conflict, lateness)) = time_group(road, &ego, d, g, &stations[i]) {
+            if let Some((conflict, lateness)) = time_group(road, &ego, d, g) {
                 conflicts.push(conflict);
                 late = late.max(lateness);
             }
@@ -691,8 +691,7 @@ struct Extent {
 
 impl Extent {
     /// An arm's stop line: its incoming traffic's front is towards smaller stations.
-    fn stop_line(arm: Arm) -> Extent {
-        let _ = arm;
+    fn stop_line() -> Extent {
         Extent { lane: 0, stop_line: true, low: 0.0, high: 0.0, forward: 1.0, speed: 0.0 }
     }
 }
@@ -909,12 +908,7 @@ fn paths(road: &Road, a: &mut Agent, obstacles: &[(i64, f64, f64)]) {
                 a.path_start = start;
                 if a.place != Place::Lane {
                     let offset = a.lateral - road.lateral(a.lane);
-                    let shifted = a.path.points().iter().enumerate().map(|(k, p)| {
-                        let s = a.path.project(*p).0;
-                        let _ = k;
-                        *p + Vec2::from_yaw(a.path.pose(s).yaw).left() * offset * if a.lane < 0 { -1.0 } else { 1.0 }
-                    });
-                    a.path = Path::new(shifted.collect::<Vec<_>>());
+                    a.path = a.path.offset(if a.lane < 0 { -offset } else { offset });
                 }
             }
         }
@@ -982,13 +976,7 @@ fn blend(a: f64, b: f64, x1: f64, x2: f64, x: f64) -> f64 {
 
 /// Start a group where its first actor reaches its path's first meeting with the ego's
 /// path when the ego does; `None` when their paths do not meet ahead of both.
-fn time_group(
-    road: &Road,
-    ego: &Agent,
-    d: &Decision,
-    g: &mut GroupLayout,
-    stations: &[(Station, f64)],
-) -> Option<(Conflict, f64)> {
+fn time_group(road: &Road, ego: &Agent, d: &Decision, g: &mut GroupLayout) -> Option<(Conflict, f64)> {
     let first = g.agents.first()?;
     let reach = (ego.width + first.width) / 2.0 + 0.3;
     // the ego's path ahead of it
@@ -1004,7 +992,6 @@ fn time_group(
     let time = s_ego / ego.speed;
     let v = first.speed.max(0.1);
     let point = own_ahead.pose(s_own).position;
-    let _ = stations;
     if d.crosser {
         // walkers wait on the sidewalk, then cross in time
         let wait = time - s_own / v;

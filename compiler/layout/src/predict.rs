@@ -25,17 +25,6 @@ pub fn roll_out(layout: &Layout, steps: usize, dt: f64) -> Trace {
         .map(|a| TraceObject { group: a.group, index: a.index, length: a.length, width: a.width })
         .collect();
     let mut states: Vec<Vec<Pose>> = Vec::with_capacity(steps + 1);
-    let pose = |k: usize, s: &[f64]| {
-        let a = agents[k];
-        if a.is_static() && started[k] || a.path.length() == 0.0 {
-            a.pose
-        } else {
-            let along = a.path.pose(s[k]);
-            // walkers keep facing the way they started
-            if a.body == Body::Walker { Pose { yaw: a.pose.yaw, ..along } } else { along }
-        }
-    };
-    let _ = pose;
     let place = |k: usize, s: f64| -> Pose {
         let a = agents[k];
         if a.is_static() || a.path.length() == 0.0 || (s - a.path_start).abs() < 1e-9 {
@@ -67,7 +56,7 @@ pub fn roll_out(layout: &Layout, steps: usize, dt: f64) -> Trace {
             if k == 0 || a.body != Body::Vehicle {
                 v[k] = a.speed;
             } else {
-                let leader = leader(layout, &agents, &current, k, s[k], adversary[k]);
+                let leader = leader(&agents, &current, k, s[k], adversary[k]);
                 let (a_max, b, headway, jam) = IDM;
                 let free = 1.0 - (v[k] / a.speed.max(0.1)).powi(4);
                 let interaction = leader.map_or(0.0, |(gap, lead_speed)| {
@@ -85,16 +74,8 @@ pub fn roll_out(layout: &Layout, steps: usize, dt: f64) -> Trace {
 }
 
 /// The nearest actor ahead on `k`'s path within its corridor: (bumper gap, its speed along).
-fn leader(
-    layout: &Layout,
-    agents: &[&crate::Agent],
-    current: &[Pose],
-    k: usize,
-    s: f64,
-    adversary: bool,
-) -> Option<(f64, f64)> {
+fn leader(agents: &[&crate::Agent], current: &[Pose], k: usize, s: f64, adversary: bool) -> Option<(f64, f64)> {
     let me = agents[k];
-    let _ = layout;
     let mut best: Option<(f64, f64)> = None;
     let mut ahead = 1.0;
     while ahead <= LOOKAHEAD {

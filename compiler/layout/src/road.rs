@@ -193,12 +193,7 @@ impl Road {
 
     /// The pose of a lane's centre at a station; facing the lane's traffic.
     pub fn lane_pose(&self, station: Station, lane: i64) -> Pose {
-        self.pose_at(station, lane, self.lateral_on(station.arm, lane))
-    }
-
-    /// Offset from the arm's centre line (left of its incoming traffic positive) of a lane.
-    fn lateral_on(&self, _arm: Arm, lane: i64) -> f64 {
-        self.lateral(lane)
+        self.pose_at(station, lane, self.lateral(lane))
     }
 
     /// A point `lateral` metres left of the centre line (as the arm's incoming traffic sees
@@ -257,7 +252,7 @@ impl Road {
         let exit = self.pose_at(out_station, -exit_lane, self.lateral(-exit_lane));
         let u = Vec2::from_yaw(exit.yaw);
         if junction.roundabout {
-            points.extend(ring(self.centre(), junction.half * 0.75, entry.position, exit.position, turn));
+            points.extend(ring(self.centre(), junction.half * 0.75, entry.position, turn));
         } else if turn == Turn::UTurn {
             let mid = self.centre() + d * (junction.half * 0.5);
             points.extend(bezier(entry.position, d, mid, d.left()));
@@ -277,7 +272,7 @@ fn sample(a: f64, b: f64, f: impl Fn(f64) -> Vec2) -> Vec<Vec2> {
 }
 
 /// Round a roundabout's island counter-clockwise, from the entry towards the exit.
-fn ring(centre: Vec2, radius: f64, entry: Vec2, exit: Vec2, turn: Turn) -> Vec<Vec2> {
+fn ring(centre: Vec2, radius: f64, entry: Vec2, turn: Turn) -> Vec<Vec2> {
     let start = (entry - centre).yaw() + 0.35;
     let quarters = match turn {
         Turn::Right => 1.0,
@@ -286,7 +281,6 @@ fn ring(centre: Vec2, radius: f64, entry: Vec2, exit: Vec2, turn: Turn) -> Vec<V
         Turn::UTurn => 4.0,
     };
     let sweep = quarters * std::f64::consts::FRAC_PI_2 - 0.7;
-    let _ = exit;
     let n = (sweep * radius).ceil().max(4.0) as usize;
     (0..=n).map(|k| centre + Vec2::from_yaw(start + sweep * k as f64 / n as f64) * radius).collect()
 }

@@ -9,13 +9,9 @@ use super::kmh;
 use super::report::{Annotate, Report, named, unsupported};
 use crate::mapping::Class;
 
-/// The motion an actor of `class` gets when the scenario states no behavior.
+/// The motion an actor of `class` gets when the scenario states no behavior: the layout's.
 fn default_motion(class: Class) -> Motion {
-    match class {
-        Class::Car => Motion::Follow,
-        Class::Pedestrian => Motion::Stand,
-        Class::Debris => Motion::Parked,
-    }
+    class.body().default_motion()
 }
 
 /// The first behavior of the vocabulary with `motion`: the one chosen for it.
