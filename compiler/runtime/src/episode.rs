@@ -1,0 +1,646 @@
+//! One episode: the ego driven by a policy through a scene, every other actor run by its
+//! script, scored each step as SafeBench records it.
+//!
+//! Each step: scripts advance (conditions read the previous step's state, then actions apply
+//! in program order, as esmini does, so the order never depends on iteration); the ego's
+//! policy sees the previous state and acts; every actor moves (vehicles on the kinematic
+//! bicycle with pure pursuit and IDM, walkers along their track); rapier reports the ego's new
+//! contacts; the criteria read the new state; the record is stored; the stop rules run.
+
+use crate::detect::{Detectors, footprint};
+use crate::models::{self, Kinematics, MAX_BRAKE, MAX_WHEEL, WHEELBASE, idm, pursue};
+use crate::physics::{Physics, Shape};
+use crate::scene::Scene;
+use crate::track::Track;
+use crate::world::Spot;
+use tad_bytecode::{Instr, Light, Value};
+use tad_layout::geom::{Footprint, Pose, Vec2, wrap};
+use tad_layout::road::Station;
+use tad_layout::{Arm, Body, Facing, Turn};
+use tad_metrics::StepRecord;
+use tad_policy::{Action, EgoPolicy, EgoView};
+
+/// Why an episode ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum StopReason {
+    Collision,
+    RouteComplete,
+    OffRoad,
+    MaxDistance,
+    Timeout,
+    MaxSteps,
+}
+
+impl StopReason {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            StopReason::Collision => "collision",
+            StopReason::RouteComplete => "route_complete",
+            StopReason::OffRoad => "off_road",
+            StopReason::MaxDistance => "max_distance",
+            StopReason::Timeout => "timeout",
+            StopReason::MaxSteps => "max_steps",
+        }
+    }
+}
+
+/// How an episode runs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Options {
+    /// SafeBench's quirks: off-road never ends an episode.
+    pub compat: bool,
+    /// Keep every actor's pose at every step (for traces and pictures).
+    pub keep_frames: bool,
+    /// Off-road this long (s) ends the episode (unless `compat`).
+    pub off_road_limit: f64,
+}
+
+impl Default for Options {
+    fn default() -> Options {
+        Options { compat: false, keep_frames: false, off_road_limit: 0.5 }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EventKind {
+    Collision,
+    RedLight,
+    StopSign,
+    LaneInvasion,
+    OffRoad,
+}
+
+impl EventKind {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            EventKind::Collision => "collision",
+            EventKind::RedLight => "red_light",
+            EventKind::StopSign => "stop_sign",
+            EventKind::LaneInvasion => "lane_invasion",
+            EventKind::OffRoad => "off_road",
+        }
+    }
+}
+
+/// Something the criteria noticed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Event {
+    pub step: u32,
+    pub kind: EventKind,
+    pub position: Vec2,
+    /// The actor the ego hit (index into the scene's actors).
+    pub other: Option<usize>,
+}
+
+/// Every actor's pose at a step (the ego first; `None` before it exists) and the lights.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Frame {
+    pub poses: Vec<(f64, f64, f64)>,
+    pub speeds: Vec<f64>,
+    pub lights: Vec<(Arm, Light)>,
+}
+
+#[derive(Clone, Debug)]
+pub struct Episode {
+    pub seed: Option<u64>,
+    pub params: Vec<f64>,
+    pub steps: u32,
+    pub stop_reason: StopReason,
+    pub records: Vec<StepRecord>,
+    pub events: Vec<Event>,
+    /// Step 0 (the start) then one per step, when asked for.
+    pub frames: Vec<Frame>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Motion {
+    Stand,
+    Drive,
+    Walk { keep_yaw: bool },
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Block {
+    None,
+    Until(f64),
+    Near(f64),
+}
+
+struct Actor {
+    body: Body,
+    length: f64,
+    width: f64,
+    wheelbase: f64,
+    kin: Kinematics,
+    target: f64,
+    motion: Motion,
+    track: Option<Track>,
+    s: f64,
+    /// Arc of its stop line on its track and the arm whose light it obeys.
+    stop_line: Option<(f64, Arm)>,
+    stopped_at_sign: bool,
+    stopping: bool,
+    obey: bool,
+    mobil: bool,
+    next_mobil: f64,
+    arm: Arm,
+    lane: i64,
+    along: f64,
+    lateral: f64,
+    turn: Turn,
+    pc: usize,
+    block: Block,
+}
+
+/// Run one episode of `scene` with parameters `params` (see [`crate::sample`]).
+pub fn run(scene: &Scene, seed: Option<u64>, params: Vec<f64>, policy: &mut dyn EgoPolicy, opts: &Options) -> Episode {
+    let world = &scene.world;
+    let dt = scene.limits.dt;
+    let route = &scene.ego.route;
+    let ego_size = scene.ego.size;
+    let desired = scene.ego.speed.eval(&params).max(0.0);
+    let start = scene.ego_pose();
+    let mut ego = Kinematics { position: start.position, yaw: start.yaw, speed: desired };
+    let mut ego_s = scene.ego.start;
+    let ego_stop = world.stop_line(Arm::Ego, scene.ego.lane).map(|p| route.locate(p, ego_s, 400.0)).and_then(
+        |(s, d)| (d.abs() < world.road.lane_width).then_some(s),
+    );
+    let mut detectors = Detectors::new(route, scene.ego.start, scene.ego.route_length, ego_stop);
+    let mut actors: Vec<Actor> = scene.actors.iter().map(|a| spawn(scene, a, &params)).collect();
+    let mut shapes = vec![Shape { length: ego_size.length, width: ego_size.width, height: ego_size.height }];
+    shapes.extend(scene.actors.iter().map(|a| Shape { length: a.size.length, width: a.size.width, height: a.size.height }));
+    let mut physics = Physics::new(&shapes);
+    let mut poses: Vec<(f64, f64, f64)> = Vec::with_capacity(shapes.len());
+    let mut hits = Vec::new();
+    policy.reset();
+
+    let mut records = Vec::with_capacity(scene.limits.max_steps as usize);
+    let mut events = Vec::new();
+    let mut frames = Vec::new();
+    let frame = |ego: &Kinematics, actors: &[Actor], t: f64| Frame {
+        poses: std::iter::once((ego.position.x, ego.position.y, ego.yaw))
+            .chain(actors.iter().map(|a| (a.kin.position.x, a.kin.position.y, a.kin.yaw)))
+            .collect(),
+        speeds: std::iter::once(ego.speed).chain(actors.iter().map(|a| a.kin.speed)).collect(),
+        lights: world.lights(t),
+    };
+    if opts.keep_frames {
+        frames.push(frame(&ego, &actors, 0.0));
+    }
+    // physics sees the start, so a spawn already touching the ego counts at step 1
+    poses.clear();
+    poses.push((ego.position.x, ego.position.y, ego.yaw));
+    poses.extend(actors.iter().map(|a| (a.kin.position.x, a.kin.position.y, a.kin.yaw)));
+    physics.step(&poses, &mut hits);
+    let mut pending_hits: Vec<usize> = hits.clone();
+
+    let mut driven = 0.0;
+    let mut collided = false;
+    let mut off_road_for = 0.0;
+    let mut velocity = Vec2::from_yaw(ego.yaw) * ego.speed;
+    let mut stop_reason = StopReason::MaxSteps;
+    let mut step = 0u32;
+    while step < scene.limits.max_steps {
+        step += 1;
+        let t = f64::from(step) * dt;
+        let before: Vec<(Vec2, f64, f64)> =
+            actors.iter().map(|a| (a.kin.position, a.kin.yaw, a.kin.speed)).collect();
+
+        // scripts, on the previous state
+        for k in 0..actors.len() {
+            run_script(scene, &scene.actors[k].script, &mut actors[k], &params, t, ego.position);
+        }
+
+        // the ego's policy
+        let (s_now, off_route) = route.locate(ego.position, ego_s, 10.0);
+        ego_s = s_now;
+        let view = ego_view(scene, &ego, ego_s, off_route, desired, &actors, &before, t, ego_stop, &detectors);
+        let action: Action = policy.act(&view);
+        let accel = if action.accel.is_finite() { action.accel.clamp(-MAX_BRAKE, 3.0) } else { 0.0 };
+        let steer = if action.steer.is_finite() { action.steer.clamp(-1.0, 1.0) } else { 0.0 };
+        let old = ego.position;
+        ego.bicycle(WHEELBASE * ego_size.length, -steer * MAX_WHEEL, accel, dt);
+        driven += old.distance(ego.position);
+
+        // everyone else
+        for k in 0..actors.len() {
+            move_actor(scene, &mut actors, k, &before, &ego, t, dt);
+        }
+
+        // contacts
+        poses.clear();
+        poses.push((ego.position.x, ego.position.y, ego.yaw));
+        poses.extend(actors.iter().map(|a| (a.kin.position.x, a.kin.position.y, a.kin.yaw)));
+        physics.step(&poses, &mut hits);
+        hits.append(&mut pending_hits);
+        if let Some(&other) = hits.first().filter(|_| !collided) {
+            collided = true;
+            events.push(Event { step, kind: EventKind::Collision, position: ego.position, other: Some(other - 1) });
+        }
+
+        // criteria
+        let (s_now, off_route) = route.locate(ego.position, ego_s, 10.0);
+        ego_s = s_now;
+        let fp = footprint(ego.pose(), ego_size.length, ego_size.width);
+        let reading = detectors.read(world, route, fp, ego_s, off_route, ego.speed, t);
+        for (happened, kind) in [
+            (reading.lane_invasion, EventKind::LaneInvasion),
+            (reading.red_light, EventKind::RedLight),
+            (reading.stop_sign, EventKind::StopSign),
+            (reading.off_road && off_road_for == 0.0, EventKind::OffRoad),
+        ] {
+            if happened {
+                events.push(Event { step, kind, position: ego.position, other: None });
+            }
+        }
+        off_road_for = if reading.off_road { off_road_for + dt } else { 0.0 };
+        let new_velocity = Vec2::from_yaw(ego.yaw) * ego.speed;
+        let acceleration = (new_velocity - velocity) * (1.0 / dt);
+        velocity = new_velocity;
+        records.push(StepRecord {
+            time: t,
+            velocity: ego.speed,
+            acceleration: [acceleration.x, acceleration.y, 0.0],
+            position: [ego.position.x, ego.position.y, 0.0],
+            // CARLA's yaw turns clockwise, in degrees within [-180, 180]
+            yaw_deg: (-ego.yaw).to_degrees().clamp(-180.0, 180.0),
+            driven_distance: driven,
+            lane_invasion: detectors.lane_invasions,
+            off_road: reading.off_road,
+            collision: collided,
+            run_red_light: detectors.red_lights,
+            run_stop: detectors.stop_signs,
+            distance_to_route: reading.distance_to_route,
+            route_complete: reading.route_complete,
+        });
+        if opts.keep_frames {
+            frames.push(frame(&ego, &actors, t));
+        }
+
+        let stop = if collided {
+            Some(StopReason::Collision)
+        } else if reading.route_complete >= 100.0 {
+            Some(StopReason::RouteComplete)
+        } else if !opts.compat && off_road_for >= opts.off_road_limit - 1e-9 {
+            Some(StopReason::OffRoad)
+        } else if driven >= scene.limits.max_distance {
+            Some(StopReason::MaxDistance)
+        } else if t >= scene.limits.timeout - 1e-9 {
+            Some(StopReason::Timeout)
+        } else {
+            None
+        };
+        if let Some(reason) = stop {
+            stop_reason = reason;
+            break;
+        }
+    }
+    Episode { seed, params, steps: step, stop_reason, records, events, frames }
+}
+
+fn spawn(scene: &Scene, a: &crate::scene::ActorSetup, params: &[f64]) -> Actor {
+    let along = a.along.eval(params);
+    let mut pose = scene.world.pose_at(a.arm, along, a.lane, a.lateral);
+    pose.yaw = a.yaw;
+    Actor {
+        body: a.body,
+        length: a.size.length,
+        width: a.size.width,
+        wheelbase: WHEELBASE * a.size.length,
+        kin: Kinematics { position: pose.position, yaw: pose.yaw, speed: a.speed.max(0.0) },
+        target: a.speed.max(0.0),
+        motion: Motion::Stand,
+        track: None,
+        s: 0.0,
+        stop_line: None,
+        stopped_at_sign: false,
+        stopping: false,
+        obey: true,
+        mobil: false,
+        next_mobil: 1.0,
+        arm: a.arm,
+        lane: a.lane,
+        along,
+        lateral: a.lateral,
+        turn: Turn::Straight,
+        pc: 0,
+        block: Block::None,
+    }
+}
+
+/// A vehicle's lane path from its spawn station, kept as far off the lane's centre as it
+/// stands.
+fn lane_track(scene: &Scene, a: &Actor, lane: i64) -> Track {
+    let road = &scene.world.road;
+    let (path, _) = road.vehicle_path(Station { arm: a.arm, along: a.along }, lane, a.turn);
+    let offset = a.lateral - road.lateral(a.lane);
+    let path = if offset.abs() > 1e-6 && lane == a.lane { path.offset(if lane < 0 { -offset } else { offset }) } else { path };
+    Track::new(&path)
+}
+
+fn set_track(scene: &Scene, a: &mut Actor, track: Track) {
+    let (s, _) = track.project(a.kin.position);
+    a.s = s;
+    a.stop_line = if a.lane > 0 {
+        scene.world.stop_line(a.arm, a.lane).and_then(|p| {
+            let (s, d) = track.project(p);
+            (d.abs() < scene.world.road.lane_width / 2.0 && s > a.s - a.length).then_some((s, a.arm))
+        })
+    } else {
+        None
+    };
+    a.track = Some(track);
+}
+
+/// Advance an actor's script until it blocks or ends.
+fn run_script(scene: &Scene, script: &[Instr], a: &mut Actor, params: &[f64], t: f64, ego: Vec2) {
+    let v = |value: &Value| value.eval(params);
+    while let Some(instr) = script.get(a.pc) {
+        match (instr, a.block) {
+            (Instr::Wait { seconds, .. }, Block::None) => {
+                a.block = Block::Until(t + v(seconds).max(0.0));
+                continue;
+            }
+            (Instr::WaitNear { distance, .. }, Block::None) => {
+                a.block = Block::Near(v(distance).max(0.0));
+                continue;
+            }
+            (Instr::Wait { .. }, Block::Until(until)) => {
+                if t + 1e-9 < until {
+                    return;
+                }
+            }
+            (Instr::WaitNear { .. }, Block::Near(d)) => {
+                if ego.distance(a.kin.position) > d {
+                    return;
+                }
+            }
+            (Instr::Drive { speed, turn, .. }, _) => {
+                a.turn = *turn;
+                a.target = v(speed).max(0.0);
+                a.motion = Motion::Drive;
+                a.stopping = false;
+                let track = lane_track(scene, a, a.lane);
+                set_track(scene, a, track);
+            }
+            (Instr::Follow { path, speed, .. }, _) => {
+                a.target = v(speed).max(0.0);
+                a.stopping = false;
+                a.motion = if a.body == Body::Vehicle { Motion::Drive } else { Motion::Walk { keep_yaw: false } };
+                let track = scene.paths.get(usize::from(*path)).cloned().unwrap_or_default();
+                set_track(scene, a, track);
+            }
+            (Instr::Cross { speed, .. }, _) => {
+                a.target = v(speed).max(0.0);
+                a.motion = Motion::Walk { keep_yaw: true };
+                let road = &scene.world.road;
+                let width = f64::from(road.lanes + road.opposite.max(road.cross_lanes)) * road.lane_width + 12.0;
+                let heading = Vec2::from_yaw(a.kin.yaw);
+                a.track = Some(Track::from_points([a.kin.position, a.kin.position + heading * width]));
+                a.s = 0.0;
+            }
+            (Instr::ChangeLane { lanes, .. }, _) => change_lane(scene, a, *lanes),
+            (Instr::Speed { speed, .. }, _) => {
+                a.target = v(speed).max(0.0);
+                a.stopping = false;
+            }
+            (Instr::Stop { .. }, _) => a.stopping = true,
+            (Instr::Signals { obey, .. }, _) => a.obey = *obey,
+            (Instr::Mobil { on, .. }, _) => a.mobil = *on,
+            _ => {}
+        }
+        a.block = Block::None;
+        a.pc += 1;
+    }
+}
+
+/// Move a vehicle `lanes` lanes to its right (negative: left) when the arm has them.
+fn change_lane(scene: &Scene, a: &mut Actor, lanes: i64) {
+    let Some(lane) = neighbour(scene, a, lanes) else { return };
+    let track = lane_track(scene, a, lane);
+    a.lane = lane;
+    a.lateral = scene.world.road.lateral(lane);
+    set_track(scene, a, track);
+}
+
+/// The lane `lanes` to an actor's right, if its arm has it (same direction).
+fn neighbour(scene: &Scene, a: &Actor, lanes: i64) -> Option<i64> {
+    let (incoming, outgoing) = scene.world.road.arm_lanes(a.arm);
+    let lane = if a.lane > 0 { a.lane + lanes } else { a.lane - lanes };
+    let ok = if a.lane > 0 { (1..=i64::from(incoming)).contains(&lane) } else { (1..=i64::from(outgoing)).contains(&-lane) };
+    (ok && lane != a.lane).then_some(lane)
+}
+
+fn move_actor(scene: &Scene, actors: &mut [Actor], k: usize, before: &[(Vec2, f64, f64)], ego: &Kinematics, t: f64, dt: f64) {
+    match actors[k].motion {
+        Motion::Stand => {
+            let a = &mut actors[k];
+            a.kin.speed = 0.0;
+        }
+        Motion::Walk { keep_yaw } => {
+            let a = &mut actors[k];
+            let Some(track) = &a.track else { return };
+            let speed = if a.stopping || a.s >= track.length() { 0.0 } else { a.target };
+            a.s = (a.s + speed * dt).min(track.length());
+            let pose = track.pose(a.s);
+            a.kin = Kinematics { position: pose.position, yaw: if keep_yaw { a.kin.yaw } else { pose.yaw }, speed };
+        }
+        Motion::Drive => {
+            if actors[k].mobil && t >= actors[k].next_mobil {
+                actors[k].next_mobil = t + 1.0;
+                mobil(scene, actors, k, before, ego);
+            }
+            let leader = leader_of(scene, actors, k, before, ego, t);
+            let a = &mut actors[k];
+            let Some(track) = &a.track else { return };
+            let (s, _) = track.locate(a.kin.position, a.s, 8.0);
+            a.s = s;
+            let wheel = pursue(track, s, a.kin.pose(), a.kin.speed, a.wheelbase);
+            let accel = if a.stopping { -(a.kin.speed / dt).min(4.0) } else { idm(a.kin.speed, a.target, leader) };
+            a.kin.bicycle(a.wheelbase, wheel, accel, dt);
+            // a stop sign is passed once it has stood at it
+            if let Some((line, _)) = a.stop_line
+                && a.kin.speed < 0.1
+                && line - (a.s + a.length / 2.0) < IDM_STOP_REACH
+            {
+                a.stopped_at_sign = true;
+            }
+        }
+    }
+}
+
+/// How near its stop line a vehicle standing still counts as having stopped at it, m.
+const IDM_STOP_REACH: f64 = 6.0;
+/// How far ahead vehicles look for a leader, m.
+const LOOK: f64 = 60.0;
+
+/// The nearest thing ahead of actor `k` on its track: (bumper gap, its speed along), the
+/// ego included unless `k` runs lights (an adversary), and its stop line when it must stop.
+fn leader_of(scene: &Scene, actors: &[Actor], k: usize, before: &[(Vec2, f64, f64)], ego: &Kinematics, t: f64) -> Option<(f64, f64)> {
+    let me = &actors[k];
+    let track = me.track.as_ref()?;
+    let others = before.iter().enumerate().filter(|(j, _)| *j != k).map(|(j, &(p, yaw, v))| {
+        let a = &actors[j];
+        (p, yaw, v, a.length, a.width)
+    });
+    let ego_entry = me.obey.then_some((ego.position, ego.yaw, ego.speed, scene.ego.size.length, scene.ego.size.width));
+    let mut best = ahead_on(track, me.kin.position, me.kin.yaw, me.s, me.length, me.width, others.chain(ego_entry));
+    if me.obey
+        && let Some((line, arm)) = me.stop_line
+    {
+        let gap = line - (me.s + me.length / 2.0);
+        if gap > -0.5 && must_stop(scene, arm, gap, me.kin.speed, t, me.stopped_at_sign) && best.is_none_or(|(g, _)| gap < g) {
+            best = Some((gap.max(0.0), 0.0));
+        }
+    }
+    best
+}
+
+/// Whether a vehicle `gap` metres before its stop line must stop there: its light is red,
+/// or yellow and it can still stop comfortably, or a stop sign it has not stood at.
+fn must_stop(scene: &Scene, arm: Arm, gap: f64, speed: f64, t: f64, stopped_at_sign: bool) -> bool {
+    match scene.world.light(arm, t) {
+        Light::Red => true,
+        Light::Yellow => gap > speed * speed / (2.0 * models::IDM_B),
+        Light::Green => false,
+        Light::Off => scene.world.stop_signs() && !stopped_at_sign,
+    }
+}
+
+/// The nearest of `others` ahead on `track` within a vehicle's corridor.
+fn ahead_on(
+    track: &Track,
+    position: Vec2,
+    yaw: f64,
+    s: f64,
+    length: f64,
+    width: f64,
+    others: impl Iterator<Item = (Vec2, f64, f64, f64, f64)>,
+) -> Option<(f64, f64)> {
+    let heading = Vec2::from_yaw(yaw);
+    let mut best: Option<(f64, f64)> = None;
+    for (p, other_yaw, v, l, w) in others {
+        let d = p - position;
+        let ahead = d.dot(heading);
+        if ahead <= 0.0 || d.length() > LOOK {
+            continue;
+        }
+        let (sj, lat) = track.locate(p, s + ahead, 8.0);
+        if sj <= s {
+            continue;
+        }
+        let rel = wrap(other_yaw - track.pose(sj).yaw);
+        let (c, sn) = (rel.cos().abs(), rel.sin().abs());
+        if lat.abs() > width / 2.0 + sn * l / 2.0 + c * w / 2.0 + 0.3 {
+            continue;
+        }
+        let gap = sj - s - length / 2.0 - (c * l / 2.0 + sn * w / 2.0);
+        let speed = (v * rel.cos()).max(0.0);
+        if best.is_none_or(|(g, _)| gap < g) {
+            best = Some((gap, speed));
+        }
+    }
+    best
+}
+
+/// MOBIL (Kesting, Treiber and Helbing 2007) with politeness 0: change to a neighbouring lane
+/// when it gains more than 0.2 m/s² and its new follower need not brake harder than 4 m/s².
+fn mobil(scene: &Scene, actors: &mut [Actor], k: usize, before: &[(Vec2, f64, f64)], ego: &Kinematics) {
+    const GAIN: f64 = 0.2;
+    const SAFE: f64 = 4.0;
+    let now = {
+        let me = &actors[k];
+        let Some(track) = &me.track else { return };
+        let others = before.iter().enumerate().filter(|(j, _)| *j != k).map(|(j, &(p, y, v))| (p, y, v, actors[j].length, actors[j].width));
+        let ego_entry = std::iter::once((ego.position, ego.yaw, ego.speed, scene.ego.size.length, scene.ego.size.width));
+        idm(me.kin.speed, me.target, ahead_on(track, me.kin.position, me.kin.yaw, me.s, me.length, me.width, others.chain(ego_entry)))
+    };
+    let mut choice: Option<(i64, f64)> = None;
+    for dir in [-1, 1] {
+        let me = &actors[k];
+        let Some(lane) = neighbour(scene, me, dir) else { continue };
+        let track = lane_track(scene, me, lane);
+        let (s, _) = track.project(me.kin.position);
+        let entries: Vec<(Vec2, f64, f64, f64, f64)> = before
+            .iter()
+            .enumerate()
+            .filter(|(j, _)| *j != k)
+            .map(|(j, &(p, y, v))| (p, y, v, actors[j].length, actors[j].width))
+            .chain(std::iter::once((ego.position, ego.yaw, ego.speed, scene.ego.size.length, scene.ego.size.width)))
+            .collect();
+        let then = idm(me.kin.speed, me.target, ahead_on(&track, me.kin.position, me.kin.yaw, s, me.length, me.width, entries.iter().copied()));
+        // the new follower: the nearest behind in the target lane, with this vehicle ahead of it
+        let back = me.kin.yaw + std::f64::consts::PI;
+        let behind = ahead_on(&track, me.kin.position, back, s, me.length, me.width, entries.iter().map(|&(p, y, v, l, w)| (p, y + std::f64::consts::PI, v, l, w)));
+        let safe = behind.is_none_or(|(gap, speed_back)| idm(speed_back, speed_back.max(me.target), Some((gap, me.kin.speed))) >= -SAFE && gap > 1.0);
+        if safe && then - now > GAIN && choice.is_none_or(|(_, g)| then - now > g) {
+            choice = Some((dir, then - now));
+        }
+    }
+    if let Some((dir, _)) = choice {
+        change_lane(scene, &mut actors[k], dir);
+    }
+}
+
+/// What the ego's driver sees: SafeBench's observation and the full state.
+#[allow(clippy::too_many_arguments)]
+fn ego_view(
+    scene: &Scene,
+    ego: &Kinematics,
+    s: f64,
+    off_route: f64,
+    desired: f64,
+    actors: &[Actor],
+    before: &[(Vec2, f64, f64)],
+    t: f64,
+    stop_line: Option<f64>,
+    detectors: &Detectors,
+) -> EgoView {
+    let route = &scene.ego.route;
+    let size = scene.ego.size;
+    let heading = Vec2::from_yaw(ego.yaw);
+    // the route planner's waypoint two ahead, at 5 m spacing
+    let wp = route.pose(s + 10.0);
+    let w = Vec2::from_yaw(wp.yaw);
+    let lateral_dis = -w.cross(ego.position - wp.position);
+    let minus_delta_yaw = w.cross(heading).clamp(-1.0, 1.0).asin();
+    let ego_lane = scene.world.spot(ego.position);
+    let front = before.iter().zip(actors).any(|(&(p, yaw, _), a)| {
+        a.body == Body::Vehicle
+            && p.distance(ego.position) <= 15.0
+            && (p - ego.position).dot(heading) > 0.0
+            && Vec2::from_yaw(yaw).dot(heading) > 0.0
+            && matches!(ego_lane, Spot::Lane(..))
+            && scene.world.spot(p) == ego_lane
+    });
+    let lookahead = models::lookahead(ego.speed);
+    let target = Pose { position: ego.position, yaw: ego.yaw }.local(route.pose(s + lookahead).position);
+    let others = before.iter().zip(actors).map(|(&(p, yaw, v), a)| (p, yaw, v, a.length, a.width));
+    let leader = ahead_on(route, ego.position, ego.yaw, s, size.length, size.width, others);
+    let stop = stop_line.and_then(|line| {
+        let gap = line - (s + size.length / 2.0);
+        (gap > -0.5 && must_stop(scene, Arm::Ego, gap, ego.speed, t, detectors.stopped_at_sign())).then_some(gap.max(0.0))
+    });
+    let _ = off_route;
+    EgoView {
+        obs: [lateral_dis, minus_delta_yaw, ego.speed, if front { 1.0 } else { 0.0 }],
+        speed: ego.speed,
+        desired_speed: desired,
+        target: [target.x, target.y],
+        lookahead,
+        wheelbase: WHEELBASE * size.length,
+        leader,
+        stop,
+        dt: scene.limits.dt,
+    }
+}
+
+/// Where the ego stands at the start, and its footprint, for tests.
+pub fn ego_footprint(scene: &Scene) -> Footprint {
+    footprint(scene.ego_pose(), scene.ego.size.length, scene.ego.size.width)
+}
+
+#[allow(dead_code)]
+fn _facing(f: Facing) -> bool {
+    matches!(f, Facing::Along)
+}

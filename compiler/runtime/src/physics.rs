@@ -1,0 +1,120 @@
+//! Collision detection with rapier3d: every actor is a kinematic body carrying a box the size
+//! the vocabulary gives it; rapier's collision pipeline (broad phase, narrow phase, no
+//! dynamics; the boxes are sensors, so only intersections are computed) reports when the
+//! ego's box starts touching another. The runtime moves the
+//! bodies itself, so nothing is integrated here.
+
+use rapier3d::prelude::*;
+use std::sync::mpsc::{Receiver, channel};
+
+pub struct Physics {
+    pipeline: CollisionPipeline,
+    islands: IslandManager,
+    broad_phase: BroadPhaseBvh,
+    narrow_phase: NarrowPhase,
+    bodies: RigidBodySet,
+    colliders: ColliderSet,
+    handles: Vec<RigidBodyHandle>,
+    events: ChannelEventCollector,
+    received: Receiver<CollisionEvent>,
+    _forces: Receiver<ContactForceEvent>,
+    _tears: Receiver<SoftBodyTearEvent>,
+}
+
+/// An actor's box: length, width, height (m).
+#[derive(Clone, Copy, Debug)]
+pub struct Shape {
+    pub length: f64,
+    pub width: f64,
+    pub height: f64,
+}
+
+impl Physics {
+    /// One body per actor, in order; actor 0 is the ego, the only one whose contacts are
+    /// reported.
+    pub fn new(shapes: &[Shape]) -> Physics {
+        let (send, received) = channel();
+        let (force_send, forces) = channel();
+        let (tear_send, tears) = channel();
+        let mut bodies = RigidBodySet::new();
+        let mut colliders = ColliderSet::new();
+        let mut handles = Vec::with_capacity(shapes.len());
+        for (k, s) in shapes.iter().enumerate() {
+            let body = bodies.insert(RigidBodyBuilder::kinematic_position_based().user_data(k as u128));
+            let half = |x: f64| (x.max(0.1) / 2.0) as f32;
+            let collider = ColliderBuilder::cuboid(half(s.length), half(s.width), half(s.height))
+                .translation(Vector::new(0.0, 0.0, half(s.height)))
+                .sensor(true)
+                .active_collision_types(ActiveCollisionTypes::all())
+                .active_events(if k == 0 { ActiveEvents::COLLISION_EVENTS } else { ActiveEvents::empty() })
+                .user_data(k as u128);
+            colliders.insert_with_parent(collider, body, &mut bodies);
+            handles.push(body);
+        }
+        Physics {
+            pipeline: CollisionPipeline::new(),
+            islands: IslandManager::new(),
+            broad_phase: BroadPhaseBvh::new(),
+            narrow_phase: NarrowPhase::new(),
+            bodies,
+            colliders,
+            handles,
+            events: ChannelEventCollector::new(send, force_send, tear_send),
+            received,
+            _forces: forces,
+            _tears: tears,
+        }
+    }
+
+    /// Move every actor to its pose `(x, y, yaw)` and return the actors the ego started
+    /// touching.
+    pub fn step(&mut self, poses: &[(f64, f64, f64)], hits: &mut Vec<usize>) {
+        hits.clear();
+        for (&handle, &(x, y, yaw)) in self.handles.iter().zip(poses) {
+            if let Some(body) = self.bodies.get_mut(handle) {
+                let pose = Pose::new(Vector::new(x as f32, y as f32, 0.0), Vector::new(0.0, 0.0, yaw as f32));
+                body.set_position(pose, true);
+            }
+        }
+        self.pipeline.step(
+            0.02,
+            &mut self.islands,
+            &mut self.broad_phase,
+            &mut self.narrow_phase,
+            &mut self.bodies,
+            &mut self.colliders,
+            &(),
+            &self.events,
+        );
+        while let Ok(event) = self.received.try_recv() {
+            if let CollisionEvent::Started(a, b, _) = event {
+                let index = |h: ColliderHandle| self.colliders.get(h).map(|c| c.user_data as usize);
+                match (index(a), index(b)) {
+                    (Some(0), Some(k)) | (Some(k), Some(0)) if k != 0 => hits.push(k),
+                    _ => {}
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_ego_touching_a_box_is_reported_once() {
+        let car = Shape { length: 4.5, width: 1.8, height: 1.5 };
+        let mut physics = Physics::new(&[car, car, Shape { length: 0.5, width: 0.5, height: 1.0 }]);
+        let mut hits = Vec::new();
+        physics.step(&[(0.0, 0.0, 0.0), (10.0, 0.0, 0.0), (0.0, 5.0, 0.0)], &mut hits);
+        assert!(hits.is_empty());
+        physics.step(&[(6.0, 0.0, 0.0), (10.0, 0.0, 0.0), (0.0, 5.0, 0.0)], &mut hits);
+        assert_eq!(hits, vec![1]);
+        physics.step(&[(6.2, 0.0, 0.0), (10.0, 0.0, 0.0), (0.0, 5.0, 0.0)], &mut hits);
+        assert!(hits.is_empty(), "still touching: no new start");
+        // rotated: a car across the ego's path, its box turned 90°
+        physics.step(&[(0.0, 3.0, std::f64::consts::FRAC_PI_2), (10.0, 0.0, 0.0), (0.0, 5.0, 0.0)], &mut hits);
+        assert_eq!(hits, vec![2]);
+    }
+}

@@ -1,0 +1,121 @@
+//! Episodes on hand-built programs: each detector on a scenario built for it.
+
+use tad_bytecode::{Instr, Polyline, Program, Size, Value};
+use tad_layout::road::{LANE_WIDTH, RUN};
+use tad_layout::{Arm, Body, Facing, Place, Road, Shape, Turn};
+use tad_policy::{Action, EgoPolicy, EgoView};
+use tad_runtime::{Options, Scene, StopReason, run};
+
+const CAR: Size = Size { length: 4.5, width: 1.8, height: 1.5 };
+
+fn straight() -> Road {
+    Road {
+        shape: Shape::Straight,
+        lanes: 2,
+        opposite: 1,
+        cross_lanes: 0,
+        lane_width: LANE_WIDTH,
+        sidewalks: true,
+        crosswalks: false,
+        signal: None,
+        junction: None,
+        approach: 0.0,
+    }
+}
+
+fn program(road: Road, speed: f64, extra: Vec<Instr>) -> Program {
+    let (path, start) = road.vehicle_path(tad_layout::Station { arm: Arm::Ego, along: 0.0 }, 1, Turn::Straight);
+    let mut code = vec![
+        Instr::Road(road),
+        Instr::Limits { dt: 0.1, max_steps: 300, max_distance: 200.0, timeout: 60.0 },
+        Instr::Ego {
+            class: "car".into(),
+            size: CAR,
+            lane: 1,
+            turn: Turn::Straight,
+            path: 0,
+            start,
+            route_length: 100.0,
+            speed: Value::lit(speed),
+        },
+    ];
+    code.extend(extra);
+    Program {
+        name: "hand".into(),
+        source: "hand.tad".into(),
+        params: vec![],
+        paths: vec![Polyline(path.points().iter().map(|p| [p.x, p.y]).collect())],
+        code,
+    }
+}
+
+fn parked(actor: u16, along: f64, lane: i64) -> Instr {
+    Instr::Spawn {
+        actor,
+        group: "parked".into(),
+        index: 0,
+        body: Body::Vehicle,
+        class: "sedan".into(),
+        size: CAR,
+        arm: Arm::Ego,
+        lane,
+        place: Place::Lane,
+        along: Value::lit(along),
+        lateral: -(lane as f64 - 0.5) * LANE_WIDTH,
+        facing: Facing::Along,
+        yaw: 0.0,
+        speed: 0.0,
+    }
+}
+
+/// Keeps its speed and its route, brakes for nothing.
+struct Blind;
+impl EgoPolicy for Blind {
+    fn name(&self) -> &str {
+        "blind"
+    }
+    fn act(&mut self, v: &EgoView) -> Action {
+        let k = 2.0 * v.target[1] / (v.target[0].powi(2) + v.target[1].powi(2));
+        Action { accel: 0.0, steer: -(v.wheelbase * k).atan() / 1.2217 }
+    }
+}
+
+/// Brakes hard for anything within 15 m.
+struct Careful;
+impl EgoPolicy for Careful {
+    fn name(&self) -> &str {
+        "careful"
+    }
+    fn act(&mut self, v: &EgoView) -> Action {
+        let mut a = Blind.act(v);
+        let gap = v.leader.map(|l| l.0).into_iter().chain(v.stop).fold(f64::INFINITY, f64::min);
+        a.accel = if gap < 20.0 { -8.0 } else { 0.0 };
+        a
+    }
+}
+
+#[test]
+fn a_blind_ego_rear_ends_a_parked_car_and_a_careful_one_stops() {
+    let scene = Scene::new(&program(straight(), 10.0, vec![parked(0, 40.0, 1)])).unwrap();
+    let e = run(&scene, None, vec![], &mut Blind, &Options::default());
+    assert_eq!(e.stop_reason, StopReason::Collision);
+    let hit = e.events.iter().find(|e| e.kind == tad_runtime::EventKind::Collision).unwrap();
+    // the ego's front reaches the car's rear at 40 - 4.5 = 35.5 m: about 3.5 s
+    assert!((34..=37).contains(&hit.step), "hit at step {}", hit.step);
+    assert!(e.records.last().unwrap().collision);
+    let e = run(&scene, None, vec![], &mut Careful, &Options::default());
+    assert_ne!(e.stop_reason, StopReason::Collision);
+    assert!(e.records.iter().all(|r| !r.collision));
+}
+
+#[test]
+fn the_route_completes_on_a_free_road() {
+    let scene = Scene::new(&program(straight(), 10.0, vec![])).unwrap();
+    let e = run(&scene, None, vec![], &mut Blind, &Options::default());
+    assert_eq!(e.stop_reason, StopReason::RouteComplete);
+    let last = e.records.last().unwrap();
+    assert_eq!(last.route_complete, 100.0);
+    assert!((last.driven_distance - 99.5).abs() < 1.0, "{}", last.driven_distance);
+    assert!(e.records.iter().all(|r| r.lane_invasion == 0 && !r.off_road && r.distance_to_route < 0.05));
+    let _ = RUN;
+}
