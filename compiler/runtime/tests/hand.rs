@@ -119,3 +119,56 @@ fn the_route_completes_on_a_free_road() {
     assert!(e.records.iter().all(|r| r.lane_invasion == 0 && !r.off_road && r.distance_to_route < 0.05));
     let _ = RUN;
 }
+
+fn with_route(mut p: Program, points: Vec<[f64; 2]>) -> Program {
+    p.paths[0] = Polyline(points);
+    for i in &mut p.code {
+        if let Instr::Ego { start, .. } = i {
+            *start = 0.0;
+        }
+    }
+    p
+}
+
+#[test]
+fn crossing_a_lane_marking_is_a_lane_invasion() {
+    // from lane 1 (y = -1.75) to lane 2 (y = -5.25) between x = 20 and 40
+    let route = vec![[0.0, -1.75], [20.0, -1.75], [40.0, -5.25], [150.0, -5.25]];
+    let scene = Scene::new(&with_route(program(straight(), 10.0, vec![]), route)).unwrap();
+    let e = run(&scene, None, vec![], &mut Blind, &Options::default());
+    let last = e.records.last().unwrap();
+    // each corner crosses the marking at its own step: one event per step with a crossing
+    assert!(last.lane_invasion >= 1 && last.lane_invasion <= 4, "{} invasions", last.lane_invasion);
+    assert!(e.records.iter().all(|r| !r.off_road));
+}
+
+#[test]
+fn leaving_the_road_ends_the_episode_unless_compat() {
+    // straight off the right edge (lanes end at y = -7)
+    let route = vec![[0.0, -1.75], [20.0, -1.75], [40.0, -14.0], [150.0, -14.0]];
+    let scene = Scene::new(&with_route(program(straight(), 10.0, vec![]), route)).unwrap();
+    let e = run(&scene, None, vec![], &mut Blind, &Options::default());
+    assert_eq!(e.stop_reason, StopReason::OffRoad);
+    assert!(e.records.last().unwrap().off_road);
+    let e = run(&scene, None, vec![], &mut Blind, &Options { compat: true, ..Options::default() });
+    assert_ne!(e.stop_reason, StopReason::OffRoad);
+    let off = e.records.iter().filter(|r| r.off_road).count();
+    assert!(off > 50, "off road for {off} steps");
+}
+
+#[test]
+fn the_same_seed_gives_the_same_episode() {
+    let mut p = program(straight(), 10.0, vec![parked(0, 40.0, 2)]);
+    p.params.push(tad_bytecode::ParamSlot { name: "parked.shift".into(), min: -10.0, max: 10.0, default: 0.0 });
+    if let Some(Instr::Spawn { along, .. }) = p.code.last_mut() {
+        along.slot = Some(0);
+    }
+    let scene = Scene::new(&p).unwrap();
+    let opts = Options { keep_frames: true, ..Options::default() };
+    let one = run(&scene, Some(3), tad_runtime::sample::sample(&p.params, Some(3)), &mut Blind, &opts);
+    let two = run(&scene, Some(3), tad_runtime::sample::sample(&p.params, Some(3)), &mut Blind, &opts);
+    assert_eq!(one.records, two.records);
+    assert_eq!(one.frames, two.frames);
+    let other = run(&scene, Some(4), tad_runtime::sample::sample(&p.params, Some(4)), &mut Blind, &opts);
+    assert_ne!(one.frames[0].poses[1], other.frames[0].poses[1], "the parked car's place is sampled");
+}
