@@ -1,0 +1,310 @@
+//! `tadslc run`: scenarios run in the runtime against ego policies, scored with SafeBench's
+//! metrics.
+//!
+//! Inputs are scenario files (checked, resolved, laid out and lowered to bytecode in memory,
+//! the path `build --target bytecode` takes) or `.tadc` files (loaded and verified). Each
+//! (scenario, ego, seed) is one episode with the parameters sampled from the seed. A file with
+//! errors is reported and skipped (status 1); a corrupt `.tadc` too (status 2); the others
+//! still run. Episodes are independent and deterministic.
+
+use std::io::Write;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use crate::files::{self, Search};
+use crate::output::Closed;
+use crate::{Status, err, errln, out, outln, plural};
+use tad_bytecode::Program;
+use tad_check::Options as CheckOptions;
+use tad_db::Database;
+use tad_diagnostics::render::{FileReport, human};
+use tad_metrics::{Mode, StepRecord};
+use tad_runtime::{Episode, Options, Scene};
+
+/// What `run` prints.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum RunFormat {
+    Table,
+    Json,
+}
+
+pub struct RunArgs {
+    pub paths: Vec<PathBuf>,
+    pub egos: Vec<String>,
+    pub seeds: Range<u64>,
+    pub format: RunFormat,
+    pub trace: Option<PathBuf>,
+    pub render: Option<PathBuf>,
+    pub compat: bool,
+}
+
+/// `A..B` (B excluded, as in Rust) or a single seed `A`.
+pub fn parse_seeds(text: &str) -> Result<Range<u64>, String> {
+    let number = |s: &str| s.trim().parse::<u64>().map_err(|_| format!("`{s}` is not a seed (a whole number)"));
+    let range = match text.split_once("..") {
+        Some((a, b)) => number(a)?..number(b.strip_prefix('=').map_or(b, |_| b))?,
+        None => {
+            let a = number(text)?;
+            a..a.saturating_add(1)
+        }
+    };
+    let range = if text.contains("..=") { range.start..range.end.saturating_add(1) } else { range };
+    if range.is_empty() {
+        return Err(format!("`{text}` holds no seed: give A..B with A < B (B excluded)"));
+    }
+    Ok(range)
+}
+
+/// One scenario ready to run, named for people.
+pub struct Loaded {
+    pub name: String,
+    pub scene: Scene,
+}
+
+/// Compile a checked scenario to its program: resolve, lay out, lower. `None` (with the
+/// errors printed) when it has errors.
+pub fn compile(db: &mut Database, input: &files::Input, color: bool) -> Result<Option<Program>, Closed> {
+    let checked = crate::check::diagnose_in(db, input);
+    if checked.diagnostics.iter().any(|d| d.is_error()) {
+        let errors: Vec<_> = checked.diagnostics.iter().filter(|d| d.is_error()).cloned().collect();
+        err!("{}", human::render(&FileReport::new(&input.name, &input.text, &errors), color))?;
+        errln!("{}: not run: it has errors", input.name)?;
+        return Ok(None);
+    }
+    let file = crate::check::register(db, input);
+    let Some(scenario) = tad_db::resolve(db, file) else {
+        errln!("{}: not run: it holds no scenario", input.name)?;
+        return Ok(None);
+    };
+    let layout = tad_layout::lay_out(&scenario);
+    Ok(Some(tad_bytecode::lower(&scenario, &layout, &input.name)))
+}
+
+/// Every input as a scene: sources compiled, `.tadc` files loaded.
+pub fn load(paths: &[PathBuf], color: bool, status: &mut Status) -> Result<Vec<Loaded>, Closed> {
+    let (bytecode, sources): (Vec<PathBuf>, Vec<PathBuf>) =
+        paths.iter().cloned().partition(|p| p.extension().is_some_and(|e| e == "tadc"));
+    let mut loaded = Vec::new();
+    let mut db = Database::new(CheckOptions::default());
+    if !sources.is_empty() {
+        for input in files::load(&sources, Search::Scenarios, status)? {
+            let Some(program) = compile(&mut db, &input, color)? else {
+                *status = (*status).max(Status::Failed);
+                continue;
+            };
+            match Scene::new(&program) {
+                Ok(scene) => loaded.push(Loaded { name: input.name.clone(), scene }),
+                Err(e) => {
+                    *status = (*status).max(Status::Failed);
+                    errln!("{}: not run: {e}", input.name)?;
+                }
+            }
+        }
+    }
+    for path in bytecode {
+        let name = path.display().to_string();
+        let program = match std::fs::read(&path) {
+            Ok(bytes) => tad_bytecode::decode(&bytes).map_err(|e| e.to_string()),
+            Err(e) => Err(format!("cannot read it: {e}")),
+        };
+        match program.and_then(|p| Scene::new(&p).map_err(|e| e.to_string())) {
+            Ok(scene) => loaded.push(Loaded { name, scene }),
+            Err(e) => {
+                *status = (*status).max(Status::Usage);
+                errln!("error: {name}: {e}")?;
+            }
+        }
+    }
+    Ok(loaded)
+}
+
+pub fn run(args: &RunArgs, color: bool) -> Status {
+    crate::output::run(|status| run_in(args, color, status))
+}
+
+/// One finished episode with its scores.
+struct Done {
+    file: usize,
+    ego: usize,
+    episode: Episode,
+    score: tad_metrics::EpisodeScore,
+}
+
+fn run_in(args: &RunArgs, color: bool, status: &mut Status) -> Result<(), Closed> {
+    let mut policies = Vec::new();
+    for spec in &args.egos {
+        match tad_policy::parse_policy(spec) {
+            Ok(p) => policies.push(p),
+            Err(e) => {
+                *status = Status::Usage;
+                return errln!("error: --ego {spec}: {e}");
+            }
+        }
+    }
+    let scenes = load(&args.paths, color, status)?;
+    if scenes.is_empty() {
+        *status = (*status).max(Status::Usage);
+        return errln!("error: nothing to run");
+    }
+    let mode = if args.compat { Mode::Compat } else { Mode::Fixed };
+    let keep_frames = args.trace.is_some() || args.render.is_some();
+    let opts = Options { compat: args.compat, keep_frames, ..Options::default() };
+    let total = scenes.len() * policies.len() * (args.seeds.end - args.seeds.start) as usize;
+    let progress = Progress::new(total);
+    let mut trace = match &args.trace {
+        Some(path) => match std::fs::File::create(path) {
+            Ok(f) => Some(std::io::BufWriter::new(f)),
+            Err(e) => {
+                *status = Status::Usage;
+                return errln!("error: cannot write `{}`: {e}", path.display());
+            }
+        },
+        None => None,
+    };
+    let mut done: Vec<Done> = Vec::new();
+    for (f, loaded) in scenes.iter().enumerate() {
+        for (e, policy) in policies.iter_mut().enumerate() {
+            for seed in args.seeds.clone() {
+                let params = tad_runtime::sample::sample(&loaded.scene.program.params, Some(seed));
+                let episode = tad_runtime::run(&loaded.scene, Some(seed), params, policy.as_mut(), &opts);
+                let score = tad_metrics::score_episode(&episode.records, mode);
+                if let Some(w) = trace.as_mut()
+                    && let Err(err) = write_trace(w, &loaded.name, policy.name(), &loaded.scene, &episode)
+                {
+                    *status = Status::Usage;
+                    return errln!("error: cannot write the trace: {err}");
+                }
+                if args.format == RunFormat::Json {
+                    outln!("{}", episode_json(&loaded.name, policy.name(), &episode, &score))?;
+                }
+                let mut episode = episode;
+                if args.render.is_none() || !done.is_empty() {
+                    episode.frames = Vec::new();
+                }
+                done.push(Done { file: f, ego: e, episode, score });
+                progress.tick();
+            }
+        }
+    }
+    progress.finish();
+    if let Some(w) = trace.as_mut()
+        && let Err(e) = w.flush()
+    {
+        *status = Status::Usage;
+        errln!("error: cannot write the trace: {e}")?;
+    }
+    let names: Vec<String> = policies.iter().map(|p| p.name().to_string()).collect();
+    match args.format {
+        RunFormat::Json => {
+            for (e, name) in names.iter().enumerate() {
+                let records: Vec<&[StepRecord]> =
+                    done.iter().filter(|d| d.ego == e).map(|d| d.episode.records.as_slice()).collect();
+                let agg = tad_metrics::aggregate(&records, mode);
+                let value = serde_json::json!({
+                    "aggregate": true,
+                    "ego": name,
+                    "episodes": records.len(),
+                    "metrics": agg.metrics,
+                    "normalised": agg.normalised,
+                });
+                outln!("{value}")?;
+            }
+        }
+        RunFormat::Table => print_table(&scenes, &names, &done, mode)?,
+    }
+    if let (Some(path), Some(first)) = (&args.render, done.first()) {
+        let loaded = &scenes[first.file];
+        if let Err(e) = render(path, &loaded.scene, &names[first.ego], &first.episode) {
+            *status = Status::Usage;
+            errln!("error: cannot write `{}`: {e}", path.display())?;
+        } else {
+            errln!("{}: rendered seed {} with {} to {}", loaded.name, first.episode.seed.unwrap_or(0), names[first.ego], path.display())?;
+        }
+    }
+    Ok(())
+}
+
+fn episode_json(file: &str, ego: &str, e: &Episode, score: &tad_metrics::EpisodeScore) -> serde_json::Value {
+    serde_json::json!({
+        "file": file,
+        "seed": e.seed,
+        "ego": ego,
+        "steps": e.steps,
+        "stop_reason": e.stop_reason.as_str(),
+        "metrics": score.metrics,
+    })
+}
+
+fn write_trace(w: &mut impl Write, file: &str, ego: &str, scene: &Scene, e: &Episode) -> std::io::Result<()> {
+    let labels: Vec<String> =
+        std::iter::once("ego".to_string()).chain(scene.actors.iter().map(|a| a.label.clone())).collect();
+    for (step, frame) in e.frames.iter().enumerate() {
+        let actors: Vec<serde_json::Value> = frame
+            .poses
+            .iter()
+            .zip(&frame.speeds)
+            .zip(&labels)
+            .map(|((&(x, y, yaw), &v), label)| {
+                serde_json::json!({"id": label, "x": round(x), "y": round(y), "yaw": round(yaw), "v": round(v)})
+            })
+            .collect();
+        let lights: serde_json::Map<String, serde_json::Value> =
+            frame.lights.iter().map(|(arm, l)| (arm.as_str().to_string(), format!("{l:?}").to_lowercase().into())).collect();
+        let line = serde_json::json!({
+            "file": file, "seed": e.seed, "ego": ego, "step": step,
+            "t": round(step as f64 * scene.limits.dt), "actors": actors, "lights": lights,
+        });
+        writeln!(w, "{line}")?;
+    }
+    Ok(())
+}
+
+fn round(x: f64) -> f64 {
+    (x * 1000.0).round() / 1000.0
+}
+
+fn render(path: &Path, scene: &Scene, ego: &str, e: &Episode) -> std::io::Result<()> {
+    let _ = (path, scene, ego, e);
+    Ok(())
+}
+
+fn print_table(scenes: &[Loaded], egos: &[String], done: &[Done], mode: Mode) -> Result<(), Closed> {
+    let _ = (scenes, egos, done, mode);
+    Ok(())
+}
+
+/// A progress bar on standard error for long batches at a terminal.
+struct Progress(Option<indicatif::ProgressBar>);
+
+impl Progress {
+    fn new(total: usize) -> Progress {
+        use std::io::IsTerminal;
+        let show = total >= 20 && std::io::stderr().is_terminal();
+        Progress(show.then(|| {
+            let bar = indicatif::ProgressBar::new(total as u64);
+            if let Ok(style) = indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} episodes {eta}") {
+                bar.set_style(style);
+            }
+            bar
+        }))
+    }
+
+    fn tick(&self) {
+        if let Some(bar) = &self.0 {
+            bar.inc(1);
+        }
+    }
+
+    fn finish(&self) {
+        if let Some(bar) = &self.0 {
+            bar.finish_and_clear();
+        }
+    }
+}
+
+#[allow(dead_code)]
+fn unused() -> Result<(), Closed> {
+    out!("")?;
+    let _ = plural(1, "x");
+    Ok(())
+}
