@@ -95,13 +95,19 @@ impl Svg<'_> {
     }
 }
 
+/// The map's view: what moved, at most [`palette::MAX_ASPECT`] times as wide as high (or
+/// high as wide), its longer side [`palette::MAP_PX`] pixels.
+pub fn view_of(scene: &Scene) -> View {
+    let bounds = view::focus(scene);
+    let (w, h) = (bounds.width(), bounds.height());
+    let bounds = bounds.at_least(h / palette::MAX_ASPECT, w / palette::MAX_ASPECT);
+    let scale = palette::MAP_PX / bounds.width().max(bounds.height());
+    View::fit(bounds, palette::PAD_PX, palette::TITLE_PX, bounds.width() * scale, bounds.height() * scale)
+}
+
 /// The SVG figure of a scene: see the module's header.
 pub fn svg(scene: &Scene) -> String {
-    let mut bounds = view::focus(scene);
-    let (w, h) = (bounds.width(), bounds.height());
-    bounds = bounds.at_least(h / palette::MAX_ASPECT, w / palette::MAX_ASPECT);
-    let scale = palette::MAP_PX / bounds.width().max(bounds.height());
-    let view = View::fit(bounds, palette::PAD_PX, palette::TITLE_PX, bounds.width() * scale, bounds.height() * scale);
+    let view = view_of(scene);
     let legend = legend_entries(scene);
     let legend_h = palette::PAD_PX * 2.0 + legend.len() as f64 * palette::FONT_PX * 1.8;
     let width = palette::PAD_PX * 3.0 + view.width() + palette::LEGEND_PX;
