@@ -23,15 +23,13 @@ use tad_ir::{GroupId, Lane, Lateral, Longitudinal, Motion, Reference, Scenario, 
 
 use crate::facts::{self, Body, Chosen, Facts};
 use crate::geom::{Path, Pose, Vec2};
-use crate::road::{self, Arm, Junction, Road, Shape, Side, Station, Turn};
+use crate::road::{self, Arm, CROSSWALK, Junction, Road, Shape, Side, Station, Turn};
 use crate::{Agent, Conflict, Facing, Finding, GroupLayout, Layout, Place, Start};
 
 /// The farthest from the ego anything is put by timing or a late walker, m.
 const MAX_REACH: f64 = 150.0;
 /// How long a moving ego takes to reach its stop line, s.
 const APPROACH_TIME: f64 = 2.0;
-/// Where crosswalks are: metres past an arm's stop line, towards the junction.
-const CROSSWALK: f64 = 2.0;
 /// The farthest a timed adversary starts from its arm's stop line, m; one that would need
 /// more waits there and starts late.
 const MAX_ARM_START: f64 = 150.0;

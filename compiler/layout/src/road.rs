@@ -21,6 +21,10 @@ pub const SIDEWALK_WIDTH: f64 = 2.0;
 pub const CURVE_RADIUS: f64 = 60.0;
 /// How far paths run before a start and after a junction, m.
 pub const RUN: f64 = 200.0;
+/// Where an arm's crosswalk is: metres past its stop line, towards the junction's centre.
+pub const CROSSWALK: f64 = 2.0;
+/// The radius of a roundabout's ring (where vehicles circle), as a fraction of [`Junction::half`].
+pub const RING: f64 = 0.75;
 
 /// A road of a junction, named from the ego's approach.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -252,7 +256,7 @@ impl Road {
         let exit = self.pose_at(out_station, -exit_lane, self.lateral(-exit_lane));
         let u = Vec2::from_yaw(exit.yaw);
         if junction.roundabout {
-            points.extend(ring(self.centre(), junction.half * 0.75, entry.position, turn));
+            points.extend(ring(self.centre(), junction.half * RING, entry.position, turn));
         } else if turn == Turn::UTurn {
             let mid = self.centre() + d * (junction.half * 0.5);
             points.extend(bezier(entry.position, d, mid, d.left()));
