@@ -264,13 +264,114 @@ fn round(x: f64) -> f64 {
 }
 
 fn render(path: &Path, scene: &Scene, ego: &str, e: &Episode) -> std::io::Result<()> {
-    let _ = (path, scene, ego, e);
-    Ok(())
+    use tad_render::{ActorInfo, Frame, Kind, Light};
+    let light = |l: tad_bytecode::Light| match l {
+        tad_bytecode::Light::Off => Light::Off,
+        tad_bytecode::Light::Red => Light::Red,
+        tad_bytecode::Light::Yellow => Light::Yellow,
+        tad_bytecode::Light::Green => Light::Green,
+    };
+    let size = scene.ego.size;
+    let actors = std::iter::once(ActorInfo { label: "ego".into(), kind: Kind::Ego, length: size.length, width: size.width })
+        .chain(scene.actors.iter().map(|a| ActorInfo {
+            label: a.label.clone(),
+            kind: match a.body {
+                tad_layout::Body::Vehicle => Kind::Vehicle,
+                tad_layout::Body::Walker => Kind::Walker,
+                tad_layout::Body::Object => Kind::Object,
+            },
+            length: a.size.length,
+            width: a.size.width,
+        }))
+        .collect();
+    let frames = e
+        .frames
+        .iter()
+        .map(|f| Frame {
+            poses: f.poses.iter().map(|&(x, y, yaw)| Some([x, y, yaw])).collect(),
+            lights: f.lights.iter().map(|&(arm, l)| (arm, light(l))).collect(),
+        })
+        .collect();
+    let (start, length) = (scene.ego.start, scene.ego.route_length);
+    let route = (0..=(length / 2.0).ceil() as usize)
+        .map(|k| scene.ego.route.pose(start + (2.0 * k as f64).min(length)).position)
+        .map(|p| [p.x, p.y])
+        .collect();
+    let events = e
+        .events
+        .iter()
+        .map(|ev| tad_render::Event {
+            step: ev.step as usize,
+            position: [ev.position.x, ev.position.y],
+            label: match ev.other {
+                Some(k) => format!("{} with {}", ev.kind.as_str(), scene.actors.get(k).map_or("?", |a| a.label.as_str())),
+                None => ev.kind.as_str().replace('_', " "),
+            },
+        })
+        .collect();
+    let picture = tad_render::Scene {
+        road: &scene.world.road,
+        title: format!("{} · seed {} · ego {ego}", scene.name, e.seed.unwrap_or(0)),
+        actors,
+        frames,
+        dt: scene.limits.dt,
+        route,
+        events,
+    };
+    let bytes = if path.extension().is_some_and(|x| x.eq_ignore_ascii_case("gif")) {
+        tad_render::gif(&picture, tad_render::GifOptions::default())
+    } else {
+        tad_render::svg(&picture).into_bytes()
+    };
+    std::fs::write(path, bytes)
 }
 
+/// One row per scenario and ego (aggregated over the seeds), then one per ego over all
+/// scenarios: the paper's normalised values (value / max) and OS.
 fn print_table(scenes: &[Loaded], egos: &[String], done: &[Done], mode: Mode) -> Result<(), Closed> {
-    let _ = (scenes, egos, done, mode);
-    Ok(())
+    let width = scenes.iter().map(|s| s.scene.name.len()).max().unwrap_or(8).clamp(8, 40);
+    let header: Vec<&str> = tad_metrics::METRICS.iter().map(|m| m.key).collect();
+    out!("{:<width$}  {:<10} {:>4}", "scenario", "ego", "runs")?;
+    for key in &header {
+        out!(" {key:>6}")?;
+    }
+    outln!(" {:>6}  stops", "OS")?;
+    let row = |label: &str, ego: &str, rows: &[&Done]| -> Result<(), Closed> {
+        let scores: Vec<tad_metrics::EpisodeScore> = rows.iter().map(|d| d.score.clone()).collect();
+        let Ok(agg) = tad_metrics::aggregate(&scores, mode) else { return Ok(()) };
+        out!("{label:<width$}  {ego:<10} {:>4}", rows.len())?;
+        for m in tad_metrics::METRICS.iter() {
+            match agg.normalised.get(m.metric) {
+                Some(v) => out!(" {v:>6.3}")?,
+                None => out!(" {:>6}", "-")?,
+            }
+        }
+        let mut stops: Vec<(&str, usize)> = Vec::new();
+        for d in rows {
+            let name = d.episode.stop_reason.as_str();
+            match stops.iter_mut().find(|(n, _)| *n == name) {
+                Some((_, k)) => *k += 1,
+                None => stops.push((name, 1)),
+            }
+        }
+        let stops: Vec<String> = stops.iter().map(|(n, k)| format!("{n} {k}")).collect();
+        outln!(" {:>6.3}  {}", agg.normalised.os, stops.join(", "))
+    };
+    for (f, loaded) in scenes.iter().enumerate() {
+        for (e, ego) in egos.iter().enumerate() {
+            let rows: Vec<&Done> = done.iter().filter(|d| d.file == f && d.ego == e).collect();
+            let name: String = loaded.scene.name.chars().take(width).collect();
+            row(&name, ego, &rows)?;
+        }
+    }
+    if scenes.len() > 1 {
+        for (e, ego) in egos.iter().enumerate() {
+            let rows: Vec<&Done> = done.iter().filter(|d| d.ego == e).collect();
+            row("all", ego, &rows)?;
+        }
+    }
+    outln!()?;
+    outln!("values normalised as in TrafficAlign's tables (value / max; OS 1 is perfect); {} scoring", mode.as_str())
 }
 
 /// A progress bar on standard error for long batches at a terminal.
