@@ -1,14 +1,79 @@
 //! Ego policies: what drives the ego in the runtime.
 //!
 //! Every policy sees an [`EgoView`] each step (SafeBench's four-feature observation and,
-//! for rule-based drivers, the full state the runtime knows) and answers an [`Action`].
+//! for rule-based drivers, the full state the runtime knows) and answers an [`Action`]:
+//! an acceleration and a normalised steer the runtime applies to its kinematic bicycle.
+//! Three drivers: [`Idm`] (lane keeping and IDM car following that obeys lights and stop
+//! signs), [`Naive`] (constant speed along the route, blind to everything else) and
+//! [`Learned`] (SafeBench's SAC actor from a safetensors file). [`parse_policy`] names them.
+//!
+//! # Frames and signs
+//!
+//! Our frame is right-handed: `x` forward, `y` left, yaw counter-clockwise (seen from
+//! above), radians. CARLA's is left-handed: `y` right, yaw clockwise, degrees; a CARLA pose
+//! is ours with `y` and yaw negated. [`Action::steer`] keeps CARLA's sign (positive steers
+//! right) because learned actors were trained with it: a wheel angle δ in our frame
+//! (positive left) is `steer = −δ / MAX_WHEEL_ANGLE`.
+//!
+//! # The observation (`EgoView::obs`)
+//!
+//! SafeBench's `obs_type 0` state `[lateral_dis, −delta_yaw, speed, vehicle_front]`
+//! (`gym_carla/envs/carla_env.py::_get_obs`), fed to the actor as is (no normalisation),
+//! as `f32`. Definitions in our frame; [`observation`] computes the first three.
+//!
+//! **Route points.** `P_0, P_1, …` with headings `ψ_k`: the route densified at 1 m (SafeBench
+//! interpolates the route with `interpolate_trajectory`'s default `hop_resolution` 1 m), then
+//! continued past its end along the lane at 5 m (the route planner's `_sampling_radius`; a
+//! runtime without the lane continues straight along the last heading). `ψ_k` is the lane's
+//! heading at `P_k`.
+//!
+//! **Preview point** ([`Preview`]). A head index `h`, 0 at the episode's start. At each
+//! observation: use `P_i` with `i = h + 2` (clamped to the last point); *then* advance: let
+//! `j` be the largest offset in `0..12` (the planner's 12-point buffer) with
+//! `|P_{h+j} − ego| < 4 m` (`_min_distance`); if there is one, `h += max(j − 1, 0)`. So on
+//! the route the preview point lies 4–5 m ahead of where the ego was at the previous
+//! observation, and the head never moves back.
+//!
+//! With ego position `p`, heading `ψ`, `w = (cos ψ_i, sin ψ_i)`, `u = (cos ψ, sin ψ)` and
+//! `a × b = a.x·b.y − a.y·b.x`:
+//! - `obs[0] = lateral_dis = w × (p − P_i)`, m: positive when the ego is **left** of the
+//!   route line through `P_i`. (SafeBench computes `−|v|·(w × v/|v|)` with `v = p − P_i` in
+//!   CARLA's frame; the frame flip cancels its minus sign.)
+//! - `obs[1] = −delta_yaw = asin(w × u)`, rad in [−π/2, π/2]: positive when the ego heads
+//!   **left** of the route's direction (SafeBench: `delta_yaw = asin(w × u)` in CARLA's
+//!   frame, positive when heading right, and the observation negates it).
+//! - `obs[2] = speed = ‖(v_x, v_y)‖`, m/s, the planar speed, never negative.
+//! - `obs[3] = vehicle_front`, 1 or 0: 1 if some other *vehicle* (cars, trucks, bicycles and
+//!   motorbikes: CARLA's `*vehicle*` actors; not walkers or props) has its centre on the
+//!   same road and lane as the ego's centre (each projected to its nearest driving lane),
+//!   at most 15 m from the ego's centre (`_proximity_threshold`), and strictly in front:
+//!   `u · (c − p) > 0` for its centre `c` (less than 90° off the heading).
+//!
+//! SafeBench computes the observation after each tick, from the state the action led to;
+//! the first one at reset.
+
+mod idm;
+mod learned;
+
+pub use idm::{Idm, IdmParams, Naive};
+pub use learned::Learned;
+
+use std::fmt;
+
+/// The runtime's limits on [`Action::accel`], m/s².
+pub const ACCEL_MIN: f64 = -8.0;
+pub const ACCEL_MAX: f64 = 3.0;
+/// The wheel angle of `steer = ±1`, rad (CARLA's cars: 70°).
+pub const MAX_WHEEL_ANGLE: f64 = 70.0 * std::f64::consts::PI / 180.0;
+/// A speed below this is standing (SafeBench's stop-sign threshold), m/s.
+pub const STANDING: f64 = 0.1;
 
 /// What the ego's driver sees at a step. Frame: the ego's, `x` forward, `y` left.
 #[derive(Clone, Debug, PartialEq)]
 pub struct EgoView {
-    /// SafeBench's observation `[lateral_dis, -delta_yaw, speed, vehicle_front]` (CARLA's
-    /// conventions: `lateral_dis` > 0 right of the route, `-delta_yaw` > 0 when the route
-    /// turns right of the heading; see `obs`'s doc in the crate's spec).
+    /// SafeBench's observation `[lateral_dis, −delta_yaw, speed, vehicle_front]`, as the
+    /// crate's header defines it (positive lateral: the ego is left of the route; positive
+    /// angle: it heads left of the route).
     pub obs: [f64; 4],
     /// m/s.
     pub speed: f64,
@@ -29,8 +94,10 @@ pub struct EgoView {
     pub dt: f64,
 }
 
-/// What the driver does: `accel` in m/s² (the runtime clamps it to `[-8, 3]`), `steer`
-/// normalised to `[-1, 1]` of the maximum wheel angle, positive to the right (CARLA's sign).
+/// What the driver does: `accel` in m/s² (the runtime clamps it to
+/// [`ACCEL_MIN`]..=[`ACCEL_MAX`]), `steer` normalised to `[-1, 1]` of
+/// [`MAX_WHEEL_ANGLE`], positive to the right (CARLA's sign). Given a finite view, every
+/// policy here answers finite values within those ranges.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Action {
     pub accel: f64,
@@ -44,3 +111,124 @@ pub trait EgoPolicy: Send {
     fn reset(&mut self) {}
     fn act(&mut self, view: &EgoView) -> Action;
 }
+
+/// Pure pursuit towards `target` (ego frame, m) for a car of `wheelbase` m: the arc through
+/// the target has curvature `κ = 2y / (x² + y²)`, the wheel angle `atan(wheelbase·κ)`;
+/// the answer is that angle as a normalised steer with CARLA's sign (a target on the left
+/// gives a negative steer), clamped to `[-1, 1]`. 0 for a target at the ego.
+pub fn pure_pursuit(target: [f64; 2], wheelbase: f64) -> f64 {
+    let [x, y] = target;
+    let d2 = x * x + y * y;
+    if d2.is_nan() || d2 <= 1e-9 || !wheelbase.is_finite() {
+        return 0.0;
+    }
+    let wheel = (wheelbase * 2.0 * y / d2).atan();
+    (-wheel / MAX_WHEEL_ANGLE).clamp(-1.0, 1.0)
+}
+
+/// `[lateral_dis, −delta_yaw, speed]` of the crate's header, in our frame: the ego at
+/// `position` heading `yaw` (rad) at `speed`, the preview point at `point` heading
+/// `point_yaw`.
+pub fn observation(position: [f64; 2], yaw: f64, point: [f64; 2], point_yaw: f64, speed: f64) -> [f64; 3] {
+    let w = [point_yaw.cos(), point_yaw.sin()];
+    let v = [position[0] - point[0], position[1] - point[1]];
+    let cross = |a: [f64; 2], b: [f64; 2]| a[0] * b[1] - a[1] * b[0];
+    [cross(w, v), cross(w, [yaw.cos(), yaw.sin()]).clamp(-1.0, 1.0).asin(), speed.abs()]
+}
+
+/// SafeBench's preview point along the route (the crate's header): which route point the
+/// observation measures against, step by step.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Preview {
+    /// The planner buffer's first point.
+    pub head: usize,
+}
+
+impl Preview {
+    /// The planner's buffer length (`max_waypt`).
+    pub const BUFFER: usize = 12;
+    /// The buffer index the observation uses.
+    pub const INDEX: usize = 2;
+    /// Points closer than this to the ego are passed (`_min_distance`), m.
+    pub const REACHED: f64 = 4.0;
+
+    /// The index into `points` of this observation's preview point (`None`: no points),
+    /// then the head advanced past the points the ego at `ego` has reached.
+    pub fn step(&mut self, points: &[[f64; 2]], ego: [f64; 2]) -> Option<usize> {
+        let last = points.len().checked_sub(1)?;
+        let index = (self.head + Self::INDEX).min(last);
+        let mut window = points.iter().enumerate().skip(self.head).take(Self::BUFFER);
+        let reached = window.rfind(|(_, p)| (p[0] - ego[0]).hypot(p[1] - ego[1]) < Self::REACHED);
+        if let Some((j, _)) = reached {
+            self.head += (j - self.head).saturating_sub(1);
+        }
+        Some(index)
+    }
+}
+
+/// Why a policy could not be made.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum PolicyError {
+    /// Not one of the policies' names.
+    UnknownPolicy { spec: String },
+    /// `learned` without `:PATH`.
+    MissingPath,
+    /// The file could not be read or written.
+    Io { path: String, message: String },
+    /// The bytes are not a safetensors file (or hold a type candle cannot read).
+    NotSafetensors { path: String, message: String },
+    /// A tensor the actor needs is absent; `found` lists some that are there.
+    MissingTensor { path: String, name: String, found: Vec<String> },
+    /// A tensor has the wrong shape.
+    WrongShape { path: String, name: String, expected: String, found: Vec<usize> },
+    /// A tensor holds NaN or an infinity.
+    NonFinite { path: String, name: String },
+    /// [`Learned::random`] was given no hidden layer or an empty one.
+    BadHidden { hidden: Vec<usize> },
+    /// Anything else candle reports.
+    Tensor { message: String },
+}
+
+impl fmt::Display for PolicyError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            PolicyError::UnknownPolicy { spec } => {
+                write!(f, "unknown policy `{spec}` (expected `idm`, `naive` or `learned:PATH`)")
+            }
+            PolicyError::MissingPath => {
+                f.write_str("the learned policy needs a checkpoint: `learned:PATH` (a safetensors file)")
+            }
+            PolicyError::Io { path, message } => write!(f, "{path}: {message}"),
+            PolicyError::NotSafetensors { path, message } => write!(f, "{path}: not a safetensors file: {message}"),
+            PolicyError::MissingTensor { path, name, found } => {
+                write!(f, "{path}: no tensor `{name}` (an actor needs `fc1` … `fcN` and `fc_mu`; found ")?;
+                if found.is_empty() { f.write_str("none)") } else { write!(f, "{})", found.join(", ")) }
+            }
+            PolicyError::WrongShape { path, name, expected, found } => {
+                write!(f, "{path}: tensor `{name}` has shape {found:?}, expected {expected}")
+            }
+            PolicyError::NonFinite { path, name } => write!(f, "{path}: tensor `{name}` holds a NaN or an infinity"),
+            PolicyError::BadHidden { hidden } => {
+                write!(f, "an actor needs at least one hidden layer, each of at least one unit (got {hidden:?})")
+            }
+            PolicyError::Tensor { message } => write!(f, "tensor error: {message}"),
+        }
+    }
+}
+
+impl std::error::Error for PolicyError {}
+
+/// A policy by its command-line name: `idm`, `naive` or `learned:PATH`.
+pub fn parse_policy(spec: &str) -> Result<Box<dyn EgoPolicy>, PolicyError> {
+    match spec.split_once(':') {
+        None if spec == "idm" => Ok(Box::new(Idm::default())),
+        None if spec == "naive" => Ok(Box::new(Naive::default())),
+        None if spec == "learned" => Err(PolicyError::MissingPath),
+        Some(("learned", "")) => Err(PolicyError::MissingPath),
+        Some(("learned", path)) => Ok(Box::new(Learned::load(path)?)),
+        _ => Err(PolicyError::UnknownPolicy { spec: spec.to_string() }),
+    }
+}
+
+#[cfg(test)]
+mod tests;
