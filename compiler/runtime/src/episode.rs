@@ -8,7 +8,7 @@
 //! contacts; the criteria read the new state; the record is stored; the stop rules run.
 
 use crate::detect::{Detectors, footprint};
-use crate::models::{self, Kinematics, MAX_BRAKE, MAX_WHEEL, WHEELBASE, idm, pursue};
+use crate::models::{self, Kinematics, WHEELBASE, pursue};
 use crate::physics::{Physics, Shape};
 use crate::scene::Scene;
 use crate::track::Track;
@@ -17,38 +17,14 @@ use tad_bytecode::{Instr, Light, Value};
 use tad_layout::geom::{Footprint, Pose, Vec2, wrap};
 use tad_layout::road::Station;
 use tad_layout::{Arm, Body, Facing, Turn};
-use tad_metrics::StepRecord;
-use tad_policy::{Action, EgoPolicy, EgoView};
-
-/// Why an episode ended.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum StopReason {
-    Collision,
-    RouteComplete,
-    OffRoad,
-    MaxDistance,
-    Timeout,
-    MaxSteps,
-}
-
-impl StopReason {
-    pub fn as_str(self) -> &'static str {
-        match self {
-            StopReason::Collision => "collision",
-            StopReason::RouteComplete => "route_complete",
-            StopReason::OffRoad => "off_road",
-            StopReason::MaxDistance => "max_distance",
-            StopReason::Timeout => "timeout",
-            StopReason::MaxSteps => "max_steps",
-        }
-    }
-}
+use tad_metrics::{Mode, StepRecord, StopReason};
+use tad_policy::{ACCEL_MAX, ACCEL_MIN, Action, EgoPolicy, EgoView, IdmParams, MAX_WHEEL_ANGLE};
 
 /// How an episode runs.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Options {
-    /// SafeBench's quirks: off-road never ends an episode.
-    pub compat: bool,
+    /// Scoring mode: with `Mode::Compat` (SafeBench's quirks) off-road never ends an episode.
+    pub mode: Mode,
     /// Keep every actor's pose at every step (for traces and pictures).
     pub keep_frames: bool,
     /// Off-road this long (s) ends the episode (unless `compat`).
@@ -57,7 +33,7 @@ pub struct Options {
 
 impl Default for Options {
     fn default() -> Options {
-        Options { compat: false, keep_frames: false, off_road_limit: 0.5 }
+        Options { mode: Mode::Fixed, keep_frames: false, off_road_limit: 0.5 }
     }
 }
 
@@ -216,10 +192,10 @@ pub fn run(scene: &Scene, seed: Option<u64>, params: Vec<f64>, policy: &mut dyn 
         ego_s = s_now;
         let view = ego_view(scene, &ego, ego_s, off_route, desired, &actors, &before, t, ego_stop, &detectors);
         let action: Action = policy.act(&view);
-        let accel = if action.accel.is_finite() { action.accel.clamp(-MAX_BRAKE, 3.0) } else { 0.0 };
+        let accel = if action.accel.is_finite() { action.accel.clamp(ACCEL_MIN, ACCEL_MAX) } else { 0.0 };
         let steer = if action.steer.is_finite() { action.steer.clamp(-1.0, 1.0) } else { 0.0 };
         let old = ego.position;
-        ego.bicycle(WHEELBASE * ego_size.length, -steer * MAX_WHEEL, accel, dt);
+        ego.bicycle(WHEELBASE * ego_size.length, -steer * MAX_WHEEL_ANGLE, accel, dt);
         driven += old.distance(ego.position);
 
         // everyone else
@@ -281,7 +257,7 @@ pub fn run(scene: &Scene, seed: Option<u64>, params: Vec<f64>, policy: &mut dyn 
             Some(StopReason::Collision)
         } else if reading.route_complete >= 100.0 {
             Some(StopReason::RouteComplete)
-        } else if !opts.compat && off_road_for >= opts.off_road_limit - 1e-9 {
+        } else if opts.mode.off_road_terminates() && off_road_for >= opts.off_road_limit - 1e-9 {
             Some(StopReason::OffRoad)
         } else if driven >= scene.limits.max_distance {
             Some(StopReason::MaxDistance)
@@ -456,7 +432,7 @@ fn move_actor(scene: &Scene, actors: &mut [Actor], k: usize, before: &[(Vec2, f6
             let (s, _) = track.locate(a.kin.position, a.s, 8.0);
             a.s = s;
             let wheel = pursue(track, s, a.kin.pose(), a.kin.speed, a.wheelbase);
-            let accel = if a.stopping { -(a.kin.speed / dt).min(4.0) } else { idm(a.kin.speed, a.target, leader) };
+            let accel = if a.stopping { -(a.kin.speed / dt).min(4.0) } else { IdmParams::default().accel(a.kin.speed, a.target, leader) };
             a.kin.bicycle(a.wheelbase, wheel, accel, dt);
             // a stop sign is passed once it has stood at it
             if let Some((line, _)) = a.stop_line
@@ -501,7 +477,7 @@ fn leader_of(scene: &Scene, actors: &[Actor], k: usize, before: &[(Vec2, f64, f6
 fn must_stop(scene: &Scene, arm: Arm, gap: f64, speed: f64, t: f64, stopped_at_sign: bool) -> bool {
     match scene.world.light(arm, t) {
         Light::Red => true,
-        Light::Yellow => gap > speed * speed / (2.0 * models::IDM_B),
+        Light::Yellow => gap > speed * speed / (2.0 * IdmParams::default().comfort_decel),
         Light::Green => false,
         Light::Off => scene.world.stop_signs() && !stopped_at_sign,
     }
@@ -553,7 +529,7 @@ fn mobil(scene: &Scene, actors: &mut [Actor], k: usize, before: &[(Vec2, f64, f6
         let Some(track) = &me.track else { return };
         let others = before.iter().enumerate().filter(|(j, _)| *j != k).map(|(j, &(p, y, v))| (p, y, v, actors[j].length, actors[j].width));
         let ego_entry = std::iter::once((ego.position, ego.yaw, ego.speed, scene.ego.size.length, scene.ego.size.width));
-        idm(me.kin.speed, me.target, ahead_on(track, me.kin.position, me.kin.yaw, me.s, me.length, me.width, others.chain(ego_entry)))
+        IdmParams::default().accel(me.kin.speed, me.target, ahead_on(track, me.kin.position, me.kin.yaw, me.s, me.length, me.width, others.chain(ego_entry)))
     };
     let mut choice: Option<(i64, f64)> = None;
     for dir in [-1, 1] {
@@ -568,11 +544,11 @@ fn mobil(scene: &Scene, actors: &mut [Actor], k: usize, before: &[(Vec2, f64, f6
             .map(|(j, &(p, y, v))| (p, y, v, actors[j].length, actors[j].width))
             .chain(std::iter::once((ego.position, ego.yaw, ego.speed, scene.ego.size.length, scene.ego.size.width)))
             .collect();
-        let then = idm(me.kin.speed, me.target, ahead_on(&track, me.kin.position, me.kin.yaw, s, me.length, me.width, entries.iter().copied()));
+        let then = IdmParams::default().accel(me.kin.speed, me.target, ahead_on(&track, me.kin.position, me.kin.yaw, s, me.length, me.width, entries.iter().copied()));
         // the new follower: the nearest behind in the target lane, with this vehicle ahead of it
         let back = me.kin.yaw + std::f64::consts::PI;
         let behind = ahead_on(&track, me.kin.position, back, s, me.length, me.width, entries.iter().map(|&(p, y, v, l, w)| (p, y + std::f64::consts::PI, v, l, w)));
-        let safe = behind.is_none_or(|(gap, speed_back)| idm(speed_back, speed_back.max(me.target), Some((gap, me.kin.speed))) >= -SAFE && gap > 1.0);
+        let safe = behind.is_none_or(|(gap, speed_back)| IdmParams::default().accel(speed_back, speed_back.max(me.target), Some((gap, me.kin.speed))) >= -SAFE && gap > 1.0);
         if safe && then - now > GAIN && choice.is_none_or(|(_, g)| then - now > g) {
             choice = Some((dir, then - now));
         }

@@ -20,5 +20,6 @@ pub mod scene;
 pub mod track;
 pub mod world;
 
-pub use episode::{Episode, Event, EventKind, Frame, Options, StopReason, run};
+pub use episode::{Episode, Event, EventKind, Frame, Options, run};
+pub use tad_metrics::{Mode, StopReason};
 pub use scene::{Scene, SetupError};

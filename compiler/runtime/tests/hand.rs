@@ -150,7 +150,7 @@ fn leaving_the_road_ends_the_episode_unless_compat() {
     let e = run(&scene, None, vec![], &mut Blind, &Options::default());
     assert_eq!(e.stop_reason, StopReason::OffRoad);
     assert!(e.records.last().unwrap().off_road);
-    let e = run(&scene, None, vec![], &mut Blind, &Options { compat: true, ..Options::default() });
+    let e = run(&scene, None, vec![], &mut Blind, &Options { mode: tad_runtime::Mode::Compat, ..Options::default() });
     assert_ne!(e.stop_reason, StopReason::OffRoad);
     let off = e.records.iter().filter(|r| r.off_road).count();
     assert!(off > 50, "off road for {off} steps");
