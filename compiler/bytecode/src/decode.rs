@@ -451,3 +451,45 @@ impl Decoder {
 fn coordinate(mm: i64) -> ErrorKind {
     ErrorKind::OutOfRange { what: "a path coordinate", value: from_mm(mm), expected: "within ±1000 km" }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::encode::{sleb, uleb};
+
+    fn reader(bytes: &[u8]) -> Reader<'_> {
+        Reader { bytes, pos: 0, base: 0 }
+    }
+
+    #[test]
+    fn varints_round_trip_in_their_shortest_form_only() {
+        for v in [0u64, 1, 127, 128, 300, 16_383, 16_384, u64::from(u32::MAX)] {
+            let mut out = Vec::new();
+            uleb(&mut out, v);
+            let mut r = reader(&out);
+            assert_eq!(r.uleb("x"), Ok(v));
+            assert_eq!(r.pos, out.len());
+        }
+        for v in [0i64, -1, 1, -64, 64, i64::MIN, i64::MAX, -1_000_000_000] {
+            let mut out = Vec::new();
+            sleb(&mut out, v);
+            assert_eq!(reader(&out).sleb("x"), Ok(v), "{v}");
+        }
+        // over-long, too large for 32 bits, unterminated
+        for bad in [
+            &[0x80, 0x00][..],
+            &[0xff, 0x80, 0x00],
+            &[0x80, 0x80, 0x80, 0x80, 0x10],
+            &[0x80, 0x80, 0x80, 0x80, 0x80, 0x01],
+        ] {
+            assert_eq!(reader(bad).uleb("x").map_err(|e| e.kind), Err(ErrorKind::BadVarint), "{bad:x?}");
+        }
+        assert!(matches!(reader(&[0x80, 0x80]).uleb("x").map_err(|e| e.kind), Err(ErrorKind::Truncated { .. })));
+        // 64-bit: the tenth byte holds one bit
+        let mut max = vec![0xff; 9];
+        max.push(0x01);
+        assert_eq!(reader(&max).leb(64, "x"), Ok(u64::MAX));
+        max[9] = 0x02;
+        assert_eq!(reader(&max).leb(64, "x").map_err(|e| e.kind), Err(ErrorKind::BadVarint));
+    }
+}

@@ -206,3 +206,37 @@ pub struct Program {
     pub paths: Vec<Polyline>,
     pub code: Vec<Instr>,
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_canonical_form_drops_collinear_points_keeps_corners_and_is_idempotent() {
+        // a straight run sampled every metre, a corner, a gentle arc
+        let mut points: Vec<[f64; 2]> = (0..=100).map(|x| [f64::from(x), 0.004 * f64::from(x % 2)]).collect();
+        points.extend((1..=50).map(|y| [100.0, f64::from(y)]));
+        points.extend((1..=90).map(|k| {
+            let a = f64::from(k).to_radians();
+            [100.0 - 20.0 + 20.0 * a.cos(), 50.0 + 20.0 * a.sin()]
+        }));
+        let line = Polyline(points.clone());
+        let c = line.canonical();
+        assert!(c.0.len() < 50 && points.len() > 200, "{} points kept", c.0.len());
+        assert_eq!(c.0.first(), Some(&[0.0, 0.0]));
+        assert!(c.0.contains(&[100.0, 0.0]), "the corner is kept");
+        assert_eq!(c.canonical(), c, "idempotent");
+        for p in &points {
+            let d = c.0.windows(2).map(|w| segment_distance(*p, w[0], w[1])).fold(f64::INFINITY, f64::min);
+            assert!(d <= Polyline::TOLERANCE + 0.001, "{p:?} is {d} m off");
+        }
+        for q in c.0.iter().flatten() {
+            assert_eq!(from_mm(to_mm(*q)), *q, "on the millimetre grid");
+        }
+        assert!((c.length() - line.length()).abs() < 0.1);
+        // repeated points go; a non-finite polyline is left as it is
+        assert_eq!(Polyline(vec![[1.0, 2.0], [1.0, 2.0], [1.0004, 2.0]]).canonical(), Polyline(vec![[1.0, 2.0]]));
+        let bad = Polyline(vec![[f64::NAN, 0.0], [1.0, 0.0], [2.0, 0.0]]);
+        assert_eq!(bad.canonical().0.len(), 3);
+    }
+}
