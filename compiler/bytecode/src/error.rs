@@ -147,14 +147,16 @@ impl fmt::Display for ErrorKind {
             ErrorKind::UnknownFormat { found } => write!(f, "unknown format version {found}"),
             ErrorKind::Flags(flags) => write!(f, "reserved header flags set ({flags:#06x})"),
             ErrorKind::Truncated { inside } => write!(f, "truncated inside {inside}"),
-            ErrorKind::TrailingBytes { count } => write!(f, "{count} trailing byte(s) after the last section"),
+            ErrorKind::TrailingBytes { count } => {
+                write!(f, "{} after the last section", bytes(*count, "trailing byte"))
+            }
             ErrorKind::SectionLeftover { section, count } => {
-                write!(f, "the {section} section has {count} byte(s) after its content")
+                write!(f, "the {section} section has {} after its content", bytes(*count, "byte"))
             }
             ErrorKind::BadVarint => write!(f, "malformed number encoding (over-long or too large)"),
             ErrorKind::BadUtf8 => write!(f, "a string is not valid UTF-8"),
             ErrorKind::TooMany { what, count, left } => {
-                write!(f, "{count} {what} cannot fit in the {left} byte(s) left")
+                write!(f, "{count} {what} cannot fit in the {} left", bytes(*left, "byte"))
             }
             ErrorKind::IndexOutOfRange { what, index, len } => {
                 write!(f, "{what} index {index} out of range (there are {len})")
@@ -166,7 +168,7 @@ impl fmt::Display for ErrorKind {
                 write!(f, "{what} is {value}, expected {expected}")
             }
             ErrorKind::UnknownActor { actor, spawned } => {
-                write!(f, "actor a{actor} is never spawned ({spawned} actor(s) are)")
+                write!(f, "actor a{actor} is never spawned (only {})", bytes(*spawned, "actor"))
             }
             ErrorKind::SpawnOrder { actor, expected } => {
                 write!(f, "spawn of actor a{actor} where a{expected} is next (actors are numbered in spawn order)")
@@ -178,4 +180,9 @@ impl fmt::Display for ErrorKind {
             ErrorKind::BadPath(problem) => write!(f, "{problem}"),
         }
     }
+}
+
+/// `1 byte`, `2 bytes`.
+fn bytes(n: usize, noun: &str) -> String {
+    if n == 1 { format!("1 {noun}") } else { format!("{n} {noun}s") }
 }

@@ -260,7 +260,7 @@ fn behaviour_of_an_actor_never_spawned_is_refused() {
     let (e, bytes) = rule(|p| p.code.push(Instr::Stop { actor: 3 }));
     assert_eq!(e.kind, ErrorKind::UnknownActor { actor: 3, spawned: 1 });
     assert_eq!(bytes[e.offset], Op::Stop as u8);
-    assert_eq!(e.to_string(), format!("actor a3 is never spawned (1 actor(s) are) (at byte {})", e.offset));
+    assert_eq!(e.to_string(), format!("actor a3 is never spawned (only 1 actor) (at byte {})", e.offset));
     let (e, _) = rule(|p| p.code[3] = spawn(1));
     assert_eq!(e.kind, ErrorKind::SpawnOrder { actor: 1, expected: 0 });
 }
