@@ -62,8 +62,8 @@ fn build_in(
             errln!("{}: not built", input.name)?;
             continue;
         };
-        let layout = tad_layout::lay_out(&scenario);
-        let program = tad_bytecode::lower(&scenario, &layout, &input.name);
+        let layout = tad_layout::lay_out(scenario);
+        let program = tad_bytecode::lower(scenario, &layout, &input.name);
         let bytes = tad_bytecode::encode(&program);
         let stem = input
             .path
