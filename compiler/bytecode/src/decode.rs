@@ -256,7 +256,7 @@ impl Decoder {
                     return Err(r.error(start, coordinate(i64::MAX)));
                 };
                 for v in [x, y] {
-                    if v.abs() > MAX_MM {
+                    if v.unsigned_abs() > MAX_MM.unsigned_abs() {
                         return Err(r.error(start, coordinate(v)));
                     }
                 }

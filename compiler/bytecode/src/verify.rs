@@ -75,7 +75,7 @@ fn path(p: &Program, index: u16) -> Result<&crate::Polyline, ErrorKind> {
 }
 
 fn lane_change(lanes: i64) -> Check {
-    if lanes != 0 && lanes.abs() <= MAX_LANES {
+    if lanes != 0 && lanes.unsigned_abs() <= MAX_LANES.unsigned_abs() {
         Ok(())
     } else {
         Err(ErrorKind::OutOfRange { what: "a lane change", value: lanes as f64, expected: "±1 to ±12 lanes" })
@@ -102,6 +102,10 @@ fn road(r: &Road) -> Check {
     if let Some(j) = &r.junction {
         if !j.arms.contains(&Arm::Ego) || j.arms.len() < 3 {
             return Err(ErrorKind::Misplaced("a junction needs the ego's arm and two others"));
+        }
+        // a set, in `Arm::ALL`'s order: as the format stores it
+        if j.arms.windows(2).any(|w| w[0] >= w[1]) {
+            return Err(ErrorKind::Misplaced("a junction's arms repeat or are out of order"));
         }
         positive("the junction's half-size", j.half)?;
     }
@@ -258,7 +262,7 @@ impl<'p> State<'p> {
                 if !self.road.is_some_and(|r| r.has_arm(*arm)) {
                     return Err(ErrorKind::Misplaced("a spawn on an arm the road does not have"));
                 }
-                if *lane == 0 || lane.abs() > MAX_LANES {
+                if *lane == 0 || lane.unsigned_abs() > MAX_LANES.unsigned_abs() {
                     return Err(ErrorKind::OutOfRange {
                         what: "a spawn's lane",
                         value: *lane as f64,

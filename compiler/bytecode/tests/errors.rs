@@ -329,3 +329,56 @@ fn paths_the_runtime_cannot_follow_are_refused() {
     assert_eq!(verify(&p).unwrap_err().kind, ErrorKind::BadPath("a path repeats a point"));
     assert_eq!(decode(&encode(&p)), Ok(valid()));
 }
+
+#[test]
+fn extreme_integers_are_refused_not_overflowed() {
+    // a path's first x of i64::MIN millimetres (zig-zag u64::MAX), a lane of i64::MIN
+    let mut pool = vec![0, 0, 1, 2];
+    pool.extend([0xff; 9]);
+    pool.extend([0x01, 0x00, 0x02, 0x00]);
+    let e = decode(&file(&pool, &[], &[])).unwrap_err();
+    assert!(matches!(e.kind, ErrorKind::OutOfRange { what: "a path coordinate", .. }), "{e}");
+    let (e, _) = rule(|p| {
+        if let Instr::Spawn { lane, .. } = &mut p.code[3] {
+            *lane = i64::MIN;
+        }
+    });
+    assert!(matches!(e.kind, ErrorKind::OutOfRange { what: "a spawn's lane", .. }), "{e}");
+    let (e, _) = rule(|p| p.code.push(Instr::ChangeLane { actor: 0, lanes: i64::MIN }));
+    assert!(matches!(e.kind, ErrorKind::OutOfRange { what: "a lane change", .. }), "{e}");
+    let (e, _) = rule(|p| {
+        if let Instr::Ego { lane, .. } = &mut p.code[2] {
+            *lane = i64::MIN;
+        }
+    });
+    assert!(matches!(e.kind, ErrorKind::OutOfRange { what: "the ego's lane", .. }), "{e}");
+}
+
+#[test]
+fn a_junctions_arms_are_a_set_in_order() {
+    let junction = |arms: Vec<Arm>| {
+        Instr::Road(Road {
+            shape: Shape::Junction { arms: arms.len() as u8, roundabout: false },
+            junction: Some(tad_layout::road::Junction {
+                arms,
+                roundabout: false,
+                half: 10.0,
+                signalised: false,
+                stop_signs: false,
+            }),
+            ..road()
+        })
+    };
+    // in memory only: the file stores a set, read back in order
+    let mut p = valid();
+    p.code[0] = junction(vec![Arm::Ego, Arm::Right, Arm::Left]);
+    let e = verify(&p).unwrap_err();
+    assert_eq!(e.kind, ErrorKind::Misplaced("a junction's arms repeat or are out of order"));
+    assert_eq!(e.to_string(), "instruction 0: a junction's arms repeat or are out of order");
+    let sorted = Program {
+        code: [vec![junction(vec![Arm::Ego, Arm::Left, Arm::Right])], p.code[1..].to_vec()].concat(),
+        ..p.clone()
+    };
+    assert_eq!(decode(&encode(&p)), Ok(sorted.clone()));
+    assert_eq!(decode(&encode(&sorted)), Ok(sorted));
+}
