@@ -156,10 +156,13 @@ pub fn lower(scenario: &Scenario, layout: &Layout, source: &str) -> Program {
         let Some(group) = scenario.group(gl.group) else { continue };
         let along_slot = b.along_slot(scenario, layout, gl, &group.name);
         let entry = group.actor_type.given().and_then(|t| scenario.entries.resolved(t));
-        let class = match group.actor_type.given() {
-            Some(t) => scenario.entries.name(t).to_string(),
-            None => crate::format::body_name(gl.facts.body).to_string(),
-        };
+        let class = group
+            .actor_type
+            .given()
+            .map(|t| scenario.entries.name(t))
+            .filter(|n| !n.is_empty())
+            .unwrap_or(crate::format::body_name(gl.facts.body))
+            .to_string();
         for agent in &gl.agents {
             let Ok(actor) = ActorId::try_from(scripts.len()) else { break 'groups };
             let height =

@@ -47,12 +47,10 @@ pub struct ParamSlot {
 pub struct Polyline(pub Vec<[f64; 2]>);
 
 impl Polyline {
-    /// The grid a stored point lies on, m: the `.tadc` format keeps whole millimetres.
-    pub const QUANTUM: f64 = 0.001;
     /// How far a dropped point may lie from the stored polyline, m.
     pub const TOLERANCE: f64 = 0.01;
 
-    /// The form the `.tadc` format stores: every point rounded to the millimetre, repeated
+    /// The form the `.tadc` format stores: every point rounded to whole millimetres, repeated
     /// points dropped, then every point within [`Polyline::TOLERANCE`] of the polyline
     /// through the points kept dropped (Douglas–Peucker; the ends are always kept).
     /// Idempotent: the canonical form of a canonical polyline is itself.
