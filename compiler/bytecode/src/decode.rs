@@ -4,7 +4,7 @@
 //! add up to the file, canonical varints, UTF-8, pool indices, opcodes and tags; every
 //! count is checked against the bytes left before anything is allocated for it, so a
 //! length field never makes the loader allocate more than the file's size. Then
-//! [`crate::verify`] checks the rules the runtime relies on, and its item (an
+//! [`crate::verify()`] checks the rules the runtime relies on, and its item (an
 //! instruction, a slot, a path) becomes the byte offset where that item starts.
 //! Nothing here panics, whatever the bytes.
 

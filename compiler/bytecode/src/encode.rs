@@ -4,7 +4,7 @@
 //! are met (strings and numbers once each, numbers compared bit for bit), then joined
 //! behind the header that gives their lengths. Paths are stored in their canonical form
 //! ([`Polyline::canonical`]): millimetre points as zig-zag deltas. The writer checks
-//! nothing: a program [`crate::verify`] rejects is written as it is, and the loader
+//! nothing: a program [`crate::verify()`] rejects is written as it is, and the loader
 //! rejects its bytes.
 
 use std::collections::HashMap;

@@ -1,7 +1,7 @@
 //! The rules a program keeps so that the runtime can index and divide without checks
 //! (`spec/bytecode.md` §6): every number finite and in its range, every slot, path and
 //! actor index valid, the set-up complete and before the behaviour. The loader runs them
-//! on every file; [`crate::lower`]'s programs keep them (its tests check).
+//! on every file; [`crate::lower()`]'s programs keep them (its tests check).
 
 use tad_layout::{Arm, Road, Shape};
 
