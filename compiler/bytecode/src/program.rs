@@ -46,6 +46,73 @@ pub struct ParamSlot {
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct Polyline(pub Vec<[f64; 2]>);
 
+impl Polyline {
+    /// How far a dropped point may lie from the stored polyline, m.
+    pub const TOLERANCE: f64 = 0.01;
+
+    /// The form the `.tadc` format stores: every point rounded to whole millimetres, repeated
+    /// points dropped, then every point within [`Polyline::TOLERANCE`] of the polyline
+    /// through the points kept dropped (Douglas–Peucker; the ends are always kept).
+    /// Idempotent: the canonical form of a canonical polyline is itself.
+    /// A polyline with a non-finite coordinate is returned as it is (it is invalid anyway).
+    pub fn canonical(&self) -> Polyline {
+        if self.0.iter().flatten().any(|v| !v.is_finite()) {
+            return self.clone();
+        }
+        let mut points: Vec<[f64; 2]> = Vec::with_capacity(self.0.len());
+        for p in &self.0 {
+            let q = [from_mm(to_mm(p[0])), from_mm(to_mm(p[1]))];
+            if points.last() != Some(&q) {
+                points.push(q);
+            }
+        }
+        if points.len() <= 2 {
+            return Polyline(points);
+        }
+        let mut keep = vec![false; points.len()];
+        keep[0] = true;
+        keep[points.len() - 1] = true;
+        let mut stack = vec![(0, points.len() - 1)];
+        while let Some((a, b)) = stack.pop() {
+            let far = (a + 1..b)
+                .map(|i| (i, segment_distance(points[i], points[a], points[b])))
+                .max_by(|x, y| x.1.total_cmp(&y.1));
+            if let Some((i, d)) = far
+                && d > Self::TOLERANCE
+            {
+                keep[i] = true;
+                stack.push((a, i));
+                stack.push((i, b));
+            }
+        }
+        Polyline(points.into_iter().zip(keep).filter(|(_, k)| *k).map(|(p, _)| p).collect())
+    }
+
+    /// Its length, m.
+    pub fn length(&self) -> f64 {
+        self.0.windows(2).map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1])).sum()
+    }
+}
+
+/// A coordinate in whole millimetres, as the format stores it (saturating; a non-finite
+/// one is `i64::MAX`, which the loader rejects as out of range).
+pub(crate) fn to_mm(v: f64) -> i64 {
+    if v.is_finite() { (v * 1000.0).round() as i64 } else { i64::MAX }
+}
+
+/// A coordinate from whole millimetres.
+pub(crate) fn from_mm(mm: i64) -> f64 {
+    mm as f64 / 1000.0
+}
+
+/// The distance from `p` to the segment `a`–`b`.
+fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let (abx, aby) = (b[0] - a[0], b[1] - a[1]);
+    let len2 = abx * abx + aby * aby;
+    let t = if len2 > 0.0 { (((p[0] - a[0]) * abx + (p[1] - a[1]) * aby) / len2).clamp(0.0, 1.0) } else { 0.0 };
+    (a[0] + abx * t - p[0]).hypot(a[1] + aby * t - p[1])
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Light {
     Off,
@@ -136,4 +203,38 @@ pub struct Program {
     pub params: Vec<ParamSlot>,
     pub paths: Vec<Polyline>,
     pub code: Vec<Instr>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_canonical_form_drops_collinear_points_keeps_corners_and_is_idempotent() {
+        // a straight run sampled every metre, a corner, a gentle arc
+        let mut points: Vec<[f64; 2]> = (0..=100).map(|x| [f64::from(x), 0.004 * f64::from(x % 2)]).collect();
+        points.extend((1..=50).map(|y| [100.0, f64::from(y)]));
+        points.extend((1..=90).map(|k| {
+            let a = f64::from(k).to_radians();
+            [100.0 - 20.0 + 20.0 * a.cos(), 50.0 + 20.0 * a.sin()]
+        }));
+        let line = Polyline(points.clone());
+        let c = line.canonical();
+        assert!(c.0.len() < 50 && points.len() > 200, "{} points kept", c.0.len());
+        assert_eq!(c.0.first(), Some(&[0.0, 0.0]));
+        assert!(c.0.contains(&[100.0, 0.0]), "the corner is kept");
+        assert_eq!(c.canonical(), c, "idempotent");
+        for p in &points {
+            let d = c.0.windows(2).map(|w| segment_distance(*p, w[0], w[1])).fold(f64::INFINITY, f64::min);
+            assert!(d <= Polyline::TOLERANCE + 0.001, "{p:?} is {d} m off");
+        }
+        for q in c.0.iter().flatten() {
+            assert_eq!(from_mm(to_mm(*q)), *q, "on the millimetre grid");
+        }
+        assert!((c.length() - line.length()).abs() < 0.1);
+        // repeated points go; a non-finite polyline is left as it is
+        assert_eq!(Polyline(vec![[1.0, 2.0], [1.0, 2.0], [1.0004, 2.0]]).canonical(), Polyline(vec![[1.0, 2.0]]));
+        let bad = Polyline(vec![[f64::NAN, 0.0], [1.0, 0.0], [2.0, 0.0]]);
+        assert_eq!(bad.canonical().0.len(), 3);
+    }
 }

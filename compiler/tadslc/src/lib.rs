@@ -5,6 +5,7 @@
 
 pub mod bench;
 pub mod build;
+pub mod bytecode;
 pub mod check;
 pub mod corpus;
 pub mod explain;

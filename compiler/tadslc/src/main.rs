@@ -67,7 +67,7 @@ enum Command {
         #[arg(long)]
         canonicalize: bool,
     },
-    /// Compile checked scenarios to Scenic 3 programs for a simulator
+    /// Compile checked scenarios to Scenic 3 programs for a simulator, or to bytecode
     Build {
         /// Scenario files or directories (searched recursively for *.tad)
         #[arg(required = true)]
@@ -75,7 +75,8 @@ enum Command {
         /// The target language
         #[arg(long, value_enum, default_value_t = Target::Scenic)]
         target: Target,
-        /// Output directory (default: standard output for a single file)
+        /// Output directory (default: standard output for a single file; required for
+        /// bytecode)
         #[arg(short, long)]
         output: Option<PathBuf>,
         /// Directory of the CARLA OpenDRIVE maps (`TownNN.xodr`); default: the map
@@ -114,6 +115,11 @@ enum Command {
         /// Where to write (default: standard output)
         #[arg(short, long)]
         output: Option<PathBuf>,
+    },
+    /// Print the listing of a bytecode program (`.tadc`), checking every byte
+    Disasm {
+        /// The `.tadc` file
+        path: PathBuf,
     },
     /// Explain a diagnostic code, e.g. `tadslc explain E0203`
     Explain {
@@ -220,7 +226,10 @@ enum ExportFormat {
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum Target {
+    /// Scenic 3 programs (`NAME.scenic`)
     Scenic,
+    /// Bytecode for the runtime (`NAME.tadc`, `spec/bytecode.md`)
+    Bytecode,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -263,6 +272,10 @@ fn main() -> ExitCode {
             },
             color,
         ),
+        Command::Build { paths, target: Target::Bytecode, output, map_dir, map, simulator: _ } => {
+            tadslc::bytecode::build(&paths, output.as_deref(), map_dir.is_some() || map.is_some(), color)
+        }
+        Command::Disasm { path } => tadslc::bytecode::disasm(&path),
         Command::Import { path, output } => tadslc::interchange::run_import(&path, output.as_deref(), color),
         Command::Export { format: ExportFormat::Yaml, yaml: _, path, output } => {
             tadslc::interchange::run_export(&path, output.as_deref(), color)

@@ -1,0 +1,144 @@
+//! `tadslc build --target bytecode` and `tadslc disasm` (`spec/output.md`, `spec/bytecode.md`).
+//!
+//! `build` checks each file as the Scenic target does (a file with errors is refused, its
+//! errors printed, status 1), lays the scenario out, lowers the layout to a program
+//! (`tad_bytecode::lower`) and writes `NAME.tadc` into the `-o` directory; the bytes are
+//! binary, so an output directory is required. `disasm` loads a `.tadc` file (every byte
+//! checked) and prints its listing; a file that does not load is status 1, with the
+//! loader's reason and byte offset.
+
+use std::path::{Path, PathBuf};
+
+use crate::files::{self, Search};
+use crate::output::Closed;
+use crate::{Status, err, errln, out, plural};
+use tad_check::Options;
+use tad_db::Database;
+use tad_diagnostics::render::{FileReport, human};
+
+/// `build --target bytecode`; `scenic_options`: a Scenic-only option (`--map`,
+/// `--map-dir`) was given.
+pub fn build(paths: &[PathBuf], out: Option<&Path>, scenic_options: bool, color: bool) -> Status {
+    crate::output::run(|status| build_in(paths, out, scenic_options, color, status))
+}
+
+fn build_in(
+    paths: &[PathBuf],
+    out: Option<&Path>,
+    scenic_options: bool,
+    color: bool,
+    status: &mut Status,
+) -> Result<(), Closed> {
+    if scenic_options {
+        *status = Status::Usage;
+        return errln!("error: `--map` and `--map-dir` are options of the scenic target");
+    }
+    let Some(dir) = out else {
+        *status = Status::Usage;
+        return errln!("error: the bytecode target writes binary files: give an output directory with -o");
+    };
+    let inputs = files::load(paths, Search::Tad, status)?;
+    if let Err(e) = std::fs::create_dir_all(dir) {
+        *status = Status::Usage;
+        return errln!("error: cannot create `{}`: {e}", dir.display());
+    }
+    let mut written: Vec<PathBuf> = Vec::new();
+    let mut db = Database::new(Options::default());
+    for input in &inputs {
+        let checked = crate::check::diagnose_in(&mut db, input);
+        if checked.diagnostics.iter().any(|d| d.is_error()) {
+            *status = (*status).max(Status::Failed);
+            let errors: Vec<_> = checked.diagnostics.iter().filter(|d| d.is_error()).cloned().collect();
+            err!("{}", human::render(&FileReport::new(&input.name, &input.text, &errors), color))?;
+            errln!("{}: not built: it has errors", input.name)?;
+            continue;
+        }
+        let file = crate::check::register(&mut db, input);
+        let Some(scenario) = tad_db::resolve(&db, file) else {
+            *status = (*status).max(Status::Failed);
+            let module = &tad_db::analyze(&db, file).module;
+            let diagnostics = tad_scenic::no_scenario(module).diagnostics;
+            err!("{}", human::render(&FileReport::new(&input.name, &input.text, &diagnostics), color))?;
+            errln!("{}: not built", input.name)?;
+            continue;
+        };
+        let layout = tad_layout::lay_out(scenario);
+        let program = tad_bytecode::lower(scenario, &layout, &input.name);
+        let bytes = tad_bytecode::encode(&program);
+        let stem = input
+            .path
+            .as_deref()
+            .and_then(Path::file_stem)
+            .map_or_else(|| "stdin".to_string(), |s| s.to_string_lossy().into_owned());
+        let target = dir.join(format!("{stem}.tadc"));
+        if written.contains(&target) {
+            *status = (*status).max(Status::Usage);
+            errln!("error: {} would overwrite `{}`, written for an earlier file", input.name, target.display())?;
+            continue;
+        }
+        if let Err(e) = std::fs::write(&target, &bytes) {
+            *status = (*status).max(Status::Usage);
+            errln!("error: cannot write `{}`: {e}", target.display())?;
+            continue;
+        }
+        let actors = program.code.iter().filter(|i| matches!(i, tad_bytecode::Instr::Spawn { .. })).count();
+        errln!(
+            "{}: wrote {} ({}, {}, {} bytes)",
+            input.name,
+            target.display(),
+            plural(actors, "actor"),
+            plural(program.code.len(), "instruction"),
+            bytes.len()
+        )?;
+        written.push(target);
+    }
+    Ok(())
+}
+
+/// `disasm FILE.tadc`: the listing on standard output.
+pub fn disasm(path: &Path) -> Status {
+    crate::output::run(|status| {
+        let bytes = match std::fs::read(path) {
+            Ok(bytes) => bytes,
+            Err(e) => {
+                *status = Status::Usage;
+                return errln!("error: cannot read `{}`: {e}", path.display());
+            }
+        };
+        match tad_bytecode::decode(&bytes) {
+            Ok(program) => out!("{}", tad_bytecode::disasm(&program)),
+            Err(e) => {
+                *status = Status::Failed;
+                errln!("error: {}: {e}", path.display())
+            }
+        }
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scratch(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("tadslc-bytecode-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    #[test]
+    fn builds_a_program_per_input_and_refuses_without_an_output_directory() {
+        let out = scratch("ok");
+        let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/safety/right_turn.tad");
+        assert_eq!(build(std::slice::from_ref(&example), Some(&out), false, false), Status::Ok);
+        let bytes = std::fs::read(out.join("right_turn.tadc")).unwrap();
+        let program = tad_bytecode::decode(&bytes).unwrap();
+        assert_eq!(program.name, "right_turn");
+        assert_eq!(disasm(&out.join("right_turn.tadc")), Status::Ok);
+        assert_eq!(build(std::slice::from_ref(&example), None, false, false), Status::Usage);
+        assert_eq!(build(std::slice::from_ref(&example), Some(&out), true, false), Status::Usage);
+        std::fs::write(out.join("bad.tadc"), b"TADC\x09\x00").unwrap();
+        assert_eq!(disasm(&out.join("bad.tadc")), Status::Failed);
+        assert_eq!(disasm(&out.join("missing.tadc")), Status::Usage);
+    }
+}
