@@ -45,25 +45,10 @@ fn build_in(
     let mut written: Vec<PathBuf> = Vec::new();
     let mut db = Database::new(Options::default());
     for input in &inputs {
-        let checked = crate::check::diagnose_in(&mut db, input);
-        if checked.diagnostics.iter().any(|d| d.is_error()) {
+        let Some(program) = compile(&mut db, input, "built", color)? else {
             *status = (*status).max(Status::Failed);
-            let errors: Vec<_> = checked.diagnostics.iter().filter(|d| d.is_error()).cloned().collect();
-            err!("{}", human::render(&FileReport::new(&input.name, &input.text, &errors), color))?;
-            errln!("{}: not built: it has errors", input.name)?;
-            continue;
-        }
-        let file = crate::check::register(&mut db, input);
-        let Some(scenario) = tad_db::resolve(&db, file) else {
-            *status = (*status).max(Status::Failed);
-            let module = &tad_db::analyze(&db, file).module;
-            let diagnostics = tad_scenic::no_scenario(module).diagnostics;
-            err!("{}", human::render(&FileReport::new(&input.name, &input.text, &diagnostics), color))?;
-            errln!("{}: not built", input.name)?;
             continue;
         };
-        let layout = tad_layout::lay_out(scenario);
-        let program = tad_bytecode::lower(scenario, &layout, &input.name);
         let bytes = tad_bytecode::encode(&program);
         let stem = input
             .path
@@ -93,6 +78,34 @@ fn build_in(
         written.push(target);
     }
     Ok(())
+}
+
+/// A scenario file's program: checked (errors printed, then `NAME: not VERB`), resolved,
+/// laid out and lowered; `None` when it has errors or holds no scenario. What `build
+/// --target bytecode` writes and `run` runs.
+pub fn compile(
+    db: &mut Database,
+    input: &files::Input,
+    verb: &str,
+    color: bool,
+) -> Result<Option<tad_bytecode::Program>, Closed> {
+    let checked = crate::check::diagnose_in(db, input);
+    if checked.diagnostics.iter().any(|d| d.is_error()) {
+        let errors: Vec<_> = checked.diagnostics.iter().filter(|d| d.is_error()).cloned().collect();
+        err!("{}", human::render(&FileReport::new(&input.name, &input.text, &errors), color))?;
+        errln!("{}: not {verb}: it has errors", input.name)?;
+        return Ok(None);
+    }
+    let file = crate::check::register(db, input);
+    let Some(scenario) = tad_db::resolve(db, file) else {
+        let module = &tad_db::analyze(db, file).module;
+        let diagnostics = tad_scenic::no_scenario(module).diagnostics;
+        err!("{}", human::render(&FileReport::new(&input.name, &input.text, &diagnostics), color))?;
+        errln!("{}: not {verb}", input.name)?;
+        return Ok(None);
+    };
+    let layout = tad_layout::lay_out(scenario);
+    Ok(Some(tad_bytecode::lower(scenario, &layout, &input.name)))
 }
 
 /// `disasm FILE.tadc`: the listing on standard output.

@@ -14,6 +14,7 @@ pub mod fmt;
 pub mod interchange;
 pub mod manual;
 pub mod output;
+pub mod run;
 
 /// Output format of `check`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]

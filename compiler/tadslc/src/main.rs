@@ -116,6 +116,37 @@ enum Command {
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
+    /// Run scenarios in the runtime against ego policies and print SafeBench's metrics
+    ///
+    /// Scenario files are compiled in memory; `.tadc` files are loaded. Each file, ego and
+    /// seed is one episode, its parameters sampled from the seed.
+    Run {
+        /// Scenario files or directories (searched recursively for *.tad and *.yaml), or
+        /// `.tadc` bytecode files
+        #[arg(required = true)]
+        paths: Vec<PathBuf>,
+        /// The ego policies, comma-separated or repeated: `idm`, `naive`, `learned:PATH`
+        /// (a SafeBench SAC actor in safetensors)
+        #[arg(long, value_delimiter = ',', default_values_t = ["idm".to_string(), "naive".to_string()])]
+        ego: Vec<String>,
+        /// Seeds `A..B` (B excluded, as in Rust) or one seed `A`
+        #[arg(long, default_value = "0..3", value_parser = tadslc::run::parse_seeds)]
+        seeds: std::ops::Range<u64>,
+        /// Output format: a table for people, or JSON lines (one object per episode, then
+        /// one aggregate object per ego)
+        #[arg(long, value_enum, default_value_t = tadslc::run::RunFormat::Table)]
+        format: tadslc::run::RunFormat,
+        /// Write every actor's pose at every step as JSON lines
+        #[arg(long, value_name = "FILE")]
+        trace: Option<PathBuf>,
+        /// Draw the first episode: `.svg` (a figure) or `.gif` (an animation)
+        #[arg(long, value_name = "FILE")]
+        render: Option<PathBuf>,
+        /// Score as SafeBench's scorer does, quirks included (TS 0 when nothing completes,
+        /// yaw not unwrapped, off-road never ends an episode)
+        #[arg(long)]
+        compat: bool,
+    },
     /// Print the listing of a bytecode program (`.tadc`), checking every byte
     Disasm {
         /// The `.tadc` file
@@ -276,6 +307,10 @@ fn main() -> ExitCode {
             tadslc::bytecode::build(&paths, output.as_deref(), map_dir.is_some() || map.is_some(), color)
         }
         Command::Disasm { path } => tadslc::bytecode::disasm(&path),
+        Command::Run { paths, ego, seeds, format, trace, render, compat } => tadslc::run::run(
+            &tadslc::run::RunArgs { paths, egos: ego, seeds, format, trace, render, compat },
+            color,
+        ),
         Command::Import { path, output } => tadslc::interchange::run_import(&path, output.as_deref(), color),
         Command::Export { format: ExportFormat::Yaml, yaml: _, path, output } => {
             tadslc::interchange::run_export(&path, output.as_deref(), color)

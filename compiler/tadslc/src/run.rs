@@ -13,12 +13,10 @@ use std::path::{Path, PathBuf};
 
 use crate::files::{self, Search};
 use crate::output::Closed;
-use crate::{Status, err, errln, out, outln, plural};
-use tad_bytecode::Program;
+use crate::{Status, errln, out, outln};
 use tad_check::Options as CheckOptions;
 use tad_db::Database;
-use tad_diagnostics::render::{FileReport, human};
-use tad_metrics::{Mode, StepRecord};
+use tad_metrics::Mode;
 use tad_runtime::{Episode, Options, Scene};
 
 /// What `run` prints.
@@ -61,25 +59,6 @@ pub struct Loaded {
     pub scene: Scene,
 }
 
-/// Compile a checked scenario to its program: resolve, lay out, lower. `None` (with the
-/// errors printed) when it has errors.
-pub fn compile(db: &mut Database, input: &files::Input, color: bool) -> Result<Option<Program>, Closed> {
-    let checked = crate::check::diagnose_in(db, input);
-    if checked.diagnostics.iter().any(|d| d.is_error()) {
-        let errors: Vec<_> = checked.diagnostics.iter().filter(|d| d.is_error()).cloned().collect();
-        err!("{}", human::render(&FileReport::new(&input.name, &input.text, &errors), color))?;
-        errln!("{}: not run: it has errors", input.name)?;
-        return Ok(None);
-    }
-    let file = crate::check::register(db, input);
-    let Some(scenario) = tad_db::resolve(db, file) else {
-        errln!("{}: not run: it holds no scenario", input.name)?;
-        return Ok(None);
-    };
-    let layout = tad_layout::lay_out(&scenario);
-    Ok(Some(tad_bytecode::lower(&scenario, &layout, &input.name)))
-}
-
 /// Every input as a scene: sources compiled, `.tadc` files loaded.
 pub fn load(paths: &[PathBuf], color: bool, status: &mut Status) -> Result<Vec<Loaded>, Closed> {
     let (bytecode, sources): (Vec<PathBuf>, Vec<PathBuf>) =
@@ -88,7 +67,7 @@ pub fn load(paths: &[PathBuf], color: bool, status: &mut Status) -> Result<Vec<L
     let mut db = Database::new(CheckOptions::default());
     if !sources.is_empty() {
         for input in files::load(&sources, Search::Scenarios, status)? {
-            let Some(program) = compile(&mut db, &input, color)? else {
+            let Some(program) = crate::bytecode::compile(&mut db, &input, "run", color)? else {
                 *status = (*status).max(Status::Failed);
                 continue;
             };
@@ -148,7 +127,7 @@ fn run_in(args: &RunArgs, color: bool, status: &mut Status) -> Result<(), Closed
     }
     let mode = if args.compat { Mode::Compat } else { Mode::Fixed };
     let keep_frames = args.trace.is_some() || args.render.is_some();
-    let opts = Options { compat: args.compat, keep_frames, ..Options::default() };
+    let opts = Options { mode, keep_frames, ..Options::default() };
     let total = scenes.len() * policies.len() * (args.seeds.end - args.seeds.start) as usize;
     let progress = Progress::new(total);
     let mut trace = match &args.trace {
@@ -167,7 +146,7 @@ fn run_in(args: &RunArgs, color: bool, status: &mut Status) -> Result<(), Closed
             for seed in args.seeds.clone() {
                 let params = tad_runtime::sample::sample(&loaded.scene.program.params, Some(seed));
                 let episode = tad_runtime::run(&loaded.scene, Some(seed), params, policy.as_mut(), &opts);
-                let score = tad_metrics::score_episode(&episode.records, mode);
+                let Ok(score) = tad_metrics::score_episode(&episode.records, mode) else { continue };
                 if let Some(w) = trace.as_mut()
                     && let Err(err) = write_trace(w, &loaded.name, policy.name(), &loaded.scene, &episode)
                 {
@@ -197,15 +176,20 @@ fn run_in(args: &RunArgs, color: bool, status: &mut Status) -> Result<(), Closed
     match args.format {
         RunFormat::Json => {
             for (e, name) in names.iter().enumerate() {
-                let records: Vec<&[StepRecord]> =
-                    done.iter().filter(|d| d.ego == e).map(|d| d.episode.records.as_slice()).collect();
-                let agg = tad_metrics::aggregate(&records, mode);
+                let scores: Vec<tad_metrics::EpisodeScore> =
+                    done.iter().filter(|d| d.ego == e).map(|d| d.score.clone()).collect();
+                let Ok(agg) = tad_metrics::aggregate(&scores, mode) else { continue };
                 let value = serde_json::json!({
                     "aggregate": true,
                     "ego": name,
-                    "episodes": records.len(),
-                    "metrics": agg.metrics,
+                    "episodes": agg.episodes,
+                    "completed": agg.completed,
+                    "mode": mode.as_str(),
+                    "metrics": agg.raw,
                     "normalised": agg.normalised,
+                    "safety": agg.safety,
+                    "task": agg.task,
+                    "comfort": agg.comfort,
                 });
                 outln!("{value}")?;
             }
@@ -401,11 +385,4 @@ impl Progress {
             bar.finish_and_clear();
         }
     }
-}
-
-#[allow(dead_code)]
-fn unused() -> Result<(), Closed> {
-    out!("")?;
-    let _ = plural(1, "x");
-    Ok(())
 }
