@@ -460,7 +460,7 @@ fn leader_of(scene: &Scene, actors: &[Actor], k: usize, before: &[(Vec2, f64, f6
         (p, yaw, v, a.length, a.width)
     });
     let ego_entry = me.obey.then_some((ego.position, ego.yaw, ego.speed, scene.ego.size.length, scene.ego.size.width));
-    let mut best = ahead_on(track, me.kin.position, me.kin.yaw, me.s, me.length, me.width, others.chain(ego_entry));
+    let mut best = ahead_on(track, me.kin.position, me.kin.yaw, me.s, me.length, me.width, me.kin.speed, me.obey, others.chain(ego_entry));
     if me.obey
         && let Some((line, arm)) = me.stop_line
     {
@@ -483,7 +483,14 @@ fn must_stop(scene: &Scene, arm: Arm, gap: f64, speed: f64, t: f64, stopped_at_s
     }
 }
 
-/// The nearest of `others` ahead on `track` within a vehicle's corridor.
+/// The nearest of `others` ahead on `track` within a vehicle's corridor: `(gap, speed
+/// along)`. Something going its way (or against it) counts where it is; something moving
+/// across counts only if, going on straight at its speed, it will be in the corridor when
+/// this vehicle (at `speed`, at least 1 m/s) gets there, within [`CROSS_HORIZON`] s, and then
+/// as standing where they meet: crossing traffic that will have gone is no obstacle, and
+/// one about to cross is one before it arrives. One that does not `yield` (an adversary)
+/// only stops for crossing traffic already in front of it.
+#[allow(clippy::too_many_arguments)]
 fn ahead_on(
     track: &Track,
     position: Vec2,
@@ -491,32 +498,73 @@ fn ahead_on(
     s: f64,
     length: f64,
     width: f64,
+    speed: f64,
+    yields: bool,
     others: impl Iterator<Item = (Vec2, f64, f64, f64, f64)>,
 ) -> Option<(f64, f64)> {
     let heading = Vec2::from_yaw(yaw);
     let mut best: Option<(f64, f64)> = None;
+    let mut keep = |gap: f64, along: f64| {
+        if best.is_none_or(|(g, _)| gap < g) {
+            best = Some((gap, along));
+        }
+    };
     for (p, other_yaw, v, l, w) in others {
         let d = p - position;
-        let ahead = d.dot(heading);
-        if ahead <= 0.0 || d.length() > LOOK {
+        if d.length() > LOOK {
             continue;
         }
-        let (sj, lat) = track.locate(p, s + ahead, 8.0);
-        if sj <= s {
+        let crossing = v > 0.3 && Vec2::from_yaw(other_yaw).dot(heading).abs() < 0.7;
+        if !crossing {
+            if d.dot(heading) <= 0.0 {
+                continue;
+            }
+            if let Some((gap, rel)) = in_corridor(track, s, length, width, p, other_yaw, l, w, d.dot(heading)) {
+                keep(gap, (v * rel.cos()).max(0.0));
+            }
             continue;
         }
-        let rel = wrap(other_yaw - track.pose(sj).yaw);
-        let (c, sn) = (rel.cos().abs(), rel.sin().abs());
-        if lat.abs() > width / 2.0 + sn * l / 2.0 + c * w / 2.0 + 0.3 {
-            continue;
-        }
-        let gap = sj - s - length / 2.0 - (c * l / 2.0 + sn * w / 2.0);
-        let speed = (v * rel.cos()).max(0.0);
-        if best.is_none_or(|(g, _)| gap < g) {
-            best = Some((gap, speed));
+        let velocity = Vec2::from_yaw(other_yaw) * v;
+        let samples = if yields { CROSS_SAMPLES } else { 0 };
+        for k in 0..=samples {
+            let tau = CROSS_HORIZON * k as f64 / CROSS_SAMPLES as f64;
+            let q = p + velocity * tau;
+            let ahead = (q - position).dot(heading);
+            if ahead <= 0.0 {
+                continue;
+            }
+            if let Some((gap, _)) = in_corridor(track, s, length, width, q, other_yaw, l, w, ahead) {
+                let arrive = gap.max(0.0) / speed.max(1.0);
+                if (arrive - tau).abs() <= CROSS_MARGIN || (k == 0 && gap < 3.0) {
+                    keep(gap, 0.0);
+                    break;
+                }
+            }
         }
     }
     best
+}
+
+/// How far ahead crossing traffic is predicted, s, in how many steps, and how near in time
+/// its passage and this vehicle's arrival must be to count.
+const CROSS_HORIZON: f64 = 4.0;
+const CROSS_SAMPLES: usize = 8;
+const CROSS_MARGIN: f64 = 1.5;
+
+/// Whether a box at `p` reaches into the corridor of a vehicle at arc `s` of `track`: the
+/// bumper gap and the box's heading relative to the track there.
+#[allow(clippy::too_many_arguments)]
+fn in_corridor(track: &Track, s: f64, length: f64, width: f64, p: Vec2, yaw: f64, l: f64, w: f64, ahead: f64) -> Option<(f64, f64)> {
+    let (sj, lat) = track.locate(p, s + ahead, 8.0);
+    if sj <= s {
+        return None;
+    }
+    let rel = wrap(yaw - track.pose(sj).yaw);
+    let (c, sn) = (rel.cos().abs(), rel.sin().abs());
+    if lat.abs() > width / 2.0 + sn * l / 2.0 + c * w / 2.0 + 0.3 {
+        return None;
+    }
+    Some((sj - s - length / 2.0 - (c * l / 2.0 + sn * w / 2.0), rel))
 }
 
 /// MOBIL (Kesting, Treiber and Helbing 2007) with politeness 0: change to a neighbouring lane
@@ -529,7 +577,7 @@ fn mobil(scene: &Scene, actors: &mut [Actor], k: usize, before: &[(Vec2, f64, f6
         let Some(track) = &me.track else { return };
         let others = before.iter().enumerate().filter(|(j, _)| *j != k).map(|(j, &(p, y, v))| (p, y, v, actors[j].length, actors[j].width));
         let ego_entry = std::iter::once((ego.position, ego.yaw, ego.speed, scene.ego.size.length, scene.ego.size.width));
-        IdmParams::default().accel(me.kin.speed, me.target, ahead_on(track, me.kin.position, me.kin.yaw, me.s, me.length, me.width, others.chain(ego_entry)))
+        IdmParams::default().accel(me.kin.speed, me.target, ahead_on(track, me.kin.position, me.kin.yaw, me.s, me.length, me.width, me.kin.speed, me.obey, others.chain(ego_entry)))
     };
     let mut choice: Option<(i64, f64)> = None;
     for dir in [-1, 1] {
@@ -544,10 +592,10 @@ fn mobil(scene: &Scene, actors: &mut [Actor], k: usize, before: &[(Vec2, f64, f6
             .map(|(j, &(p, y, v))| (p, y, v, actors[j].length, actors[j].width))
             .chain(std::iter::once((ego.position, ego.yaw, ego.speed, scene.ego.size.length, scene.ego.size.width)))
             .collect();
-        let then = IdmParams::default().accel(me.kin.speed, me.target, ahead_on(&track, me.kin.position, me.kin.yaw, s, me.length, me.width, entries.iter().copied()));
+        let then = IdmParams::default().accel(me.kin.speed, me.target, ahead_on(&track, me.kin.position, me.kin.yaw, s, me.length, me.width, me.kin.speed, me.obey, entries.iter().copied()));
         // the new follower: the nearest behind in the target lane, with this vehicle ahead of it
         let back = me.kin.yaw + std::f64::consts::PI;
-        let behind = ahead_on(&track, me.kin.position, back, s, me.length, me.width, entries.iter().map(|&(p, y, v, l, w)| (p, y + std::f64::consts::PI, v, l, w)));
+        let behind = ahead_on(&track, me.kin.position, back, s, me.length, me.width, me.kin.speed, me.obey, entries.iter().map(|&(p, y, v, l, w)| (p, y + std::f64::consts::PI, v, l, w)));
         let safe = behind.is_none_or(|(gap, speed_back)| IdmParams::default().accel(speed_back, speed_back.max(me.target), Some((gap, me.kin.speed))) >= -SAFE && gap > 1.0);
         if safe && then - now > GAIN && choice.is_none_or(|(_, g)| then - now > g) {
             choice = Some((dir, then - now));
@@ -592,7 +640,7 @@ fn ego_view(
     let lookahead = models::lookahead(ego.speed);
     let target = Pose { position: ego.position, yaw: ego.yaw }.local(route.pose(s + lookahead).position);
     let others = before.iter().zip(actors).map(|(&(p, yaw, v), a)| (p, yaw, v, a.length, a.width));
-    let leader = ahead_on(route, ego.position, ego.yaw, s, size.length, size.width, others);
+    let leader = ahead_on(route, ego.position, ego.yaw, s, size.length, size.width, ego.speed, true, others);
     let stop = stop_line.and_then(|line| {
         let gap = line - (s + size.length / 2.0);
         (gap > -0.5 && must_stop(scene, Arm::Ego, gap, ego.speed, t, detectors.stopped_at_sign())).then_some(gap.max(0.0))
