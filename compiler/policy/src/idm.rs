@@ -56,7 +56,7 @@ impl IdmParams {
 }
 
 /// Rule-based ego with full state: pure pursuit on the route and IDM towards the desired
-/// speed behind the leader; a stop point (`EgoView::stop`) is a standing leader, so it
+/// speed (capped by the route's curves) behind the leader; a stop point (`EgoView::stop`) is a standing leader, so it
 /// stops about `s0` short of it. At a stop sign the runtime clears `stop` once the ego
 /// has stood; then it drives on. It never brakes into reverse.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -71,7 +71,7 @@ impl EgoPolicy for Idm {
 
     fn act(&mut self, view: &EgoView) -> Action {
         let obstacles = view.leader.into_iter().chain(view.stop.map(|d| (d, 0.0)));
-        let accel = self.params.accel(view.speed, view.desired_speed, obstacles);
+        let accel = self.params.accel(view.speed, view.desired_speed.min(view.curve_speed), obstacles);
         Action { accel: no_reverse(accel, view), steer: pure_pursuit(view.target, view.wheelbase) }
     }
 }

@@ -90,6 +90,9 @@ pub struct EgoView {
     /// Distance from the ego's front to where it must stop (a stop line whose light is red
     /// or yellow, a stop sign it has not stopped at yet), m.
     pub stop: Option<f64>,
+    /// The highest speed at which the route ahead can be driven at a comfortable lateral
+    /// acceleration, m/s (infinite where it is straight).
+    pub curve_speed: f64,
     /// Step length, s.
     pub dt: f64,
 }

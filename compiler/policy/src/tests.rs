@@ -17,6 +17,7 @@ fn view(speed: f64, desired_speed: f64) -> EgoView {
         wheelbase: 2.9,
         leader: None,
         stop: None,
+        curve_speed: f64::INFINITY,
         dt: 0.1,
     }
 }

@@ -432,7 +432,7 @@ fn move_actor(scene: &Scene, actors: &mut [Actor], k: usize, before: &[(Vec2, f6
             let (s, _) = track.locate(a.kin.position, a.s, 8.0);
             a.s = s;
             let wheel = pursue(track, s, a.kin.pose(), a.kin.speed, a.wheelbase);
-            let accel = if a.stopping { -(a.kin.speed / dt).min(4.0) } else { IdmParams::default().accel(a.kin.speed, a.target, leader) };
+            let accel = if a.stopping { -(a.kin.speed / dt).min(4.0) } else { IdmParams::default().accel(a.kin.speed, a.target.min(models::curve_speed(track, s, a.kin.speed)), leader) };
             a.kin.bicycle(a.wheelbase, wheel, accel, dt);
             // a stop sign is passed once it has stood at it
             if let Some((line, _)) = a.stop_line
@@ -520,7 +520,13 @@ fn ahead_on(
                 continue;
             }
             if let Some((gap, rel)) = in_corridor(track, s, length, width, p, other_yaw, l, w, d.dot(heading)) {
-                keep(gap, (v * rel.cos()).max(0.0));
+                let along = v * rel.cos();
+                if along >= 0.0 {
+                    keep(gap, along);
+                } else {
+                    // oncoming: a standing obstacle where the two would meet
+                    keep(gap * speed.max(1.0) / (speed.max(1.0) - along), 0.0);
+                }
             }
             continue;
         }
@@ -655,6 +661,7 @@ fn ego_view(
         wheelbase: WHEELBASE * size.length,
         leader,
         stop,
+        curve_speed: models::curve_speed(route, s, ego.speed),
         dt: scene.limits.dt,
     }
 }

@@ -45,9 +45,27 @@ pub fn pursue(track: &Track, s: f64, pose: Pose, speed: f64, wheelbase: f64) -> 
     (wheelbase * curvature).atan().clamp(-0.7, 0.7)
 }
 
+/// Lateral acceleration drivers keep to in curves, m/s².
+pub const LATERAL_ACCEL: f64 = 2.5;
+
+/// The highest speed for the track ahead of arc `s`: over the distance covered in 3 s (at
+/// least 15 m), `sqrt(LATERAL_ACCEL / κ)` of its sharpest curvature κ, measured as the
+/// heading's change over 2 m; infinite where it is straight.
+pub fn curve_speed(track: &Track, s: f64, speed: f64) -> f64 {
+    let reach = (3.0 * speed).max(15.0);
+    let mut sharpest: f64 = 0.0;
+    let mut x = s;
+    while x < s + reach {
+        let turn = tad_layout::geom::wrap(track.pose(x + 2.0).yaw - track.pose(x).yaw).abs() / 2.0;
+        sharpest = sharpest.max(turn);
+        x += 1.0;
+    }
+    if sharpest < 1e-4 { f64::INFINITY } else { (LATERAL_ACCEL / sharpest).sqrt() }
+}
+
 /// How far ahead pure pursuit aims, m.
 pub fn lookahead(speed: f64) -> f64 {
-    (0.6 * speed + 3.0).clamp(4.0, 20.0)
+    (0.5 * speed + 2.5).clamp(3.5, 20.0)
 }
 
 #[cfg(test)]
