@@ -172,3 +172,78 @@ fn the_same_seed_gives_the_same_episode() {
     let other = run(&scene, Some(4), tad_runtime::sample::sample(&p.params, Some(4)), &mut Blind, &opts);
     assert_ne!(one.frames[0].poses[1], other.frames[0].poses[1], "the parked car's place is sampled");
 }
+
+fn junction(signalised: bool) -> Road {
+    Road {
+        shape: Shape::Junction { arms: 4, roundabout: false },
+        cross_lanes: 1,
+        junction: Some(tad_layout::road::Junction {
+            arms: Arm::ALL.to_vec(),
+            roundabout: false,
+            half: 8.0,
+            signalised,
+            stop_signs: !signalised,
+        }),
+        approach: 30.0,
+        ..straight()
+    }
+}
+
+fn policy(name: &str) -> Box<dyn EgoPolicy> {
+    tad_policy::parse_policy(name).unwrap()
+}
+
+#[test]
+fn naive_runs_the_red_light_and_idm_waits() {
+    let red = vec![tad_bytecode::Phase { light: tad_bytecode::Light::Red, seconds: 60.0 }];
+    let p = program(junction(true), 10.0, vec![Instr::Signal { arm: Arm::Ego, phases: red }]);
+    let scene = Scene::new(&p).unwrap();
+    let e = run(&scene, None, vec![], policy("naive").as_mut(), &Options::default());
+    assert_eq!(e.records.last().unwrap().run_red_light, 1, "one light, counted once");
+    assert!(e.events.iter().any(|ev| ev.kind == tad_runtime::EventKind::RedLight));
+    let e = run(&scene, None, vec![], policy("idm").as_mut(), &Options::default());
+    let last = e.records.last().unwrap();
+    assert_eq!(last.run_red_light, 0);
+    assert_eq!(e.stop_reason, StopReason::MaxSteps, "it waits at the line for the whole episode");
+    // the ego's front stands before the stop line at x = 30
+    assert!(last.position[0] + 2.25 < 30.0 && last.position[0] > 20.0, "stopped at {:.1}", last.position[0]);
+}
+
+#[test]
+fn naive_runs_the_stop_sign_and_idm_stops_then_goes() {
+    let scene = Scene::new(&program(junction(false), 10.0, vec![])).unwrap();
+    let e = run(&scene, None, vec![], policy("naive").as_mut(), &Options::default());
+    assert_eq!(e.records.last().unwrap().run_stop, 1);
+    let e = run(&scene, None, vec![], policy("idm").as_mut(), &Options::default());
+    let last = e.records.last().unwrap();
+    assert_eq!(last.run_stop, 0);
+    assert!(e.records.iter().any(|r| r.velocity < 0.1), "it stood");
+    assert_eq!(e.stop_reason, StopReason::RouteComplete, "then drove on");
+}
+
+#[test]
+fn naive_rear_ends_a_standing_car_and_idm_does_not() {
+    let scene = Scene::new(&program(straight(), 12.0, vec![parked(0, 50.0, 1)])).unwrap();
+    let e = run(&scene, None, vec![], policy("naive").as_mut(), &Options::default());
+    assert_eq!(e.stop_reason, StopReason::Collision);
+    let e = run(&scene, None, vec![], policy("idm").as_mut(), &Options::default());
+    assert!(e.records.iter().all(|r| !r.collision));
+    let last = e.records.last().unwrap();
+    assert!(last.velocity < 0.1 && last.position[0] > 40.0, "waits behind it at {:.1}", last.position[0]);
+}
+
+#[test]
+fn metrics_of_a_free_run_are_the_hand_computed_ones() {
+    // 10 m/s on a straight road, 100 m of route: complete after 99.5 m, no acceleration,
+    // no yaw change, on the route
+    let scene = Scene::new(&program(straight(), 10.0, vec![])).unwrap();
+    let e = run(&scene, None, vec![], policy("naive").as_mut(), &Options::default());
+    let score = tad_metrics::score_episode(&e.records, tad_metrics::Mode::Fixed).unwrap();
+    let m = score.metrics;
+    assert_eq!((m.cr, m.rr, m.ss, m.or, m.li), (0.0, 0.0, 0.0, 0.0, 0.0));
+    assert_eq!(m.comp, 1.0);
+    assert!(m.acc.abs() < 1e-9 && m.yv.abs() < 1e-9 && (m.rf - 1.0).abs() < 1e-6);
+    // first record at t = 0.1, the last when the route completes: 99.5 m at 10 m/s
+    let ts = m.ts.unwrap();
+    assert!((ts - (e.records.last().unwrap().time - 0.1)).abs() < 1e-9 && (ts - 9.9).abs() < 0.15, "TS {ts}");
+}
