@@ -18,7 +18,7 @@ use tad_layout::geom::{Footprint, Pose, Vec2, wrap};
 use tad_layout::road::Station;
 use tad_layout::{Arm, Body, Facing, Turn};
 use tad_metrics::{Mode, StepRecord, StopReason};
-use tad_policy::{ACCEL_MAX, ACCEL_MIN, Action, EgoPolicy, EgoView, IdmParams, MAX_WHEEL_ANGLE};
+use tad_policy::{ACCEL_MAX, ACCEL_MIN, Action, EgoPolicy, EgoView, IdmParams, MAX_WHEEL_ANGLE, Preview};
 
 /// How an episode runs.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -149,6 +149,7 @@ pub fn run(scene: &Scene, seed: Option<u64>, params: Vec<f64>, policy: &mut dyn 
     let mut poses: Vec<(f64, f64, f64)> = Vec::with_capacity(shapes.len());
     let mut hits = Vec::new();
     policy.reset();
+    let mut preview = Preview::default();
 
     let mut records = Vec::with_capacity(scene.limits.max_steps as usize);
     let mut events = Vec::new();
@@ -190,7 +191,7 @@ pub fn run(scene: &Scene, seed: Option<u64>, params: Vec<f64>, policy: &mut dyn 
         // the ego's policy
         let (s_now, off_route) = route.locate(ego.position, ego_s, 10.0);
         ego_s = s_now;
-        let view = ego_view(scene, &ego, ego_s, off_route, desired, &actors, &before, t, ego_stop, &detectors);
+        let view = ego_view(scene, &ego, ego_s, off_route, desired, &actors, &before, t, ego_stop, &detectors, &mut preview);
         let action: Action = policy.act(&view);
         let accel = if action.accel.is_finite() { action.accel.clamp(ACCEL_MIN, ACCEL_MAX) } else { 0.0 };
         let steer = if action.steer.is_finite() { action.steer.clamp(-1.0, 1.0) } else { 0.0 };
@@ -625,15 +626,20 @@ fn ego_view(
     t: f64,
     stop_line: Option<f64>,
     detectors: &Detectors,
+    preview: &mut Preview,
 ) -> EgoView {
     let route = &scene.ego.route;
     let size = scene.ego.size;
     let heading = Vec2::from_yaw(ego.yaw);
-    // the route planner's waypoint two ahead, at 5 m spacing
-    let wp = route.pose(s + 10.0);
-    let w = Vec2::from_yaw(wp.yaw);
-    let lateral_dis = -w.cross(ego.position - wp.position);
-    let minus_delta_yaw = w.cross(heading).clamp(-1.0, 1.0).asin();
+    let i = preview.step(&scene.preview, [ego.position.x, ego.position.y]).unwrap_or(0);
+    let point = scene.preview.get(i).copied().unwrap_or([ego.position.x, ego.position.y]);
+    let [lateral_dis, minus_delta_yaw, _] = tad_policy::observation(
+        [ego.position.x, ego.position.y],
+        ego.yaw,
+        point,
+        scene.preview_yaw.get(i).copied().unwrap_or(ego.yaw),
+        ego.speed,
+    );
     let ego_lane = scene.world.spot(ego.position);
     let front = before.iter().zip(actors).any(|(&(p, yaw, _), a)| {
         a.body == Body::Vehicle

@@ -74,6 +74,10 @@ pub struct Scene {
     pub ego: EgoSetup,
     pub actors: Vec<ActorSetup>,
     pub paths: Vec<Track>,
+    /// SafeBench's route points for the observation (`tad_policy`'s header): every metre
+    /// of the route, then 12 more at 5 m past its end; positions and headings.
+    pub preview: Vec<[f64; 2]>,
+    pub preview_yaw: Vec<f64>,
 }
 
 impl Scene {
@@ -167,7 +171,13 @@ impl Scene {
         }
         let Some(road) = road else { return err("the program sets up no road".into()) };
         let Some(ego) = ego else { return err("the program has no ego".into()) };
+        let mut arcs: Vec<f64> = (0..=ego.route_length.max(0.0).floor() as usize).map(|k| ego.start + k as f64).collect();
+        let end = ego.start + ego.route_length.max(0.0);
+        arcs.extend((1..=12).map(|k| end + 5.0 * f64::from(k)));
+        let poses: Vec<Pose> = arcs.iter().map(|&a| ego.route.pose(a)).collect();
         Ok(Scene {
+            preview: poses.iter().map(|p| [p.position.x, p.position.y]).collect(),
+            preview_yaw: poses.iter().map(|p| p.yaw).collect(),
             name: program.name.clone(),
             source: program.source.clone(),
             program: program.clone(),
