@@ -109,12 +109,14 @@ impl Detectors {
         let mut sign = false;
         if let Some(line) = self.stop_line {
             let rear = s - 0.4 * ego.length;
-            if !self.red_counted && rear >= line && rear - speed * 0.1 - 1.0 < line {
-                if world.light(tad_layout::Arm::Ego, t) == Light::Red {
-                    red = true;
-                    self.red_counted = true;
-                    self.red_lights += 1;
-                }
+            if !self.red_counted
+                && rear >= line
+                && rear - speed * 0.1 - 1.0 < line
+                && world.light(tad_layout::Arm::Ego, t) == Light::Red
+            {
+                red = true;
+                self.red_counted = true;
+                self.red_lights += 1;
             }
             if world.stop_signs() {
                 let inside = s >= line - STOP_BOX && s < line;

@@ -138,13 +138,18 @@ pub fn run(scene: &Scene, seed: Option<u64>, params: Vec<f64>, policy: &mut dyn 
     let start = scene.ego_pose();
     let mut ego = Kinematics { position: start.position, yaw: start.yaw, speed: desired };
     let mut ego_s = scene.ego.start;
-    let ego_stop = world.stop_line(Arm::Ego, scene.ego.lane).map(|p| route.locate(p, ego_s, 400.0)).and_then(
-        |(s, d)| (d.abs() < world.road.lane_width).then_some(s),
-    );
+    let ego_stop = world
+        .stop_line(Arm::Ego, scene.ego.lane)
+        .map(|p| route.locate(p, ego_s, 400.0))
+        .and_then(|(s, d)| (d.abs() < world.road.lane_width).then_some(s));
     let mut detectors = Detectors::new(route, scene.ego.start, scene.ego.route_length, ego_stop);
     let mut actors: Vec<Actor> = scene.actors.iter().map(|a| spawn(scene, a, &params)).collect();
     let mut shapes = vec![Shape { length: ego_size.length, width: ego_size.width, height: ego_size.height }];
-    shapes.extend(scene.actors.iter().map(|a| Shape { length: a.size.length, width: a.size.width, height: a.size.height }));
+    shapes.extend(scene.actors.iter().map(|a| Shape {
+        length: a.size.length,
+        width: a.size.width,
+        height: a.size.height,
+    }));
     let mut physics = Physics::new(&shapes);
     let mut poses: Vec<(f64, f64, f64)> = Vec::with_capacity(shapes.len());
     let mut hits = Vec::new();
@@ -180,18 +185,18 @@ pub fn run(scene: &Scene, seed: Option<u64>, params: Vec<f64>, policy: &mut dyn 
     while step < scene.limits.max_steps {
         step += 1;
         let t = f64::from(step) * dt;
-        let before: Vec<(Vec2, f64, f64)> =
-            actors.iter().map(|a| (a.kin.position, a.kin.yaw, a.kin.speed)).collect();
+        let before: Vec<(Vec2, f64, f64)> = actors.iter().map(|a| (a.kin.position, a.kin.yaw, a.kin.speed)).collect();
 
         // scripts, on the previous state
-        for k in 0..actors.len() {
-            run_script(scene, &scene.actors[k].script, &mut actors[k], &params, t, ego.position);
+        for (setup, actor) in scene.actors.iter().zip(actors.iter_mut()) {
+            run_script(scene, &setup.script, actor, &params, t, ego.position);
         }
 
         // the ego's policy
         let (s_now, off_route) = route.locate(ego.position, ego_s, 10.0);
         ego_s = s_now;
-        let view = ego_view(scene, &ego, ego_s, off_route, desired, &actors, &before, t, ego_stop, &detectors, &mut preview);
+        let view =
+            ego_view(scene, &ego, ego_s, off_route, desired, &actors, &before, t, ego_stop, &detectors, &mut preview);
         let action: Action = policy.act(&view);
         let accel = if action.accel.is_finite() { action.accel.clamp(ACCEL_MIN, ACCEL_MAX) } else { 0.0 };
         let steer = if action.steer.is_finite() { action.steer.clamp(-1.0, 1.0) } else { 0.0 };
@@ -311,7 +316,8 @@ fn lane_track(scene: &Scene, a: &Actor, lane: i64) -> Track {
     let road = &scene.world.road;
     let (path, _) = road.vehicle_path(Station { arm: a.arm, along: a.along }, lane, a.turn);
     let offset = a.lateral - road.lateral(a.lane);
-    let path = if offset.abs() > 1e-6 && lane == a.lane { path.offset(if lane < 0 { -offset } else { offset }) } else { path };
+    let path =
+        if offset.abs() > 1e-6 && lane == a.lane { path.offset(if lane < 0 { -offset } else { offset }) } else { path };
     Track::new(&path)
 }
 
@@ -342,16 +348,9 @@ fn run_script(scene: &Scene, script: &[Instr], a: &mut Actor, params: &[f64], t:
                 a.block = Block::Near(v(distance).max(0.0));
                 continue;
             }
-            (Instr::Wait { .. }, Block::Until(until)) => {
-                if t + 1e-9 < until {
-                    return;
-                }
-            }
-            (Instr::WaitNear { .. }, Block::Near(d)) => {
-                if ego.distance(a.kin.position) > d {
-                    return;
-                }
-            }
+            (Instr::Wait { .. }, Block::Until(until)) if t + 1e-9 < until => return,
+            (Instr::WaitNear { .. }, Block::Near(d)) if ego.distance(a.kin.position) > d => return,
+            (Instr::Wait { .. } | Instr::WaitNear { .. }, _) => {}
             (Instr::Drive { speed, turn, .. }, _) => {
                 a.turn = *turn;
                 a.target = v(speed).max(0.0);
@@ -404,11 +403,20 @@ fn change_lane(scene: &Scene, a: &mut Actor, lanes: i64) {
 fn neighbour(scene: &Scene, a: &Actor, lanes: i64) -> Option<i64> {
     let (incoming, outgoing) = scene.world.road.arm_lanes(a.arm);
     let lane = if a.lane > 0 { a.lane + lanes } else { a.lane - lanes };
-    let ok = if a.lane > 0 { (1..=i64::from(incoming)).contains(&lane) } else { (1..=i64::from(outgoing)).contains(&-lane) };
+    let ok =
+        if a.lane > 0 { (1..=i64::from(incoming)).contains(&lane) } else { (1..=i64::from(outgoing)).contains(&-lane) };
     (ok && lane != a.lane).then_some(lane)
 }
 
-fn move_actor(scene: &Scene, actors: &mut [Actor], k: usize, before: &[(Vec2, f64, f64)], ego: &Kinematics, t: f64, dt: f64) {
+fn move_actor(
+    scene: &Scene,
+    actors: &mut [Actor],
+    k: usize,
+    before: &[(Vec2, f64, f64)],
+    ego: &Kinematics,
+    t: f64,
+    dt: f64,
+) {
     match actors[k].motion {
         Motion::Stand => {
             let a = &mut actors[k];
@@ -433,7 +441,15 @@ fn move_actor(scene: &Scene, actors: &mut [Actor], k: usize, before: &[(Vec2, f6
             let (s, _) = track.locate(a.kin.position, a.s, 8.0);
             a.s = s;
             let wheel = pursue(track, s, a.kin.pose(), a.kin.speed, a.wheelbase);
-            let accel = if a.stopping { -(a.kin.speed / dt).min(4.0) } else { IdmParams::default().accel(a.kin.speed, a.target.min(models::curve_speed(track, s, a.kin.speed)), leader) };
+            let accel = if a.stopping {
+                -(a.kin.speed / dt).min(4.0)
+            } else {
+                IdmParams::default().accel(
+                    a.kin.speed,
+                    a.target.min(models::curve_speed(track, s, a.kin.speed)),
+                    leader,
+                )
+            };
             a.kin.bicycle(a.wheelbase, wheel, accel, dt);
             // a stop sign is passed once it has stood at it
             if let Some((line, _)) = a.stop_line
@@ -453,7 +469,14 @@ const LOOK: f64 = 60.0;
 
 /// The nearest thing ahead of actor `k` on its track: (bumper gap, its speed along), the
 /// ego included unless `k` runs lights (an adversary), and its stop line when it must stop.
-fn leader_of(scene: &Scene, actors: &[Actor], k: usize, before: &[(Vec2, f64, f64)], ego: &Kinematics, t: f64) -> Option<(f64, f64)> {
+fn leader_of(
+    scene: &Scene,
+    actors: &[Actor],
+    k: usize,
+    before: &[(Vec2, f64, f64)],
+    ego: &Kinematics,
+    t: f64,
+) -> Option<(f64, f64)> {
     let me = &actors[k];
     let track = me.track.as_ref()?;
     let others = before.iter().enumerate().filter(|(j, _)| *j != k).map(|(j, &(p, yaw, v))| {
@@ -461,12 +484,25 @@ fn leader_of(scene: &Scene, actors: &[Actor], k: usize, before: &[(Vec2, f64, f6
         (p, yaw, v, a.length, a.width)
     });
     let ego_entry = me.obey.then_some((ego.position, ego.yaw, ego.speed, scene.ego.size.length, scene.ego.size.width));
-    let mut best = ahead_on(track, me.kin.position, me.kin.yaw, me.s, me.length, me.width, me.kin.speed, me.obey, others.chain(ego_entry));
+    let mut best = ahead_on(
+        track,
+        me.kin.position,
+        me.kin.yaw,
+        me.s,
+        me.length,
+        me.width,
+        me.kin.speed,
+        me.obey,
+        others.chain(ego_entry),
+    );
     if me.obey
         && let Some((line, arm)) = me.stop_line
     {
         let gap = line - (me.s + me.length / 2.0);
-        if gap > -0.5 && must_stop(scene, arm, gap, me.kin.speed, t, me.stopped_at_sign) && best.is_none_or(|(g, _)| gap < g) {
+        if gap > -0.5
+            && must_stop(scene, arm, gap, me.kin.speed, t, me.stopped_at_sign)
+            && best.is_none_or(|(g, _)| gap < g)
+        {
             best = Some((gap.max(0.0), 0.0));
         }
     }
@@ -561,7 +597,17 @@ const CROSS_MARGIN: f64 = 1.5;
 /// Whether a box at `p` reaches into the corridor of a vehicle at arc `s` of `track`: the
 /// bumper gap and the box's heading relative to the track there.
 #[allow(clippy::too_many_arguments)]
-fn in_corridor(track: &Track, s: f64, length: f64, width: f64, p: Vec2, yaw: f64, l: f64, w: f64, ahead: f64) -> Option<(f64, f64)> {
+fn in_corridor(
+    track: &Track,
+    s: f64,
+    length: f64,
+    width: f64,
+    p: Vec2,
+    yaw: f64,
+    l: f64,
+    w: f64,
+    ahead: f64,
+) -> Option<(f64, f64)> {
     let (sj, lat) = track.locate(p, s + ahead, 8.0);
     if sj <= s {
         return None;
@@ -582,9 +628,28 @@ fn mobil(scene: &Scene, actors: &mut [Actor], k: usize, before: &[(Vec2, f64, f6
     let now = {
         let me = &actors[k];
         let Some(track) = &me.track else { return };
-        let others = before.iter().enumerate().filter(|(j, _)| *j != k).map(|(j, &(p, y, v))| (p, y, v, actors[j].length, actors[j].width));
-        let ego_entry = std::iter::once((ego.position, ego.yaw, ego.speed, scene.ego.size.length, scene.ego.size.width));
-        IdmParams::default().accel(me.kin.speed, me.target, ahead_on(track, me.kin.position, me.kin.yaw, me.s, me.length, me.width, me.kin.speed, me.obey, others.chain(ego_entry)))
+        let others = before
+            .iter()
+            .enumerate()
+            .filter(|(j, _)| *j != k)
+            .map(|(j, &(p, y, v))| (p, y, v, actors[j].length, actors[j].width));
+        let ego_entry =
+            std::iter::once((ego.position, ego.yaw, ego.speed, scene.ego.size.length, scene.ego.size.width));
+        IdmParams::default().accel(
+            me.kin.speed,
+            me.target,
+            ahead_on(
+                track,
+                me.kin.position,
+                me.kin.yaw,
+                me.s,
+                me.length,
+                me.width,
+                me.kin.speed,
+                me.obey,
+                others.chain(ego_entry),
+            ),
+        )
     };
     let mut choice: Option<(i64, f64)> = None;
     for dir in [-1, 1] {
@@ -599,11 +664,38 @@ fn mobil(scene: &Scene, actors: &mut [Actor], k: usize, before: &[(Vec2, f64, f6
             .map(|(j, &(p, y, v))| (p, y, v, actors[j].length, actors[j].width))
             .chain(std::iter::once((ego.position, ego.yaw, ego.speed, scene.ego.size.length, scene.ego.size.width)))
             .collect();
-        let then = IdmParams::default().accel(me.kin.speed, me.target, ahead_on(&track, me.kin.position, me.kin.yaw, s, me.length, me.width, me.kin.speed, me.obey, entries.iter().copied()));
+        let then = IdmParams::default().accel(
+            me.kin.speed,
+            me.target,
+            ahead_on(
+                &track,
+                me.kin.position,
+                me.kin.yaw,
+                s,
+                me.length,
+                me.width,
+                me.kin.speed,
+                me.obey,
+                entries.iter().copied(),
+            ),
+        );
         // the new follower: the nearest behind in the target lane, with this vehicle ahead of it
         let back = me.kin.yaw + std::f64::consts::PI;
-        let behind = ahead_on(&track, me.kin.position, back, s, me.length, me.width, me.kin.speed, me.obey, entries.iter().map(|&(p, y, v, l, w)| (p, y + std::f64::consts::PI, v, l, w)));
-        let safe = behind.is_none_or(|(gap, speed_back)| IdmParams::default().accel(speed_back, speed_back.max(me.target), Some((gap, me.kin.speed))) >= -SAFE && gap > 1.0);
+        let behind = ahead_on(
+            &track,
+            me.kin.position,
+            back,
+            s,
+            me.length,
+            me.width,
+            me.kin.speed,
+            me.obey,
+            entries.iter().map(|&(p, y, v, l, w)| (p, y + std::f64::consts::PI, v, l, w)),
+        );
+        let safe = behind.is_none_or(|(gap, speed_back)| {
+            IdmParams::default().accel(speed_back, speed_back.max(me.target), Some((gap, me.kin.speed))) >= -SAFE
+                && gap > 1.0
+        });
         if safe && then - now > GAIN && choice.is_none_or(|(_, g)| then - now > g) {
             choice = Some((dir, then - now));
         }
@@ -655,7 +747,8 @@ fn ego_view(
     let leader = ahead_on(route, ego.position, ego.yaw, s, size.length, size.width, ego.speed, true, others);
     let stop = stop_line.and_then(|line| {
         let gap = line - (s + size.length / 2.0);
-        (gap > -0.5 && must_stop(scene, Arm::Ego, gap, ego.speed, t, detectors.stopped_at_sign())).then_some(gap.max(0.0))
+        (gap > -0.5 && must_stop(scene, Arm::Ego, gap, ego.speed, t, detectors.stopped_at_sign()))
+            .then_some(gap.max(0.0))
     });
     let _ = off_route;
     EgoView {

@@ -21,5 +21,5 @@ pub mod track;
 pub mod world;
 
 pub use episode::{Episode, Event, EventKind, Frame, Options, run};
-pub use tad_metrics::{Mode, StopReason};
 pub use scene::{Scene, SetupError};
+pub use tad_metrics::{Mode, StopReason};

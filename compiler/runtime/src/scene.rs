@@ -83,11 +83,8 @@ pub struct Scene {
 impl Scene {
     pub fn new(program: &Program) -> Result<Scene, SetupError> {
         let err = |m: String| Err(SetupError(m));
-        let paths: Vec<Track> = program
-            .paths
-            .iter()
-            .map(|p| Track::from_points(p.0.iter().map(|&[x, y]| Vec2::new(x, y))))
-            .collect();
+        let paths: Vec<Track> =
+            program.paths.iter().map(|p| Track::from_points(p.0.iter().map(|&[x, y]| Vec2::new(x, y)))).collect();
         let mut road = None;
         let mut limits = Limits::default();
         let mut signals = Vec::new();
@@ -171,7 +168,8 @@ impl Scene {
         }
         let Some(road) = road else { return err("the program sets up no road".into()) };
         let Some(ego) = ego else { return err("the program has no ego".into()) };
-        let mut arcs: Vec<f64> = (0..=ego.route_length.max(0.0).floor() as usize).map(|k| ego.start + k as f64).collect();
+        let mut arcs: Vec<f64> =
+            (0..=ego.route_length.max(0.0).floor() as usize).map(|k| ego.start + k as f64).collect();
         let end = ego.start + ego.route_length.max(0.0);
         arcs.extend((1..=12).map(|k| end + 5.0 * f64::from(k)));
         let poses: Vec<Pose> = arcs.iter().map(|&a| ego.route.pose(a)).collect();

@@ -189,11 +189,11 @@ mod tests {
 
     #[test]
     fn phase_programs_cycle() {
-        let phases =
-            vec![Phase { light: Light::Green, seconds: 10.0 }, Phase { light: Light::Yellow, seconds: 3.0 }, Phase {
-                light: Light::Red,
-                seconds: 7.0,
-            }];
+        let phases = vec![
+            Phase { light: Light::Green, seconds: 10.0 },
+            Phase { light: Light::Yellow, seconds: 3.0 },
+            Phase { light: Light::Red, seconds: 7.0 },
+        ];
         let w = World::new(crossroads(true), vec![(Arm::Ego, phases)]);
         assert_eq!(w.light(Arm::Ego, 0.0), Light::Green);
         assert_eq!(w.light(Arm::Ego, 11.0), Light::Yellow);

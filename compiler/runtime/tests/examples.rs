@@ -24,7 +24,11 @@ fn episode(scene: &Scene, ego: &str, seed: u64) -> Episode {
 /// The least bumper-to-bumper distance from the ego to any actor over the episode, m.
 fn closest(scene: &Scene, e: &Episode) -> f64 {
     let size = |k: usize| {
-        if k == 0 { (scene.ego.size.length, scene.ego.size.width) } else { (scene.actors[k - 1].size.length, scene.actors[k - 1].size.width) }
+        if k == 0 {
+            (scene.ego.size.length, scene.ego.size.width)
+        } else {
+            (scene.actors[k - 1].size.length, scene.actors[k - 1].size.width)
+        }
     };
     let fp = |k: usize, (x, y, yaw): (f64, f64, f64)| {
         let (length, width) = size(k);
@@ -70,9 +74,18 @@ fn the_safety_examples_conflict_with_naive_and_idm_avoids_most() {
             let idm = episode(&scene, "idm", seed);
             idm_collisions += usize::from(idm.stop_reason == StopReason::Collision);
             runs += 1;
-            report.push(format!("{name} seed {seed}: naive {:?} ({:.2} m), idm {:?}", naive.stop_reason, closest(&scene, &naive), idm.stop_reason));
+            report.push(format!(
+                "{name} seed {seed}: naive {:?} ({:.2} m), idm {:?}",
+                naive.stop_reason,
+                closest(&scene, &naive),
+                idm.stop_reason
+            ));
         }
-        assert!(naive_conflicts >= 2, "{name}: naive met its conflict in {naive_conflicts} of 3 seeds\n{}", report.join("\n"));
+        assert!(
+            naive_conflicts >= 2,
+            "{name}: naive met its conflict in {naive_conflicts} of 3 seeds\n{}",
+            report.join("\n")
+        );
     }
     assert!(idm_collisions * 3 <= runs, "idm collided in {idm_collisions} of {runs} runs\n{}", report.join("\n"));
 }

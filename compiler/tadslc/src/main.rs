@@ -307,10 +307,9 @@ fn main() -> ExitCode {
             tadslc::bytecode::build(&paths, output.as_deref(), map_dir.is_some() || map.is_some(), color)
         }
         Command::Disasm { path } => tadslc::bytecode::disasm(&path),
-        Command::Run { paths, ego, seeds, format, trace, render, compat } => tadslc::run::run(
-            &tadslc::run::RunArgs { paths, egos: ego, seeds, format, trace, render, compat },
-            color,
-        ),
+        Command::Run { paths, ego, seeds, format, trace, render, compat } => {
+            tadslc::run::run(&tadslc::run::RunArgs { paths, egos: ego, seeds, format, trace, render, compat }, color)
+        }
         Command::Import { path, output } => tadslc::interchange::run_import(&path, output.as_deref(), color),
         Command::Export { format: ExportFormat::Yaml, yaml: _, path, output } => {
             tadslc::interchange::run_export(&path, output.as_deref(), color)

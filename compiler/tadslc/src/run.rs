@@ -202,7 +202,13 @@ fn run_in(args: &RunArgs, color: bool, status: &mut Status) -> Result<(), Closed
             *status = Status::Usage;
             errln!("error: cannot write `{}`: {e}", path.display())?;
         } else {
-            errln!("{}: rendered seed {} with {} to {}", loaded.name, first.episode.seed.unwrap_or(0), names[first.ego], path.display())?;
+            errln!(
+                "{}: rendered seed {} with {} to {}",
+                loaded.name,
+                first.episode.seed.unwrap_or(0),
+                names[first.ego],
+                path.display()
+            )?;
         }
     }
     Ok(())
@@ -232,8 +238,11 @@ fn write_trace(w: &mut impl Write, file: &str, ego: &str, scene: &Scene, e: &Epi
                 serde_json::json!({"id": label, "x": round(x), "y": round(y), "yaw": round(yaw), "v": round(v)})
             })
             .collect();
-        let lights: serde_json::Map<String, serde_json::Value> =
-            frame.lights.iter().map(|(arm, l)| (arm.as_str().to_string(), format!("{l:?}").to_lowercase().into())).collect();
+        let lights: serde_json::Map<String, serde_json::Value> = frame
+            .lights
+            .iter()
+            .map(|(arm, l)| (arm.as_str().to_string(), format!("{l:?}").to_lowercase().into()))
+            .collect();
         let line = serde_json::json!({
             "file": file, "seed": e.seed, "ego": ego, "step": step,
             "t": round(step as f64 * scene.limits.dt), "actors": actors, "lights": lights,
@@ -256,18 +265,19 @@ fn render(path: &Path, scene: &Scene, ego: &str, e: &Episode) -> std::io::Result
         tad_bytecode::Light::Green => Light::Green,
     };
     let size = scene.ego.size;
-    let actors = std::iter::once(ActorInfo { label: "ego".into(), kind: Kind::Ego, length: size.length, width: size.width })
-        .chain(scene.actors.iter().map(|a| ActorInfo {
-            label: a.label.clone(),
-            kind: match a.body {
-                tad_layout::Body::Vehicle => Kind::Vehicle,
-                tad_layout::Body::Walker => Kind::Walker,
-                tad_layout::Body::Object => Kind::Object,
-            },
-            length: a.size.length,
-            width: a.size.width,
-        }))
-        .collect();
+    let actors =
+        std::iter::once(ActorInfo { label: "ego".into(), kind: Kind::Ego, length: size.length, width: size.width })
+            .chain(scene.actors.iter().map(|a| ActorInfo {
+                label: a.label.clone(),
+                kind: match a.body {
+                    tad_layout::Body::Vehicle => Kind::Vehicle,
+                    tad_layout::Body::Walker => Kind::Walker,
+                    tad_layout::Body::Object => Kind::Object,
+                },
+                length: a.size.length,
+                width: a.size.width,
+            }))
+            .collect();
     let frames = e
         .frames
         .iter()
@@ -288,7 +298,9 @@ fn render(path: &Path, scene: &Scene, ego: &str, e: &Episode) -> std::io::Result
             step: ev.step as usize,
             position: [ev.position.x, ev.position.y],
             label: match ev.other {
-                Some(k) => format!("{} with {}", ev.kind.as_str(), scene.actors.get(k).map_or("?", |a| a.label.as_str())),
+                Some(k) => {
+                    format!("{} with {}", ev.kind.as_str(), scene.actors.get(k).map_or("?", |a| a.label.as_str()))
+                }
                 None => ev.kind.as_str().replace('_', " "),
             },
         })

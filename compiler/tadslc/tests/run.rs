@@ -12,7 +12,10 @@ const KEYS: [&str; 11] = ["CR", "RR", "SS", "OR", "RF", "Comp", "TS", "ACC", "YV
 
 #[test]
 fn json_has_one_object_per_episode_then_one_aggregate() {
-    let out = tadslc(&["run", "examples/safety/red_light_running.tad", "--ego", "naive", "--seeds", "3..6", "--format", "json"], "");
+    let out = tadslc(
+        &["run", "examples/safety/red_light_running.tad", "--ego", "naive", "--seeds", "3..6", "--format", "json"],
+        "",
+    );
     assert_eq!(code(&out), 0, "{}", stderr(&out));
     let lines = json_lines(&out);
     assert_eq!(lines.len(), 4, "three episodes and the aggregate");
@@ -31,7 +34,10 @@ fn json_has_one_object_per_episode_then_one_aggregate() {
     assert_eq!(agg["episodes"], 3);
     assert!(agg["metrics"]["OS"].as_f64().is_some());
     // the same command again: the same bytes
-    let again = tadslc(&["run", "examples/safety/red_light_running.tad", "--ego", "naive", "--seeds", "3..6", "--format", "json"], "");
+    let again = tadslc(
+        &["run", "examples/safety/red_light_running.tad", "--ego", "naive", "--seeds", "3..6", "--format", "json"],
+        "",
+    );
     assert_eq!(stdout(&out), stdout(&again));
 }
 
@@ -56,12 +62,21 @@ fn the_table_has_a_row_per_scenario_and_ego() {
 fn bytecode_runs_like_its_source_and_traces_and_pictures_are_written() {
     let out = scratch("run-bytecode");
     let dir = out.to_string_lossy().into_owned();
-    assert_eq!(code(&tadslc(&["build", "--target", "bytecode", "examples/safety/straight_obstacle.tad", "-o", &dir], "")), 0);
+    assert_eq!(
+        code(&tadslc(&["build", "--target", "bytecode", "examples/safety/straight_obstacle.tad", "-o", &dir], "")),
+        0
+    );
     let tadc = out.join("straight_obstacle.tadc").to_string_lossy().into_owned();
-    let from_source = tadslc(&["run", "examples/safety/straight_obstacle.tad", "--ego", "idm", "--seeds", "1", "--format", "json"], "");
+    let from_source = tadslc(
+        &["run", "examples/safety/straight_obstacle.tad", "--ego", "idm", "--seeds", "1", "--format", "json"],
+        "",
+    );
     let trace = out.join("trace.jsonl").to_string_lossy().into_owned();
     let svg = out.join("run.svg").to_string_lossy().into_owned();
-    let from_bytes = tadslc(&["run", &tadc, "--ego", "idm", "--seeds", "1", "--format", "json", "--trace", &trace, "--render", &svg], "");
+    let from_bytes = tadslc(
+        &["run", &tadc, "--ego", "idm", "--seeds", "1", "--format", "json", "--trace", &trace, "--render", &svg],
+        "",
+    );
     assert_eq!(code(&from_bytes), 0, "{}", stderr(&from_bytes));
     let (a, b) = (json_lines(&from_source), json_lines(&from_bytes));
     assert_eq!(a[0]["metrics"], b[0]["metrics"], "the .tadc runs as its source");
@@ -83,7 +98,8 @@ fn a_learned_ego_drives_from_a_safetensors_file() {
     let actor = out.join("actor.safetensors");
     tad_policy::Learned::random(&[16, 16], 3).unwrap().save(&actor).unwrap();
     let ego = format!("learned:{}", actor.display());
-    let run = tadslc(&["run", "examples/safety/lane_changing.tad", "--ego", &ego, "--seeds", "0..2", "--format", "json"], "");
+    let run =
+        tadslc(&["run", "examples/safety/lane_changing.tad", "--ego", &ego, "--seeds", "0..2", "--format", "json"], "");
     assert_eq!(code(&run), 0, "{}", stderr(&run));
     let lines = json_lines(&run);
     assert_eq!(lines.len(), 3);
@@ -95,7 +111,10 @@ fn bad_input_is_refused_clearly() {
     let out = scratch("run-bad");
     let bad = out.join("bad.tadc");
     std::fs::write(&bad, b"TADC\x01\x00garbage").unwrap();
-    let run = tadslc(&["run", &bad.to_string_lossy(), "examples/safety/right_turn.tad", "--seeds", "0", "--format", "json"], "");
+    let run = tadslc(
+        &["run", &bad.to_string_lossy(), "examples/safety/right_turn.tad", "--seeds", "0", "--format", "json"],
+        "",
+    );
     assert_eq!(code(&run), 2, "a corrupt file is an error, the rest still runs");
     assert!(stderr(&run).contains("bad.tadc"), "{}", stderr(&run));
     assert_eq!(json_lines(&run).len(), 4, "right_turn with idm and naive, then an aggregate per ego");
