@@ -372,6 +372,17 @@ impl Builder {
                 };
                 if same_path(&agent.path, agent.path_start, &lane_path, lane_start) {
                     out.push(Instr::Drive { actor, speed, turn: agent.turn });
+                    // background traffic (not timed, keeping its lane, with lanes beside it
+                    // its way) passes what blocks it, as drivers do
+                    let (incoming, outgoing) = road.arm_lanes(agent.station.arm);
+                    let beside = if agent.lane > 0 { incoming } else { outgoing };
+                    if layout.conflict(gl.group).is_none()
+                        && change.is_none()
+                        && agent.place == Place::Lane
+                        && beside >= 2
+                    {
+                        out.push(Instr::Mobil { actor, on: true });
+                    }
                 } else if let Some(lanes) = change {
                     // the layout baked the change after 1.5 s of driving: the runtime's own
                     // lane change, at the same moment

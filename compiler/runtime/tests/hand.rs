@@ -247,3 +247,49 @@ fn metrics_of_a_free_run_are_the_hand_computed_ones() {
     let ts = m.ts.unwrap();
     assert!((ts - (e.records.last().unwrap().time - 0.1)).abs() < 1e-9 && (ts - 9.9).abs() < 0.15, "TS {ts}");
 }
+
+fn driving(actor: u16, along: f64, lane: i64, speed: f64) -> Instr {
+    Instr::Spawn {
+        actor,
+        group: format!("car{actor}"),
+        index: 0,
+        body: Body::Vehicle,
+        class: "sedan".into(),
+        size: CAR,
+        arm: Arm::Ego,
+        lane,
+        place: Place::Lane,
+        along: Value::lit(along),
+        lateral: -(lane as f64 - 0.5) * LANE_WIDTH,
+        facing: Facing::Along,
+        yaw: 0.0,
+        speed,
+    }
+}
+
+#[test]
+fn mobil_passes_a_slow_car_and_stays_put_without_it() {
+    let slow = |mobil: bool| {
+        let mut code = vec![
+            driving(0, 40.0, 1, 4.0),
+            driving(1, 20.0, 1, 12.0),
+            Instr::Drive { actor: 0, speed: Value::lit(4.0), turn: Turn::Straight },
+            Instr::Drive { actor: 1, speed: Value::lit(12.0), turn: Turn::Straight },
+        ];
+        if mobil {
+            code.push(Instr::Mobil { actor: 1, on: true });
+        }
+        Scene::new(&program(straight(), 0.0, code)).unwrap()
+    };
+    let opts = Options { keep_frames: true, ..Options::default() };
+    // the ego stands at the start, out of the way
+    let e = run(&slow(true), None, vec![], policy("idm").as_mut(), &opts);
+    let last = e.frames.last().unwrap();
+    let (fast, slow_car) = (last.poses[2], last.poses[1]);
+    assert!(fast.0 > slow_car.0 + 10.0, "the fast car got past: {fast:?} vs {slow_car:?}");
+    assert!((fast.1 + 5.25).abs() < 0.5, "in lane 2: {fast:?}");
+    let e = run(&slow(false), None, vec![], policy("idm").as_mut(), &opts);
+    let last = e.frames.last().unwrap();
+    assert!(last.poses[2].0 < last.poses[1].0, "without MOBIL it follows");
+    assert!((last.poses[2].1 + 1.75).abs() < 0.2);
+}
