@@ -239,6 +239,8 @@ fn written_ranges_become_parameter_slots() {
                 speed: Value { base: 0.0, slot: Some(lead_speed) },
                 turn: tad_layout::Turn::Straight
             },
+            // background traffic on a road with lanes beside it
+            &Instr::Mobil { actor: lead, on: true },
         ]
     );
     let (trigger, s) = slot("walkers.trigger");
