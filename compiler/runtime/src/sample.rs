@@ -1,37 +1,16 @@
 //! Parameters per run: each slot drawn uniformly from its range by a seeded generator
-//! (SplitMix64), so a seed always gives the same values.
+//! (`tad_ir::SplitMix64`, the workspace's one generator), so a seed always gives the same
+//! values.
 
 use tad_bytecode::ParamSlot;
-
-/// SplitMix64 (Steele, Lea and Flood 2014).
-#[derive(Clone, Debug)]
-pub struct Rng(u64);
-
-impl Rng {
-    pub fn new(seed: u64) -> Rng {
-        Rng(seed ^ 0x5DEE_CE66_D1CE_4E5B)
-    }
-
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in `[0, 1)`.
-    pub fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
+use tad_ir::{Rng, SplitMix64};
 
 /// The slots' values for a seed; `None` gives every slot its default.
 pub fn sample(slots: &[ParamSlot], seed: Option<u64>) -> Vec<f64> {
     match seed {
         None => slots.iter().map(|p| p.default).collect(),
         Some(seed) => {
-            let mut rng = Rng::new(seed);
+            let mut rng = SplitMix64::new(seed);
             slots.iter().map(|p| p.min + (p.max - p.min) * rng.unit()).collect()
         }
     }
