@@ -196,6 +196,32 @@ impl Path {
         best
     }
 
+    /// The arc of the point nearest `p` among the segments within `window` metres of arc
+    /// `hint`, with the signed distance to it (positive: `p` is left of the path); beyond
+    /// either end the path goes on straight. What follows a path step by step uses this:
+    /// its cost does not grow with the path's length.
+    pub fn locate(&self, p: Vec2, hint: f64, window: f64) -> (f64, f64) {
+        let n = self.points.len();
+        if n < 2 {
+            return (0.0, self.points.first().map_or(f64::INFINITY, |q| q.distance(p)));
+        }
+        let (first, last) = (self.segment(hint - window), self.segment(hint + window));
+        let mut best = (hint, f64::INFINITY, 0.0);
+        for i in first..=last {
+            let (a, b) = (self.points[i], self.points[i + 1]);
+            let ab = b - a;
+            let mut t = (p - a).dot(ab) / ab.dot(ab);
+            if !(i == 0 && t < 0.0 || i == n - 2 && t > 1.0) {
+                t = t.clamp(0.0, 1.0);
+            }
+            let d = (a + ab * t).distance(p);
+            if d < best.1 {
+                best = (self.arcs[i] + t * (self.arcs[i + 1] - self.arcs[i]), d, ab.cross(p - a));
+            }
+        }
+        (best.0, if best.2 < 0.0 { -best.1 } else { best.1 })
+    }
+
     /// The first arc length of this path at which it comes within `reach` of `other`,
     /// with the arc length on `other`; sampled every `step` metres.
     pub fn first_within(&self, other: &Path, reach: f64, step: f64) -> Option<(f64, f64)> {
@@ -296,6 +322,20 @@ fn point_segment(p: Vec2, a: Vec2, b: Vec2) -> f64 {
 mod tests {
     use super::*;
     use std::f64::consts::FRAC_PI_2;
+
+    #[test]
+    fn locate_is_signed_local_and_extrapolates() {
+        let t = Path::new([Vec2::new(0.0, 0.0), Vec2::new(10.0, 0.0), Vec2::new(10.0, 10.0)]);
+        let (s, d) = t.locate(Vec2::new(5.0, 1.0), 5.0, 3.0);
+        assert!((s - 5.0).abs() < 1e-9 && (d - 1.0).abs() < 1e-9);
+        let (s, d) = t.locate(Vec2::new(11.0, 5.0), 15.0, 3.0);
+        assert!((s - 15.0).abs() < 1e-9 && (d + 1.0).abs() < 1e-9, "right of the path: {d}");
+        let (s, d) = t.locate(Vec2::new(-4.0, 0.0), 0.0, 2.0);
+        assert!((s + 4.0).abs() < 1e-9 && d.abs() < 1e-9, "beyond the start it goes on straight");
+        // only near the hint: the far leg is not searched
+        let (s, _) = t.locate(Vec2::new(10.5, 9.0), 2.0, 2.0);
+        assert!((s - 10.0).abs() < 1e-9, "the end of the first leg, not 19 m on the second: {s}");
+    }
 
     fn boxed(x: f64, y: f64, yaw: f64, length: f64, width: f64) -> Footprint {
         Footprint { pose: Pose { position: Vec2::new(x, y), yaw }, length, width }

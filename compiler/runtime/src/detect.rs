@@ -3,10 +3,9 @@
 //! lane invasion (a bounding-box corner changes lane), off-road (the centre on no driving
 //! lane), distance to the route and route completion, red lights and stop signs.
 
-use crate::track::Track;
 use crate::world::{Spot, World};
 use tad_bytecode::Light;
-use tad_layout::geom::{Footprint, Pose};
+use tad_layout::geom::{Footprint, Path, Pose};
 
 /// Route completion counts as complete past this share within [`END_DISTANCE`] of the end.
 const COMPLETE_SHARE: f64 = 0.99;
@@ -53,7 +52,7 @@ pub struct Reading {
 }
 
 impl Detectors {
-    pub fn new(route: &Track, start: f64, length: f64, stop_line: Option<f64>) -> Detectors {
+    pub fn new(route: &Path, start: f64, length: f64, stop_line: Option<f64>) -> Detectors {
         let _ = route;
         Detectors {
             corners: None,
@@ -75,7 +74,7 @@ impl Detectors {
     pub fn read(
         &mut self,
         world: &World,
-        route: &Track,
+        route: &Path,
         ego: Footprint,
         s: f64,
         off_route: f64,

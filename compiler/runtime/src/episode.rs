@@ -11,10 +11,9 @@ use crate::detect::{Detectors, footprint};
 use crate::models::{self, Kinematics, WHEELBASE, pursue};
 use crate::physics::{Physics, Shape};
 use crate::scene::Scene;
-use crate::track::Track;
 use crate::world::Spot;
 use tad_bytecode::{Instr, Light, Value};
-use tad_layout::geom::{Footprint, Pose, Vec2, wrap};
+use tad_layout::geom::{Footprint, Path, Pose, Vec2, wrap};
 use tad_layout::road::Station;
 use tad_layout::{Arm, Body, Facing, Turn};
 use tad_metrics::{Mode, StepRecord, StopReason};
@@ -110,7 +109,7 @@ struct Actor {
     kin: Kinematics,
     target: f64,
     motion: Motion,
-    track: Option<Track>,
+    track: Option<Path>,
     s: f64,
     /// Arc of its stop line on its track and the arm whose light it obeys.
     stop_line: Option<(f64, Arm)>,
@@ -312,16 +311,14 @@ fn spawn(scene: &Scene, a: &crate::scene::ActorSetup, params: &[f64]) -> Actor {
 
 /// A vehicle's lane path from its spawn station, kept as far off the lane's centre as it
 /// stands.
-fn lane_track(scene: &Scene, a: &Actor, lane: i64) -> Track {
+fn lane_track(scene: &Scene, a: &Actor, lane: i64) -> Path {
     let road = &scene.world.road;
     let (path, _) = road.vehicle_path(Station { arm: a.arm, along: a.along }, lane, a.turn);
     let offset = a.lateral - road.lateral(a.lane);
-    let path =
-        if offset.abs() > 1e-6 && lane == a.lane { path.offset(if lane < 0 { -offset } else { offset }) } else { path };
-    Track::new(&path)
+    if offset.abs() > 1e-6 && lane == a.lane { path.offset(if lane < 0 { -offset } else { offset }) } else { path }
 }
 
-fn set_track(scene: &Scene, a: &mut Actor, track: Track) {
+fn set_track(scene: &Scene, a: &mut Actor, track: Path) {
     let (s, _) = track.project(a.kin.position);
     a.s = s;
     a.stop_line = if a.lane > 0 {
@@ -372,7 +369,7 @@ fn run_script(scene: &Scene, script: &[Instr], a: &mut Actor, params: &[f64], t:
                 let road = &scene.world.road;
                 let width = f64::from(road.lanes + road.opposite.max(road.cross_lanes)) * road.lane_width + 12.0;
                 let heading = Vec2::from_yaw(a.kin.yaw);
-                a.track = Some(Track::from_points([a.kin.position, a.kin.position + heading * width]));
+                a.track = Some(Path::new([a.kin.position, a.kin.position + heading * width]));
                 a.s = 0.0;
             }
             (Instr::ChangeLane { lanes, .. }, _) => change_lane(scene, a, *lanes),
@@ -433,7 +430,7 @@ fn move_actor(
         Motion::Drive => {
             if actors[k].mobil && t >= actors[k].next_mobil {
                 actors[k].next_mobil = t + 1.0;
-                mobil(scene, actors, k, before, ego);
+                mobil(scene, actors, k, before, ego, t);
             }
             let leader = leader_of(scene, actors, k, before, ego, t);
             let a = &mut actors[k];
@@ -529,7 +526,7 @@ fn must_stop(scene: &Scene, arm: Arm, gap: f64, speed: f64, t: f64, stopped_at_s
 /// only stops for crossing traffic already in front of it.
 #[allow(clippy::too_many_arguments)]
 fn ahead_on(
-    track: &Track,
+    track: &Path,
     position: Vec2,
     yaw: f64,
     s: f64,
@@ -598,7 +595,7 @@ const CROSS_MARGIN: f64 = 1.5;
 /// bumper gap and the box's heading relative to the track there.
 #[allow(clippy::too_many_arguments)]
 fn in_corridor(
-    track: &Track,
+    track: &Path,
     s: f64,
     length: f64,
     width: f64,
@@ -622,34 +619,12 @@ fn in_corridor(
 
 /// MOBIL (Kesting, Treiber and Helbing 2007) with politeness 0: change to a neighbouring lane
 /// when it gains more than 0.2 m/s² and its new follower need not brake harder than 4 m/s².
-fn mobil(scene: &Scene, actors: &mut [Actor], k: usize, before: &[(Vec2, f64, f64)], ego: &Kinematics) {
+fn mobil(scene: &Scene, actors: &mut [Actor], k: usize, before: &[(Vec2, f64, f64)], ego: &Kinematics, t: f64) {
     const GAIN: f64 = 0.2;
     const SAFE: f64 = 4.0;
     let now = {
         let me = &actors[k];
-        let Some(track) = &me.track else { return };
-        let others = before
-            .iter()
-            .enumerate()
-            .filter(|(j, _)| *j != k)
-            .map(|(j, &(p, y, v))| (p, y, v, actors[j].length, actors[j].width));
-        let ego_entry =
-            std::iter::once((ego.position, ego.yaw, ego.speed, scene.ego.size.length, scene.ego.size.width));
-        IdmParams::default().accel(
-            me.kin.speed,
-            me.target,
-            ahead_on(
-                track,
-                me.kin.position,
-                me.kin.yaw,
-                me.s,
-                me.length,
-                me.width,
-                me.kin.speed,
-                me.obey,
-                others.chain(ego_entry),
-            ),
-        )
+        IdmParams::default().accel(me.kin.speed, me.target, leader_of(scene, actors, k, before, ego, t))
     };
     let mut choice: Option<(i64, f64)> = None;
     for dir in [-1, 1] {

@@ -6,7 +6,7 @@
 //!                          (records scored by tad-metrics, events, frames)
 //! ```
 //!
-//! Modules: `track` (paths with local projection), `world` (lanes, stop lines, phase
+//! Modules: `world` (lanes, stop lines, phase
 //! programs), `models` (kinematic bicycle, pure pursuit, IDM), `physics` (rapier3d contacts),
 //! `detect` (SafeBench's criteria), `scene` (set-up), `episode` (the loop, scripts, MOBIL,
 //! the ego's view), `sample` (seeded parameters).
@@ -17,7 +17,6 @@ pub mod models;
 pub mod physics;
 pub mod sample;
 pub mod scene;
-pub mod track;
 pub mod world;
 
 pub use episode::{Episode, Event, EventKind, Frame, Options, run};

@@ -2,8 +2,7 @@
 //! vehicles), pure-pursuit steering onto a track, and the Intelligent Driver Model for speed
 //! (`tad_policy::IdmParams`, the one IDM of the workspace).
 
-use crate::track::Track;
-use tad_layout::geom::{Pose, Vec2};
+use tad_layout::geom::{Path, Pose, Vec2};
 
 /// Wheelbase as a share of a vehicle's length.
 pub const WHEELBASE: f64 = 0.6;
@@ -34,7 +33,7 @@ impl Kinematics {
 
 /// The wheel angle (rad, left positive) that steers a vehicle at `pose` onto `track` at arc
 /// `s`, aiming at the point a speed-dependent distance ahead.
-pub fn pursue(track: &Track, s: f64, pose: Pose, speed: f64, wheelbase: f64) -> f64 {
+pub fn pursue(track: &Path, s: f64, pose: Pose, speed: f64, wheelbase: f64) -> f64 {
     let lookahead = lookahead(speed);
     let target = pose.local(track.pose(s + lookahead).position);
     let d2 = target.x * target.x + target.y * target.y;
@@ -51,7 +50,7 @@ pub const LATERAL_ACCEL: f64 = 2.5;
 /// The highest speed for the track ahead of arc `s`: over the distance covered in 3 s (at
 /// least 15 m), `sqrt(LATERAL_ACCEL / κ)` of its sharpest curvature κ, measured as the
 /// heading's change over 2 m; infinite where it is straight.
-pub fn curve_speed(track: &Track, s: f64, speed: f64) -> f64 {
+pub fn curve_speed(track: &Path, s: f64, speed: f64) -> f64 {
     let reach = (3.0 * speed).max(15.0);
     let mut sharpest: f64 = 0.0;
     let mut x = s;
@@ -74,7 +73,7 @@ mod tests {
 
     #[test]
     fn pursuit_converges_onto_an_offset_track() {
-        let track = Track::from_points([Vec2::new(-10.0, 0.0), Vec2::new(200.0, 0.0)]);
+        let track = Path::new([Vec2::new(-10.0, 0.0), Vec2::new(200.0, 0.0)]);
         let mut k = Kinematics { position: Vec2::new(0.0, -3.5), yaw: 0.0, speed: 10.0 };
         for _ in 0..100 {
             let (s, _) = track.locate(k.position, k.position.x + 10.0, 20.0);

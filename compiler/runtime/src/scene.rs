@@ -2,7 +2,6 @@
 //! Checks what a hand-built [`Program`] could get wrong (the loader already checks files),
 //! so running never indexes out of bounds.
 
-use crate::track::Track;
 use crate::world::World;
 use tad_bytecode::{ActorId, Instr, Program, Size};
 use tad_layout::geom::{Path, Pose, Vec2};
@@ -26,7 +25,7 @@ pub struct EgoSetup {
     pub size: Size,
     pub lane: i64,
     pub turn: Turn,
-    pub route: Track,
+    pub route: Path,
     pub start: f64,
     pub route_length: f64,
     pub speed: tad_bytecode::Value,
@@ -73,7 +72,7 @@ pub struct Scene {
     pub limits: Limits,
     pub ego: EgoSetup,
     pub actors: Vec<ActorSetup>,
-    pub paths: Vec<Track>,
+    pub paths: Vec<Path>,
     /// SafeBench's route points for the observation (`tad_policy`'s header): every metre
     /// of the route, then 12 more at 5 m past its end; positions and headings.
     pub preview: Vec<[f64; 2]>,
@@ -83,8 +82,8 @@ pub struct Scene {
 impl Scene {
     pub fn new(program: &Program) -> Result<Scene, SetupError> {
         let err = |m: String| Err(SetupError(m));
-        let paths: Vec<Track> =
-            program.paths.iter().map(|p| Track::from_points(p.0.iter().map(|&[x, y]| Vec2::new(x, y)))).collect();
+        let paths: Vec<Path> =
+            program.paths.iter().map(|p| Path::new(p.0.iter().map(|&[x, y]| Vec2::new(x, y)))).collect();
         let mut road = None;
         let mut limits = Limits::default();
         let mut signals = Vec::new();
