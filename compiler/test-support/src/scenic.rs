@@ -15,9 +15,12 @@ use crate::{repo, shared};
 pub fn python() -> Option<PathBuf> {
     let candidates =
         [std::env::var_os("TADSL_SCENIC_PYTHON").map(PathBuf::from), Some(repo().join(".venv-scenic/bin/python"))];
-    candidates.into_iter().flatten().find(|p| {
-        p.is_file() && Command::new(p).args(["-c", "import scenic"]).output().is_ok_and(|o| o.status.success())
-    })
+    candidates.into_iter().flatten().find(|p| imports_scenic(p))
+}
+
+/// Whether `python` is a Python that imports `scenic`.
+pub fn imports_scenic(python: &Path) -> bool {
+    python.is_file() && Command::new(python).args(["-c", "import scenic"]).output().is_ok_and(|o| o.status.success())
 }
 
 /// The oracle script.

@@ -60,6 +60,9 @@ pub struct Trace {
     pub dt: f64,
     /// Why the simulation ended (e.g. `timeLimit: ...`), when it ended without an error.
     pub termination: Option<String>,
+    /// Seconds Scenic spent simulating (the script's `sim_s`: the steps, not compiling or
+    /// sampling), when it simulated.
+    pub sim_s: Option<f64>,
     /// The scene's objects, in `scene.objects` order (the ego first in TADSL's programs).
     pub objects: Vec<TraceObject>,
     /// `states[step][object]`; step 0 is the sampled scene, before any step. Empty when
@@ -115,6 +118,7 @@ impl Trace {
             error: text(&v["error"]),
             dt: float(&v["dt"]),
             termination: text(&v["termination"]),
+            sim_s: v["sim_s"].as_f64(),
             objects,
             states,
         })
@@ -297,43 +301,57 @@ impl Tracer {
 
 /// [`Tracer::run`] with a given python and script.
 pub fn run(python: &Path, script: &Path, files: &[PathBuf], options: &TraceOptions) -> Vec<Trace> {
+    try_run(python, script, files, options).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// [`run`], saying why instead of panicking when the script cannot be started or does not
+/// give every record (with Scenic's standard error).
+pub fn try_run(python: &Path, script: &Path, files: &[PathBuf], options: &TraceOptions) -> Result<Vec<Trace>, String> {
     if files.is_empty() || options.seeds.is_empty() {
-        return Vec::new();
+        return Ok(Vec::new());
     }
     let _turn = scenic::turn();
     let seeds = options.seeds.iter().map(u64::to_string).collect::<Vec<_>>().join(",");
     let steps = options.steps.to_string();
-    let run_batch = |batch: &[PathBuf]| {
+    let run_batch = |batch: &[PathBuf]| -> Result<Vec<Trace>, String> {
         let output = Command::new(python)
             .arg(script)
             .args(["--seeds", &seeds, "--steps", &steps])
             .args(&options.args)
             .args(batch)
             .output()
-            .unwrap_or_else(|e| panic!("{} {}: {e}", python.display(), script.display()));
+            .map_err(|e| format!("{} {}: {e}", python.display(), script.display()))?;
         let stdout = String::from_utf8_lossy(&output.stdout).into_owned();
         let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
-        let traces: Result<Vec<Trace>, String> =
-            stdout.lines().filter(|l| l.starts_with('{')).map(Trace::parse).collect();
-        let traces = traces.unwrap_or_else(|e| panic!("the trace script printed a bad record: {e}\n{stderr}"));
+        let traces: Vec<Trace> = stdout
+            .lines()
+            .filter(|l| l.starts_with('{'))
+            .map(Trace::parse)
+            .collect::<Result<_, _>>()
+            .map_err(|e| format!("the trace script printed a bad record: {e}\n{stderr}"))?;
         if traces.len() != batch.len() * options.seeds.len() {
-            panic!(
+            return Err(format!(
                 "the trace script printed {} records for {} files and {} seeds\n--- stderr\n{stderr}",
                 traces.len(),
                 batch.len(),
                 options.seeds.len()
-            );
+            ));
         }
-        traces
+        Ok(traces)
     };
     let batches = batches(files, options.jobs);
     let mut traces: Vec<Trace> = if batches.len() == 1 {
-        run_batch(&batches[0])
+        run_batch(&batches[0])?
     } else {
-        std::thread::scope(|s| {
+        let results: Vec<Result<Vec<Trace>, String>> = std::thread::scope(|s| {
             let handles: Vec<_> = batches.iter().map(|b| s.spawn(|| run_batch(b))).collect();
-            handles.into_iter().flat_map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e))).collect()
-        })
+            handles.into_iter().map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e))).collect()
+        });
+        let mut all = Vec::new();
+        for r in results {
+            all.extend(r?);
+        }
+        all
     };
     let order = |t: &Trace| {
         let file = files.iter().position(|f| *f == t.file).unwrap_or(usize::MAX);
@@ -341,7 +359,7 @@ pub fn run(python: &Path, script: &Path, files: &[PathBuf], options: &TraceOptio
         (file, seed)
     };
     traces.sort_by_key(order);
-    traces
+    Ok(traces)
 }
 
 #[cfg(test)]
@@ -366,6 +384,10 @@ mod tests {
         assert_eq!(t.states[1][1], Pose { x: 0.0, y: 21.0, heading: 0.5, speed: 0.0 });
         assert!((t.time(1) - 0.1).abs() < 1e-12);
         assert_eq!((t.objects[1].length, t.objects[1].width), (12.0, 2.5));
+        assert_eq!(t.sim_s, None);
+        let timed =
+            Trace::parse(&RECORD.replace('\n', "").replace(r#""steps":1,"#, r#""steps":1,"sim_s":0.25,"#)).unwrap();
+        assert_eq!(timed.sim_s, Some(0.25));
     }
 
     #[test]
