@@ -4,7 +4,10 @@
 //! figures compare as a ratio whatever the machine. Each measurement is the best of
 //! `runs` repetitions. The full check runs through the database, as the CLI and the
 //! language server do; the incremental row edits one line of a 2,000-line file and
-//! re-checks it, against checking that file from scratch.
+//! re-checks it, against checking that file from scratch. `bench --runtime` measures the
+//! runtime instead ([`runtime`]).
+
+pub mod runtime;
 
 use crate::output::Closed;
 use crate::{Status, corpus, errln, outln};

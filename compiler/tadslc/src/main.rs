@@ -158,20 +158,43 @@ enum Command {
         /// every code
         code: Option<String>,
     },
-    /// Measure check throughput on a generated corpus and on the examples
+    /// Measure check throughput on a generated corpus and on the examples, or with
+    /// `--runtime` the runtime's speed
+    ///
+    /// `--runtime` times 300-step episodes with 1, 14 and 50 actors against Scenic's
+    /// Newtonian simulator on the same scenarios, and ChatScene's parameter search over the
+    /// safety examples; on one core.
     Bench {
         /// Number of generated scenarios
-        #[arg(long, default_value_t = 10_000)]
+        #[arg(long, default_value_t = 10_000, conflicts_with = "runtime")]
         scenarios: usize,
         /// Seed of the corpus generator
-        #[arg(long, default_value_t = 1)]
+        #[arg(long, default_value_t = 1, conflicts_with = "runtime")]
         seed: u64,
         /// Directory of real scenarios to measure as well
-        #[arg(long)]
+        #[arg(long, conflicts_with = "runtime")]
         examples: Option<PathBuf>,
         /// Timed repetitions of each measurement (the best is reported)
         #[arg(long, default_value_t = 5)]
         runs: usize,
+        /// Measure the runtime instead: episode time with 1, 14 and 50 actors, Scenic's
+        /// Newtonian simulator on the same scenarios, and a parameter search's episodes per
+        /// second
+        #[arg(long)]
+        runtime: bool,
+        /// The Python with Scenic 3.1.1 for the Scenic peer (default: TADSL_SCENIC_PYTHON);
+        /// without one the peer is skipped
+        #[arg(long, value_name = "PATH", requires = "runtime")]
+        scenic_python: Option<PathBuf>,
+        /// Skip the Scenic peer
+        #[arg(long, requires = "runtime", conflicts_with = "scenic_python")]
+        no_scenic: bool,
+        /// Episodes of the parameter search (the safety examples round robin)
+        #[arg(long, value_name = "N", default_value_t = 20_000, requires = "runtime")]
+        episodes: usize,
+        /// Steps per episode (fewer for tests)
+        #[arg(long, default_value_t = 300, requires = "runtime", hide = true)]
+        steps: u32,
     },
     /// Print the shell completion script for a shell
     ///
@@ -315,7 +338,12 @@ fn main() -> ExitCode {
             tadslc::interchange::run_export(&path, output.as_deref(), color)
         }
         Command::Explain { code } => explain::run(code.as_deref()),
-        Command::Bench { scenarios, seed, examples, runs } => bench::run(scenarios, seed, examples.as_deref(), runs),
+        Command::Bench { runtime: true, runs, scenic_python, no_scenic, episodes, steps, .. } => {
+            bench::runtime::run(&bench::runtime::RuntimeArgs { runs, episodes, steps, scenic_python, no_scenic })
+        }
+        Command::Bench { scenarios, seed, examples, runs, .. } => {
+            bench::run(scenarios, seed, examples.as_deref(), runs)
+        }
         Command::Completions { shell } => tadslc::manual::completions(Cli::command(), shell),
         Command::Man { output } => tadslc::manual::man(Cli::command(), output.as_deref()),
     };

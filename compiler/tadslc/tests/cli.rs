@@ -286,6 +286,34 @@ fn bench_reports_throughput_against_the_peer() {
 }
 
 #[test]
+fn bench_runtime_reports_episodes_and_the_search() {
+    // fewer steps through the hidden `--steps`, to stay fast in a debug build
+    let args = ["bench", "--runtime", "--runs", "1", "--episodes", "16", "--no-scenic", "--steps", "20"];
+    let out = tadslc(&args, "");
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    let text = stdout(&out);
+    for (name, actors) in [("traffic_1", 1), ("traffic_14", 14), ("traffic_50", 50)] {
+        let row = text
+            .lines()
+            .find(|l| l.starts_with(&format!("{name} ")))
+            .unwrap_or_else(|| panic!("{name} missing from\n{text}"));
+        let cells: Vec<&str> = row.split_whitespace().collect();
+        assert_eq!(cells[1..3], [actors.to_string(), "20".to_string()], "{row}");
+        assert!(cells[3].parse::<f64>().is_ok_and(|ms| ms > 0.0), "{row}");
+        assert_eq!(cells[6..], ["-", "-"], "no Scenic: {row}");
+    }
+    assert!(text.contains("Scenic peer skipped: --no-scenic"), "{text}");
+    let search = text
+        .lines()
+        .find(|l| l.starts_with("search: 16 episodes of the 8 safety examples"))
+        .unwrap_or_else(|| panic!("{text}"));
+    assert!(search.contains("episodes/s") && search.contains("stops: "), "{search}");
+    // the check benchmark's options do not apply
+    assert_eq!(code(&tadslc(&["bench", "--runtime", "--scenarios", "5"], "")), 2);
+    assert_eq!(code(&tadslc(&["bench", "--episodes", "5"], "")), 2);
+}
+
+#[test]
 fn fmt_canonicalize_applies_canonical_forms_and_then_checks_clean() {
     let dir = scratch("canonical");
     let path = dir.join("aliases.tad");
