@@ -125,6 +125,8 @@ struct Actor {
     turn: Turn,
     pc: usize,
     block: Block,
+    /// The tracks of lanes beside its own, by lane and turn ([`beside_track`]).
+    beside: Vec<(i64, Turn, Path)>,
 }
 
 /// Run one episode of `scene` with parameters `params` (see [`crate::sample`]).
@@ -306,6 +308,7 @@ fn spawn(scene: &Scene, a: &crate::scene::ActorSetup, params: &[f64]) -> Actor {
         turn: Turn::Straight,
         pc: 0,
         block: Block::None,
+        beside: Vec::new(),
     }
 }
 
@@ -316,6 +319,18 @@ fn lane_track(scene: &Scene, a: &Actor, lane: i64) -> Path {
     let (path, _) = road.vehicle_path(Station { arm: a.arm, along: a.along }, lane, a.turn);
     let offset = a.lateral - road.lateral(a.lane);
     if offset.abs() > 1e-6 && lane == a.lane { path.offset(if lane < 0 { -offset } else { offset }) } else { path }
+}
+
+/// The index in `a.beside` of the track of `lane`, another than its own: built once, as
+/// [`lane_track`] of another lane depends only on the spawn station and the turn, and MOBIL
+/// weighs the lanes beside every second.
+fn beside_track(scene: &Scene, a: &mut Actor, lane: i64) -> usize {
+    if let Some(i) = a.beside.iter().position(|&(l, turn, _)| l == lane && turn == a.turn) {
+        return i;
+    }
+    let track = lane_track(scene, a, lane);
+    a.beside.push((lane, a.turn, track));
+    a.beside.len() - 1
 }
 
 fn set_track(scene: &Scene, a: &mut Actor, track: Path) {
@@ -390,7 +405,8 @@ fn run_script(scene: &Scene, script: &[Instr], a: &mut Actor, params: &[f64], t:
 /// Move a vehicle `lanes` lanes to its right (negative: left) when the arm has them.
 fn change_lane(scene: &Scene, a: &mut Actor, lanes: i64) {
     let Some(lane) = neighbour(scene, a, lanes) else { return };
-    let track = lane_track(scene, a, lane);
+    let slot = beside_track(scene, a, lane);
+    let track = a.beside[slot].2.clone();
     a.lane = lane;
     a.lateral = scene.world.road.lateral(lane);
     set_track(scene, a, track);
@@ -628,9 +644,10 @@ fn mobil(scene: &Scene, actors: &mut [Actor], k: usize, before: &[(Vec2, f64, f6
     };
     let mut choice: Option<(i64, f64)> = None;
     for dir in [-1, 1] {
+        let Some(lane) = neighbour(scene, &actors[k], dir) else { continue };
+        let slot = beside_track(scene, &mut actors[k], lane);
         let me = &actors[k];
-        let Some(lane) = neighbour(scene, me, dir) else { continue };
-        let track = lane_track(scene, me, lane);
+        let track = &me.beside[slot].2;
         let (s, _) = track.project(me.kin.position);
         let entries: Vec<(Vec2, f64, f64, f64, f64)> = before
             .iter()
@@ -643,7 +660,7 @@ fn mobil(scene: &Scene, actors: &mut [Actor], k: usize, before: &[(Vec2, f64, f6
             me.kin.speed,
             me.target,
             ahead_on(
-                &track,
+                track,
                 me.kin.position,
                 me.kin.yaw,
                 s,
@@ -657,7 +674,7 @@ fn mobil(scene: &Scene, actors: &mut [Actor], k: usize, before: &[(Vec2, f64, f6
         // the new follower: the nearest behind in the target lane, with this vehicle ahead of it
         let back = me.kin.yaw + std::f64::consts::PI;
         let behind = ahead_on(
-            &track,
+            track,
             me.kin.position,
             back,
             s,
