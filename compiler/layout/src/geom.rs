@@ -105,10 +105,51 @@ pub fn wrap(angle: f64) -> f64 {
 
 /// A path as a polyline with its cumulative arc lengths. Positions beyond either end
 /// continue straight along the end segments.
+///
+/// Projections onto a path are the runtime's hottest code (every vehicle projects the
+/// others onto its path each step), so they visit the segments from the hint outwards and
+/// rule out runs of [`CHUNK`] segments by their bounding box and single segments by their
+/// squared distance before taking a square root, each with a margin far above rounding:
+/// the result is the one a forward scan with exact distances gives (the nearest segment,
+/// ties to the first). A segment is found from the mean spacing, then walked to.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Path {
     points: Vec<Vec2>,
     arcs: Vec<f64>,
+    /// The bounding box `[min x, min y, max x, max y]` of each run of [`CHUNK`] segments.
+    boxes: Vec<[f64; 4]>,
+}
+
+/// Segments per bounding box.
+const CHUNK: usize = 16;
+
+/// A projection under way: the best segment so far (index, parameter on it, distance), the
+/// distance beyond which nothing matters (the best's, at first the caller's reach), and the
+/// squared distance beyond which a point is surely farther than that (a margin far above
+/// rounding; below 1e-100 m nothing is ruled out). A box of segments is surely farther when
+/// its distance exceeds `limit` + 1 µm (it holds the exact points, not the rounded ones).
+struct Scan {
+    best: (usize, f64, f64),
+    limit: f64,
+    bound: f64,
+}
+
+impl Scan {
+    fn new(reach: f64) -> Scan {
+        Scan { best: (usize::MAX, 0.0, f64::INFINITY), limit: reach, bound: Scan::bound(reach) }
+    }
+
+    fn bound(limit: f64) -> f64 {
+        if limit >= 1e-100 { limit * limit * (1.0 + 1e-9) } else { f64::INFINITY }
+    }
+
+    /// Whether every point of `box` is surely farther from `p` than the limit.
+    fn rules_out(&self, [x0, y0, x1, y1]: [f64; 4], p: Vec2) -> bool {
+        let dx = (x0 - p.x).max(p.x - x1).max(0.0);
+        let dy = (y0 - p.y).max(p.y - y1).max(0.0);
+        let m = self.limit + 1e-6;
+        dx * dx + dy * dy > m * m
+    }
 }
 
 impl Path {
@@ -130,6 +171,15 @@ impl Path {
                 }
             }
         }
+        let segments = path.points.len().saturating_sub(1);
+        path.boxes = (0..segments.div_ceil(CHUNK))
+            .map(|c| {
+                let run = &path.points[c * CHUNK..=((c + 1) * CHUNK).min(segments)];
+                run.iter().fold([f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY], |b, q| {
+                    [b[0].min(q.x), b[1].min(q.y), b[2].max(q.x), b[3].max(q.y)]
+                })
+            })
+            .collect();
         path
     }
 
@@ -146,8 +196,30 @@ impl Path {
         if self.points.len() < 2 {
             return 0;
         }
-        let i = self.arcs.partition_point(|&a| a <= s);
-        i.clamp(1, self.points.len() - 1) - 1
+        self.arcs_upto(s).clamp(1, self.points.len() - 1) - 1
+    }
+
+    /// How many arcs are at most `s` (`partition_point`): guessed from the mean segment
+    /// length (paths are mostly sampled evenly), then walked a few steps; bisection when the
+    /// guess is far off.
+    fn arcs_upto(&self, s: f64) -> usize {
+        let arcs = &self.arcs;
+        let n = arcs.len();
+        let guess = s / self.length() * (n - 1) as f64;
+        if !guess.is_finite() {
+            return arcs.partition_point(|&a| a <= s);
+        }
+        let mut k = (guess.max(0.0) as usize).min(n);
+        for _ in 0..4 {
+            if k < n && arcs[k] <= s {
+                k += 1;
+            } else if k > 0 && arcs[k - 1] > s {
+                k -= 1;
+            } else {
+                return k;
+            }
+        }
+        arcs.partition_point(|&a| a <= s)
     }
 
     /// The pose at arc length `s` (extrapolated straight beyond the ends).
@@ -180,20 +252,21 @@ impl Path {
 
     /// The arc length of the point of the path nearest `p`, and the distance to it.
     pub fn project(&self, p: Vec2) -> (f64, f64) {
-        if self.points.len() < 2 {
+        self.project_from(p, self.length() / 2.0)
+    }
+
+    /// [`Path::project`], searched from arc `hint` outwards: the same result, found sooner
+    /// from a hint near it.
+    pub fn project_from(&self, p: Vec2, hint: f64) -> (f64, f64) {
+        let n = self.points.len();
+        if n < 2 {
             return (0.0, self.points.first().map_or(f64::INFINITY, |q| q.distance(p)));
         }
-        let mut best = (0.0, f64::INFINITY);
-        for i in 0..self.points.len() - 1 {
-            let (a, b) = (self.points[i], self.points[i + 1]);
-            let ab = b - a;
-            let t = ((p - a).dot(ab) / ab.dot(ab)).clamp(0.0, 1.0);
-            let d = (a + ab * t).distance(p);
-            if d < best.1 {
-                best = (self.arcs[i] + t * (self.arcs[i + 1] - self.arcs[i]), d);
-            }
+        let start = if hint.is_nan() { 0 } else { self.segment(hint) };
+        match self.scan(p, 0, n - 2, start, f64::INFINITY, false) {
+            Some((i, t, d)) => (self.arc(i, t), d),
+            None => (0.0, f64::INFINITY),
         }
-        best
     }
 
     /// The arc of the point nearest `p` among the segments within `window` metres of arc
@@ -201,25 +274,78 @@ impl Path {
     /// either end the path goes on straight. What follows a path step by step uses this:
     /// its cost does not grow with the path's length.
     pub fn locate(&self, p: Vec2, hint: f64, window: f64) -> (f64, f64) {
-        let n = self.points.len();
-        if n < 2 {
-            return (0.0, self.points.first().map_or(f64::INFINITY, |q| q.distance(p)));
+        self.nearest(p, hint, window, f64::INFINITY).unwrap_or((hint, f64::INFINITY))
+    }
+
+    /// [`Path::locate`]'s result when its distance is at most `reach`; otherwise `None`, or
+    /// a result farther than `reach` (the caller compares).
+    pub fn nearest(&self, p: Vec2, hint: f64, window: f64, reach: f64) -> Option<(f64, f64)> {
+        if self.points.len() < 2 {
+            return Some((0.0, self.points.first().map_or(f64::INFINITY, |q| q.distance(p))));
         }
         let (first, last) = (self.segment(hint - window), self.segment(hint + window));
-        let mut best = (hint, f64::INFINITY, 0.0);
-        for i in first..=last {
-            let (a, b) = (self.points[i], self.points[i + 1]);
-            let ab = b - a;
-            let mut t = (p - a).dot(ab) / ab.dot(ab);
-            if !(i == 0 && t < 0.0 || i == n - 2 && t > 1.0) {
-                t = t.clamp(0.0, 1.0);
+        let start = self.segment(hint).clamp(first, last);
+        let (i, t, d) = self.scan(p, first, last, start, reach, true)?;
+        let (a, b) = (self.points[i], self.points[i + 1]);
+        Some((self.arc(i, t), if (b - a).cross(p - a) < 0.0 { -d } else { d }))
+    }
+
+    fn arc(&self, i: usize, t: f64) -> f64 {
+        self.arcs[i] + t * (self.arcs[i + 1] - self.arcs[i])
+    }
+
+    /// The segment of `first..=last` nearest `p` within `reach` (index, parameter on it,
+    /// distance), visited from `start` outwards; with `extend`, the path goes on straight
+    /// beyond its end segments.
+    fn scan(
+        &self,
+        p: Vec2,
+        first: usize,
+        last: usize,
+        start: usize,
+        reach: f64,
+        extend: bool,
+    ) -> Option<(usize, f64, f64)> {
+        let n = self.points.len();
+        let mut scan = Scan::new(reach);
+        let home = start / CHUNK;
+        for c in (home..=last / CHUNK).chain((first / CHUNK..home).rev()) {
+            let from = (c * CHUNK).max(first);
+            let to = (c * CHUNK + CHUNK - 1).min(last);
+            // extended end segments reach beyond their box
+            let boxed = !extend || (from > 0 && to < n - 2);
+            if boxed && scan.rules_out(self.boxes[c], p) {
+                continue;
             }
-            let d = (a + ab * t).distance(p);
-            if d < best.1 {
-                best = (self.arcs[i] + t * (self.arcs[i + 1] - self.arcs[i]), d, ab.cross(p - a));
+            if c == home {
+                (start..=to).chain((from..start).rev()).for_each(|i| self.visit(i, p, extend, &mut scan));
+            } else {
+                (from..=to).for_each(|i| self.visit(i, p, extend, &mut scan));
             }
         }
-        (best.0, if best.2 < 0.0 { -best.1 } else { best.1 })
+        (scan.best.0 != usize::MAX).then_some(scan.best)
+    }
+
+    /// Segment `i` against the best so far.
+    fn visit(&self, i: usize, p: Vec2, extend: bool, scan: &mut Scan) {
+        let (a, b) = (self.points[i], self.points[i + 1]);
+        let ab = b - a;
+        let mut t = (p - a).dot(ab) / ab.dot(ab);
+        if !(extend && (i == 0 && t < 0.0 || i == self.points.len() - 2 && t > 1.0)) {
+            t = t.clamp(0.0, 1.0);
+        }
+        let q = a + ab * t;
+        let e = q - p;
+        if e.dot(e) > scan.bound {
+            return;
+        }
+        let d = q.distance(p);
+        let (best_i, _, best_d) = scan.best;
+        if d < best_d || (d == best_d && d.is_finite() && i < best_i) {
+            scan.best = (i, t, d);
+            scan.limit = scan.limit.min(d);
+            scan.bound = Scan::bound(scan.limit);
+        }
     }
 
     /// The first arc length of this path at which it comes within `reach` of `other`,
@@ -322,6 +448,83 @@ fn point_segment(p: Vec2, a: Vec2, b: Vec2) -> f64 {
 mod tests {
     use super::*;
     use std::f64::consts::FRAC_PI_2;
+
+    /// [`Path::locate`] (with `extend`) or [`Path::project`] over `first..=last` as a plain
+    /// forward scan with exact distances: (arc, distance, side).
+    fn scan(t: &Path, p: Vec2, first: usize, last: usize, extend: bool) -> (f64, f64, f64) {
+        let n = t.points.len();
+        let mut best = (f64::NAN, f64::INFINITY, 0.0);
+        for i in first..=last {
+            let (a, b) = (t.points[i], t.points[i + 1]);
+            let ab = b - a;
+            let mut u = (p - a).dot(ab) / ab.dot(ab);
+            if !(extend && (i == 0 && u < 0.0 || i == n - 2 && u > 1.0)) {
+                u = u.clamp(0.0, 1.0);
+            }
+            let d = (a + ab * u).distance(p);
+            if d < best.1 {
+                best = (t.arcs[i] + u * (t.arcs[i + 1] - t.arcs[i]), d, ab.cross(p - a));
+            }
+        }
+        best
+    }
+
+    #[test]
+    fn projections_give_what_a_forward_scan_gives() {
+        // a lane sampled every metre, a hairpin that comes back beside itself, a vee with a
+        // point equally near both arms; points on the paths and far off them
+        let lane = Path::new((0..=400).map(|k| Vec2::new(k as f64 - 200.0, -5.25)));
+        let hairpin = Path::new(
+            (0..=60)
+                .map(|k| Vec2::new(k as f64, 0.0))
+                .chain((1..=30).map(|k| Vec2::from_yaw(-FRAC_PI_2 + k as f64 * 0.1047) * 3.0 + Vec2::new(60.0, 3.0)))
+                .chain((0..=60).rev().map(|k| Vec2::new(k as f64, 6.0))),
+        );
+        let vee = Path::new([Vec2::new(-10.0, 10.0), Vec2::new(0.0, 0.0), Vec2::new(10.0, 10.0)]);
+        let bits = |(s, d): (f64, f64)| (s.to_bits(), d.to_bits());
+        let mut checked = 0;
+        for path in [&lane, &hairpin, &vee] {
+            let n = path.points.len();
+            for k in 0..2000 {
+                let x = (k as f64 * 0.37).sin() * 90.0 + 30.0;
+                let y = (k as f64 * 0.91).cos() * 12.0 + 3.0;
+                let p = if k % 7 == 0 { Vec2::new(0.0, 5.0) } else { Vec2::new(x, y) };
+                let (s0, d0, _) = scan(path, p, 0, n - 2, false);
+                assert_eq!(bits(path.project(p)), bits((s0, d0)), "project {p:?}");
+                for (hint, window) in
+                    [(k as f64 * 0.2 - 100.0, 8.0), (50.0, 30.0), (path.length() / 2.0, path.length())]
+                {
+                    assert_eq!(bits(path.project_from(p, hint)), bits((s0, d0)), "project {p:?} from {hint}");
+                    let (first, last) = (path.segment(hint - window), path.segment(hint + window));
+                    let (s1, d1, side) = scan(path, p, first, last, true);
+                    let d1 = if side < 0.0 { -d1 } else { d1 };
+                    assert_eq!(bits(path.locate(p, hint, window)), bits((s1, d1)), "{p:?} hint {hint} window {window}");
+                    for reach in [0.5, 3.0, d1.abs(), 20.0] {
+                        match path.nearest(p, hint, window, reach) {
+                            Some(found) if d1.abs() <= reach => assert_eq!(bits(found), bits((s1, d1))),
+                            Some((_, d)) => assert!(d.abs() > reach, "{p:?} {d} within {reach}, but {d1}"),
+                            None => assert!(d1.abs() > reach, "{p:?} {d1} within {reach}, not found"),
+                        }
+                    }
+                    checked += 1;
+                }
+            }
+        }
+        assert_eq!(checked, 18_000);
+    }
+
+    #[test]
+    fn the_arcs_before_a_point_are_counted_as_a_bisection_counts_them() {
+        let even = Path::new((0..=400).map(|k| Vec2::new(k as f64 - 200.0, 1.0)));
+        let uneven = Path::new((0..=100).map(|k| Vec2::new((k * k) as f64 / 50.0, 0.0)));
+        let two = Path::new([Vec2::new(0.0, 0.0), Vec2::new(5.0, 0.0)]);
+        for t in [&even, &uneven, &two] {
+            let extra = [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 0.0, t.length(), 1.0];
+            for s in (-50..=4500).map(|k| k as f64 * 0.1003 - 2.0).chain(extra) {
+                assert_eq!(t.arcs_upto(s), t.arcs.partition_point(|&a| a <= s), "{s}");
+            }
+        }
+    }
 
     #[test]
     fn locate_is_signed_local_and_extrapolates() {
