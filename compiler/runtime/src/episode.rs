@@ -110,6 +110,8 @@ struct Actor {
     target: f64,
     motion: Motion,
     track: Option<Path>,
+    /// Its track's [`models::bend`].
+    bend: f64,
     s: f64,
     /// Arc of its stop line on its track and the arm whose light it obeys.
     stop_line: Option<(f64, Arm)>,
@@ -127,6 +129,30 @@ struct Actor {
     block: Block,
     /// The tracks of lanes beside its own, by lane and turn ([`beside_track`]).
     beside: Vec<(i64, Turn, Path)>,
+}
+
+/// An actor as the others see it during a step: its state at the end of the previous one,
+/// its heading as a unit vector (computed once per step), its size.
+#[derive(Clone, Copy, Debug)]
+struct Seen {
+    position: Vec2,
+    yaw: f64,
+    heading: Vec2,
+    speed: f64,
+    length: f64,
+    width: f64,
+}
+
+impl Seen {
+    fn new(kin: &Kinematics, length: f64, width: f64) -> Seen {
+        Seen { position: kin.position, yaw: kin.yaw, heading: Vec2::from_yaw(kin.yaw), speed: kin.speed, length, width }
+    }
+
+    /// Seen from behind: turned round.
+    fn reversed(self) -> Seen {
+        let yaw = self.yaw + std::f64::consts::PI;
+        Seen { yaw, heading: Vec2::from_yaw(yaw), ..self }
+    }
 }
 
 /// Run one episode of `scene` with parameters `params` (see [`crate::sample`]).
@@ -183,10 +209,13 @@ pub fn run(scene: &Scene, seed: Option<u64>, params: Vec<f64>, policy: &mut dyn 
     let mut velocity = Vec2::from_yaw(ego.yaw) * ego.speed;
     let mut stop_reason = StopReason::MaxSteps;
     let mut step = 0u32;
+    let mut before: Vec<Seen> = Vec::with_capacity(actors.len());
+    let route_bend = models::bend(route);
     while step < scene.limits.max_steps {
         step += 1;
         let t = f64::from(step) * dt;
-        let before: Vec<(Vec2, f64, f64)> = actors.iter().map(|a| (a.kin.position, a.kin.yaw, a.kin.speed)).collect();
+        before.clear();
+        before.extend(actors.iter().map(|a| Seen::new(&a.kin, a.length, a.width)));
 
         // scripts, on the previous state
         for (setup, actor) in scene.actors.iter().zip(actors.iter_mut()) {
@@ -196,8 +225,20 @@ pub fn run(scene: &Scene, seed: Option<u64>, params: Vec<f64>, policy: &mut dyn 
         // the ego's policy
         let (s_now, off_route) = route.locate(ego.position, ego_s, 10.0);
         ego_s = s_now;
-        let view =
-            ego_view(scene, &ego, ego_s, off_route, desired, &actors, &before, t, ego_stop, &detectors, &mut preview);
+        let view = ego_view(
+            scene,
+            &ego,
+            ego_s,
+            route_bend,
+            off_route,
+            desired,
+            &actors,
+            &before,
+            t,
+            ego_stop,
+            &detectors,
+            &mut preview,
+        );
         let action: Action = policy.act(&view);
         let accel = if action.accel.is_finite() { action.accel.clamp(ACCEL_MIN, ACCEL_MAX) } else { 0.0 };
         let steer = if action.steer.is_finite() { action.steer.clamp(-1.0, 1.0) } else { 0.0 };
@@ -206,8 +247,9 @@ pub fn run(scene: &Scene, seed: Option<u64>, params: Vec<f64>, policy: &mut dyn 
         driven += old.distance(ego.position);
 
         // everyone else
+        let ego_seen = Seen::new(&ego, ego_size.length, ego_size.width);
         for k in 0..actors.len() {
-            move_actor(scene, &mut actors, k, &before, &ego, t, dt);
+            move_actor(scene, &mut actors, k, &before, ego_seen, t, dt);
         }
 
         // contacts
@@ -294,6 +336,7 @@ fn spawn(scene: &Scene, a: &crate::scene::ActorSetup, params: &[f64]) -> Actor {
         target: a.speed.max(0.0),
         motion: Motion::Stand,
         track: None,
+        bend: 0.0,
         s: 0.0,
         stop_line: None,
         stopped_at_sign: false,
@@ -344,6 +387,7 @@ fn set_track(scene: &Scene, a: &mut Actor, track: Path) {
     } else {
         None
     };
+    a.bend = models::bend(&track);
     a.track = Some(track);
 }
 
@@ -421,15 +465,7 @@ fn neighbour(scene: &Scene, a: &Actor, lanes: i64) -> Option<i64> {
     (ok && lane != a.lane).then_some(lane)
 }
 
-fn move_actor(
-    scene: &Scene,
-    actors: &mut [Actor],
-    k: usize,
-    before: &[(Vec2, f64, f64)],
-    ego: &Kinematics,
-    t: f64,
-    dt: f64,
-) {
+fn move_actor(scene: &Scene, actors: &mut [Actor], k: usize, before: &[Seen], ego: Seen, t: f64, dt: f64) {
     match actors[k].motion {
         Motion::Stand => {
             let a = &mut actors[k];
@@ -459,7 +495,7 @@ fn move_actor(
             } else {
                 IdmParams::default().accel(
                     a.kin.speed,
-                    a.target.min(models::curve_speed(track, s, a.kin.speed)),
+                    a.target.min(models::curve_speed_knowing(track, a.bend, s, a.kin.speed)),
                     leader,
                 )
             };
@@ -482,21 +518,11 @@ const LOOK: f64 = 60.0;
 
 /// The nearest thing ahead of actor `k` on its track: (bumper gap, its speed along), the
 /// ego included unless `k` runs lights (an adversary), and its stop line when it must stop.
-fn leader_of(
-    scene: &Scene,
-    actors: &[Actor],
-    k: usize,
-    before: &[(Vec2, f64, f64)],
-    ego: &Kinematics,
-    t: f64,
-) -> Option<(f64, f64)> {
+fn leader_of(scene: &Scene, actors: &[Actor], k: usize, before: &[Seen], ego: Seen, t: f64) -> Option<(f64, f64)> {
     let me = &actors[k];
     let track = me.track.as_ref()?;
-    let others = before.iter().enumerate().filter(|(j, _)| *j != k).map(|(j, &(p, yaw, v))| {
-        let a = &actors[j];
-        (p, yaw, v, a.length, a.width)
-    });
-    let ego_entry = me.obey.then_some((ego.position, ego.yaw, ego.speed, scene.ego.size.length, scene.ego.size.width));
+    let others = before.iter().enumerate().filter(|(j, _)| *j != k).map(|(_, &o)| o);
+    let ego_entry = me.obey.then_some(ego);
     let mut best = ahead_on(
         track,
         me.kin.position,
@@ -550,7 +576,7 @@ fn ahead_on(
     width: f64,
     speed: f64,
     yields: bool,
-    others: impl Iterator<Item = (Vec2, f64, f64, f64, f64)>,
+    others: impl Iterator<Item = Seen>,
 ) -> Option<(f64, f64)> {
     let heading = Vec2::from_yaw(yaw);
     let mut best: Option<(f64, f64)> = None;
@@ -559,12 +585,12 @@ fn ahead_on(
             best = Some((gap, along));
         }
     };
-    for (p, other_yaw, v, l, w) in others {
+    for Seen { position: p, yaw: other_yaw, heading: other_heading, speed: v, length: l, width: w } in others {
         let d = p - position;
-        if d.length() > LOOK {
+        if beyond(d, LOOK) {
             continue;
         }
-        let crossing = v > 0.3 && Vec2::from_yaw(other_yaw).dot(heading).abs() < 0.7;
+        let crossing = v > 0.3 && other_heading.dot(heading).abs() < 0.7;
         if !crossing {
             if d.dot(heading) <= 0.0 {
                 continue;
@@ -580,7 +606,7 @@ fn ahead_on(
             }
             continue;
         }
-        let velocity = Vec2::from_yaw(other_yaw) * v;
+        let velocity = other_heading * v;
         let samples = if yields { CROSS_SAMPLES } else { 0 };
         for k in 0..=samples {
             let tau = CROSS_HORIZON * k as f64 / CROSS_SAMPLES as f64;
@@ -599,6 +625,16 @@ fn ahead_on(
         }
     }
     best
+}
+
+/// Whether `d` is longer than `limit`, its exact length taken only when the bounds
+/// `max(|x|, |y|) ≤ length ≤ |x| + |y|` do not tell.
+fn beyond(d: Vec2, limit: f64) -> bool {
+    let (x, y) = (d.x.abs(), d.y.abs());
+    if x > limit || y > limit {
+        return true;
+    }
+    x + y > limit && d.length() > limit
 }
 
 /// How far ahead crossing traffic is predicted, s, in how many steps, and how near in time
@@ -621,8 +657,10 @@ fn in_corridor(
     w: f64,
     ahead: f64,
 ) -> Option<(f64, f64)> {
-    let (sj, lat) = track.locate(p, s + ahead, 8.0);
-    if sj <= s {
+    // out of reach whatever the headings: the reach below with |sin| and |cos| at 1
+    let reach = width / 2.0 + l / 2.0 + w / 2.0 + 0.3;
+    let (sj, lat) = track.nearest(p, s + ahead, 8.0, reach)?;
+    if sj <= s || lat.abs() > reach {
         return None;
     }
     let rel = wrap(yaw - track.pose(sj).yaw);
@@ -635,7 +673,7 @@ fn in_corridor(
 
 /// MOBIL (Kesting, Treiber and Helbing 2007) with politeness 0: change to a neighbouring lane
 /// when it gains more than 0.2 m/s² and its new follower need not brake harder than 4 m/s².
-fn mobil(scene: &Scene, actors: &mut [Actor], k: usize, before: &[(Vec2, f64, f64)], ego: &Kinematics, t: f64) {
+fn mobil(scene: &Scene, actors: &mut [Actor], k: usize, before: &[Seen], ego: Seen, t: f64) {
     const GAIN: f64 = 0.2;
     const SAFE: f64 = 4.0;
     let now = {
@@ -648,28 +686,14 @@ fn mobil(scene: &Scene, actors: &mut [Actor], k: usize, before: &[(Vec2, f64, f6
         let slot = beside_track(scene, &mut actors[k], lane);
         let me = &actors[k];
         let track = &me.beside[slot].2;
-        let (s, _) = track.project(me.kin.position);
-        let entries: Vec<(Vec2, f64, f64, f64, f64)> = before
-            .iter()
-            .enumerate()
-            .filter(|(j, _)| *j != k)
-            .map(|(j, &(p, y, v))| (p, y, v, actors[j].length, actors[j].width))
-            .chain(std::iter::once((ego.position, ego.yaw, ego.speed, scene.ego.size.length, scene.ego.size.width)))
-            .collect();
+        // the lanes are sampled alike: its arc on its own is near its arc on this one
+        let (s, _) = track.project_from(me.kin.position, me.s);
+        let entries =
+            || before.iter().enumerate().filter(|(j, _)| *j != k).map(|(_, &o)| o).chain(std::iter::once(ego));
         let then = IdmParams::default().accel(
             me.kin.speed,
             me.target,
-            ahead_on(
-                track,
-                me.kin.position,
-                me.kin.yaw,
-                s,
-                me.length,
-                me.width,
-                me.kin.speed,
-                me.obey,
-                entries.iter().copied(),
-            ),
+            ahead_on(track, me.kin.position, me.kin.yaw, s, me.length, me.width, me.kin.speed, me.obey, entries()),
         );
         // the new follower: the nearest behind in the target lane, with this vehicle ahead of it
         let back = me.kin.yaw + std::f64::consts::PI;
@@ -682,7 +706,7 @@ fn mobil(scene: &Scene, actors: &mut [Actor], k: usize, before: &[(Vec2, f64, f6
             me.width,
             me.kin.speed,
             me.obey,
-            entries.iter().map(|&(p, y, v, l, w)| (p, y + std::f64::consts::PI, v, l, w)),
+            entries().map(Seen::reversed),
         );
         let safe = behind.is_none_or(|(gap, speed_back)| {
             IdmParams::default().accel(speed_back, speed_back.max(me.target), Some((gap, me.kin.speed))) >= -SAFE
@@ -703,10 +727,11 @@ fn ego_view(
     scene: &Scene,
     ego: &Kinematics,
     s: f64,
+    route_bend: f64,
     off_route: f64,
     desired: f64,
     actors: &[Actor],
-    before: &[(Vec2, f64, f64)],
+    before: &[Seen],
     t: f64,
     stop_line: Option<f64>,
     detectors: &Detectors,
@@ -725,18 +750,19 @@ fn ego_view(
         ego.speed,
     );
     let ego_lane = scene.world.spot(ego.position);
-    let front = before.iter().zip(actors).any(|(&(p, yaw, _), a)| {
+    let front = before.iter().zip(actors).any(|(o, a)| {
+        let p = o.position;
         a.body == Body::Vehicle
             && p.distance(ego.position) <= 15.0
             && (p - ego.position).dot(heading) > 0.0
-            && Vec2::from_yaw(yaw).dot(heading) > 0.0
+            && o.heading.dot(heading) > 0.0
             && matches!(ego_lane, Spot::Lane(..))
             && scene.world.spot(p) == ego_lane
     });
     let lookahead = models::lookahead(ego.speed);
     let target = Pose { position: ego.position, yaw: ego.yaw }.local(route.pose(s + lookahead).position);
-    let others = before.iter().zip(actors).map(|(&(p, yaw, v), a)| (p, yaw, v, a.length, a.width));
-    let leader = ahead_on(route, ego.position, ego.yaw, s, size.length, size.width, ego.speed, true, others);
+    let leader =
+        ahead_on(route, ego.position, ego.yaw, s, size.length, size.width, ego.speed, true, before.iter().copied());
     let stop = stop_line.and_then(|line| {
         let gap = line - (s + size.length / 2.0);
         (gap > -0.5 && must_stop(scene, Arm::Ego, gap, ego.speed, t, detectors.stopped_at_sign()))
@@ -752,7 +778,7 @@ fn ego_view(
         wheelbase: WHEELBASE * size.length,
         leader,
         stop,
-        curve_speed: models::curve_speed(route, s, ego.speed),
+        curve_speed: models::curve_speed_knowing(route, route_bend, s, ego.speed),
         dt: scene.limits.dt,
     }
 }

@@ -62,6 +62,20 @@ pub fn curve_speed(track: &Path, s: f64, speed: f64) -> f64 {
     if sharpest < 1e-4 { f64::INFINITY } else { (LATERAL_ACCEL / sharpest).sqrt() }
 }
 
+/// The largest turn, rad, between a path's first heading and any other: no two headings of
+/// the path differ by more than twice this.
+pub fn bend(track: &Path) -> f64 {
+    let mut headings = track.points().windows(2).map(|w| (w[1] - w[0]).yaw());
+    let Some(first) = headings.next() else { return 0.0 };
+    headings.map(|y| tad_layout::geom::wrap(y - first).abs()).fold(0.0, f64::max)
+}
+
+/// [`curve_speed`] of a path whose [`bend`] is known: where no two headings differ by 1e-4
+/// rad (and the turns it measures are half a difference), there is no curve to slow for.
+pub fn curve_speed_knowing(track: &Path, bend: f64, s: f64, speed: f64) -> f64 {
+    if bend < 0.5e-4 { f64::INFINITY } else { curve_speed(track, s, speed) }
+}
+
 /// How far ahead pure pursuit aims, m.
 pub fn lookahead(speed: f64) -> f64 {
     (0.5 * speed + 2.5).clamp(3.5, 20.0)
@@ -70,6 +84,22 @@ pub fn lookahead(speed: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_straight_path_has_no_curve_speed_and_a_bend_has_one() {
+        let lane = Path::new((0..=400).map(|k| Vec2::new(k as f64 * 0.999 - 200.0, -5.25 + k as f64 * 1e-9)));
+        assert!(bend(&lane) < 1e-6);
+        for s in [-10.0, 0.0, 150.0, 399.0, 420.0] {
+            assert_eq!(curve_speed(&lane, s, 10.0), f64::INFINITY);
+            assert_eq!(curve_speed_knowing(&lane, bend(&lane), s, 10.0), f64::INFINITY);
+        }
+        let corner =
+            Path::new((0..=20).map(|k| Vec2::new(k as f64, 0.0)).chain((1..=20).map(|k| Vec2::new(20.0, k as f64))));
+        assert!((bend(&corner) - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+        assert_eq!(curve_speed_knowing(&corner, bend(&corner), 10.0, 5.0), curve_speed(&corner, 10.0, 5.0));
+        assert!(curve_speed(&corner, 10.0, 5.0).is_finite());
+        assert_eq!(bend(&Path::default()), 0.0);
+    }
 
     #[test]
     fn pursuit_converges_onto_an_offset_track() {
