@@ -118,6 +118,8 @@ pub struct Path {
     arcs: Vec<f64>,
     /// The bounding box `[min x, min y, max x, max y]` of each run of [`CHUNK`] segments.
     boxes: Vec<[f64; 4]>,
+    /// Segments per metre, on average.
+    density: f64,
 }
 
 /// Segments per bounding box.
@@ -180,6 +182,8 @@ impl Path {
                 })
             })
             .collect();
+        // (paths compare equal by value: no NaN for a path of fewer than two points)
+        path.density = if segments > 0 { segments as f64 / path.length() } else { 0.0 };
         path
     }
 
@@ -205,7 +209,7 @@ impl Path {
     fn arcs_upto(&self, s: f64) -> usize {
         let arcs = &self.arcs;
         let n = arcs.len();
-        let guess = s / self.length() * (n - 1) as f64;
+        let guess = s * self.density;
         if !guess.is_finite() {
             return arcs.partition_point(|&a| a <= s);
         }
@@ -511,6 +515,14 @@ mod tests {
             }
         }
         assert_eq!(checked, 18_000);
+    }
+
+    #[test]
+    fn paths_of_the_same_points_are_equal() {
+        for points in [vec![], vec![Vec2::new(1.0, 2.0)], vec![Vec2::new(0.0, 0.0), Vec2::new(3.0, 4.0)]] {
+            assert_eq!(Path::new(points.clone()), Path::new(points));
+        }
+        assert_eq!(Path::new([]), Path::default());
     }
 
     #[test]
