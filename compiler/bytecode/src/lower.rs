@@ -304,13 +304,7 @@ impl Builder {
                 .map_or(0.0, |r| r.station.along),
             _ => 0.0,
         };
-        let room = gl
-            .agents
-            .iter()
-            .filter(|a| a.station.arm != Arm::Ego && a.facing == Facing::Along)
-            .map(|a| a.station.along - a.length / 2.0 - 0.5)
-            .fold(f64::INFINITY, f64::min);
-        let slack = gl.slack.min(room);
+        let slack = gl.shift_room();
         let roomy = slack >= MIN_ROOM && slack.is_finite();
         if !roomy {
             return None;

@@ -114,6 +114,20 @@ pub struct GroupLayout {
     pub slack: f64,
 }
 
+impl GroupLayout {
+    /// How far the whole group may be sampled nearer its reference: its [`slack`], but never
+    /// so far that an actor on another arm would reach into the junction (0.5 m kept).
+    ///
+    /// [`slack`]: GroupLayout::slack
+    pub fn shift_room(&self) -> f64 {
+        self.agents
+            .iter()
+            .filter(|a| a.station.arm != Arm::Ego && a.facing == Facing::Along)
+            .map(|a| a.station.along - a.length / 2.0 - 0.5)
+            .fold(self.slack, f64::min)
+    }
+}
+
 /// A group timed to meet the ego.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Conflict {

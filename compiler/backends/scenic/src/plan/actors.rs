@@ -91,14 +91,7 @@ pub fn build(
             shift: if let Some((low, high)) = g.distance.filter(|(low, high)| low < high) {
                 Some((high - low, -away))
             } else if conflict.is_none() {
-                // never into the junction on another arm
-                let room = gl
-                    .agents
-                    .iter()
-                    .filter(|a| a.station.arm != Arm::Ego && a.facing == Facing::Along)
-                    .map(|a| a.station.along - a.length / 2.0 - 0.5)
-                    .fold(f64::INFINITY, f64::min);
-                Some((gl.slack.min(room), -away)).filter(|(s, _)| *s >= 0.5)
+                Some((gl.shift_room(), -away)).filter(|(s, _)| *s >= 0.5)
             } else {
                 None
             },
