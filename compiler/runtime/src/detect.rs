@@ -5,7 +5,7 @@
 
 use crate::world::{Spot, World};
 use tad_bytecode::Light;
-use tad_layout::geom::{Footprint, Path, Pose};
+use tad_layout::geom::{Footprint, Path};
 
 /// Route completion counts as complete past this share within [`END_DISTANCE`] of the end.
 const COMPLETE_SHARE: f64 = 0.99;
@@ -52,8 +52,7 @@ pub struct Reading {
 }
 
 impl Detectors {
-    pub fn new(route: &Path, start: f64, length: f64, stop_line: Option<f64>) -> Detectors {
-        let _ = route;
+    pub fn new(start: f64, length: f64, stop_line: Option<f64>) -> Detectors {
         Detectors {
             corners: None,
             lane_invasions: 0,
@@ -147,9 +146,4 @@ impl Detectors {
     pub fn stopped_at_sign(&self) -> bool {
         matches!(self.sign, SignState::Inside(true) | SignState::Done)
     }
-}
-
-/// The ego's footprint at a pose.
-pub fn footprint(pose: Pose, length: f64, width: f64) -> Footprint {
-    Footprint { pose, length, width }
 }

@@ -7,7 +7,7 @@
 //! bicycle with pure pursuit and IDM, walkers along their track); rapier reports the ego's new
 //! contacts; the criteria read the new state; the record is stored; the stop rules run.
 
-use crate::detect::{Detectors, footprint};
+use crate::detect::Detectors;
 use crate::models::{self, Kinematics, WHEELBASE, pursue};
 use crate::physics::{Physics, Shape};
 use crate::scene::Scene;
@@ -15,7 +15,7 @@ use crate::world::Spot;
 use tad_bytecode::{Instr, Light, Value};
 use tad_layout::geom::{Footprint, Path, Pose, Vec2, wrap};
 use tad_layout::road::Station;
-use tad_layout::{Arm, Body, Facing, Turn};
+use tad_layout::{Arm, Body, Turn};
 use tad_metrics::{Mode, StepRecord, StopReason};
 use tad_policy::{ACCEL_MAX, ACCEL_MIN, Action, EgoPolicy, EgoView, IdmParams, MAX_WHEEL_ANGLE, Preview};
 
@@ -164,12 +164,12 @@ pub fn run(scene: &Scene, seed: Option<u64>, params: Vec<f64>, policy: &mut dyn 
     let desired = scene.ego.speed.eval(&params).max(0.0);
     let start = scene.ego_pose();
     let mut ego = Kinematics { position: start.position, yaw: start.yaw, speed: desired };
-    let mut ego_s = scene.ego.start;
+    let (mut ego_s, _) = route.locate(start.position, scene.ego.start, 10.0);
     let ego_stop = world
         .stop_line(Arm::Ego, scene.ego.lane)
         .map(|p| route.locate(p, ego_s, 400.0))
         .and_then(|(s, d)| (d.abs() < world.road.lane_width).then_some(s));
-    let mut detectors = Detectors::new(route, scene.ego.start, scene.ego.route_length, ego_stop);
+    let mut detectors = Detectors::new(scene.ego.start, scene.ego.route_length, ego_stop);
     let mut actors: Vec<Actor> = scene.actors.iter().map(|a| spawn(scene, a, &params)).collect();
     let mut shapes = vec![Shape { length: ego_size.length, width: ego_size.width, height: ego_size.height }];
     shapes.extend(scene.actors.iter().map(|a| Shape {
@@ -222,23 +222,9 @@ pub fn run(scene: &Scene, seed: Option<u64>, params: Vec<f64>, policy: &mut dyn 
             run_script(scene, &setup.script, actor, &params, t, ego.position);
         }
 
-        // the ego's policy
-        let (s_now, off_route) = route.locate(ego.position, ego_s, 10.0);
-        ego_s = s_now;
-        let view = ego_view(
-            scene,
-            &ego,
-            ego_s,
-            route_bend,
-            off_route,
-            desired,
-            &actors,
-            &before,
-            t,
-            ego_stop,
-            &detectors,
-            &mut preview,
-        );
+        // the ego's policy (its arc on the route is the last criteria's: it has not moved)
+        let view =
+            ego_view(scene, &ego, ego_s, route_bend, desired, &actors, &before, t, ego_stop, &detectors, &mut preview);
         let action: Action = policy.act(&view);
         let accel = if action.accel.is_finite() { action.accel.clamp(ACCEL_MIN, ACCEL_MAX) } else { 0.0 };
         let steer = if action.steer.is_finite() { action.steer.clamp(-1.0, 1.0) } else { 0.0 };
@@ -266,7 +252,7 @@ pub fn run(scene: &Scene, seed: Option<u64>, params: Vec<f64>, policy: &mut dyn 
         // criteria
         let (s_now, off_route) = route.locate(ego.position, ego_s, 10.0);
         ego_s = s_now;
-        let fp = footprint(ego.pose(), ego_size.length, ego_size.width);
+        let fp = Footprint { pose: ego.pose(), length: ego_size.length, width: ego_size.width };
         let reading = detectors.read(world, route, fp, ego_s, off_route, ego.speed, t);
         for (happened, kind) in [
             (reading.lane_invasion, EventKind::LaneInvasion),
@@ -728,7 +714,6 @@ fn ego_view(
     ego: &Kinematics,
     s: f64,
     route_bend: f64,
-    off_route: f64,
     desired: f64,
     actors: &[Actor],
     before: &[Seen],
@@ -768,7 +753,6 @@ fn ego_view(
         (gap > -0.5 && must_stop(scene, Arm::Ego, gap, ego.speed, t, detectors.stopped_at_sign()))
             .then_some(gap.max(0.0))
     });
-    let _ = off_route;
     EgoView {
         obs: [lateral_dis, minus_delta_yaw, ego.speed, if front { 1.0 } else { 0.0 }],
         speed: ego.speed,
@@ -781,14 +765,4 @@ fn ego_view(
         curve_speed: models::curve_speed_knowing(route, route_bend, s, ego.speed),
         dt: scene.limits.dt,
     }
-}
-
-/// Where the ego stands at the start, and its footprint, for tests.
-pub fn ego_footprint(scene: &Scene) -> Footprint {
-    footprint(scene.ego_pose(), scene.ego.size.length, scene.ego.size.width)
-}
-
-#[allow(dead_code)]
-fn _facing(f: Facing) -> bool {
-    matches!(f, Facing::Along)
 }

@@ -190,11 +190,6 @@ impl Scene {
     pub fn ego_pose(&self) -> Pose {
         self.ego.route.pose(self.ego.start)
     }
-
-    /// A path as the layout's `Path` (for the renderer and tests).
-    pub fn route_path(&self) -> Path {
-        Path::new(self.ego.route.points().iter().copied())
-    }
 }
 
 /// The actor a behaviour instruction is about.
