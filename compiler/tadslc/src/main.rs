@@ -129,7 +129,7 @@ enum Command {
         /// (a SafeBench SAC actor in safetensors)
         #[arg(long, value_delimiter = ',', default_values_t = ["idm".to_string(), "naive".to_string()])]
         ego: Vec<String>,
-        /// Seeds `A..B` (B excluded, as in Rust) or one seed `A`
+        /// Seeds `A..B` (B excluded, as in Rust), `A..=B` (B included) or one seed `A`
         #[arg(long, default_value = "0..3", value_parser = tadslc::run::parse_seeds)]
         seeds: std::ops::Range<u64>,
         /// Output format: a table for people, or JSON lines (one object per episode, then

@@ -36,17 +36,19 @@ pub struct RunArgs {
     pub compat: bool,
 }
 
-/// `A..B` (B excluded, as in Rust) or a single seed `A`.
+/// `A..B` (B excluded, as in Rust), `A..=B` (B included) or a single seed `A`.
 pub fn parse_seeds(text: &str) -> Result<Range<u64>, String> {
     let number = |s: &str| s.trim().parse::<u64>().map_err(|_| format!("`{s}` is not a seed (a whole number)"));
     let range = match text.split_once("..") {
-        Some((a, b)) => number(a)?..number(b.strip_prefix('=').map_or(b, |_| b))?,
+        Some((a, b)) => match b.strip_prefix('=') {
+            Some(last) => number(a)?..number(last)?.saturating_add(1),
+            None => number(a)?..number(b)?,
+        },
         None => {
             let a = number(text)?;
             a..a.saturating_add(1)
         }
     };
-    let range = if text.contains("..=") { range.start..range.end.saturating_add(1) } else { range };
     if range.is_empty() {
         return Err(format!("`{text}` holds no seed: give A..B with A < B (B excluded)"));
     }
@@ -396,5 +398,19 @@ impl Progress {
         if let Some(bar) = &self.0 {
             bar.finish_and_clear();
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::parse_seeds;
+
+    #[test]
+    fn seeds_are_rust_ranges() {
+        assert_eq!(parse_seeds("3..6"), Ok(3..6));
+        assert_eq!(parse_seeds("3..=6"), Ok(3..7));
+        assert_eq!(parse_seeds("4"), Ok(4..5));
+        assert!(parse_seeds("5..5").unwrap_err().contains("holds no seed"));
+        assert!(parse_seeds("a..3").unwrap_err().contains("not a seed"));
     }
 }
