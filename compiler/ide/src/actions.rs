@@ -1,0 +1,1 @@
+//! Code actions and formatting. TO BE WRITTEN.
