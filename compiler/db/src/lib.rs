@@ -301,6 +301,13 @@ pub fn resolve(db: &dyn Db, file: SourceFile) -> Option<tad_ir::Scenario> {
     tad_ir::resolve(&analyze(db, file).module, &vocabulary(db, file).vocabulary)
 }
 
+/// Run `f`, a reader of a database snapshot; `None` when a write cancelled it (salsa
+/// unwinds the readers of inputs being set, so an edit never waits for stale work).
+/// Other panics propagate.
+pub fn cancellable<T>(f: impl FnOnce() -> T + std::panic::UnwindSafe) -> Option<T> {
+    salsa::Cancelled::catch(f).ok()
+}
+
 /// Whether a source is the prelude's (embedded, or `stdlib/core.tad` checked from disk),
 /// which must not see the prelude a second time.
 fn is_prelude_source(path: &Path, text: &str) -> bool {

@@ -40,7 +40,10 @@ pub fn code_actions(db: &Database, file: SourceFile, range: Span) -> Vec<Action>
             continue;
         }
         for fix in usable(diagnostic) {
-            if fix.span.end > text.len() || !text.is_char_boundary(fix.span.start) || !text.is_char_boundary(fix.span.end) {
+            if fix.span.end > text.len()
+                || !text.is_char_boundary(fix.span.start)
+                || !text.is_char_boundary(fix.span.end)
+            {
                 continue;
             }
             out.push(Action {

@@ -79,7 +79,8 @@ pub(crate) mod testing {
 
     pub fn with_language(text: &str, language: Language) -> (Database, SourceFile) {
         let mut db = Database::new(tad_check::Options::default());
-        let path = PathBuf::from(if language == Language::Yaml { "/fixture/answer.yaml" } else { "/fixture/scenario.tad" });
+        let path =
+            PathBuf::from(if language == Language::Yaml { "/fixture/answer.yaml" } else { "/fixture/scenario.tad" });
         let file = db.set_source(path, text.to_string(), language, &tad_db::NoFs);
         (db, file)
     }

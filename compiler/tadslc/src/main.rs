@@ -153,6 +153,13 @@ enum Command {
         path: PathBuf,
     },
     /// Explain a diagnostic code, e.g. `tadslc explain E0203`
+    /// Serve the language server protocol on standard input and output, for editors
+    /// (`editors/`: VS Code, Neovim, Helix, Emacs); settings come from the client
+    Lsp {
+        /// Accepted for clients that pass it (stdio is the only transport)
+        #[arg(long, hide = true)]
+        stdio: bool,
+    },
     Explain {
         /// The code, or its number whatever its letter (`203`, `w600`); omit it to list
         /// every code
@@ -340,6 +347,13 @@ fn main() -> ExitCode {
             tadslc::interchange::run_export(&path, output.as_deref(), color)
         }
         Command::Explain { code } => explain::run(code.as_deref()),
+        Command::Lsp { stdio: _ } => match tad_lsp::run_stdio() {
+            Ok(()) => tadslc::Status::Ok,
+            Err(error) => {
+                eprintln!("error: the language server could not start: {error}");
+                tadslc::Status::Usage
+            }
+        },
         Command::Bench { runtime: true, runs, scenic_python, no_scenic, episodes, steps, .. } => {
             bench::runtime::run(&bench::runtime::RuntimeArgs { runs, episodes, steps, scenic_python, no_scenic })
         }
