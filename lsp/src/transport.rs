@@ -149,11 +149,8 @@ where
                 Ok(None) | Err(_) => server_open = false,
             },
             answer = answers.recv() => match answer {
-                Some(bytes) => {
-                    if client.write_all(&bytes).await.is_err() || client.flush().await.is_err() {
-                        return;
-                    }
-                }
+                Some(bytes) if client.write_all(&bytes).await.is_err() || client.flush().await.is_err() => return,
+                Some(_) => {}
                 None if !server_open => return,
                 None => {}
             },
