@@ -32,9 +32,15 @@ pub struct View {
     pub doc: Document,
     pub encoding: Encoding,
     pub locator: Locator,
+    /// Line indexes of other files (a used module, the stdlib), made once per view.
+    pub indexes: std::cell::RefCell<HashMap<SourceFile, std::sync::Arc<LineIndex>>>,
 }
 
 impl View {
+    pub fn new(db: Database, doc: Document, encoding: Encoding, locator: Locator) -> View {
+        View { db, doc, encoding, locator, indexes: Default::default() }
+    }
+
     pub fn offset(&self, position: lsp::Position) -> usize {
         self.doc.index.offset(&self.doc.text, position, self.encoding)
     }
@@ -61,7 +67,8 @@ impl View {
         }
         let uri = self.uri_of(file)?;
         let text = file.text(&self.db);
-        Some(lsp::Location { uri, range: LineIndex::new(text).range(text, span, self.encoding) })
+        let index = self.indexes.borrow_mut().entry(file).or_insert_with(|| std::sync::Arc::new(LineIndex::new(text))).clone();
+        Some(lsp::Location { uri, range: index.range(text, span, self.encoding) })
     }
 
     pub fn ide_location(&self, location: Location) -> Option<lsp::Location> {

@@ -132,7 +132,7 @@ impl Server {
         let view = {
             let ws = lock(&self.state);
             let Some(doc) = ws.doc(uri) else { return Ok(None) };
-            View { db: ws.snapshot(), doc: doc.clone(), encoding: ws.encoding, locator: ws.locator() }
+            View::new(ws.snapshot(), doc.clone(), ws.encoding, ws.locator())
         };
         let task = tokio::task::spawn_blocking(move || {
             std::panic::catch_unwind(AssertUnwindSafe(|| tad_db::cancellable(AssertUnwindSafe(|| f(&view)))))
@@ -196,12 +196,9 @@ fn check_worker(state: &Mutex<Workspace>, checks: &Checks, client: &Client, runt
             for key in &batch {
                 let Ok(uri) = key.parse::<Uri>() else { continue };
                 match ws.doc(&uri) {
-                    Some(doc) if !doc.read_only => views.push(View {
-                        db: db.clone(),
-                        doc: doc.clone(),
-                        encoding: ws.encoding,
-                        locator: locator.clone(),
-                    }),
+                    Some(doc) if !doc.read_only => {
+                        views.push(View::new(db.clone(), doc.clone(), ws.encoding, locator.clone()))
+                    }
                     Some(_) => {}
                     None => closed.push(uri),
                 }
@@ -209,12 +206,18 @@ fn check_worker(state: &Mutex<Workspace>, checks: &Checks, client: &Client, runt
             (views, closed)
         };
         let _ = closed;
-        for view in views {
-            let result = std::panic::catch_unwind(AssertUnwindSafe(|| {
-                tad_db::cancellable(AssertUnwindSafe(|| publishable(&view)))
-            }));
-            let (uri, version) = (view.doc.uri.clone(), view.doc.version);
-            drop(view);
+        // every snapshot is dropped before anything is published: an edit waiting for
+        // them may hold the task that writes to the client
+        let results: Vec<_> = views
+            .into_iter()
+            .map(|view| {
+                let result = std::panic::catch_unwind(AssertUnwindSafe(|| {
+                    tad_db::cancellable(AssertUnwindSafe(|| publishable(&view)))
+                }));
+                (view.doc.uri.clone(), view.doc.version, result)
+            })
+            .collect();
+        for (uri, version, result) in results {
             match result {
                 Ok(Some((diagnostics, class))) => runtime.block_on(async {
                     client.publish_diagnostics(uri.clone(), diagnostics, Some(version)).await;

@@ -5,8 +5,9 @@
 //! `runs` repetitions. The full check runs through the database, as the CLI and the
 //! language server do; the incremental row edits one line of a 2,000-line file and
 //! re-checks it, against checking that file from scratch. `bench --runtime` measures the
-//! runtime instead ([`runtime`]).
+//! runtime instead ([`runtime`]), `bench --lsp` the language server ([`lsp`]).
 
+pub mod lsp;
 pub mod runtime;
 
 use crate::output::Closed;
@@ -16,7 +17,7 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 use tad_db::{Database, Language, NoFs};
 
-fn best_of(runs: usize, mut f: impl FnMut()) -> Duration {
+pub(crate) fn best_of(runs: usize, mut f: impl FnMut()) -> Duration {
     (0..runs.max(1))
         .map(|_| {
             let start = Instant::now();
@@ -158,7 +159,7 @@ fn run_in(n: usize, seed: u64, examples: Option<&Path>, runs: usize, status: &mu
 }
 
 /// A scenario of about `lines` lines: the usual sections and many actor groups.
-fn long_scenario(lines: usize) -> String {
+pub(crate) fn long_scenario(lines: usize) -> String {
     let mut text = String::from(
         "scenario long {\n  environment {\n    weather: clear\n    time: daytime\n  }\n  road {\n    type: straight_road\n    lanes: 3\n    direction: two_way\n  }\n  ego {\n    behavior: move_forward\n    speed: 40 km/h\n    lane: 2\n  }\n",
     );

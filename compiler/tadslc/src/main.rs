@@ -175,13 +175,13 @@ enum Command {
     /// safety examples; on one core.
     Bench {
         /// Number of generated scenarios
-        #[arg(long, default_value_t = 10_000, conflicts_with = "runtime")]
+        #[arg(long, default_value_t = 10_000, conflicts_with_all = ["runtime", "lsp"])]
         scenarios: usize,
         /// Seed of the corpus generator
-        #[arg(long, default_value_t = 1, conflicts_with = "runtime")]
+        #[arg(long, default_value_t = 1, conflicts_with_all = ["runtime", "lsp"])]
         seed: u64,
         /// Directory of real scenarios to measure as well
-        #[arg(long, conflicts_with = "runtime")]
+        #[arg(long, conflicts_with_all = ["runtime", "lsp"])]
         examples: Option<PathBuf>,
         /// Timed repetitions of each measurement (the best is reported)
         #[arg(long, default_value_t = 5)]
@@ -189,8 +189,15 @@ enum Command {
         /// Measure the runtime instead: episode time with 1, 14 and 50 actors, Scenic's
         /// Newtonian simulator on the same scenarios, and a parameter search's episodes per
         /// second
-        #[arg(long)]
+        #[arg(long, conflicts_with = "lsp")]
         runtime: bool,
+        /// Measure the language server instead: didChange → diagnostics, completion and
+        /// hover latency on a 2,000-line file, and its memory with every example open
+        #[arg(long)]
+        lsp: bool,
+        /// Samples of each language server measurement
+        #[arg(long, value_name = "N", default_value_t = 200, requires = "lsp")]
+        samples: usize,
         /// The Python with Scenic 3.1.1 for the Scenic peer (default: TADSL_SCENIC_PYTHON);
         /// without one the peer is skipped
         #[arg(long, value_name = "PATH", requires = "runtime")]
@@ -354,6 +361,7 @@ fn main() -> ExitCode {
                 tadslc::Status::Usage
             }
         },
+        Command::Bench { lsp: true, samples, runs, .. } => bench::lsp::run(samples, runs),
         Command::Bench { runtime: true, runs, scenic_python, no_scenic, episodes, steps, .. } => {
             bench::runtime::run(&bench::runtime::RuntimeArgs { runs, episodes, steps, scenic_python, no_scenic })
         }
