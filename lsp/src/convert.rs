@@ -67,7 +67,8 @@ impl View {
         }
         let uri = self.uri_of(file)?;
         let text = file.text(&self.db);
-        let index = self.indexes.borrow_mut().entry(file).or_insert_with(|| std::sync::Arc::new(LineIndex::new(text))).clone();
+        let index =
+            self.indexes.borrow_mut().entry(file).or_insert_with(|| std::sync::Arc::new(LineIndex::new(text))).clone();
         Some(lsp::Location { uri, range: index.range(text, span, self.encoding) })
     }
 

@@ -186,6 +186,9 @@ fn panic_message(panic: &Box<dyn std::any::Any + Send>) -> String {
 /// Check every queued document on a snapshot and publish; a batch cancelled by an edit
 /// is dropped (the edit queued its documents again).
 fn check_worker(state: &Mutex<Workspace>, checks: &Checks, client: &Client, runtime: &tokio::runtime::Handle) {
+    // what each document last had published: a document whose version and diagnostics are
+    // unchanged (another document was edited) is not published again
+    let mut published: std::collections::HashMap<Uri, (i32, Vec<Diagnostic>)> = std::collections::HashMap::new();
     while let Some(batch) = checks.next() {
         let (views, closed): (Vec<View>, Vec<Uri>) = {
             let ws = lock(state);
@@ -205,7 +208,9 @@ fn check_worker(state: &Mutex<Workspace>, checks: &Checks, client: &Client, runt
             }
             (views, closed)
         };
-        let _ = closed;
+        for uri in closed {
+            published.remove(&uri);
+        }
         // every snapshot is dropped before anything is published: an edit waiting for
         // them may hold the task that writes to the client
         let results: Vec<_> = views
@@ -219,10 +224,16 @@ fn check_worker(state: &Mutex<Workspace>, checks: &Checks, client: &Client, runt
             .collect();
         for (uri, version, result) in results {
             match result {
-                Ok(Some((diagnostics, class))) => runtime.block_on(async {
-                    client.publish_diagnostics(uri.clone(), diagnostics, Some(version)).await;
-                    client.send_notification::<ScenarioClass>(ScenarioClassParams { uri, version, class }).await;
-                }),
+                Ok(Some((diagnostics, class))) => {
+                    if published.get(&uri).is_some_and(|(v, d)| *v == version && *d == diagnostics) {
+                        continue;
+                    }
+                    published.insert(uri.clone(), (version, diagnostics.clone()));
+                    runtime.block_on(async {
+                        client.publish_diagnostics(uri.clone(), diagnostics, Some(version)).await;
+                        client.send_notification::<ScenarioClass>(ScenarioClassParams { uri, version, class }).await;
+                    })
+                }
                 Ok(None) => {}
                 Err(panic) => {
                     let message = format!("tadsl: internal error checking {}: {}", uri.as_str(), panic_message(&panic));
@@ -404,6 +415,8 @@ impl LanguageServer for Server {
         let closed = lock(&self.state).close(&uri).is_some();
         if closed {
             self.queue_all();
+            // the worker forgets what it published for it
+            self.checks.push([uri.clone()]);
             self.client.publish_diagnostics(uri, Vec::new(), None).await;
         }
     }

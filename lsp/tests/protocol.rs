@@ -188,3 +188,39 @@ fn apply(text: &str, edits: &Value) -> String {
     }
     out
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn an_edit_republishes_only_what_changed_and_a_used_module_rechecks_its_users() {
+    let dir = std::env::temp_dir().join(format!("tadsl-protocol-modules-{}", std::process::id()));
+    let module_uri = format!("file://{}/mine.tad", dir.display());
+    let main_uri = format!("file://{}/main.tad", dir.display());
+    let other_uri = format!("file://{}/other.tad", dir.display());
+    let mut client = Client::default().await;
+    client.open(&module_uri, "tad", "weather glum {\n  description: \"grey and low\"\n}\n").await;
+    let scenario = "use mine\nscenario demo {\n  environment {\n    weather: glum\n    time: daytime\n  }\n}\n";
+    client.open(&main_uri, "tad", scenario).await;
+    client.open(&other_uri, "tad", "scenario other {\n  environment {\n    weather: clear\n  }\n}\n").await;
+    let main = codes(&client.diagnostics(&main_uri, 1).await);
+    assert!(!main.contains(&"E0400".to_string()), "the unsaved module declares `glum`: {main:?}");
+    client.diagnostics(&other_uri, 1).await;
+    // rename the declaration in the module: its user now has an unknown name
+    let change = json!({"range": {"start": pos(0, 8), "end": pos(0, 12)}, "text": "gloom"});
+    client
+        .notify(
+            "textDocument/didChange",
+            json!({"textDocument": {"uri": module_uri, "version": 2}, "contentChanges": [change]}),
+        )
+        .await;
+    let again = client
+        .wait(|m| m["method"] == "textDocument/publishDiagnostics" && m["params"]["uri"] == main_uri.as_str())
+        .await;
+    let found = codes(again["params"]["diagnostics"].as_array().unwrap());
+    assert!(found.contains(&"E0400".to_string()), "{found:?}");
+    client.diagnostics(&module_uri, 2).await;
+    // the unrelated document was not published again
+    client
+        .seen
+        .retain(|m| m["method"] == "textDocument/publishDiagnostics" && m["params"]["uri"] == other_uri.as_str());
+    assert!(client.seen.is_empty(), "{:?}", client.seen);
+    client.shutdown().await;
+}
