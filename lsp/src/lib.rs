@@ -41,9 +41,18 @@ where
     let reading = tokio::spawn(transport::filter_input(input, filtered, answers));
     let writing = tokio::spawn(transport::merge_output(replies, output, answered));
     let (service, socket) = LspService::build(server::Server::new).finish();
-    Server::new(server_in, server_out, socket).serve(service).await;
-    reading.abort();
-    let _ = writing.await;
+    let serving = Server::new(server_in, server_out, socket).serve(service);
+    // a client that goes away without `exit` (its end of the pipe closed) must not leave
+    // the server running: once the input has ended, it gets a moment to finish
+    let gone = async {
+        let _ = reading.await;
+        tokio::time::sleep(std::time::Duration::from_secs(2)).await;
+    };
+    tokio::select! {
+        _ = serving => {}
+        _ = gone => {}
+    }
+    let _ = tokio::time::timeout(std::time::Duration::from_secs(1), writing).await;
 }
 
 /// Serve on standard input and output: `tadslc lsp`.

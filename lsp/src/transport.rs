@@ -136,8 +136,8 @@ where
     W: AsyncWrite + Unpin,
 {
     let mut from_server = BufReader::with_capacity(1 << 16, server);
-    let mut server_open = true;
-    loop {
+    let (mut server_open, mut answers_open) = (true, true);
+    while server_open || answers_open {
         tokio::select! {
             frame_read = read_frame(&mut from_server), if server_open => match frame_read {
                 Ok(Some(Ok(body))) => {
@@ -148,13 +148,12 @@ where
                 Ok(Some(Err(_))) => {}
                 Ok(None) | Err(_) => server_open = false,
             },
-            answer = answers.recv() => match answer {
+            answer = answers.recv(), if answers_open => match answer {
                 Some(bytes) if client.write_all(&bytes).await.is_err() || client.flush().await.is_err() => return,
                 Some(_) => {}
-                None if !server_open => return,
-                None => {}
+                // the input has ended: only the server's last frames remain
+                None => answers_open = false,
             },
-            else => return,
         }
     }
 }

@@ -800,3 +800,23 @@ fn the_readme_and_the_spec_show_what_check_prints() {
     let example = &spec[human..human + spec[human..].find("```\n").unwrap()];
     assert!(stderr(&tadslc(&["check", "tests/ui/structure/unknown_field.tad"], "")).contains(example), "{example}");
 }
+
+#[test]
+fn the_language_server_answers_garbage_and_leaves_when_its_client_does() {
+    // initialize and a malformed frame, then the input ends: both are answered and the
+    // server stops by itself
+    let message = |body: &str| format!("Content-Length: {}\r\n\r\n{body}", body.len());
+    let input = [
+        message(r#"{"jsonrpc":"2.0","id":1,"method":"initialize","params":{"capabilities":{}}}"#),
+        message("{not json"),
+    ]
+    .concat();
+    let out = tadslc(&["lsp"], &input);
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    let text = stdout(&out);
+    assert!(text.contains(r#""serverInfo":{"name":"tadslc""#), "{text}");
+    assert!(text.contains("-32700"), "{text}");
+    // a client that closes at once: the server stops by itself
+    let out = tadslc(&["lsp"], "");
+    assert_eq!(code(&out), 0);
+}
