@@ -23,7 +23,7 @@ pub mod vocab;
 
 pub use completeness::{Class, Essential};
 pub use names::{Groups, Target, target};
-pub use semantics::lanes_counted_from_zero;
+pub use semantics::{EGO_KIND, lanes_counted_from_zero, performs};
 pub use vocab::{Conflict, Entry, Layer, Lookup, Vocabulary};
 
 use tad_diagnostics::Diagnostic;

@@ -16,7 +16,14 @@ const LONGITUDINAL: &str = "longitudinal";
 use tad_syntax::model::{Attr, Known, Scenario, Val};
 
 /// The ego vehicle's actor kind.
-const EGO_KIND: &str = "vehicle";
+/// The actor kind of the ego vehicle.
+pub const EGO_KIND: &str = "vehicle";
+
+/// Whether an actor of `kind` can perform `behavior` (a behavior that names no performers
+/// is open to all).
+pub fn performs(behavior: &Entry, kind: &str) -> bool {
+    behavior.symbols("performers").is_none_or(|performers| performers.contains(&kind))
+}
 
 fn entry<'v>(vocabulary: &'v Vocabulary, kind: &str, attr: Option<&Attr>) -> Option<&'v Entry> {
     vocabulary.get(kind, &attr?.symbol()?.name)
@@ -271,7 +278,7 @@ fn lanes_check(
 fn performers(behavior: Option<&Entry>, attr: Option<&Attr>, kind: &str, what: &str, out: &mut Vec<Diagnostic>) {
     let (Some(behavior), Some(attr)) = (behavior, attr) else { return };
     let Some(performers) = behavior.symbols("performers") else { return };
-    if !performers.contains(&kind) {
+    if !performs(behavior, kind) {
         out.push(
             Diagnostic::new(
                 Code::E0502,
