@@ -57,7 +57,10 @@ enum Frame {
     Scenario,
     Section(String),
     /// An actor group: its name and type as written.
-    Actor { name: String, kind: Option<String> },
+    Actor {
+        name: String,
+        kind: Option<String>,
+    },
     Declaration(String),
     /// A block of something unknown.
     Other,
@@ -105,7 +108,7 @@ pub fn completions(db: &Database, file: SourceFile, offset: usize) -> Vec<Comple
         .rev()
         .collect();
     let scope = tad_db::vocabulary(db, file);
-    let context = Context { vocabulary: &scope.vocabulary, replace, tokens, before, stack: &stack, text };
+    let context = Context { vocabulary: &scope.vocabulary, replace, tokens, stack: &stack, text };
     context.offer(&line)
 }
 
@@ -117,7 +120,7 @@ fn frames(tokens: &[(usize, Token, usize)], before: usize) -> Vec<Open> {
         match token {
             Token::LBrace => {
                 let header: Vec<Token> = tokens[header_from..i].iter().map(|t| t.1).collect();
-                let frame = classify(&header, &tokens[header_from..i]);
+                let frame = classify(&header);
                 stack.push(Open { frame, at: i });
                 header_from = i + 1;
             }
@@ -135,8 +138,7 @@ fn frames(tokens: &[(usize, Token, usize)], before: usize) -> Vec<Open> {
     stack
 }
 
-fn classify(header: &[Token], spans: &[(usize, Token, usize)]) -> Frame {
-    let _ = spans;
+fn classify(header: &[Token]) -> Frame {
     match header.first() {
         Some(Token::Scenario) => Frame::Scenario,
         Some(Token::Actor) => Frame::Actor { name: String::new(), kind: None },
@@ -150,7 +152,6 @@ struct Context<'a> {
     vocabulary: &'a Vocabulary,
     replace: Span,
     tokens: &'a [(usize, Token, usize)],
-    before: usize,
     stack: &'a [Open],
     text: &'a str,
 }
@@ -173,16 +174,24 @@ impl Context<'_> {
         let header = &self.tokens[from..header_end];
         match &open.frame {
             Frame::Actor { .. } => {
-                let name = header.iter().find(|t| t.1 == Token::Key).map_or(String::new(), |t| {
-                    self.text[t.0..t.2].trim_end_matches(':').trim().to_string()
-                });
-                let kind = header.iter().rev().find(|t| matches!(t.1, Token::Head | Token::Ident)).map(|t| self.text[t.0..t.2].to_string());
+                let name = header
+                    .iter()
+                    .find(|t| t.1 == Token::Key)
+                    .map_or(String::new(), |t| self.text[t.0..t.2].trim_end_matches(':').trim().to_string());
+                let kind = header
+                    .iter()
+                    .rev()
+                    .find(|t| matches!(t.1, Token::Head | Token::Ident))
+                    .map(|t| self.text[t.0..t.2].to_string());
                 Frame::Actor { name, kind }
             }
             Frame::Section(_) => Frame::Section(self.word(header_end - 1).to_string()),
-            Frame::Declaration(_) => {
-                Frame::Declaration(header.iter().find(|t| t.1 == Token::DeclKind).map_or(String::new(), |t| self.text[t.0..t.2].to_string()))
-            }
+            Frame::Declaration(_) => Frame::Declaration(
+                header
+                    .iter()
+                    .find(|t| t.1 == Token::DeclKind)
+                    .map_or(String::new(), |t| self.text[t.0..t.2].to_string()),
+            ),
             other => other.clone(),
         }
     }
@@ -196,7 +205,10 @@ impl Context<'_> {
                 Token::LBrace => depth += 1,
                 Token::RBrace if depth == 0 => break,
                 Token::RBrace => depth -= 1,
-                Token::Key if depth == 0 && *e <= self.replace.start || (*token == Token::Key && depth == 0 && *s >= self.replace.end) => {
+                Token::Key
+                    if depth == 0 && *e <= self.replace.start
+                        || (*token == Token::Key && depth == 0 && *s >= self.replace.end) =>
+                {
                     keys.insert(self.text[*s..*e].trim_end_matches(':').trim().to_string());
                 }
                 Token::Head if depth == 0 => {
@@ -230,9 +242,13 @@ impl Context<'_> {
         let key = line.iter().rposition(|t| t.0 == Token::Key);
         match (&frame, key) {
             (Frame::Scenario, None) => self.sections(open.at),
-            (Frame::Section(name), None) => schema::section(name).map_or_else(Vec::new, |def| self.fields(def, open.at)),
+            (Frame::Section(name), None) => {
+                schema::section(name).map_or_else(Vec::new, |def| self.fields(def, open.at))
+            }
             (Frame::Actor { .. }, None) => self.fields(&schema::ACTOR, open.at),
-            (Frame::Declaration(kind), None) => schema::declaration(kind).map_or_else(Vec::new, |def| self.fields(def, open.at)),
+            (Frame::Declaration(kind), None) => {
+                schema::declaration(kind).map_or_else(Vec::new, |def| self.fields(def, open.at))
+            }
             (_, Some(k)) => {
                 let key = line[k].1.trim_end_matches(':').trim();
                 let def = match &frame {
@@ -254,7 +270,10 @@ impl Context<'_> {
         if line.first().is_some_and(|t| t.0 == Token::Use) {
             return tad_db::stdlib::MODULES
                 .iter()
-                .map(|(name, _)| Completion { detail: Some("standard module".into()), ..self.item(name, CompletionKind::Module) })
+                .map(|(name, _)| Completion {
+                    detail: Some("standard module".into()),
+                    ..self.item(name, CompletionKind::Module)
+                })
                 .collect();
         }
         if !line.is_empty() {
@@ -267,7 +286,11 @@ impl Context<'_> {
                 preselect: true,
                 ..self.item("scenario", CompletionKind::Keyword)
             },
-            Completion { detail: Some("use a module".into()), insert: Some("use ".into()), ..self.item("use", CompletionKind::Keyword) },
+            Completion {
+                detail: Some("use a module".into()),
+                insert: Some("use ".into()),
+                ..self.item("use", CompletionKind::Keyword)
+            },
         ];
         out.extend(DECLARATIONS.iter().map(|def| Completion {
             detail: Some("declaration kind".into()),
@@ -317,14 +340,20 @@ impl Context<'_> {
 
     fn value(&self, def: &FieldDef, frame: &Frame, after: &[(Token, &str)]) -> Vec<Completion> {
         let last = after.last().map(|t| t.0);
-        let unspecified = || Completion { detail: Some("explicitly unknown".into()), ..self.item(KEYWORDS[3].0, CompletionKind::Keyword) };
+        let unspecified = || Completion {
+            detail: Some("explicitly unknown".into()),
+            ..self.item(KEYWORDS[3].0, CompletionKind::Keyword)
+        };
         match def.ty {
             ValueType::Speed | ValueType::Length | ValueType::Duration => {
                 if last == Some(Token::Number) {
                     return UNITS
                         .iter()
                         .filter(|u| Unit::parse(u).is_some_and(|unit| unit.measures() == def.ty))
-                        .map(|u| Completion { detail: Some(def.ty.describe().into()), ..self.item(u, CompletionKind::Unit) })
+                        .map(|u| Completion {
+                            detail: Some(def.ty.describe().into()),
+                            ..self.item(u, CompletionKind::Unit)
+                        })
                         .collect();
                 }
                 if after.is_empty() { vec![unspecified()] } else { Vec::new() }
@@ -351,9 +380,9 @@ impl Context<'_> {
                     return Vec::new();
                 }
                 let performer = match frame {
-                    Frame::Actor { kind: Some(t), .. } if kind == "behavior" => {
-                        Some(self.vocabulary.get("actor_type", t).and_then(|e| e.symbol("kind")).unwrap_or("").to_string())
-                    }
+                    Frame::Actor { kind: Some(t), .. } if kind == "behavior" => Some(
+                        self.vocabulary.get("actor_type", t).and_then(|e| e.symbol("kind")).unwrap_or("").to_string(),
+                    ),
                     Frame::Section(s) if s == "ego" && kind == "behavior" => Some(tad_check::EGO_KIND.to_string()),
                     _ => None,
                 };
@@ -363,7 +392,13 @@ impl Context<'_> {
                 }
                 out
             }
-            ValueType::Integer | ValueType::Text => if after.is_empty() { vec![unspecified()] } else { Vec::new() },
+            ValueType::Integer | ValueType::Text => {
+                if after.is_empty() {
+                    vec![unspecified()]
+                } else {
+                    Vec::new()
+                }
+            }
         }
     }
 
@@ -402,12 +437,15 @@ impl Context<'_> {
                 _ => {}
             }
         }
-        let _ = self.before;
         let mut out: Vec<Completion> = groups
             .into_iter()
             .map(|g| Completion { detail: Some("actor group".into()), ..self.item(g, CompletionKind::Group) })
             .collect();
-        out.extend(self.names("reference", None).into_iter().map(|c| Completion { preselect: true, kind: CompletionKind::Group, ..c }));
+        out.extend(self.names("reference", None).into_iter().map(|c| Completion {
+            preselect: true,
+            kind: CompletionKind::Group,
+            ..c
+        }));
         out.extend(self.names("road_element", None));
         out
     }
@@ -514,7 +552,10 @@ mod tests {
         assert!(found.contains(&"km/h".into()) && !found.contains(&"m".into()));
         let text = "scenario demo {\n  actor a: car {\n    position: front of $0\n  }\n  actor b: bus {\n  }\n}\n";
         let found = labels(text);
-        assert!(found.contains(&"b".into()) && found.contains(&"ego".into()) && !found.contains(&"a".into()), "{found:?}");
+        assert!(
+            found.contains(&"b".into()) && found.contains(&"ego".into()) && !found.contains(&"a".into()),
+            "{found:?}"
+        );
         let text = "scenario demo {\n  actor a: car {\n    position: $0\n  }\n}\n";
         assert!(labels(text).contains(&"left_front".into()));
     }

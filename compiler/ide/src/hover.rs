@@ -32,7 +32,8 @@ pub fn hover(db: &Database, file: SourceFile, offset: usize) -> Option<Hover> {
             span = span.or(Some(s));
         }
     }
-    (!parts.is_empty()).then(|| Hover { span: span.unwrap_or(Span::new(offset, offset)), markdown: parts.join("\n\n---\n\n") })
+    (!parts.is_empty())
+        .then(|| Hover { span: span.unwrap_or(Span::new(offset, offset)), markdown: parts.join("\n\n---\n\n") })
 }
 
 fn describe(db: &Database, file: SourceFile, found: &At) -> Option<String> {
@@ -52,10 +53,11 @@ fn describe(db: &Database, file: SourceFile, found: &At) -> Option<String> {
             if let Some(doc) = crate::completion::documentation(entry) {
                 out.push_str(&format!("\n\n{doc}"));
             }
-            let carla: Vec<String> = ["cloudiness", "precipitation", "wetness", "fog_density", "sun_altitude", "sun_azimuth"]
-                .iter()
-                .filter_map(|f| entry.declaration.attr(f).and_then(|a| a.integer()).map(|v| format!("{f} {v}")))
-                .collect();
+            let carla: Vec<String> =
+                ["cloudiness", "precipitation", "wetness", "fog_density", "sun_altitude", "sun_azimuth"]
+                    .iter()
+                    .filter_map(|f| entry.declaration.attr(f).and_then(|a| a.integer()).map(|v| format!("{f} {v}")))
+                    .collect();
             if !carla.is_empty() {
                 out.push_str(&format!("\n\nCARLA: {}", carla.join(", ")));
             }
@@ -157,7 +159,13 @@ fn quantity(field: &FieldDef, value: &Val) -> String {
         Val::Quantity(q) | Val::Range(q, _) => q.unit,
         _ => Unit::Seconds,
     };
-    format!("`{}`: {body}\n\nunit `{}` is {} {}", field.name, unit.as_str(), number(unit.to_si()), si_unit(unit.measures()))
+    format!(
+        "`{}`: {body}\n\nunit `{}` is {} {}",
+        field.name,
+        unit.as_str(),
+        number(unit.to_si()),
+        si_unit(unit.measures())
+    )
 }
 
 fn number(v: f64) -> String {
@@ -223,7 +231,8 @@ mod tests {
         let text = "scenario demo {\n  ego { lane: 2 }\n  actor a: 3 taxi {\n    behavior: turn_left\n  }\n  actor b: car {\n    position: front of $0a\n  }\n}\n";
         let md = hover_at(text);
         assert!(md.contains("actor a: 3 taxi") && md.contains("turn_left"), "{md}");
-        let md = hover_at("scenario demo {\n  ego { lane: 2 }\n  actor b: car {\n    position: front of eg$0o\n  }\n}\n");
+        let md =
+            hover_at("scenario demo {\n  ego { lane: 2 }\n  actor b: car {\n    position: front of eg$0o\n  }\n}\n");
         assert!(md.contains("the ego vehicle, lane 2"), "{md}");
     }
 

@@ -196,7 +196,9 @@ fn in_uses(text: &str, offset: usize) -> Option<At> {
 
 /// The section or declaration kind a field key belongs to, for messages.
 pub fn owner(section: &str) -> Option<&'static SectionDef> {
-    schema::section(section).or_else(|| schema::declaration(section)).or_else(|| (section == "actor").then_some(&schema::ACTOR))
+    schema::section(section)
+        .or_else(|| schema::declaration(section))
+        .or_else(|| (section == "actor").then_some(&schema::ACTOR))
 }
 
 #[cfg(test)]
@@ -248,6 +250,10 @@ mod tests {
         let yaml = "Scenario:\n  Environment:\n    Weather: sunny\n    Time: day\n";
         let (db, file) = testing::with_language(yaml, crate::Language::Yaml);
         let offset = yaml.find("sunny").unwrap() + 2;
-        assert!(matches!(at(&db, file, offset), Some(At::Name { kind, .. }) if kind == "weather"), "{:?}", at(&db, file, offset));
+        assert!(
+            matches!(at(&db, file, offset), Some(At::Name { kind, .. }) if kind == "weather"),
+            "{:?}",
+            at(&db, file, offset)
+        );
     }
 }

@@ -30,16 +30,23 @@ pub fn definition(db: &Database, file: SourceFile, offset: usize) -> Vec<Locatio
                 let ego = module.scenario.as_ref().and_then(|s| s.section("ego")).map(|s| s.name_span);
                 match (ego, vocabulary.get("reference", &name)) {
                     (Some(span), Some(_)) => here(span),
-                    _ => declared(db, vocabulary, "reference", &name).into_iter().chain(declared(db, vocabulary, "road_element", &name)).collect(),
+                    _ => declared(db, vocabulary, "reference", &name)
+                        .into_iter()
+                        .chain(declared(db, vocabulary, "road_element", &name))
+                        .collect(),
                 }
             }
         },
         At::Name { kind, name, declared: false, .. } => declared(db, vocabulary, &kind, &name).into_iter().collect(),
         At::Name { span, declared: true, .. } => here(span),
         At::Group { span, .. } => here(span),
-        At::Module { name, .. } => {
-            file.imports(db).modules.get(&name).map(|m| Location { file: *m, span: Span::new(0, 0) }).into_iter().collect()
-        }
+        At::Module { name, .. } => file
+            .imports(db)
+            .modules
+            .get(&name)
+            .map(|m| Location { file: *m, span: Span::new(0, 0) })
+            .into_iter()
+            .collect(),
         _ => Vec::new(),
     }
 }
@@ -51,7 +58,7 @@ fn declared(db: &Database, vocabulary: &Vocabulary, kind: &str, name: &str) -> O
 }
 
 /// Every symbol of the module with the vocabulary kind it is a name of.
-fn symbols(module: &Module) -> Vec<(&str, &tad_syntax::model::Symbol)> {
+pub(crate) fn symbols(module: &Module) -> Vec<(&str, &tad_syntax::model::Symbol)> {
     let mut out = Vec::new();
     fn from_attr<'m>(attr: &'m Attr, out: &mut Vec<(&'static str, &'m tad_syntax::model::Symbol)>) {
         let Known::Given(value) = &attr.value else { return };
@@ -112,12 +119,15 @@ pub fn references(db: &Database, file: SourceFile, offset: usize, include_declar
     let module = &tad_db::analyze(db, file).module;
     let vocabulary = &tad_db::vocabulary(db, file).vocabulary;
     let group = match &found {
-        At::Group { index, .. } => module.scenario.as_ref().and_then(|s| s.actors.get(*index)).map(|g| g.name.text.clone()),
+        At::Group { index, .. } => {
+            module.scenario.as_ref().and_then(|s| s.actors.get(*index)).map(|g| g.name.text.clone())
+        }
         At::Reference { name, .. } if group_index(module, name).is_some() => Some(name.clone()),
         _ => None,
     };
     if let Some(name) = group {
-        let header = module.scenario.as_ref().and_then(|s| s.actors.iter().find(|g| g.name.text == name)).map(|g| g.name.span);
+        let header =
+            module.scenario.as_ref().and_then(|s| s.actors.iter().find(|g| g.name.text == name)).map(|g| g.name.span);
         return group_spans(module, &name)
             .into_iter()
             .filter(|s| include_declaration || Some(*s) != header)
@@ -132,7 +142,9 @@ pub fn references(db: &Database, file: SourceFile, offset: usize, include_declar
     let Some(entry) = vocabulary.get(&kind, &name) else { return Vec::new() };
     let mut out: Vec<Location> = symbols(module)
         .into_iter()
-        .filter(|(k, s)| *k == kind && vocabulary.get(k, &s.name).is_some_and(|e| e.name == entry.name && e.file == entry.file))
+        .filter(|(k, s)| {
+            *k == kind && vocabulary.get(k, &s.name).is_some_and(|e| e.name == entry.name && e.file == entry.file)
+        })
         .map(|(_, s)| Location { file, span: s.span })
         .collect();
     if let Some(scenario) = &module.scenario
@@ -212,7 +224,10 @@ mod tests {
         let offset = TWO.find("behind of lead").unwrap() + 11;
         let (db, file) = testing::file(TWO);
         let found = definition(&db, file, offset);
-        assert_eq!(found, vec![Location { file, span: Span::new(TWO.find("lead").unwrap(), TWO.find("lead").unwrap() + 4) }]);
+        assert_eq!(
+            found,
+            vec![Location { file, span: Span::new(TWO.find("lead").unwrap(), TWO.find("lead").unwrap() + 4) }]
+        );
         let bus = TWO.find("bus").unwrap() + 1;
         let found = definition(&db, file, bus);
         assert_eq!(found.len(), 1);
@@ -232,7 +247,11 @@ mod tests {
         assert_eq!(references(&db, file, at, false).len(), 2);
         let edit = rename(&db, file, at, "leader").unwrap();
         let renamed = crate::actions::apply(TWO, &edit[0].1);
-        assert!(renamed.contains("actor leader: car") && renamed.contains("behind of leader") && renamed.contains("left of leader"));
+        assert!(
+            renamed.contains("actor leader: car")
+                && renamed.contains("behind of leader")
+                && renamed.contains("left of leader")
+        );
         assert!(rename(&db, file, at, "tail").unwrap_err().contains("already"));
         assert!(rename(&db, file, at, "9x").is_err());
         assert!(rename(&db, file, at, "of").is_err());
@@ -261,7 +280,8 @@ mod tests {
         struct Fs;
         impl tad_db::FileSystem for Fs {
             fn read(&self, path: &std::path::Path) -> Option<String> {
-                (path == std::path::Path::new("/fixture/mine.tad")).then(|| "weather glum {\n  cloudiness: 90\n}\n".to_string())
+                (path == std::path::Path::new("/fixture/mine.tad"))
+                    .then(|| "weather glum {\n  cloudiness: 90\n}\n".to_string())
             }
         }
         let text = "use mine\nscenario demo {\n  environment {\n    weather: glum\n  }\n}\n";
@@ -273,7 +293,8 @@ mod tests {
         let module = definition(&db, file, 5);
         assert_eq!(module[0].file, found[0].file);
         for offset in 0..text.len() + 3 {
-            let _ = (definition(&db, file, offset), references(&db, file, offset, true), prepare_rename(&db, file, offset));
+            let _ =
+                (definition(&db, file, offset), references(&db, file, offset, true), prepare_rename(&db, file, offset));
         }
     }
 }
