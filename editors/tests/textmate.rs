@@ -110,7 +110,9 @@ fn file_name(path: &Path) -> String {
 #[test]
 fn keywords_and_units_of_the_lexer_have_their_scopes() {
     use tad_syntax::lexer::{KEYWORDS, UNITS};
-    let mut text = String::from("use national_park\nscenario demo {\n  actor g: 2 car {\n    position: front of ego\n    time: unspecified\n");
+    let mut text = String::from(
+        "use national_park\nscenario demo {\n  actor g: 2 car {\n    position: front of ego\n    time: unspecified\n",
+    );
     for unit in UNITS {
         text.push_str(&format!("    x: 3 {unit}\n"));
     }
@@ -119,7 +121,10 @@ fn keywords_and_units_of_the_lexer_have_their_scopes() {
     let Some((_, lines)) = snaps.first() else { return };
     let scope_of = |word: &str| -> Option<String> {
         lines.iter().find_map(|line| {
-            line.pieces.iter().find(|(s, e, _)| line.text.get(*s..*e) == Some(word)).map(|(_, _, scopes)| scopes.clone())
+            line.pieces
+                .iter()
+                .find(|(s, e, _)| line.text.get(*s..*e) == Some(word))
+                .map(|(_, _, scopes)| scopes.clone())
         })
     };
     for (keyword, _) in KEYWORDS {

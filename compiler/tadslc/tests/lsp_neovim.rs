@@ -79,3 +79,8 @@ fn run(plugin: bool) {
 fn neovim_as_the_client() {
     run(false);
 }
+
+#[test]
+fn neovim_with_the_editor_package() {
+    run(true);
+}

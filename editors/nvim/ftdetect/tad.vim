@@ -1,0 +1,2 @@
+" TAD traffic scenarios (TADSL)
+autocmd BufRead,BufNewFile *.tad setfiletype tad
