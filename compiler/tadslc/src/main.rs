@@ -152,14 +152,16 @@ enum Command {
         /// The `.tadc` file
         path: PathBuf,
     },
-    /// Explain a diagnostic code, e.g. `tadslc explain E0203`
-    /// Serve the language server protocol on standard input and output, for editors
-    /// (`editors/`: VS Code, Neovim, Helix, Emacs); settings come from the client
+    /// Serve the language server protocol on stdin and stdout, for editors
+    ///
+    /// The packages in `editors/` (VS Code, Neovim, Helix, Emacs) start it; settings come
+    /// from the client (`spec/lsp.md`).
     Lsp {
         /// Accepted for clients that pass it (stdio is the only transport)
         #[arg(long, hide = true)]
         stdio: bool,
     },
+    /// Explain a diagnostic code, e.g. `tadslc explain E0203`
     Explain {
         /// The code, or its number whatever its letter (`203`, `w600`); omit it to list
         /// every code
