@@ -471,7 +471,8 @@ fn build_writes_scenic_programs_and_refuses_broken_files() {
 }
 
 /// Every subcommand, as `--help` lists them.
-const SUBCOMMANDS: &[&str] = &["check", "fmt", "build", "import", "export", "lsp", "explain", "bench", "completions", "man"];
+const SUBCOMMANDS: &[&str] =
+    &["check", "fmt", "build", "import", "export", "lsp", "explain", "bench", "completions", "man"];
 
 /// Which standard stream the reader closes.
 #[derive(Clone, Copy)]
