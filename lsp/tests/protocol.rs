@@ -224,3 +224,32 @@ async fn an_edit_republishes_only_what_changed_and_a_used_module_rechecks_its_us
     assert!(client.seen.is_empty(), "{:?}", client.seen);
     client.shutdown().await;
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn definition_opens_the_standard_library_read_only() {
+    let mut client = Client::default().await;
+    let (uri, text) = example("examples/safety/right_turn.tad");
+    client.open(&uri, "tad", &text).await;
+    let line = text.lines().position(|l| l.contains("4 pedestrian")).unwrap() as u32;
+    let column = text.lines().nth(line as usize).unwrap().find("4 pedestrian").unwrap() as u32 + 4;
+    let found = client
+        .request("textDocument/definition", json!({"textDocument": {"uri": uri}, "position": pos(line, column)}))
+        .await;
+    let target = &found[0];
+    let path = target["uri"].as_str().unwrap().strip_prefix("file://").unwrap().to_string();
+    assert!(path.ends_with("/core.tad"), "{target}");
+    let core = std::fs::read_to_string(&path).unwrap();
+    assert!(std::fs::metadata(&path).unwrap().permissions().readonly());
+    let at = target["range"]["start"]["line"].as_u64().unwrap() as usize;
+    assert!(core.lines().nth(at).unwrap().starts_with("actor_type pedestrian"), "{}", core.lines().nth(at).unwrap());
+    // opened in the editor it is the embedded module: no diagnostics, hover works
+    client.open(target["uri"].as_str().unwrap(), "tad", &core).await;
+    let hover = client
+        .request(
+            "textDocument/hover",
+            json!({"textDocument": {"uri": target["uri"]}, "position": target["range"]["start"]}),
+        )
+        .await;
+    assert!(hover["contents"]["value"].as_str().unwrap().contains("pedestrian"), "{hover}");
+    client.shutdown().await;
+}
