@@ -88,6 +88,7 @@
 ;;;###autoload
 (add-to-list 'auto-mode-alist '("\\.tad\\'" . tad-mode))
 
+(defvar eglot-server-programs)
 (with-eval-after-load 'eglot
   (add-to-list 'eglot-server-programs `(tad-mode . ,tad-server-command)))
 
