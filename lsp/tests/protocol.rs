@@ -253,3 +253,77 @@ async fn definition_opens_the_standard_library_read_only() {
     assert!(hover["contents"]["value"].as_str().unwrap().contains("pedestrian"), "{hover}");
     client.shutdown().await;
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn every_feature_answers_with_content() {
+    let snippets = json!({"textDocument": {"completion": {"completionItem": {"snippetSupport": true}}}});
+    let (mut client, result) = Client::start(snippets, Value::Null).await;
+    let legend = result["capabilities"]["semanticTokensProvider"]["legend"]["tokenTypes"].clone();
+    let text = "scenario demo {\n  road {\n    lanes: 2\n  }\n  ego {\n    speed: 20 mph\n    lane: 2\n  }\n  actor lead: car {\n    position: front of ego\n  }\n  actor tail: bus {\n    position: behind of lead\n  }\n  \n}\n";
+    client.open(UNTITLED, "tad", text).await;
+    client.diagnostics(UNTITLED, 1).await;
+    let doc = json!({"uri": UNTITLED});
+
+    let symbols = client.request("textDocument/documentSymbol", json!({"textDocument": doc})).await;
+    assert_eq!(symbols[0]["name"], "demo");
+    assert_eq!(symbols[0]["children"].as_array().unwrap().len(), 4);
+
+    let folds = client.request("textDocument/foldingRange", json!({"textDocument": doc})).await;
+    assert_eq!(folds.as_array().unwrap().len(), 5, "{folds}");
+
+    let whole = json!({"start": pos(0, 0), "end": pos(16, 0)});
+    let hints = client.request("textDocument/inlayHint", json!({"textDocument": doc, "range": whole})).await;
+    let labels: Vec<&str> = hints.as_array().unwrap().iter().filter_map(|h| h["label"].as_str()).collect();
+    assert!(labels.contains(&"= 8.9 m/s") && labels.contains(&"2 of 2, rightmost"), "{labels:?}");
+
+    let tokens = client.request("textDocument/semanticTokens/full", json!({"textDocument": doc})).await;
+    let data: Vec<u64> = tokens["data"].as_array().unwrap().iter().map(|v| v.as_u64().unwrap()).collect();
+    assert_eq!(&data[..3], &[0, 0, 8], "`scenario` first, 8 long");
+    assert_eq!(legend[data[3] as usize], "keyword");
+
+    let lead = pos(12, 24);
+    let refs = client
+        .request(
+            "textDocument/references",
+            json!({"textDocument": doc, "position": lead, "context": {"includeDeclaration": true}}),
+        )
+        .await;
+    assert_eq!(refs.as_array().unwrap().len(), 2);
+    let prepared = client.request("textDocument/prepareRename", json!({"textDocument": doc, "position": lead})).await;
+    assert_eq!(prepared["start"], pos(12, 24));
+    let edit = client
+        .request("textDocument/rename", json!({"textDocument": doc, "position": lead, "newName": "leader"}))
+        .await;
+    assert_eq!(edit["changes"][UNTITLED].as_array().unwrap().len(), 2);
+    let id = client
+        .start_request("textDocument/rename", json!({"textDocument": doc, "position": lead, "newName": "tail"}))
+        .await;
+    let refused = client.response(id).await;
+    assert!(refused["error"]["message"].as_str().unwrap().contains("already"), "{refused}");
+
+    // a section completes as a snippet for a client that takes snippets
+    let items = client.request("textDocument/completion", json!({"textDocument": doc, "position": pos(14, 2)})).await;
+    let environment = items.as_array().unwrap().iter().find(|i| i["label"] == "environment").expect("environment");
+    assert_eq!(environment["insertTextFormat"], 2);
+    assert!(environment["textEdit"]["newText"].as_str().unwrap().contains("$0"));
+    assert!(items.as_array().unwrap().iter().all(|i| i["label"] != "road"), "road is written already");
+
+    let range = json!({"start": pos(2, 0), "end": pos(2, 5)});
+    let formatted = client
+        .request(
+            "textDocument/rangeFormatting",
+            json!({"textDocument": doc, "range": range, "options": {"tabSize": 2, "insertSpaces": true}}),
+        )
+        .await;
+    assert!(formatted.as_array().is_some(), "{formatted}");
+    client.shutdown().await;
+
+    // without snippet support the same item is plain text
+    let mut client = Client::default().await;
+    client.open(UNTITLED, "tad", text).await;
+    let items = client.request("textDocument/completion", json!({"textDocument": doc, "position": pos(14, 2)})).await;
+    let environment = items.as_array().unwrap().iter().find(|i| i["label"] == "environment").unwrap();
+    assert_eq!(environment["insertTextFormat"], 1);
+    assert!(!environment["textEdit"]["newText"].as_str().unwrap().contains('$'));
+    client.shutdown().await;
+}
