@@ -345,12 +345,41 @@ mod tests {
     }
 
     #[test]
+    fn names_of_a_used_local_module() {
+        struct Fs;
+        impl tad_db::FileSystem for Fs {
+            fn read(&self, path: &std::path::Path) -> Option<String> {
+                (path == std::path::Path::new("/fixture/mine.tad"))
+                    .then(|| "weather glum {\n  aliases: [mirk]\n}\n".to_string())
+            }
+        }
+        let text = "use mine\nscenario demo {\n  environment {\n    weather: clear | mirk\n  }\n}\n";
+        let mut db = Database::new(tad_check::Options::default());
+        let file = db.set_source("/fixture/scenario.tad".into(), text.into(), crate::Language::Tad, &Fs);
+        let found = at(&db, file, text.find("mirk").unwrap() + 1).unwrap();
+        assert!(found.is_alias());
+        let At::Name { entry: Some(entry), .. } = found else { panic!("{found:?}") };
+        assert_eq!((entry.name.as_str(), entry.module.as_str()), ("glum", "mine"));
+        assert_eq!(db.file(entry.file).unwrap().path(&db), std::path::Path::new("/fixture/mine.tad"));
+        assert!(
+            matches!(at(&db, file, 6), Some(At::Module { name, span }) if name == "mine" && span == Span::new(4, 8))
+        );
+    }
+
+    #[test]
     fn stdlib_files_are_located_too() {
         let (db, _) = testing::file("");
         let core = db.standard_module("core").unwrap();
         let text = core.text(&db);
         let offset = text.find("actor_type pedestrian").unwrap() + "actor_type ped".len();
         assert!(matches!(at(&db, core, offset), Some(At::Name { name, declared: true, .. }) if name == "pedestrian"));
+        // the kind it names, resolved in the module's own vocabulary
+        let kind = offset + text[offset..].find("kind: pedestrian").unwrap() + "kind: p".len();
+        let found = at(&db, core, kind);
+        assert!(
+            matches!(&found, Some(At::Name { kind, entry: Some(e), declared: false, .. }) if kind == "actor_kind" && e.file == core.id(&db)),
+            "{found:?}"
+        );
     }
 
     #[test]

@@ -396,6 +396,39 @@ mod tests {
         }
     }
 
+    /// Every position-based feature at every offset of the examples and of YAML answers:
+    /// no panic, and every location's span is inside its file at character boundaries.
+    #[test]
+    fn every_offset_of_the_examples() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let mut files = Vec::new();
+        for dir in ["examples/safety", "examples/regions", "tests/yaml/paper", "tests/yaml/answers"] {
+            let Ok(entries) = std::fs::read_dir(root.join(dir)) else { continue };
+            let paths = entries.flatten().map(|e| e.path());
+            files.extend(paths.filter(|p| p.extension().is_some_and(|e| e == "tad" || e == "yaml")));
+        }
+        assert!(files.len() > 10, "{files:?}");
+        for path in files {
+            let text = std::fs::read_to_string(&path).unwrap();
+            let language = tad_db::Language::guess(&path, &text);
+            let (db, file) = testing::with_language(&text, language);
+            let valid = |l: &Location| {
+                let t = l.file.text(&db);
+                l.span.start <= l.span.end && t.get(l.span.start..l.span.end).is_some()
+            };
+            for offset in (0..=text.len()).filter(|o| text.is_char_boundary(*o)) {
+                assert!(definition(&db, file, offset).iter().all(valid), "{}:{offset}", path.display());
+                assert!(references(&db, file, offset, true).iter().all(valid), "{}:{offset}", path.display());
+                if let Ok(span) = prepare_rename(&db, file, offset) {
+                    assert!(text.get(span.start..span.end).is_some());
+                    let _ = rename(&db, file, offset, "renamed_group");
+                }
+                let _ = crate::hover::hover(&db, file, offset);
+            }
+            let _ = crate::inlay::inlay_hints(&db, file, Span::new(0, text.len()));
+        }
+    }
+
     #[test]
     fn non_ascii_yaml_and_broken_documents() {
         let text = "// voilà 🚗\nscenario demo {\n  source { description: \"çà 🚦\" }\n  actor lead: car {}\n  actor b: car {\n    position: behind of lead\n  }\n}\n";
