@@ -1,0 +1,201 @@
+//! Every exported grammar accepts every example and rejects broken programs.
+//!
+//! The Lark grammar runs in llguidance with a byte-level tokenizer (one token per byte), as
+//! a constrained decoder would run it; the GBNF is read back by a converter written here
+//! (rules, literals, classes, repetitions) into Lark for the same engine, so it is judged
+//! from its text, not from the printer's structure. The JSON Schema is checked by a
+//! validator (`jsonschema`) against each example's YAML form, and compiled by llguidance.
+
+use std::sync::Arc;
+
+use llguidance::api::TopLevelGrammar;
+use llguidance::{Matcher, ParserFactory};
+use tad_grammar::Format;
+use tad_test_support::examples;
+use toktrie::{ApproximateTokEnv, TokEnv};
+
+fn env() -> TokEnv {
+    ApproximateTokEnv::single_byte_env()
+}
+
+fn factory() -> Arc<ParserFactory> {
+    Arc::new(ParserFactory::new_simple(&env()).expect("a parser factory"))
+}
+
+/// Whether the grammar accepts `text` as a whole program.
+fn accepts(factory: &ParserFactory, grammar: &TopLevelGrammar, text: &str) -> Result<(), String> {
+    let tokens = factory.tok_env().tokenize_bytes(text.as_bytes());
+    let mut matcher = Matcher::new(factory.create_parser(grammar.clone()));
+    if let Some(e) = matcher.get_error() {
+        return Err(format!("grammar: {e}"));
+    }
+    for (i, &t) in tokens.iter().enumerate() {
+        if matcher.consume_token(t).is_err() || matcher.is_error() {
+            let at = tokens[..i].len();
+            return Err(format!(
+                "rejected at byte {at}: {:?}",
+                &text[at.saturating_sub(40)..(at + 10).min(text.len())]
+            ));
+        }
+    }
+    if matcher.is_accepting().unwrap_or(false) { Ok(()) } else { Err("the program ends too early".into()) }
+}
+
+fn lark(region: Option<&str>) -> String {
+    let (vocabulary, modules) = tad_grammar::scope(region).unwrap();
+    tad_grammar::export(Format::Lark, &vocabulary, &modules, "test")
+}
+
+fn gbnf(region: Option<&str>) -> String {
+    let (vocabulary, modules) = tad_grammar::scope(region).unwrap();
+    tad_grammar::export(Format::Gbnf, &vocabulary, &modules, "test")
+}
+
+/// GBNF read back as llguidance Lark: `a-b ::= ...` becomes `a_b: ...`, `root` `start`,
+/// character classes regular-expression lexemes; literals and repetitions are the same.
+fn gbnf_to_lark(gbnf: &str) -> String {
+    let mut out = String::new();
+    for line in gbnf.lines() {
+        if line.starts_with('#') || line.trim().is_empty() {
+            continue;
+        }
+        let (name, body) = line.split_once(" ::= ").expect("a GBNF rule per line");
+        let name = if name == "root" { "start".to_string() } else { name.replace('-', "_") };
+        let mut converted = String::new();
+        let mut chars = body.chars().peekable();
+        while let Some(c) = chars.next() {
+            match c {
+                '"' => {
+                    converted.push('"');
+                    while let Some(c) = chars.next() {
+                        converted.push(c);
+                        if c == '\\' {
+                            converted.push(chars.next().unwrap());
+                        } else if c == '"' {
+                            break;
+                        }
+                    }
+                }
+                '[' => {
+                    converted.push_str("/[");
+                    while let Some(c) = chars.next() {
+                        converted.push(c);
+                        if c == '\\' {
+                            converted.push(chars.next().unwrap());
+                        } else if c == ']' {
+                            break;
+                        }
+                    }
+                    converted.push('/');
+                }
+                '-' => converted.push('_'),
+                c => converted.push(c),
+            }
+        }
+        out.push_str(&format!("{name}: {converted}\n"));
+    }
+    out
+}
+
+fn programs() -> Vec<(String, String)> {
+    examples().into_iter().map(|p| (p.display().to_string(), std::fs::read_to_string(&p).unwrap())).collect()
+}
+
+#[test]
+fn the_lark_grammar_accepts_every_example_and_the_region_grammar_its_own() {
+    let factory = factory();
+    let grammar = TopLevelGrammar::from_lark(lark(None));
+    for (path, text) in programs() {
+        accepts(&factory, &grammar, &text).unwrap_or_else(|e| panic!("{path}: {e}"));
+    }
+    let yellowstone = TopLevelGrammar::from_lark(lark(Some("yellowstone")));
+    let (_, text) = programs().into_iter().find(|(p, _)| p.contains("yellowstone")).unwrap();
+    accepts(&factory, &yellowstone, &text).unwrap();
+    // a region without the national-park module has no bison
+    let los_angeles = TopLevelGrammar::from_lark(lark(Some("los_angeles")));
+    assert!(accepts(&factory, &los_angeles, &text).is_err());
+}
+
+#[test]
+fn the_gbnf_grammar_accepts_every_example() {
+    let factory = factory();
+    let grammar = TopLevelGrammar::from_lark(gbnf_to_lark(&gbnf(None)));
+    for (path, text) in programs() {
+        accepts(&factory, &grammar, &text).unwrap_or_else(|e| panic!("{path}: {e}"));
+    }
+}
+
+/// Programs one edit away from an example that the language or the vocabulary rules out.
+fn mutants(text: &str) -> Vec<(&'static str, String)> {
+    let mut out = Vec::new();
+    let mut push = |what: &'static str, from: &str, to: &str| {
+        if text.contains(from) {
+            out.push((what, text.replacen(from, to, 1)));
+        }
+    };
+    push("an undeclared weather", "weather: ", "weather: sunnyish_");
+    push("an undeclared behavior", "behavior: ", "behavior: teleport_");
+    if let Some(line) = text.lines().find(|l| l.starts_with("    speed: ") && l.ends_with(" km/h")) {
+        push("a unit that does not exist", line, &line.replace("km/h", "kmh"));
+    }
+    push("an unknown field", "    lane: ", "    lane_no: ");
+    push("a missing brace", "\n  }\n", "\n");
+    push("a lane that is not a number", "lane: 1", "lane: one");
+    push("a range in a single-valued field", "lanes: ", "lanes: 1..");
+    push("prose before the program", "scenario ", "Here is the scenario:\nscenario ");
+    out
+}
+
+#[test]
+fn both_grammars_reject_broken_programs() {
+    let factory = factory();
+    let grammars = [
+        ("lark", TopLevelGrammar::from_lark(lark(None))),
+        ("gbnf", TopLevelGrammar::from_lark(gbnf_to_lark(&gbnf(None)))),
+    ];
+    let mut checked = 0;
+    for (path, text) in programs().into_iter().take(6) {
+        for (what, mutant) in mutants(&text) {
+            for (notation, grammar) in &grammars {
+                assert!(accepts(&factory, grammar, &mutant).is_err(), "{notation} accepts {what} in {path}");
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked >= 60, "only {checked} mutants");
+}
+
+fn json_form(text: &str) -> serde_json::Value {
+    let module = tad_syntax::analyze(text).0;
+    let yaml = tad_yaml::export(&module, text);
+    serde_norway::from_str(&yaml).expect("YAML that reads as JSON values")
+}
+
+#[test]
+fn the_json_schema_validates_every_example_and_rejects_mutants() {
+    let (vocabulary, _) = tad_grammar::scope(None).unwrap();
+    let schema = tad_grammar::json_schema(&vocabulary, "test");
+    let validator = jsonschema::validator_for(&schema).expect("a valid JSON Schema");
+    let factory = factory();
+    let grammar = TopLevelGrammar::from_json_schema(schema.clone());
+    for (path, text) in programs() {
+        let value = json_form(&text);
+        let errors: Vec<String> =
+            validator.iter_errors(&value).map(|e| format!("{e} at {}", e.instance_path())).collect();
+        assert!(errors.is_empty(), "{path}: {errors:?}");
+        accepts(&factory, &grammar, &serde_json::to_string(&value).unwrap()).unwrap_or_else(|e| panic!("{path}: {e}"));
+
+        let mut bad = value.clone();
+        bad["environment"]["weather"] = "sunnyish".into();
+        assert!(!validator.is_valid(&bad), "{path}: an undeclared weather");
+        let mut bad = value.clone();
+        bad["actors"]["ego_vehicle"]["lane_index"] = "two".into();
+        assert!(!validator.is_valid(&bad), "{path}: a lane in words");
+        let mut bad = value.clone();
+        bad["road_network"]["colour"] = "red".into();
+        assert!(!validator.is_valid(&bad), "{path}: an unknown key");
+        let mut bad = value;
+        bad.as_object_mut().unwrap().remove("actors");
+        assert!(!validator.is_valid(&bad), "{path}: no actors");
+    }
+}
