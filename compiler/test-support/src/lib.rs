@@ -7,6 +7,7 @@
 //! environment variable a user or CI sets (`TADSL_SHARED`, `TADSL_SCENIC_PYTHON`,
 //! `TADSL_SCENIC_CHECK`, `TADSL_SCENIC_MAPS`, `TADSL_SCENIC_TRACE`).
 
+pub mod fake_llm;
 pub mod mutate;
 pub mod scenic;
 pub mod trace;
