@@ -1,7 +1,8 @@
 //! The `tadslc` library: the command line's subcommands, shared with its tests.
 //!
 //! Exit codes: 0 success, 1 the input has errors (or warnings with `--deny-warnings`, or
-//! unformatted files with `fmt --check`), 2 usage or I/O failure.
+//! unformatted files with `fmt --check`), 2 usage or I/O failure; `translate` adds 3
+//! (incomplete), 4 (non-scenario) and 5 (the model's server could not be used).
 
 pub mod bench;
 pub mod build;
@@ -12,6 +13,7 @@ pub mod explain;
 pub mod files;
 pub mod fmt;
 pub mod interchange;
+pub mod llm;
 pub mod manual;
 pub mod output;
 pub mod run;
@@ -30,6 +32,12 @@ pub enum Status {
     Ok = 0,
     Failed = 1,
     Usage = 2,
+    /// `translate` ended with a valid but incomplete scenario.
+    Incomplete = 3,
+    /// `translate` ended with a non-scenario.
+    NonScenario = 4,
+    /// The language-model server could not be used.
+    Unreachable = 5,
 }
 
 impl From<Status> for std::process::ExitCode {

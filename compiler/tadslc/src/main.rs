@@ -214,6 +214,96 @@ enum Command {
         #[arg(long, default_value_t = 300, requires = "runtime", hide = true)]
         steps: u32,
     },
+    /// Translate a description into a TAD program with a language model, the compiler in
+    /// the loop
+    ///
+    /// The answer's program is checked; every diagnostic goes back for a corrected program,
+    /// an incomplete scenario gets the refinement request, until the program is valid or the
+    /// rounds run out. Exit status: 0 complete, 1 invalid or no program, 3 incomplete,
+    /// 4 non-scenario, 5 the server could not be used, 2 usage or I/O.
+    Translate {
+        /// The description (a text file; `-` reads standard input)
+        description: PathBuf,
+        /// Write the program here (default: standard output)
+        #[arg(short, long, value_name = "FILE")]
+        output: Option<PathBuf>,
+        /// Append every round (request, answer, diagnostics) as JSON lines
+        #[arg(long, value_name = "FILE")]
+        transcript: Option<PathBuf>,
+        /// The region: its module's names are in scope and in the prompt
+        #[arg(long, value_name = "REGION")]
+        region: Option<String>,
+        #[command(flatten)]
+        llm: tadslc::llm::LlmArgs,
+    },
+    /// Turn a driving video (or a directory of frames) into validated scenarios
+    ///
+    /// A frame every 15 s (ffmpeg), described by a multimodal model, translated, checked,
+    /// repaired; incomplete ones described again with the refinement request. One `.tad`
+    /// per frame with its provenance, a JSONL manifest; resumable; `--shard i/n` for job arrays.
+    Synth {
+        /// The video
+        #[arg(long, value_name = "FILE", conflicts_with = "frames", required_unless_present = "frames")]
+        video: Option<PathBuf>,
+        /// A directory of frames (.jpg, .png) instead of a video
+        #[arg(long, value_name = "DIR")]
+        frames: Option<PathBuf>,
+        /// The region the video was recorded in
+        #[arg(long, value_name = "REGION")]
+        region: String,
+        /// The output directory
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+        /// Seconds between frames
+        #[arg(long, value_name = "S", default_value_t = 15.0)]
+        every: f64,
+        /// Do only the frames of shard i of n (`0/4`)
+        #[arg(long, value_name = "I/N", default_value = "0/1", value_parser = tadslc::llm::parse_shard)]
+        shard: (usize, usize),
+        /// Frames under way at once
+        #[arg(long, value_name = "N", default_value_t = 1)]
+        jobs: usize,
+        /// How often an incomplete scenario's frame is described again
+        #[arg(long, value_name = "N", default_value_t = 1)]
+        max_refinements: u32,
+        #[command(flatten)]
+        llm: tadslc::llm::LlmArgs,
+    },
+    /// Generate scenarios for a region with a language model, through the same
+    /// check-and-repair loop
+    Gen {
+        /// The region
+        #[arg(long, value_name = "REGION")]
+        region: String,
+        /// How many scenarios
+        #[arg(short = 'n', long = "count", value_name = "N", default_value_t = 40)]
+        count: usize,
+        /// Write the scenarios, a manifest and a summary here (default: print them)
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+        /// The paper's unaligned baseline: the region's name only, no examples, the general
+        /// vocabulary
+        #[arg(long)]
+        baseline: bool,
+        /// Scenarios of the region to show as examples (default: examples/regions)
+        #[arg(long, value_name = "PATH")]
+        corpus: Vec<PathBuf>,
+        /// Requests under way at once
+        #[arg(long, value_name = "N", default_value_t = 1)]
+        jobs: usize,
+        #[command(flatten)]
+        llm: tadslc::llm::LlmArgs,
+    },
+    /// Print TAD's grammar for constrained decoding: GBNF (llama.cpp, XGrammar), Lark
+    /// (llguidance) or the YAML form's JSON Schema, the vocabulary as closed sets
+    Grammar {
+        /// The notation
+        #[arg(long, value_enum, default_value_t = GrammarFormat::Gbnf)]
+        format: GrammarFormat,
+        /// Only the names a scenario of this region sees (default: every standard module)
+        #[arg(long, value_name = "REGION")]
+        region: Option<String>,
+    },
     /// Print the shell completion script for a shell
     ///
     /// For example `tadslc completions bash > ~/.local/share/bash-completion/completions/tadslc`.
@@ -311,6 +401,13 @@ enum Simulator {
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum GrammarFormat {
+    Gbnf,
+    Lark,
+    JsonSchema,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum Color {
     Auto,
     Always,
@@ -370,6 +467,34 @@ fn main() -> ExitCode {
         Command::Bench { scenarios, seed, examples, runs, .. } => {
             bench::run(scenarios, seed, examples.as_deref(), runs)
         }
+        Command::Translate { description, output, transcript, region, llm } => {
+            tadslc::llm::translate(&description, output.as_deref(), transcript.as_deref(), region.as_deref(), &llm)
+        }
+        Command::Synth { video, frames, region, out, every, shard, jobs, max_refinements, llm } => tadslc::llm::synth(
+            &tadslc::llm::SynthArgs {
+                video: video.as_deref(),
+                frames: frames.as_deref(),
+                region: &region,
+                out: &out,
+                every,
+                shard,
+                jobs,
+                max_refinements,
+            },
+            &llm,
+        ),
+        Command::Gen { region, count, out, baseline, corpus, jobs, llm } => tadslc::llm::generate(
+            &tadslc::llm::GenArgs { region: &region, n: count, out: out.as_deref(), baseline, corpus: &corpus, jobs },
+            &llm,
+        ),
+        Command::Grammar { format, region } => tadslc::llm::grammar(
+            match format {
+                GrammarFormat::Gbnf => tad_grammar::Format::Gbnf,
+                GrammarFormat::Lark => tad_grammar::Format::Lark,
+                GrammarFormat::JsonSchema => tad_grammar::Format::JsonSchema,
+            },
+            region.as_deref(),
+        ),
         Command::Completions { shell } => tadslc::manual::completions(Cli::command(), shell),
         Command::Man { output } => tadslc::manual::man(Cli::command(), output.as_deref()),
     };

@@ -1,0 +1,222 @@
+//! The LLM front-end: TrafficAlign's pipeline with the compiler in the loop.
+//!
+//! ```text
+//! video ──ffmpeg, every 15 s──▶ frame ──describe (image)──▶ description ──translate──▶ program
+//!                                   ▲                                        │ session: check, repair, refine
+//!                                   └── re-describe with the refinement ◀── incomplete
+//! region ──generate (aligned: the region's module and examples; baseline: its name only)──▶ program
+//! ```
+//!
+//! [`prompt`] renders the versioned templates (the vocabulary from the declarations in
+//! scope), [`extract`] finds the program in an answer, [`session`] runs the
+//! check-and-repair loop on `tad-db` (the same checks as `tadslc check`) over `tad-llm`,
+//! [`synth`] and [`generate`] are the pipelines, [`store`] writes what they produce (sanitised
+//! names, atomic files, JSON Lines), [`summary`] counts what happened. Everything a model
+//! writes is untrusted: it never names a path, never breaks a record, and every loop is
+//! bounded in rounds, tokens and time.
+
+pub mod extract;
+pub mod generate;
+pub mod prompt;
+pub mod session;
+pub mod store;
+pub mod summary;
+pub mod synth;
+
+use tad_check::Vocabulary;
+use tad_llm::{Constraint, Dialect};
+use tad_syntax::model::Val;
+
+pub use session::{Checker, Limits, Outcome, Round, Session};
+pub use summary::Summary;
+
+/// The constraint `--constrain` sends to a server of `dialect`: TAD's GBNF where the
+/// server reads a grammar, the YAML form's JSON Schema on OpenAI.
+pub fn constraint(dialect: Dialect, vocabulary: &Vocabulary, modules: &[String]) -> Constraint {
+    let header = "TAD, as tadslc grammar prints it";
+    match dialect {
+        Dialect::OpenAi => Constraint::JsonSchema(tad_grammar::json_schema(vocabulary, header)),
+        _ => Constraint::Gbnf(tad_grammar::export(tad_grammar::Format::Gbnf, vocabulary, modules, header)),
+    }
+}
+
+/// The in-context example of the prompts: TrafficAlign's first translation example.
+const EXAMPLE: &str = include_str!("../../../examples/paper/nl_to_dsl_example_1.tad");
+
+/// The example's description and its program (without comments and `source`).
+pub fn prompt_example() -> (String, String) {
+    let (module, _) = tad_syntax::analyze(EXAMPLE);
+    let description = module
+        .scenario
+        .as_ref()
+        .and_then(|s| s.attr("source", "description"))
+        .and_then(|a| match a.value.given() {
+            Some(Val::Text(t)) => Some(t.clone()),
+            _ => None,
+        })
+        .unwrap_or_default();
+    let program = with_provenance(EXAMPLE, &Provenance::default());
+    (description, program.trim_end().to_string())
+}
+
+/// The first request of a translation: the prompt with the vocabulary of the checker's
+/// region, the example, and the description.
+pub fn translate_messages(description: &str, checker: &Checker) -> Vec<tad_llm::Message> {
+    let scope = tad_grammar::scope(checker.options.region.as_deref()).or_else(|_| tad_grammar::scope(None));
+    let vocabulary = scope.map(|(v, _)| prompt::vocabulary(&v)).unwrap_or_default();
+    let (example_description, example_program) = prompt_example();
+    prompt::TRANSLATE.messages(&[
+        ("vocabulary", &vocabulary),
+        ("example_description", &example_description),
+        ("example_program", &example_program),
+        ("description", description),
+    ])
+}
+
+/// A declaration's `description` text.
+pub fn description(vocabulary: &Vocabulary, kind: &str, name: &str) -> Option<String> {
+    let entry = vocabulary.get(kind, name)?;
+    match entry.declaration.attr("description")?.value.given()? {
+        Val::Text(t) => Some(t.clone()),
+        _ => None,
+    }
+}
+
+/// Where a program came from, written into its file.
+#[derive(Clone, Debug, Default)]
+pub struct Provenance {
+    /// Comment lines (without `//`).
+    pub comments: Vec<String>,
+    pub video: Option<String>,
+    pub time_s: Option<f64>,
+    pub frame: Option<u64>,
+    pub region: Option<String>,
+    pub description: Option<String>,
+}
+
+/// `program` (canonical TAD) with its provenance: comment lines on top and a `source`
+/// section written by us (the model's own is dropped), then formatted.
+pub fn with_provenance(program: &str, provenance: &Provenance) -> String {
+    let mut lines: Vec<&str> = program.lines().collect();
+    // drop the model's source section and comment lines
+    if let Some(start) = lines.iter().position(|l| *l == "  source {")
+        && let Some(len) = lines[start..].iter().position(|l| *l == "  }")
+    {
+        lines.drain(start..=start + len);
+    }
+    lines.retain(|l| !l.trim_start().starts_with("//"));
+    let mut source = Vec::new();
+    if let Some(video) = &provenance.video {
+        source.push(format!("    video: {}", string_literal(video)));
+    }
+    if let Some(t) = provenance.time_s {
+        source.push(format!("    time: {} s", tad_number(t)));
+    }
+    if let Some(frame) = provenance.frame {
+        source.push(format!("    frame: {frame}"));
+    }
+    if let Some(region) = &provenance.region {
+        source.push(format!("    region: {region}"));
+    }
+    if let Some(description) = &provenance.description {
+        source.push("    description: \"\"\"".into());
+        for line in text_block(description).lines() {
+            source.push(if line.is_empty() { String::new() } else { format!("      {line}") });
+        }
+        source.push("    \"\"\"".into());
+    }
+    let mut out = String::new();
+    for c in &provenance.comments {
+        let c: String = c.chars().filter(|c| !c.is_control()).collect();
+        out.push_str(&format!("// {c}\n"));
+    }
+    if !provenance.comments.is_empty() {
+        out.push('\n');
+    }
+    for line in lines {
+        out.push_str(line);
+        out.push('\n');
+        if line.starts_with("scenario ") && line.ends_with('{') && !source.is_empty() {
+            out.push_str("  source {\n");
+            for s in &source {
+                out.push_str(s);
+                out.push('\n');
+            }
+            out.push_str("  }\n");
+        }
+    }
+    tad_syntax::format::format(&out).unwrap_or(out)
+}
+
+fn tad_number(x: f64) -> String {
+    if x.fract() == 0.0 && x.abs() < 1e12 { format!("{}", x as i64) } else { format!("{x:.3}") }
+}
+
+/// A TAD string literal of untrusted text.
+pub fn string_literal(text: &str) -> String {
+    let mut out = String::from('"');
+    for c in text.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            c if c.is_control() => {}
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
+}
+
+/// Untrusted text as a text block's content: no `"""`, no control characters but line
+/// breaks, wrapped at 88 columns.
+fn text_block(text: &str) -> String {
+    let clean: String =
+        text.replace("\"\"\"", "\"'\"").chars().filter(|c| !c.is_control() || *c == '\n').collect::<String>();
+    let mut out = Vec::new();
+    for paragraph in clean.lines() {
+        let mut line = String::new();
+        for word in paragraph.split_whitespace() {
+            if !line.is_empty() && line.len() + word.len() + 1 > 88 {
+                out.push(std::mem::take(&mut line));
+            }
+            if !line.is_empty() {
+                line.push(' ');
+            }
+            line.push_str(word);
+        }
+        out.push(line);
+    }
+    let text = out.join("\n");
+    // a text block cannot end in a quote that would run into its closing `"""`
+    text.trim_end_matches('"').trim().to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn provenance_replaces_the_models_source_and_survives_hostile_text() {
+        let program =
+            "// model says hi\nscenario a {\n  source {\n    video: \"evil.mp4\"\n  }\n  ego {\n    lane: 1\n  }\n}\n";
+        let p = Provenance {
+            comments: vec!["made by a test\u{7}".into()],
+            video: Some("dash \"cam\".mp4".into()),
+            time_s: Some(15.0),
+            region: Some("yellowstone".into()),
+            description: Some("A bison.\n\"\"\" } scenario evil {\nEnd \"".into()),
+            ..Default::default()
+        };
+        let out = with_provenance(program, &p);
+        assert!(
+            out.starts_with(
+                "// made by a test\n\nscenario a {\n  source {\n    video: \"dash \\\"cam\\\".mp4\"\n    time: 15 s\n"
+            ),
+            "{out}"
+        );
+        assert!(!out.contains("evil.mp4") && !out.contains("model says hi"));
+        let (module, diagnostics) = tad_syntax::analyze(&out);
+        assert!(diagnostics.is_empty(), "{out}\n{diagnostics:?}");
+        assert_eq!(module.scenario.unwrap().name.text, "a");
+    }
+}

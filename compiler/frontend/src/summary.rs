@@ -1,0 +1,77 @@
+//! What a batch of items came to: syntax-valid at round 1, valid at round 1 and after
+//! repair, mean rounds to valid, the class distribution, tokens.
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+use crate::session::Outcome;
+
+#[derive(Clone, Debug, Default, Serialize, PartialEq)]
+pub struct Summary {
+    pub items: usize,
+    /// The first answer held a program with no lexical, syntax or YAML error.
+    pub syntax_valid_first: usize,
+    /// The first answer's program had no errors at all.
+    pub valid_first: usize,
+    /// The last program had no errors.
+    pub valid_after_repair: usize,
+    /// Over the items that became valid: the round it happened.
+    pub mean_rounds_to_valid: Option<f64>,
+    /// Items per final class (`complete`, `incomplete`, `non_scenario`, `invalid`, `no_program`).
+    pub classes: BTreeMap<String, usize>,
+    /// Items stopped by a server failure or a bound.
+    pub stopped: usize,
+    pub prompt_tokens: u64,
+    pub completion_tokens: u64,
+    #[serde(skip)]
+    rounds_to_valid: Vec<u32>,
+}
+
+impl Summary {
+    pub fn add(&mut self, o: &Outcome) {
+        self.items += 1;
+        self.syntax_valid_first += usize::from(o.syntax_valid_first);
+        self.valid_first += usize::from(o.valid_round == Some(1));
+        let valid_now = o.class.is_some_and(|c| c != "invalid");
+        self.valid_after_repair += usize::from(valid_now);
+        if let (Some(r), true) = (o.valid_round, valid_now) {
+            self.rounds_to_valid.push(r);
+            self.mean_rounds_to_valid =
+                Some(self.rounds_to_valid.iter().map(|&r| r as f64).sum::<f64>() / self.rounds_to_valid.len() as f64);
+        }
+        *self.classes.entry(o.class.unwrap_or("no_program").to_string()).or_default() += 1;
+        self.stopped += usize::from(o.stopped.is_some());
+        self.prompt_tokens += o.usage.prompt_tokens;
+        self.completion_tokens += o.usage.completion_tokens;
+    }
+
+    /// A few lines for people.
+    pub fn render(&self) -> String {
+        let pct = |n: usize| if self.items == 0 { 0.0 } else { 100.0 * n as f64 / self.items as f64 };
+        let classes: Vec<String> = self.classes.iter().map(|(c, n)| format!("{c} {n}")).collect();
+        let mut out = format!(
+            "{} items: syntax-valid at round 1 {} ({:.0}%), valid at round 1 {} ({:.0}%), valid after repair {} ({:.0}%)",
+            self.items,
+            self.syntax_valid_first,
+            pct(self.syntax_valid_first),
+            self.valid_first,
+            pct(self.valid_first),
+            self.valid_after_repair,
+            pct(self.valid_after_repair),
+        );
+        if let Some(m) = self.mean_rounds_to_valid {
+            out.push_str(&format!(", mean rounds to valid {m:.2}"));
+        }
+        out.push_str(&format!(
+            "\nclasses: {}; tokens: {} prompt + {} completion",
+            classes.join(", "),
+            self.prompt_tokens,
+            self.completion_tokens
+        ));
+        if self.stopped > 0 {
+            out.push_str(&format!("; {} stopped early", self.stopped));
+        }
+        out
+    }
+}

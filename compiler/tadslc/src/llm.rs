@@ -1,0 +1,526 @@
+//! `translate`, `synth`, `gen` and `grammar`: the LLM front-end on the command line.
+//!
+//! The server comes from flags, the environment (`TADSL_LLM_BASE_URL`, `TADSL_LLM_API_KEY`,
+//! `TADSL_LLM_MODEL`, `TADSL_LLM_DIALECT`) and a TOML file (`--llm-config`, else
+//! `TADSL_LLM_CONFIG`, else `$XDG_CONFIG_HOME/tadsl/llm.toml`). Exit statuses of
+//! `translate` name the class it ended in (`spec/output.md`).
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+
+use tad_check::Options;
+use tad_frontend::{Checker, Limits, Round, Session, Summary, store};
+use tad_llm::{Client, Config, Constraint, Overrides};
+
+use crate::Status;
+use crate::{errln, out};
+
+/// The flags every LLM subcommand shares.
+#[derive(Clone, Debug, clap::Args)]
+pub struct LlmArgs {
+    /// The server, up to `/v1` (default: TADSL_LLM_BASE_URL)
+    #[arg(long, value_name = "URL")]
+    pub base_url: Option<String>,
+    /// The model name sent to the server (default: TADSL_LLM_MODEL)
+    #[arg(long)]
+    pub model: Option<String>,
+    /// How the server takes grammars: openai, vllm, vllm-legacy, sglang, llama-cpp
+    #[arg(long)]
+    pub dialect: Option<String>,
+    /// A TOML file with base_url, model, dialect, api_key_env, timeout, ...
+    #[arg(long, value_name = "FILE")]
+    pub llm_config: Option<PathBuf>,
+    /// Constrain decoding to TAD's grammar (GBNF) or, on OpenAI, the YAML form's JSON Schema
+    #[arg(long)]
+    pub constrain: bool,
+    /// Repair and refinement requests after the first answer
+    #[arg(long, value_name = "N", default_value_t = 3)]
+    pub max_rounds: u32,
+    /// Tokens per answer
+    #[arg(long, value_name = "N", default_value_t = 1024)]
+    pub max_tokens: u32,
+    /// Tokens (prompt and answers) per item
+    #[arg(long, value_name = "N", default_value_t = 60_000)]
+    pub token_budget: u64,
+    /// Seconds per item
+    #[arg(long, value_name = "S", default_value_t = 600)]
+    pub deadline: u64,
+    /// Seconds per request
+    #[arg(long, value_name = "S")]
+    pub timeout: Option<f64>,
+    /// Retries of a failed request
+    #[arg(long, value_name = "N")]
+    pub max_retries: Option<u32>,
+    /// Sampling temperature
+    #[arg(long)]
+    pub temperature: Option<f64>,
+    /// Seed of the requests (and of the client's backoff)
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+}
+
+fn config_file(explicit: Option<&Path>) -> Result<Option<(String, String)>, String> {
+    let path = match explicit {
+        Some(p) => Some(p.to_path_buf()),
+        None => std::env::var_os("TADSL_LLM_CONFIG").map(PathBuf::from).or_else(|| {
+            let base = std::env::var_os("XDG_CONFIG_HOME")
+                .map(PathBuf::from)
+                .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".config")))?;
+            Some(base.join("tadsl/llm.toml")).filter(|p| p.exists())
+        }),
+    };
+    let Some(path) = path else { return Ok(None) };
+    let text = std::fs::read_to_string(&path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    Ok(Some((path.display().to_string(), text)))
+}
+
+impl LlmArgs {
+    fn client(&self, concurrency: usize) -> Result<Client, String> {
+        let file = config_file(self.llm_config.as_deref())?;
+        let cli = Overrides {
+            base_url: self.base_url.clone(),
+            model: self.model.clone(),
+            dialect: self.dialect.clone(),
+            timeout: self.timeout,
+            max_retries: self.max_retries,
+            concurrency: Some(concurrency),
+        };
+        let env = |k: &str| std::env::var(k).ok();
+        let config = Config::resolve(&cli, &env, file.as_ref().map(|(n, t)| (n.as_str(), t.as_str())), self.seed)
+            .map_err(|e| e.to_string())?
+            .ok_or_else(|| {
+                "no language-model server is configured: set TADSL_LLM_BASE_URL (e.g. http://127.0.0.1:8080/v1), pass \
+                 --base-url, or write base_url in ~/.config/tadsl/llm.toml"
+                    .to_string()
+            })?;
+        Client::new(config).map_err(|e| e.to_string())
+    }
+
+    fn limits(&self) -> Limits {
+        Limits {
+            max_rounds: self.max_rounds.min(10),
+            max_tokens: self.max_tokens.clamp(16, 32_768),
+            token_budget: self.token_budget,
+            deadline: Duration::from_secs(self.deadline.max(1)),
+        }
+    }
+
+    fn constraint(&self, client: &Client, region: Option<&str>) -> Result<Constraint, String> {
+        if !self.constrain {
+            return Ok(Constraint::None);
+        }
+        let (vocabulary, modules) = tad_grammar::scope(region)?;
+        Ok(tad_frontend::constraint(client.config().dialect, &vocabulary, &modules))
+    }
+}
+
+fn runtime() -> Result<tokio::runtime::Runtime, String> {
+    tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .map_err(|e| format!("cannot start the async runtime: {e}"))
+}
+
+fn checker(region: Option<&str>) -> Result<Checker, String> {
+    if let Some(r) = region {
+        tad_grammar::scope(Some(r))?;
+    }
+    Ok(Checker { options: Options { region: region.map(String::from), ..Options::default() } })
+}
+
+fn model_label(client: &Client) -> String {
+    format!("{} at {}", client.config().model, client.config().base_url)
+}
+
+/// `tadslc translate DESC`.
+pub fn translate(
+    description: &Path,
+    output: Option<&Path>,
+    transcript: Option<&Path>,
+    region: Option<&str>,
+    args: &LlmArgs,
+) -> Status {
+    let run = || -> Result<Status, String> {
+        let text = if description == Path::new("-") {
+            let mut s = String::new();
+            std::io::Read::read_to_string(&mut std::io::stdin(), &mut s)
+                .map_err(|e| format!("cannot read standard input: {e}"))?;
+            s
+        } else {
+            std::fs::read_to_string(description).map_err(|e| format!("cannot read {}: {e}", description.display()))?
+        };
+        if text.trim().is_empty() {
+            return Err(format!("{} is empty: there is nothing to translate", description.display()));
+        }
+        let client = args.client(1)?;
+        let checker = checker(region)?;
+        let session = Session {
+            client: &client,
+            checker: &checker,
+            limits: args.limits(),
+            constraint: args.constraint(&client, region)?,
+            temperature: args.temperature.unwrap_or(0.0),
+            seed: Some(args.seed),
+        };
+        let mut transcript_file = match transcript {
+            Some(p) => Some(store::Jsonl::append(p).map_err(|e| format!("cannot write {}: {e}", p.display()))?),
+            None => None,
+        };
+        let mut write_error = None;
+        let item = description.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "stdin".into());
+        let messages = tad_frontend::translate_messages(text.trim(), &checker);
+        let outcome =
+            runtime()?.block_on(session.run(&item, messages, tad_frontend::prompt::TRANSLATE.id, &mut |r: &Round| {
+                if let Some(t) = transcript_file.as_mut()
+                    && let Err(e) = t.write(r)
+                {
+                    write_error.get_or_insert(e);
+                }
+                let _ = errln!(
+                    "round {}: {}{}",
+                    r.round,
+                    r.error
+                        .as_deref()
+                        .map(|e| format!("error: {e}"))
+                        .unwrap_or_else(|| r.class.unwrap_or("no program").to_string()),
+                    if r.diagnostics.is_empty() {
+                        String::new()
+                    } else {
+                        format!(" ({} diagnostics)", r.diagnostics.len())
+                    }
+                );
+            }));
+        if let Some(e) = write_error {
+            return Err(format!("cannot write the transcript: {e}"));
+        }
+        let provenance = tad_frontend::Provenance {
+            comments: vec![format!(
+                "translated by tadslc {} from {} with model {}, {} round{}, prompt {}",
+                env!("CARGO_PKG_VERSION"),
+                description.display(),
+                model_label(&client),
+                outcome.rounds,
+                if outcome.rounds == 1 { "" } else { "s" },
+                tad_frontend::prompt::TRANSLATE.id
+            )],
+            region: region.map(String::from),
+            description: Some(text.trim().to_string()),
+            ..Default::default()
+        };
+        let program = outcome.program.as_ref().map(|p| tad_frontend::with_provenance(p, &provenance));
+        match (&program, output) {
+            (Some(p), Some(path)) => {
+                store::write_atomic(path, p.as_bytes()).map_err(|e| format!("cannot write {}: {e}", path.display()))?
+            }
+            (Some(p), None) => {
+                let _ = out!("{p}");
+            }
+            (None, _) => {}
+        }
+        for line in &outcome.diagnostics {
+            let _ = errln!("  {line}");
+        }
+        let class = outcome.class.unwrap_or("no program");
+        let _ = errln!(
+            "{class} after {} round{}; {} tokens{}",
+            outcome.rounds,
+            if outcome.rounds == 1 { "" } else { "s" },
+            outcome.usage.total(),
+            outcome.stopped.as_deref().map(|s| format!("; stopped: {s}")).unwrap_or_default()
+        );
+        Ok(match (outcome.class, &outcome.stopped) {
+            (Some("complete"), _) => Status::Ok,
+            (Some("incomplete"), _) => Status::Incomplete,
+            (Some("non_scenario"), _) => Status::NonScenario,
+            (None, Some(_)) => Status::Unreachable,
+            _ => Status::Failed,
+        })
+    };
+    run().unwrap_or_else(|e| {
+        let _ = errln!("error: {e}");
+        Status::Usage
+    })
+}
+
+fn progress(total: usize, what: &str) -> indicatif::ProgressBar {
+    use std::io::IsTerminal;
+    if !std::io::stderr().is_terminal() {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new(total as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(&format!(
+            "{{bar:30}} {{pos}}/{{len}} {what} {{msg}} [{{elapsed}}, eta {{eta}}]"
+        ))
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar
+}
+
+fn write_summary(dir: Option<&Path>, summary: &Summary, extra: serde_json::Value) -> Result<(), String> {
+    let _ = errln!("{}", summary.render());
+    if let Some(dir) = dir {
+        let mut value = serde_json::to_value(summary).unwrap_or_default();
+        if let (Some(map), serde_json::Value::Object(extra)) = (value.as_object_mut(), extra) {
+            map.extend(extra);
+        }
+        let text = serde_json::to_string_pretty(&value).unwrap_or_default() + "\n";
+        store::write_atomic(&dir.join("summary.json"), text.as_bytes())
+            .map_err(|e| format!("cannot write the summary: {e}"))?;
+    }
+    Ok(())
+}
+
+pub struct GenArgs<'a> {
+    pub region: &'a str,
+    pub n: usize,
+    pub out: Option<&'a Path>,
+    pub baseline: bool,
+    pub corpus: &'a [PathBuf],
+    pub jobs: usize,
+}
+
+/// `tadslc gen --region R -n N`.
+pub fn generate(g: &GenArgs, args: &LlmArgs) -> Status {
+    let run = || -> Result<Status, String> {
+        let (general, modules) = tad_grammar::scope(None)?;
+        let (regional, region_modules) = tad_grammar::scope(Some(g.region))?;
+        let client = args.client(g.jobs.max(1))?;
+        let checker = checker(Some(g.region))?;
+        let (vocabulary, constraint_scope) =
+            if g.baseline { (&general, (&general, &modules)) } else { (&regional, (&regional, &region_modules)) };
+        let constraint = if args.constrain {
+            tad_frontend::constraint(client.config().dialect, constraint_scope.0, constraint_scope.1)
+        } else {
+            Constraint::None
+        };
+        let session = Session {
+            client: &client,
+            checker: &checker,
+            limits: args.limits(),
+            constraint,
+            temperature: args.temperature.unwrap_or(0.8),
+            seed: Some(args.seed),
+        };
+        let examples = region_examples(g.corpus, g.region);
+        let spec = tad_frontend::generate::Spec {
+            region: g.region,
+            n: g.n,
+            seed: args.seed,
+            baseline: g.baseline,
+            vocabulary,
+            region_description: tad_frontend::description(&general, "region", g.region),
+            examples,
+            jobs: g.jobs,
+            model: model_label(&client),
+        };
+        let bar = progress(g.n, "scenarios");
+        let mut summary = Summary::default();
+        let mut transcript = match g.out {
+            Some(dir) => Some(store::Jsonl::append(&dir.join("gen.transcript.jsonl")).map_err(|e| e.to_string())?),
+            None => None,
+        };
+        let records = runtime()?
+            .block_on(tad_frontend::generate::run(
+                &session,
+                &spec,
+                g.out,
+                &mut |record, program| {
+                    summary.add(&record.outcome);
+                    bar.inc(1);
+                    bar.set_message(record.outcome.class.unwrap_or("no program").to_string());
+                    if g.out.is_none()
+                        && let Some(p) = program
+                    {
+                        let _ = out!("{p}\n");
+                    }
+                },
+                &mut |r| {
+                    if let Some(t) = transcript.as_mut() {
+                        let _ = t.write(r);
+                    }
+                },
+            ))
+            .map_err(|e| format!("cannot write the scenarios: {e}"))?;
+        bar.finish_and_clear();
+        let mode = if g.baseline { "baseline" } else { "aligned" };
+        write_summary(
+            g.out,
+            &summary,
+            serde_json::json!({ "region": g.region, "mode": mode, "model": model_label(&client) }),
+        )?;
+        let unreachable =
+            !records.is_empty() && records.iter().all(|r| r.outcome.program.is_none() && r.outcome.stopped.is_some());
+        Ok(if unreachable { Status::Unreachable } else { Status::Ok })
+    };
+    run().unwrap_or_else(|e| {
+        let _ = errln!("error: {e}");
+        Status::Usage
+    })
+}
+
+/// The programs of `corpus` (files or directories) that name `region`, for the prompt.
+fn region_examples(corpus: &[PathBuf], region: &str) -> Vec<String> {
+    let default = [tad_test_support::repo().join("examples/regions")];
+    let paths: Vec<PathBuf> = if corpus.is_empty() { default.to_vec() } else { corpus.to_vec() };
+    let mut out = Vec::new();
+    for path in paths {
+        let files = if path.is_dir() { tad_test_support::files(&path, "tad") } else { vec![path.clone()] };
+        for file in files {
+            let Ok(text) = std::fs::read_to_string(&file) else { continue };
+            let (module, _) = tad_syntax::analyze(&text);
+            let named = module
+                .scenario
+                .as_ref()
+                .and_then(|s| s.attr("source", "region"))
+                .and_then(|a| a.symbol())
+                .is_some_and(|s| s.name == region);
+            if named {
+                out.push(tad_frontend::with_provenance(&text, &tad_frontend::Provenance::default()));
+            }
+        }
+    }
+    out
+}
+
+pub struct SynthArgs<'a> {
+    pub video: Option<&'a Path>,
+    pub frames: Option<&'a Path>,
+    pub region: &'a str,
+    pub out: &'a Path,
+    pub every: f64,
+    pub shard: (usize, usize),
+    pub jobs: usize,
+    pub max_refinements: u32,
+}
+
+/// `tadslc synth`.
+pub fn synth(s: &SynthArgs, args: &LlmArgs) -> Status {
+    let run = || -> Result<Status, String> {
+        let input = match (s.video, s.frames) {
+            (Some(v), None) => tad_frontend::synth::Input::Video(v.to_path_buf()),
+            (None, Some(d)) => tad_frontend::synth::Input::Frames(d.to_path_buf()),
+            _ => return Err("give either --video FILE or --frames DIR".into()),
+        };
+        let client = args.client(s.jobs.max(1))?;
+        let checker = checker(Some(s.region))?;
+        let session = Session {
+            client: &client,
+            checker: &checker,
+            limits: args.limits(),
+            constraint: args.constraint(&client, Some(s.region))?,
+            temperature: args.temperature.unwrap_or(0.0),
+            seed: Some(args.seed),
+        };
+        let spec = tad_frontend::synth::Spec {
+            input,
+            region: s.region.to_string(),
+            out: s.out.to_path_buf(),
+            every: s.every,
+            shard: s.shard,
+            jobs: s.jobs,
+            max_refinements: s.max_refinements,
+            model: model_label(&client),
+            ffmpeg: std::env::var("TADSL_FFMPEG").unwrap_or_else(|_| "ffmpeg".into()),
+            ffprobe: std::env::var("TADSL_FFPROBE").unwrap_or_else(|_| "ffprobe".into()),
+        };
+        std::fs::create_dir_all(s.out).map_err(|e| format!("cannot create {}: {e}", s.out.display()))?;
+        let stop = Arc::new(AtomicBool::new(false));
+        let rt = runtime()?;
+        {
+            let stop = stop.clone();
+            rt.spawn(async move {
+                if tokio::signal::ctrl_c().await.is_ok() {
+                    stop.store(true, Ordering::SeqCst);
+                    let _ = errln!("\ninterrupted: finishing the frames under way (Ctrl-C again to abort)");
+                    if tokio::signal::ctrl_c().await.is_ok() {
+                        std::process::exit(130);
+                    }
+                }
+            });
+        }
+        let bar = progress(0, "frames");
+        let mut summary = Summary::default();
+        let mut failed = 0usize;
+        let report = rt
+            .block_on(tad_frontend::synth::run(
+                &session,
+                &spec,
+                &stop,
+                &mut |record| {
+                    if record.status == "failed" {
+                        failed += 1;
+                        bar.println(format!("{}: {}", record.frame, record.reasons.join("; ")));
+                    } else {
+                        summary.add(&record.outcome);
+                    }
+                    if bar.length() == Some(0) {
+                        bar.set_length(1);
+                    }
+                    bar.inc(1);
+                    bar.set_message(record.status.to_string());
+                },
+                &mut |_| {},
+            ))
+            .map_err(|e| e.0)?;
+        bar.finish_and_clear();
+        let _ = errln!(
+            "{} frame{} in this shard: {} done before, {} now, {} failed (rerun to retry)",
+            report.total,
+            if report.total == 1 { "" } else { "s" },
+            report.done_before,
+            report.records.len() - failed,
+            failed
+        );
+        write_summary(
+            Some(s.out),
+            &summary,
+            serde_json::json!({ "region": s.region, "model": model_label(&client), "shard": format!("{}/{}", s.shard.0, s.shard.1) }),
+        )?;
+        if report.interrupted {
+            let _ = errln!("interrupted: run the same command again to continue");
+            return Ok(Status::Failed);
+        }
+        Ok(if failed > 0 && failed == report.records.len() { Status::Unreachable } else { Status::Ok })
+    };
+    run().unwrap_or_else(|e| {
+        let _ = errln!("error: {e}");
+        Status::Usage
+    })
+}
+
+/// `i/n` for `--shard`.
+pub fn parse_shard(text: &str) -> Result<(usize, usize), String> {
+    let (i, n) = text.split_once('/').ok_or("a shard is written i/n, e.g. 0/4")?;
+    let (i, n): (usize, usize) =
+        (i.trim().parse().map_err(|_| "i is not a number")?, n.trim().parse().map_err(|_| "n is not a number")?);
+    if n == 0 || i >= n {
+        return Err(format!("shard {i}/{n}: i must be below n"));
+    }
+    Ok((i, n))
+}
+
+/// `tadslc grammar`.
+pub fn grammar(format: tad_grammar::Format, region: Option<&str>) -> Status {
+    match tad_grammar::scope(region) {
+        Ok((vocabulary, modules)) => {
+            let header = format!(
+                "TAD {} grammar from tadslc {} ({}); regenerate with `tadslc grammar --format {}{}`",
+                format.name(),
+                env!("CARGO_PKG_VERSION"),
+                region.map(|r| format!("region {r}")).unwrap_or_else(|| "every standard module".into()),
+                format.name(),
+                region.map(|r| format!(" --region {r}")).unwrap_or_default()
+            );
+            let _ = out!("{}", tad_grammar::export(format, &vocabulary, &modules, &header));
+            Status::Ok
+        }
+        Err(e) => {
+            let _ = errln!("error: {e}");
+            Status::Usage
+        }
+    }
+}
