@@ -217,6 +217,6 @@ mod tests {
         assert!(!out.contains("evil.mp4") && !out.contains("model says hi"));
         let (module, diagnostics) = tad_syntax::analyze(&out);
         assert!(diagnostics.is_empty(), "{out}\n{diagnostics:?}");
-        assert_eq!(module.scenario.unwrap().name.text, "a");
+        assert_eq!(module.scenario.unwrap().name.map(|n| n.text).as_deref(), Some("a"));
     }
 }

@@ -132,7 +132,7 @@ mod tests {
     #[test]
     fn the_vocabulary_comes_from_declarations() {
         let (vocabulary, _) = tad_grammar::scope(Some("yellowstone")).unwrap();
-        let text = vocabulary(&vocabulary);
+        let text = super::vocabulary(&vocabulary);
         assert!(text.contains("- environment.weather: clear, cloudy"), "{text}");
         assert!(text.contains("bison"), "the region's module is in scope");
         let (core, _) = tad_grammar::scope(Some("los_angeles")).unwrap();

@@ -135,26 +135,90 @@ fn model_label(client: &Client) -> String {
     format!("{} at {}", client.config().model, client.config().base_url)
 }
 
-/// `tadslc translate DESC`.
+/// The description files of `paths` (directories searched for `*.txt`), in order.
+fn descriptions(paths: &[PathBuf]) -> Result<Vec<PathBuf>, String> {
+    let mut out = Vec::new();
+    for path in paths {
+        if path.is_dir() {
+            let found = tad_test_support::files(path, "txt");
+            if found.is_empty() {
+                return Err(format!("{} holds no .txt descriptions", path.display()));
+            }
+            out.extend(found);
+        } else {
+            out.push(path.clone());
+        }
+    }
+    Ok(out)
+}
+
+fn read_description(path: &Path) -> Result<String, String> {
+    let text = if path == Path::new("-") {
+        let mut s = String::new();
+        std::io::Read::read_to_string(&mut std::io::stdin(), &mut s)
+            .map_err(|e| format!("cannot read standard input: {e}"))?;
+        s
+    } else {
+        std::fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?
+    };
+    if text.trim().is_empty() {
+        return Err(format!("{} is empty: there is nothing to translate", path.display()));
+    }
+    Ok(text.trim().to_string())
+}
+
+/// One description through the loop: the outcome and the program with its provenance.
+fn translate_one(
+    session: &Session,
+    rt: &tokio::runtime::Runtime,
+    path: &Path,
+    text: &str,
+    region: Option<&str>,
+    on_round: &mut dyn FnMut(&Round),
+) -> (tad_frontend::Outcome, Option<String>) {
+    let item = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "stdin".into());
+    let messages = tad_frontend::translate_messages(text, session.checker);
+    let outcome = rt.block_on(session.run(&item, messages, tad_frontend::prompt::TRANSLATE.id, on_round));
+    let provenance = tad_frontend::Provenance {
+        comments: vec![format!(
+            "translated by tadslc {} from {} with model {}, {} round{}, prompt {}",
+            env!("CARGO_PKG_VERSION"),
+            path.display(),
+            model_label(session.client),
+            outcome.rounds,
+            if outcome.rounds == 1 { "" } else { "s" },
+            tad_frontend::prompt::TRANSLATE.id
+        )],
+        region: region.map(String::from),
+        description: Some(text.to_string()),
+        ..Default::default()
+    };
+    let program = outcome.program.as_ref().map(|p| tad_frontend::with_provenance(p, &provenance));
+    (outcome, program)
+}
+
+fn status_of(outcome: &tad_frontend::Outcome) -> Status {
+    match (outcome.class, &outcome.stopped) {
+        (Some("complete"), _) => Status::Ok,
+        (Some("incomplete"), _) => Status::Incomplete,
+        (Some("non_scenario"), _) => Status::NonScenario,
+        (None, Some(_)) => Status::Unreachable,
+        _ => Status::Failed,
+    }
+}
+
+/// `tadslc translate DESC...`: one description to a file or standard output, or several
+/// (or directories of `*.txt`) into the directory `-o DIR` with a manifest and a summary.
 pub fn translate(
-    description: &Path,
+    paths: &[PathBuf],
     output: Option<&Path>,
     transcript: Option<&Path>,
     region: Option<&str>,
     args: &LlmArgs,
 ) -> Status {
     let run = || -> Result<Status, String> {
-        let text = if description == Path::new("-") {
-            let mut s = String::new();
-            std::io::Read::read_to_string(&mut std::io::stdin(), &mut s)
-                .map_err(|e| format!("cannot read standard input: {e}"))?;
-            s
-        } else {
-            std::fs::read_to_string(description).map_err(|e| format!("cannot read {}: {e}", description.display()))?
-        };
-        if text.trim().is_empty() {
-            return Err(format!("{} is empty: there is nothing to translate", description.display()));
-        }
+        let files = descriptions(paths)?;
+        let batch = files.len() > 1 || paths.iter().any(|p| p.is_dir());
         let client = args.client(1)?;
         let checker = checker(region)?;
         let session = Session {
@@ -170,74 +234,97 @@ pub fn translate(
             None => None,
         };
         let mut write_error = None;
-        let item = description.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "stdin".into());
-        let messages = tad_frontend::translate_messages(text.trim(), &checker);
-        let outcome =
-            runtime()?.block_on(session.run(&item, messages, tad_frontend::prompt::TRANSLATE.id, &mut |r: &Round| {
-                if let Some(t) = transcript_file.as_mut()
-                    && let Err(e) = t.write(r)
-                {
-                    write_error.get_or_insert(e);
+        let mut on_round = |r: &Round| {
+            if let Some(t) = transcript_file.as_mut()
+                && let Err(e) = t.write(r)
+            {
+                write_error.get_or_insert(e);
+            }
+            let _ = errln!(
+                "{} round {}: {}{}",
+                r.item,
+                r.round,
+                r.error
+                    .as_deref()
+                    .map(|e| format!("error: {e}"))
+                    .unwrap_or_else(|| r.class.unwrap_or("no program").to_string()),
+                if r.diagnostics.is_empty() {
+                    String::new()
+                } else {
+                    format!(" ({} diagnostics)", r.diagnostics.len())
                 }
-                let _ = errln!(
-                    "round {}: {}{}",
-                    r.round,
-                    r.error
-                        .as_deref()
-                        .map(|e| format!("error: {e}"))
-                        .unwrap_or_else(|| r.class.unwrap_or("no program").to_string()),
-                    if r.diagnostics.is_empty() {
-                        String::new()
-                    } else {
-                        format!(" ({} diagnostics)", r.diagnostics.len())
-                    }
-                );
-            }));
+            );
+        };
+        let rt = runtime()?;
+        if !batch {
+            let text = read_description(&files[0])?;
+            let (outcome, program) = translate_one(&session, &rt, &files[0], &text, region, &mut on_round);
+            match (&program, output) {
+                (Some(p), Some(path)) => store::write_atomic(path, p.as_bytes())
+                    .map_err(|e| format!("cannot write {}: {e}", path.display()))?,
+                (Some(p), None) => {
+                    let _ = out!("{p}");
+                }
+                (None, _) => {}
+            }
+            for line in &outcome.diagnostics {
+                let _ = errln!("  {line}");
+            }
+            let _ = errln!(
+                "{} after {} round{}; {} tokens{}",
+                outcome.class.unwrap_or("no program"),
+                outcome.rounds,
+                if outcome.rounds == 1 { "" } else { "s" },
+                outcome.usage.total(),
+                outcome.stopped.as_deref().map(|s| format!("; stopped: {s}")).unwrap_or_default()
+            );
+            if let Some(e) = write_error {
+                return Err(format!("cannot write the transcript: {e}"));
+            }
+            return Ok(status_of(&outcome));
+        }
+        let dir = output.ok_or("several descriptions need an output directory: -o DIR")?;
+        let mut manifest = store::Jsonl::append(&dir.join("translate.jsonl"))
+            .map_err(|e| format!("cannot write the manifest: {e}"))?;
+        let mut summary = Summary::default();
+        let bar = progress(files.len(), "descriptions");
+        let mut unreachable = 0;
+        for path in &files {
+            let text = match read_description(path) {
+                Ok(t) => t,
+                Err(e) => {
+                    bar.println(format!("error: {e}"));
+                    continue;
+                }
+            };
+            let (outcome, program) = translate_one(&session, &rt, path, &text, region, &mut on_round);
+            let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+            let mut file = None;
+            if let Some(p) = &program {
+                let sub = if outcome.class == Some("invalid") { dir.join("rejected") } else { dir.to_path_buf() };
+                let target = store::inside(&sub, &stem, "tad");
+                store::write_atomic(&target, p.as_bytes())
+                    .map_err(|e| format!("cannot write {}: {e}", target.display()))?;
+                file = Some(target.display().to_string());
+            }
+            unreachable += usize::from(status_of(&outcome) == Status::Unreachable);
+            summary.add(&outcome);
+            let record =
+                serde_json::json!({ "description": path.display().to_string(), "file": file, "outcome": outcome });
+            manifest.write(&record).map_err(|e| format!("cannot write the manifest: {e}"))?;
+            bar.inc(1);
+        }
+        bar.finish_and_clear();
         if let Some(e) = write_error {
             return Err(format!("cannot write the transcript: {e}"));
         }
-        let provenance = tad_frontend::Provenance {
-            comments: vec![format!(
-                "translated by tadslc {} from {} with model {}, {} round{}, prompt {}",
-                env!("CARGO_PKG_VERSION"),
-                description.display(),
-                model_label(&client),
-                outcome.rounds,
-                if outcome.rounds == 1 { "" } else { "s" },
-                tad_frontend::prompt::TRANSLATE.id
-            )],
-            region: region.map(String::from),
-            description: Some(text.trim().to_string()),
-            ..Default::default()
-        };
-        let program = outcome.program.as_ref().map(|p| tad_frontend::with_provenance(p, &provenance));
-        match (&program, output) {
-            (Some(p), Some(path)) => {
-                store::write_atomic(path, p.as_bytes()).map_err(|e| format!("cannot write {}: {e}", path.display()))?
-            }
-            (Some(p), None) => {
-                let _ = out!("{p}");
-            }
-            (None, _) => {}
-        }
-        for line in &outcome.diagnostics {
-            let _ = errln!("  {line}");
-        }
-        let class = outcome.class.unwrap_or("no program");
-        let _ = errln!(
-            "{class} after {} round{}; {} tokens{}",
-            outcome.rounds,
-            if outcome.rounds == 1 { "" } else { "s" },
-            outcome.usage.total(),
-            outcome.stopped.as_deref().map(|s| format!("; stopped: {s}")).unwrap_or_default()
-        );
-        Ok(match (outcome.class, &outcome.stopped) {
-            (Some("complete"), _) => Status::Ok,
-            (Some("incomplete"), _) => Status::Incomplete,
-            (Some("non_scenario"), _) => Status::NonScenario,
-            (None, Some(_)) => Status::Unreachable,
-            _ => Status::Failed,
-        })
+        let constrained = !matches!(session.constraint, Constraint::None);
+        write_summary(
+            Some(dir),
+            &summary,
+            serde_json::json!({ "model": model_label(&client), "constrained": constrained, "max_rounds": args.max_rounds }),
+        )?;
+        Ok(if unreachable == files.len() { Status::Unreachable } else { Status::Ok })
     };
     run().unwrap_or_else(|e| {
         let _ = errln!("error: {e}");

@@ -222,10 +222,13 @@ enum Command {
     /// rounds run out. Exit status: 0 complete, 1 invalid or no program, 3 incomplete,
     /// 4 non-scenario, 5 the server could not be used, 2 usage or I/O.
     Translate {
-        /// The description (a text file; `-` reads standard input)
-        description: PathBuf,
-        /// Write the program here (default: standard output)
-        #[arg(short, long, value_name = "FILE")]
+        /// The description (a text file; `-` reads standard input), or several, or
+        /// directories of `*.txt` descriptions
+        #[arg(required = true)]
+        description: Vec<PathBuf>,
+        /// Write the program here (default: standard output); with several descriptions, the
+        /// directory for their programs, `translate.jsonl` and `summary.json`
+        #[arg(short, long, value_name = "PATH")]
         output: Option<PathBuf>,
         /// Append every round (request, answer, diagnostics) as JSON lines
         #[arg(long, value_name = "FILE")]
