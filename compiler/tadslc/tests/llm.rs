@@ -212,7 +212,16 @@ fn video(dir: &Path) -> std::path::PathBuf {
 /// A server for synth: a description per frame (the second frame a title card), programs
 /// for descriptions; counts the images it saw.
 fn synth_server(images: Arc<AtomicUsize>) -> FakeLlm {
-    FakeLlm::start(move |_, body| {
+    synth_server_with(images, std::time::Duration::ZERO)
+}
+
+/// The same, answering each request after `delay`.
+fn synth_server_with(images: Arc<AtomicUsize>, delay: std::time::Duration) -> FakeLlm {
+    FakeLlm::start(move |_, body| Reply::Delay(delay, Box::new(synth_reply(&images, body))))
+}
+
+fn synth_reply(images: &AtomicUsize, body: &Value) -> Reply {
+    {
         let has_image = body["messages"]
             .as_array()
             .unwrap()
@@ -229,7 +238,7 @@ fn synth_server(images: Arc<AtomicUsize>) -> FakeLlm {
         } else {
             Reply::chat(COMPLETE)
         }
-    })
+    }
 }
 
 #[test]
@@ -411,4 +420,48 @@ fn a_real_llama_server_answers_and_constrained_answers_parse() {
     let rounds: Vec<Value> =
         std::fs::read_to_string(&transcript).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
     assert!(rounds.iter().all(|r| r["syntax_valid"] == true), "every constrained answer parses: {rounds:?}");
+}
+
+#[test]
+fn ctrl_c_finishes_the_frame_under_way_and_a_rerun_does_the_rest() {
+    if !ffmpeg() {
+        eprintln!("SKIPPED: ffmpeg is not installed");
+        return;
+    }
+    let dir = scratch("llm-interrupt");
+    let video = video(&dir);
+    let out_dir = dir.join("out");
+    let delayed = synth_server_with(Arc::new(AtomicUsize::new(0)), std::time::Duration::from_millis(400));
+    let args =
+        ["synth", "--video", video.to_str().unwrap(), "--region", "yellowstone", "--out", out_dir.to_str().unwrap()];
+    let home = scratch("llm-interrupt-home");
+    let child = Command::new(env!("CARGO_BIN_EXE_tadslc"))
+        .args(args)
+        .current_dir(repo())
+        .env("HOME", &home)
+        .env("TADSL_LLM_BASE_URL", &delayed.base_url)
+        .env_remove("TADSL_LLM_CONFIG")
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let manifest = out_dir.join("manifest.jsonl");
+    let lines = || std::fs::read_to_string(&manifest).map(|t| t.lines().count()).unwrap_or(0);
+    for _ in 0..200 {
+        if lines() >= 1 {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    assert_eq!(lines(), 1, "the first frame is done");
+    let _ = Command::new("kill").args(["-INT", &child.id().to_string()]).status();
+    let output = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{err}");
+    assert!(err.contains("run the same command again"), "{err}");
+    let done = lines();
+    assert!((1..3).contains(&done), "{done} frames done");
+    let out = run(&args, &env_of(&served(&delayed)));
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    assert!(stderr(&out).contains(&format!("{done} done before")), "{}", stderr(&out));
+    assert_eq!(lines(), 3);
 }
