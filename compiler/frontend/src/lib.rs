@@ -107,7 +107,7 @@ pub fn with_provenance(program: &str, provenance: &Provenance) -> String {
     lines.retain(|l| !l.trim_start().starts_with("//"));
     let mut source = Vec::new();
     if let Some(video) = &provenance.video {
-        source.push(format!("    video: {}", string_literal(video)));
+        source.push(format!("    video: {}", tad_syntax::lexer::string_literal(video)));
     }
     if let Some(t) = provenance.time_s {
         source.push(format!("    time: {} s", tad_number(t)));
@@ -150,21 +150,6 @@ pub fn with_provenance(program: &str, provenance: &Provenance) -> String {
 
 fn tad_number(x: f64) -> String {
     if x.fract() == 0.0 && x.abs() < 1e12 { format!("{}", x as i64) } else { format!("{x:.3}") }
-}
-
-/// A TAD string literal of untrusted text.
-pub fn string_literal(text: &str) -> String {
-    let mut out = String::from('"');
-    for c in text.chars() {
-        match c {
-            '"' => out.push_str("\\\""),
-            '\\' => out.push_str("\\\\"),
-            c if c.is_control() => {}
-            c => out.push(c),
-        }
-    }
-    out.push('"');
-    out
 }
 
 /// Untrusted text as a text block's content: no `"""`, no control characters but line

@@ -118,6 +118,28 @@ pub struct Round {
     pub error: Option<String>,
 }
 
+impl Round {
+    fn new(item: &str, round: u32, kind: &'static str, prompt: &'static str, request: Vec<(String, String)>) -> Round {
+        Round {
+            item: item.to_string(),
+            round,
+            kind,
+            prompt,
+            request,
+            answer: String::new(),
+            finish: String::new(),
+            language: None,
+            class: None,
+            syntax_valid: false,
+            diagnostics: Vec::new(),
+            prompt_tokens: 0,
+            completion_tokens: 0,
+            elapsed_ms: 0,
+            error: None,
+        }
+    }
+}
+
 /// How an item ended.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct Outcome {
@@ -183,23 +205,8 @@ impl<'a> Session<'a> {
             ))
         });
         let last = messages.last().map(|m| vec![(m.role.name().to_string(), m.plain())]).unwrap_or_default();
-        let mut round = Round {
-            item: item.to_string(),
-            round: 0,
-            kind: "describe",
-            prompt: crate::prompt::DESCRIBE.id,
-            request: last,
-            answer: String::new(),
-            finish: String::new(),
-            language: None,
-            class: None,
-            syntax_valid: false,
-            diagnostics: Vec::new(),
-            prompt_tokens: 0,
-            completion_tokens: 0,
-            elapsed_ms: sent.elapsed().as_millis(),
-            error: None,
-        };
+        let mut round = Round::new(item, 0, "describe", crate::prompt::DESCRIBE.id, last);
+        round.elapsed_ms = sent.elapsed().as_millis();
         match result {
             Ok(answer) => {
                 round.answer = answer.text.clone();
@@ -245,23 +252,9 @@ impl<'a> Session<'a> {
                     return outcome;
                 }
             };
-            let mut round = Round {
-                item: item.to_string(),
-                round: outcome.rounds + 1,
-                kind,
-                prompt: prompt_id,
-                request: new_messages.iter().map(|m| (m.role.name().to_string(), m.plain())).collect(),
-                answer: String::new(),
-                finish: String::new(),
-                language: None,
-                class: None,
-                syntax_valid: false,
-                diagnostics: Vec::new(),
-                prompt_tokens: 0,
-                completion_tokens: 0,
-                elapsed_ms: sent.elapsed().as_millis(),
-                error: None,
-            };
+            let request = new_messages.iter().map(|m| (m.role.name().to_string(), m.plain())).collect();
+            let mut round = Round::new(item, outcome.rounds + 1, kind, prompt_id, request);
+            round.elapsed_ms = sent.elapsed().as_millis();
             let answer = match answer {
                 Ok(answer) => answer,
                 Err(error) => {

@@ -94,6 +94,25 @@ pub const KEYWORDS: &[(&str, Token)] = &[
 /// Every unit the lexer knows.
 pub const UNITS: &[&str] = &["km/h", "mph", "m/s", "m", "s"];
 
+/// `t` as a string literal that reads back as `t` (§2.4 of the language's escapes).
+pub fn string_literal(t: &str) -> String {
+    let mut out = String::with_capacity(t.len() + 2);
+    out.push('"');
+    for c in t.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            '\n' => out.push_str("\\n"),
+            '\t' => out.push_str("\\t"),
+            '\r' => out.push_str("\\r"),
+            c if c.is_control() => out.push_str(&format!("\\u{{{:x}}}", c as u32)),
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
+}
+
 fn lex_string(lex: &mut logos::Lexer<'_, Token>) -> Result<(), LexError> {
     let rest = lex.remainder();
     let mut chars = rest.char_indices();
