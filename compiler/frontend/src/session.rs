@@ -21,7 +21,7 @@ use serde::Serialize;
 use tad_check::{Class, Options};
 use tad_db::{Database, Language, NoFs};
 use tad_diagnostics::Severity;
-use tad_llm::{Client, Constraint, Message, Request, Role, Usage};
+use tad_llm::{Chat, Constraint, Message, Request, Role, Usage};
 
 use crate::extract;
 use crate::prompt;
@@ -164,7 +164,7 @@ pub struct Outcome {
 }
 
 pub struct Session<'a> {
-    pub client: &'a Client,
+    pub client: &'a dyn Chat,
     pub checker: &'a Checker,
     pub limits: Limits,
     pub constraint: Constraint,
@@ -197,7 +197,7 @@ impl<'a> Session<'a> {
         request.temperature = self.temperature;
         request.seed = self.seed;
         let sent = Instant::now();
-        let result = tokio::time::timeout(self.limits.deadline, self.client.chat(&request, None)).await;
+        let result = tokio::time::timeout(self.limits.deadline, self.client.chat(&request)).await;
         let result = result.unwrap_or_else(|_| {
             Err(tad_llm::Error::new(
                 tad_llm::ErrorKind::Timeout,
@@ -245,7 +245,7 @@ impl<'a> Session<'a> {
             request.constraint = self.constraint.clone();
             let sent = Instant::now();
             let remaining = self.limits.deadline.saturating_sub(start.elapsed());
-            let answer = match tokio::time::timeout(remaining, self.client.chat(&request, None)).await {
+            let answer = match tokio::time::timeout(remaining, self.client.chat(&request)).await {
                 Ok(result) => result,
                 Err(_) => {
                     outcome.stopped = Some(format!("the item's time ({} s) ran out", self.limits.deadline.as_secs()));

@@ -30,6 +30,27 @@ pub use error::{Error, ErrorKind};
 pub use request::{Constraint, Message, Part, Request, Role, supports};
 pub use response::{Answer, Finish, Usage};
 
+/// A chat answer under way.
+pub type ChatFuture<'a> = std::pin::Pin<Box<dyn std::future::Future<Output = Result<Answer, Error>> + Send + 'a>>;
+
+/// What answers chat requests: a server through [`Client`], or a model in process
+/// (`tad-local`). The front-end's loop is written against this.
+pub trait Chat: Send + Sync {
+    fn chat<'a>(&'a self, request: &'a Request) -> ChatFuture<'a>;
+    /// Who answers, for provenance: `MODEL at URL`, `local smollm2-135m`.
+    fn label(&self) -> String;
+}
+
+impl Chat for Client {
+    fn chat<'a>(&'a self, request: &'a Request) -> ChatFuture<'a> {
+        Box::pin(Client::chat(self, request, None))
+    }
+
+    fn label(&self) -> String {
+        format!("{} at {}", self.config.model, self.config.base_url)
+    }
+}
+
 /// The most bytes of a server's answer read (a program is a few kilobytes).
 const MAX_BODY: usize = 8 << 20;
 

