@@ -9,7 +9,9 @@
 //!                                                       complete / non-scenario ──▶ done
 //! ```
 //!
-//! Only the newest exchange is kept in the conversation (the first request, the last answer
+//! The outcome is the best program of the rounds (complete, then incomplete, then
+//! non-scenario, then invalid with the fewest errors; the later among equals), so a repair
+//! that makes things worse loses nothing. Only the newest exchange is kept in the conversation (the first request, the last answer
 //! and the request about it), so the context does not grow with the rounds. Every round is
 //! reported to the caller as a [`Round`] for the transcript. Bounds: rounds, tokens per
 //! answer, tokens per item, and wall time per item.
@@ -96,6 +98,16 @@ impl Checker {
     }
 }
 
+/// How good a program of this class is, to keep the best of the rounds.
+fn rank(class: Class) -> u8 {
+    match class {
+        Class::Complete => 3,
+        Class::Incomplete => 2,
+        Class::NonScenario => 1,
+        Class::Invalid => 0,
+    }
+}
+
 /// One request and its answer, for the transcript.
 #[derive(Clone, Debug, Serialize)]
 pub struct Round {
@@ -143,9 +155,9 @@ impl Round {
 /// How an item ended.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct Outcome {
-    /// The last program, as canonical TAD when it parses (else as answered).
+    /// The best program of the rounds, as canonical TAD when it parses (else as answered).
     pub program: Option<String>,
-    /// The last program's class; `None` when no answer held a program.
+    /// The best program's class; `None` when no answer held a program.
     pub class: Option<&'static str>,
     #[serde(skip)]
     pub verdict_class: Option<Class>,
@@ -157,9 +169,9 @@ pub struct Outcome {
     pub usage: Usage,
     /// Why the loop stopped early: a server failure, a bound.
     pub stopped: Option<String>,
-    /// The refinement requests of an incomplete last program.
+    /// The refinement requests of an incomplete best program.
     pub requests: Vec<String>,
-    /// The last program's diagnostics.
+    /// The best program's diagnostics.
     pub diagnostics: Vec<String>,
 }
 
@@ -237,6 +249,7 @@ impl<'a> Session<'a> {
         let mut conversation = first.clone();
         let mut new_messages = first;
         let (mut kind, mut prompt_id) = ("first", first_prompt);
+        let mut best_errors = usize::MAX;
         loop {
             let mut request = Request::new(conversation.clone());
             request.max_tokens = self.limits.max_tokens;
@@ -274,8 +287,6 @@ impl<'a> Session<'a> {
             let follow_up: Option<(&'static str, prompt::Template, String)> = match extract::program(&answer.text) {
                 None => {
                     round.diagnostics = vec!["no program in the answer".into()];
-                    outcome.class = None;
-                    outcome.verdict_class = None;
                     let text =
                         "Your answer holds no TAD program. Answer with the whole program only, in a ```tad code block.";
                     Some(("repair", prompt::REPAIR, text.to_string()))
@@ -292,11 +303,23 @@ impl<'a> Session<'a> {
                     if verdict.errors == 0 && outcome.valid_round.is_none() {
                         outcome.valid_round = Some(outcome.rounds);
                     }
-                    outcome.program = Some(verdict.tad.clone().unwrap_or(text));
-                    outcome.class = Some(verdict.class.as_str());
-                    outcome.verdict_class = Some(verdict.class);
-                    outcome.diagnostics = verdict.lines.clone();
-                    outcome.requests = verdict.requests.clone();
+                    // the outcome is the best program so far, not the last one
+                    let better = match outcome.verdict_class {
+                        None => true,
+                        Some(best) => {
+                            rank(verdict.class) > rank(best)
+                                || (rank(verdict.class) == rank(best)
+                                    && (verdict.class != Class::Invalid || verdict.errors <= best_errors))
+                        }
+                    };
+                    if better {
+                        best_errors = verdict.errors;
+                        outcome.program = Some(verdict.tad.clone().unwrap_or(text));
+                        outcome.class = Some(verdict.class.as_str());
+                        outcome.verdict_class = Some(verdict.class);
+                        outcome.diagnostics = verdict.lines.clone();
+                        outcome.requests = verdict.requests.clone();
+                    }
                     match verdict.class {
                         Class::Complete | Class::NonScenario => None,
                         Class::Invalid => {

@@ -14,7 +14,7 @@ pub struct Summary {
     pub syntax_valid_first: usize,
     /// The first answer's program had no errors at all.
     pub valid_first: usize,
-    /// The last program had no errors.
+    /// The best program had no errors.
     pub valid_after_repair: usize,
     /// Over the items that became valid: the round it happened.
     pub mean_rounds_to_valid: Option<f64>,

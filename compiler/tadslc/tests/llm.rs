@@ -465,3 +465,15 @@ fn ctrl_c_finishes_the_frame_under_way_and_a_rerun_does_the_rest() {
     assert!(stderr(&out).contains(&format!("{done} done before")), "{}", stderr(&out));
     assert_eq!(lines(), 3);
 }
+
+#[test]
+fn a_round_that_makes_things_worse_loses_nothing() {
+    let dir = scratch("llm-worse");
+    let incomplete = COMPLETE.replace("    weather: clear\n", "");
+    let worse = "scenario broken {\n  road {\n    lanes: many\n  }\n}\n";
+    let server = FakeLlm::script(vec![fenced(&incomplete), fenced(worse)]);
+    let out = run(&["translate", &description(&dir, "A bus ahead."), "--max-rounds", "1"], &env_of(&served(&server)));
+    assert_eq!(code(&out), 3, "the incomplete program of round 1 is the result: {}", stderr(&out));
+    assert!(stdout(&out).contains("scenario bus_ahead") && !stdout(&out).contains("lanes: many"));
+    assert_eq!(server.requests().len(), 2);
+}
