@@ -18,12 +18,8 @@ fn run(args: &[&str]) -> Output {
     for var in ["TADSL_LLM_BASE_URL", "TADSL_LLM_MODEL", "TADSL_LLM_DIALECT", "TADSL_LLM_CONFIG"] {
         cmd.env_remove(var);
     }
-    if std::env::var_os("TADSL_MODEL_DIR").is_none() {
-        // the user's cache, as a user would have it
-        if let Some(real_home) = std::env::var_os("HOME") {
-            cmd.env("XDG_CACHE_HOME", std::path::PathBuf::from(real_home).join(".cache"));
-        }
-    }
+    // the cache this test process sees (and fetched into), whatever HOME the child has
+    cmd.env("TADSL_MODEL_DIR", tad_local::cache_dir());
     cmd.stdin(Stdio::null()).output().expect("tadslc runs")
 }
 
