@@ -23,7 +23,7 @@ use serde::Serialize;
 use tad_check::{Class, Options};
 use tad_db::{Database, Language, NoFs};
 use tad_diagnostics::Severity;
-use tad_llm::{Chat, Constraint, Message, Request, Role, Usage};
+use tad_llm::{Chat, ChatFuture, Constraint, Message, OnText, Request, Role, Usage};
 
 use crate::extract;
 use crate::prompt;
@@ -182,9 +182,18 @@ pub struct Session<'a> {
     pub constraint: Constraint,
     pub temperature: f64,
     pub seed: Option<u64>,
+    /// Receives each answer's text as the model writes it.
+    pub on_text: Option<&'a OnText>,
 }
 
 impl<'a> Session<'a> {
+    fn ask<'r>(&'r self, request: &'r Request) -> ChatFuture<'r> {
+        match self.on_text {
+            Some(on_text) => self.client.chat_streaming(request, on_text),
+            None => self.client.chat(request),
+        }
+    }
+
     /// The same session asking with `seed`.
     pub fn with_seed(&self, seed: u64) -> Session<'a> {
         Session {
@@ -194,6 +203,7 @@ impl<'a> Session<'a> {
             constraint: self.constraint.clone(),
             temperature: self.temperature,
             seed: Some(seed),
+            on_text: self.on_text,
         }
     }
 
@@ -209,7 +219,7 @@ impl<'a> Session<'a> {
         request.temperature = self.temperature;
         request.seed = self.seed;
         let sent = Instant::now();
-        let result = tokio::time::timeout(self.limits.deadline, self.client.chat(&request)).await;
+        let result = tokio::time::timeout(self.limits.deadline, self.ask(&request)).await;
         let result = result.unwrap_or_else(|_| {
             Err(tad_llm::Error::new(
                 tad_llm::ErrorKind::Timeout,
@@ -258,7 +268,7 @@ impl<'a> Session<'a> {
             request.constraint = self.constraint.clone();
             let sent = Instant::now();
             let remaining = self.limits.deadline.saturating_sub(start.elapsed());
-            let answer = match tokio::time::timeout(remaining, self.client.chat(&request)).await {
+            let answer = match tokio::time::timeout(remaining, self.ask(&request)).await {
                 Ok(result) => result,
                 Err(_) => {
                     outcome.stopped = Some(format!("the item's time ({} s) ran out", self.limits.deadline.as_secs()));

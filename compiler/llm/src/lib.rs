@@ -33,10 +33,22 @@ pub use response::{Answer, Finish, Usage};
 /// A chat answer under way.
 pub type ChatFuture<'a> = std::pin::Pin<Box<dyn std::future::Future<Output = Result<Answer, Error>> + Send + 'a>>;
 
+/// Receives an answer's text piece by piece as it is written.
+pub type OnText = dyn Fn(&str) + Sync;
+
 /// What answers chat requests: a server through [`Client`], or a model in process
 /// (`tad-local`). The front-end's loop is written against this.
 pub trait Chat: Send + Sync {
     fn chat<'a>(&'a self, request: &'a Request) -> ChatFuture<'a>;
+    /// As [`Chat::chat`], giving `on_text` the answer's text as it is written (the pieces
+    /// concatenate to the answer's text). By default, the whole text at the end.
+    fn chat_streaming<'a>(&'a self, request: &'a Request, on_text: &'a OnText) -> ChatFuture<'a> {
+        Box::pin(async move {
+            let answer = self.chat(request).await?;
+            on_text(&answer.text);
+            Ok(answer)
+        })
+    }
     /// Who answers, for provenance: `MODEL at URL`, `local smollm2-135m`.
     fn label(&self) -> String;
 }
@@ -44,6 +56,12 @@ pub trait Chat: Send + Sync {
 impl Chat for Client {
     fn chat<'a>(&'a self, request: &'a Request) -> ChatFuture<'a> {
         Box::pin(Client::chat(self, request, None))
+    }
+
+    fn chat_streaming<'a>(&'a self, request: &'a Request, on_text: &'a OnText) -> ChatFuture<'a> {
+        let mut streamed = request.clone();
+        streamed.stream = true;
+        Box::pin(async move { Client::chat(self, &streamed, Some(on_text)).await })
     }
 
     fn label(&self) -> String {
@@ -84,7 +102,7 @@ impl Client {
 
     /// One chat completion, retried as the policy allows. `on_text` receives the answer's
     /// text as it streams in (when the request streams).
-    pub async fn chat(&self, request: &Request, on_text: Option<&(dyn Fn(&str) + Sync)>) -> Result<Answer, Error> {
+    pub async fn chat(&self, request: &Request, on_text: Option<&OnText>) -> Result<Answer, Error> {
         request.validate()?;
         if !supports(self.config.dialect, &request.constraint) {
             return Err(Error::new(
@@ -145,7 +163,7 @@ impl Client {
         &self,
         body: &serde_json::Value,
         stream: bool,
-        on_text: Option<&(dyn Fn(&str) + Sync)>,
+        on_text: Option<&OnText>,
     ) -> Result<Answer, Error> {
         let url = format!("{}/chat/completions", self.config.base_url.trim_end_matches('/'));
         let mut builder = self.http.post(&url).json(body);
@@ -173,7 +191,7 @@ impl Client {
     async fn read_stream(
         &self,
         response: reqwest::Response,
-        on_text: Option<&(dyn Fn(&str) + Sync)>,
+        on_text: Option<&OnText>,
     ) -> Result<Answer, Error> {
         use eventsource_stream::Eventsource;
         let mut events = response.bytes_stream().eventsource();

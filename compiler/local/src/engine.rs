@@ -157,6 +157,16 @@ impl Engine {
         Ok((ids, first))
     }
 
+    /// The tokens the model reads for `request` (for a peer fed the same input).
+    pub fn prompt_tokens(&self, request: &Request) -> Result<Vec<u32>, Error> {
+        Ok(self.prompt(request)?.0)
+    }
+
+    /// Drops the cached system message, so the next prompt is read whole.
+    pub fn forget_prefix(&mut self) {
+        self.prefix = None;
+    }
+
     /// The model having read `prompt`, and its logits: from the cached system message when
     /// the prompt starts with it, else caching this prompt's first message on the way.
     fn prefill(&mut self, prompt: &[u32], first: usize) -> Result<(ModelWeights, Tensor), Error> {
@@ -185,8 +195,27 @@ impl Engine {
         Ok(self.tokenizer.encode(text, false).map_err(|e| failed("tokenizer", e))?.get_ids().to_vec())
     }
 
+    /// Gives `on_text` what `out` decodes to beyond the `emitted` bytes, unless it ends in
+    /// an unfinished character; returns the bytes emitted now.
+    fn stream_text(&self, out: &[u32], emitted: usize, on_text: &mut dyn FnMut(&str)) -> usize {
+        let Ok(text) = self.tokenizer.decode(out, true) else { return emitted };
+        match text.get(emitted..) {
+            Some(new) if !new.is_empty() && !new.ends_with('\u{FFFD}') => {
+                on_text(new);
+                text.len()
+            }
+            _ => emitted,
+        }
+    }
+
     /// Answers `request` (`max_tokens`, `temperature`, `seed` and the constraint honoured).
     pub fn generate(&mut self, request: &Request) -> Result<Answer, Error> {
+        self.generate_streaming(request, &mut |_| {})
+    }
+
+    /// As [`Engine::generate`], giving `on_text` the answer's text as tokens are decided
+    /// (a piece ends on a whole character; the pieces concatenate to the answer's text).
+    pub fn generate_streaming(&mut self, request: &Request, on_text: &mut dyn FnMut(&str)) -> Result<Answer, Error> {
         let (prompt, first) = self.prompt(request)?;
         if prompt.len() + request.max_tokens as usize > self.context {
             return Err(Error::new(
@@ -230,6 +259,7 @@ impl Engine {
         let decode_start = Instant::now();
         let mut out: Vec<u32> = Vec::new();
         let mut finish = Finish::Length;
+        let mut emitted = 0;
         for step in 0..request.max_tokens as usize {
             let mut row: Vec<f32> = logits.squeeze(0).and_then(|l| l.to_vec1()).map_err(|e| failed("logits", e))?;
             if let Some(m) = matcher.as_mut() {
@@ -259,6 +289,7 @@ impl Engine {
                 break;
             }
             out.push(token);
+            emitted = self.stream_text(&out, emitted, on_text);
             let next =
                 Tensor::new(&[token], &Device::Cpu).and_then(|t| t.unsqueeze(0)).map_err(|e| failed("input", e))?;
             logits = model.forward(&next, prompt.len() + step).map_err(|e| failed("forward", e))?;
@@ -266,6 +297,9 @@ impl Engine {
         self.timing.decode_tokens += out.len() as u64;
         self.timing.decode_s += decode_start.elapsed().as_secs_f64();
         let text = self.tokenizer.decode(&out, true).map_err(|e| failed("tokenizer", e))?;
+        if let Some(rest) = text.get(emitted..).filter(|r| !r.is_empty()) {
+            on_text(rest);
+        }
         Ok(Answer {
             text,
             finish,

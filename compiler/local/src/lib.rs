@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::{Arc, Mutex};
 
-use tad_llm::{Chat, ChatFuture, Error, ErrorKind, Request};
+use tad_llm::{Chat, ChatFuture, Error, ErrorKind, OnText, Request};
 
 pub use engine::{Engine, Timing};
 
@@ -205,6 +205,26 @@ impl Chat for LocalChat {
             tokio::task::spawn_blocking(move || engine.lock().unwrap_or_else(|e| e.into_inner()).generate(&request))
                 .await
                 .map_err(|e| Error::new(ErrorKind::Server, format!("the local model stopped: {e}")))?
+        })
+    }
+
+    /// The blocking thread sends the pieces over a channel; they are handed to `on_text`
+    /// here, on the caller's task.
+    fn chat_streaming<'a>(&'a self, request: &'a Request, on_text: &'a OnText) -> ChatFuture<'a> {
+        let engine = self.engine.clone();
+        let request = request.clone();
+        Box::pin(async move {
+            let (send, mut receive) = tokio::sync::mpsc::unbounded_channel::<String>();
+            let work = tokio::task::spawn_blocking(move || {
+                let mut engine = engine.lock().unwrap_or_else(|e| e.into_inner());
+                engine.generate_streaming(&request, &mut |piece| {
+                    let _ = send.send(piece.to_string());
+                })
+            });
+            while let Some(piece) = receive.recv().await {
+                on_text(&piece);
+            }
+            work.await.map_err(|e| Error::new(ErrorKind::Server, format!("the local model stopped: {e}")))?
         })
     }
 

@@ -5,8 +5,10 @@
 //! `runs` repetitions. The full check runs through the database, as the CLI and the
 //! language server do; the incremental row edits one line of a 2,000-line file and
 //! re-checks it, against checking that file from scratch. `bench --runtime` measures the
-//! runtime instead ([`runtime`]), `bench --lsp` the language server ([`lsp`]).
+//! runtime instead ([`runtime`]), `bench --lsp` the language server ([`lsp`]), `bench --llm`
+//! the local model against llama-server ([`llm`]).
 
+pub mod llm;
 pub mod lsp;
 pub mod runtime;
 
@@ -16,6 +18,13 @@ use std::hint::black_box;
 use std::path::Path;
 use std::time::{Duration, Instant};
 use tad_db::{Database, Language, NoFs};
+
+/// A field of `/proc/PID/status` in KiB (`pid` "self" for this process; Linux).
+pub(crate) fn proc_status_kib(pid: &str, field: &str) -> Option<u64> {
+    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).ok()?;
+    let line = status.lines().find(|l| l.strip_prefix(field).is_some_and(|r| r.starts_with(':')))?;
+    line.split_whitespace().nth(1)?.parse().ok()
+}
 
 pub(crate) fn best_of(runs: usize, mut f: impl FnMut()) -> Duration {
     (0..runs.max(1))

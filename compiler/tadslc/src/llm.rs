@@ -264,19 +264,34 @@ fn status_of(outcome: &tad_frontend::Outcome) -> Status {
     }
 }
 
+/// What `tadslc translate` reads and writes.
+#[derive(Clone, Copy)]
+pub struct TranslateArgs<'a> {
+    pub paths: &'a [PathBuf],
+    pub output: Option<&'a Path>,
+    pub transcript: Option<&'a Path>,
+    pub region: Option<&'a str>,
+    /// The model's answers on standard error as they are written.
+    pub stream: bool,
+}
+
 /// `tadslc translate DESC...`: one description to a file or standard output, or several
 /// (or directories of `*.txt`) into the directory `-o DIR` with a manifest and a summary.
-pub fn translate(
-    paths: &[PathBuf],
-    output: Option<&Path>,
-    transcript: Option<&Path>,
-    region: Option<&str>,
-    args: &LlmArgs,
-) -> Status {
+pub fn translate(t: &TranslateArgs, args: &LlmArgs) -> Status {
+    let TranslateArgs { paths, output, transcript, region, stream } = *t;
     let run = || -> Result<Status, String> {
         let files = descriptions(paths)?;
         let batch = files.len() > 1 || paths.iter().any(|p| p.is_dir());
+        if batch && stream {
+            return Err("--stream shows one description's answers; a batch reports in translate.jsonl".into());
+        }
         let client = args.client(1)?;
+        let show = |piece: &str| {
+            use std::io::Write;
+            let mut err = std::io::stderr().lock();
+            let _ = err.write_all(piece.as_bytes());
+            let _ = err.flush();
+        };
         let checker = checker(region)?;
         let session = Session {
             client: client.chat(),
@@ -285,6 +300,7 @@ pub fn translate(
             constraint: args.constraint(&client, region)?,
             temperature: args.temperature.unwrap_or(0.0),
             seed: Some(args.seed),
+            on_text: stream.then_some(&show as &tad_llm::OnText),
         };
         let mut transcript_file = match transcript {
             Some(p) => Some(store::Jsonl::append(p).map_err(|e| format!("cannot write {}: {e}", p.display()))?),
@@ -298,7 +314,8 @@ pub fn translate(
                 write_error.get_or_insert(e);
             }
             let _ = errln!(
-                "{} round {}: {}{}",
+                "{}{} round {}: {}{}",
+                if stream { "\n" } else { "" },
                 r.item,
                 r.round,
                 r.error
@@ -448,6 +465,7 @@ pub fn generate(g: &GenArgs, args: &LlmArgs) -> Status {
             constraint,
             temperature: args.temperature.unwrap_or(0.8),
             seed: Some(args.seed),
+            on_text: None,
         };
         let examples = region_examples(g.corpus, g.region);
         let spec = tad_frontend::generate::Spec {
@@ -558,6 +576,7 @@ pub fn synth(s: &SynthArgs, args: &LlmArgs) -> Status {
             constraint: args.constraint(&client, Some(s.region))?,
             temperature: args.temperature.unwrap_or(0.0),
             seed: Some(args.seed),
+            on_text: None,
         };
         let spec = tad_frontend::synth::Spec {
             input,

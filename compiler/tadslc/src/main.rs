@@ -177,13 +177,13 @@ enum Command {
     /// safety examples; on one core.
     Bench {
         /// Number of generated scenarios
-        #[arg(long, default_value_t = 10_000, conflicts_with_all = ["runtime", "lsp"])]
+        #[arg(long, default_value_t = 10_000, conflicts_with_all = ["runtime", "lsp", "llm"])]
         scenarios: usize,
         /// Seed of the corpus generator
-        #[arg(long, default_value_t = 1, conflicts_with_all = ["runtime", "lsp"])]
+        #[arg(long, default_value_t = 1, conflicts_with_all = ["runtime", "lsp", "llm"])]
         seed: u64,
         /// Directory of real scenarios to measure as well
-        #[arg(long, conflicts_with_all = ["runtime", "lsp"])]
+        #[arg(long, conflicts_with_all = ["runtime", "lsp", "llm"])]
         examples: Option<PathBuf>,
         /// Timed repetitions of each measurement (the best is reported)
         #[arg(long, default_value_t = 5)]
@@ -191,12 +191,33 @@ enum Command {
         /// Measure the runtime instead: episode time with 1, 14 and 50 actors, Scenic's
         /// Newtonian simulator on the same scenarios, and a parameter search's episodes per
         /// second
-        #[arg(long, conflicts_with = "lsp")]
+        #[arg(long, conflicts_with_all = ["lsp", "llm"])]
         runtime: bool,
         /// Measure the language server instead: didChange → diagnostics, completion and
         /// hover latency on a 2,000-line file, and its memory with every example open
-        #[arg(long)]
+        #[arg(long, conflicts_with = "llm")]
         lsp: bool,
+        /// Measure the local model instead: prefill and decode tokens/s, unconstrained and
+        /// constrained, and peak memory, against llama.cpp's llama-server on the same GGUF
+        /// and thread count
+        #[arg(long)]
+        llm: bool,
+        /// The llama-server binary for the peer (default: TADSL_LLAMA_SERVER); without one
+        /// the peer is skipped
+        #[arg(long, value_name = "PATH", requires = "llm")]
+        llama_server: Option<PathBuf>,
+        /// Threads of both models
+        #[arg(long, value_name = "N", default_value_t = 1, requires = "llm")]
+        threads: usize,
+        /// Translate prompts measured (the first N descriptions)
+        #[arg(long, value_name = "N", default_value_t = 4, requires = "llm")]
+        prompts: usize,
+        /// Tokens per answer
+        #[arg(long, value_name = "N", default_value_t = 256, requires = "llm")]
+        max_tokens: u32,
+        /// The descriptions the prompts are made of
+        #[arg(long, value_name = "DIR", default_value = "tests/llm/descriptions", requires = "llm")]
+        descriptions: PathBuf,
         /// Samples of each language server measurement
         #[arg(long, value_name = "N", default_value_t = 200, requires = "lsp")]
         samples: usize,
@@ -236,6 +257,9 @@ enum Command {
         /// The region: its module's names are in scope and in the prompt
         #[arg(long, value_name = "REGION")]
         region: Option<String>,
+        /// Show the model's answers on standard error as they are written (one description)
+        #[arg(long)]
+        stream: bool,
         #[command(flatten)]
         llm: tadslc::llm::LlmArgs,
     },
@@ -483,15 +507,25 @@ fn main() -> ExitCode {
             }
         },
         Command::Bench { lsp: true, samples, runs, .. } => bench::lsp::run(samples, runs),
+        Command::Bench { llm: true, llama_server, threads, prompts, max_tokens, descriptions, .. } => {
+            bench::llm::run(&bench::llm::LlmArgs { llama_server, threads, prompts, max_tokens, descriptions })
+        }
         Command::Bench { runtime: true, runs, scenic_python, no_scenic, episodes, steps, .. } => {
             bench::runtime::run(&bench::runtime::RuntimeArgs { runs, episodes, steps, scenic_python, no_scenic })
         }
         Command::Bench { scenarios, seed, examples, runs, .. } => {
             bench::run(scenarios, seed, examples.as_deref(), runs)
         }
-        Command::Translate { description, output, transcript, region, llm } => {
-            tadslc::llm::translate(&description, output.as_deref(), transcript.as_deref(), region.as_deref(), &llm)
-        }
+        Command::Translate { description, output, transcript, region, stream, llm } => tadslc::llm::translate(
+            &tadslc::llm::TranslateArgs {
+                paths: &description,
+                output: output.as_deref(),
+                transcript: transcript.as_deref(),
+                region: region.as_deref(),
+                stream,
+            },
+            &llm,
+        ),
         Command::Synth { video, frames, region, out, every, shard, jobs, max_refinements, llm } => tadslc::llm::synth(
             &tadslc::llm::SynthArgs {
                 video: video.as_deref(),

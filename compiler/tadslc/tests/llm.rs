@@ -477,3 +477,30 @@ fn a_round_that_makes_things_worse_loses_nothing() {
     assert!(stdout(&out).contains("scenario bus_ahead") && !stdout(&out).contains("lanes: many"));
     assert_eq!(server.requests().len(), 2);
 }
+
+#[test]
+fn stream_shows_each_answer_on_stderr_as_it_arrives_and_keeps_stdout_the_program() {
+    let dir = scratch("llm-stream");
+    let broken = COMPLETE.replace("weather: clear", "weather: sunnyish");
+    let first = format!("```tad\n{broken}```\n");
+    let second = format!("```tad\n{COMPLETE}```\n");
+    let server = FakeLlm::script(vec![Reply::Stream(first.clone()), Reply::Stream(second.clone())]);
+    let desc = description(&dir, "A bus drives ahead of the ego car on a clear day.");
+    let out = run(&["translate", &desc, "--stream"], &env_of(&served(&server)));
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    let requests = server.requests();
+    assert!(requests.iter().all(|r| r["stream"] == true), "{requests:?}");
+    let err = stderr(&out);
+    let (a, b) = (err.find(&first).expect("round 1 streamed"), err.find(&second).expect("round 2 streamed"));
+    let round_one = err.find("round 1: invalid").expect("round 1's verdict");
+    assert!(a < round_one && round_one < b, "each answer, then its verdict: {err}");
+    assert!(stdout(&out).starts_with("// translated by tadslc") && stdout(&out).contains("weather: clear"));
+    assert!(!stdout(&out).contains("```"), "stdout holds the program only");
+    // a batch has no single stream to show
+    let other = dir.join("more");
+    std::fs::create_dir_all(&other).unwrap();
+    std::fs::write(other.join("a.txt"), "A bus.").unwrap();
+    let batch = run(&["translate", other.to_str().unwrap(), "-o", dir.join("o").to_str().unwrap(), "--stream"], &[]);
+    assert_eq!(code(&batch), 2);
+    assert!(stderr(&batch).contains("--stream shows one description"), "{}", stderr(&batch));
+}

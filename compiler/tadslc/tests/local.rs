@@ -92,9 +92,13 @@ fn the_local_model_translates_with_the_grammar_and_every_answer_parses() {
         std::fs::read_to_string(&transcript).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
     assert!(!rounds.is_empty() && rounds.iter().all(|r| r["syntax_valid"] == true), "{rounds:?}");
     assert!(stdout(&out).contains("with model local smollm2-135m"));
-    // the same seed, the same program
-    let again = run(&args);
+    // the same seed, the same program; streamed, the answer appears on stderr as it is written
+    let mut streamed = args.to_vec();
+    streamed.push("--stream");
+    let again = run(&streamed);
     assert_eq!(stdout(&again), stdout(&out));
+    let answer = rounds[0]["answer"].as_str().unwrap();
+    assert!(!answer.is_empty() && stderr(&again).contains(answer), "{}\n---\n{answer}", stderr(&again));
 }
 
 #[test]

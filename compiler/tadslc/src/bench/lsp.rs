@@ -121,9 +121,7 @@ impl Server {
 
     /// Resident memory in bytes (Linux), if known.
     fn rss(&self) -> Option<u64> {
-        let status = std::fs::read_to_string(format!("/proc/{}/status", self.child.id())).ok()?;
-        let line = status.lines().find(|l| l.starts_with("VmRSS:"))?;
-        line.split_whitespace().nth(1)?.parse::<u64>().ok().map(|kb| kb * 1024)
+        super::proc_status_kib(&self.child.id().to_string(), "VmRSS").map(|kib| kib * 1024)
     }
 
     fn stop(mut self) {
