@@ -159,12 +159,7 @@ impl Client {
         Duration::from_secs_f64(capped * jitter)
     }
 
-    async fn once(
-        &self,
-        body: &serde_json::Value,
-        stream: bool,
-        on_text: Option<&OnText>,
-    ) -> Result<Answer, Error> {
+    async fn once(&self, body: &serde_json::Value, stream: bool, on_text: Option<&OnText>) -> Result<Answer, Error> {
         let url = format!("{}/chat/completions", self.config.base_url.trim_end_matches('/'));
         let mut builder = self.http.post(&url).json(body);
         if let Some(key) = &self.config.api_key {
@@ -188,11 +183,7 @@ impl Client {
         }
     }
 
-    async fn read_stream(
-        &self,
-        response: reqwest::Response,
-        on_text: Option<&OnText>,
-    ) -> Result<Answer, Error> {
+    async fn read_stream(&self, response: reqwest::Response, on_text: Option<&OnText>) -> Result<Answer, Error> {
         use eventsource_stream::Eventsource;
         let mut events = response.bytes_stream().eventsource();
         let mut answer = response::Streamed::default();

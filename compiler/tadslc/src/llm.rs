@@ -117,9 +117,7 @@ impl LlmArgs {
             let names: Vec<&str> = tad_local::MODELS.iter().map(|m| m.name).collect();
             format!("unknown local model `{name}` (the local models are: {})", names.join(", "))
         })?;
-        // no other thread runs yet: the async runtime starts after the backend is chosen
-        tad_local::configure_process(self.threads);
-        let chat = tad_local::LocalChat::load(model).map_err(|e| format!("{e}{}", why.unwrap_or("")))?;
+        let chat = tad_local::LocalChat::load(model, self.threads).map_err(|e| format!("{e}{}", why.unwrap_or("")))?;
         Ok(Backend::Local(chat))
     }
 

@@ -20,8 +20,8 @@ use serde_json::{Value, json};
 use tad_llm::{Constraint, Request};
 use tad_local::Engine;
 
-use crate::output::Closed;
 use super::proc_status_kib;
+use crate::output::Closed;
 use crate::{Status, errln, outln};
 
 pub struct LlmArgs {
@@ -57,8 +57,6 @@ impl Side {
 }
 
 pub fn run(args: &LlmArgs) -> Status {
-    // before any thread starts: candle's pool takes its size from the environment
-    tad_local::configure_process(args.threads);
     crate::output::run(|status| match run_in(args) {
         Ok(()) => Ok(()),
         Err(error) => {
@@ -107,7 +105,7 @@ fn run_in(args: &LlmArgs) -> Result<(), String> {
     )
     .map_err(|_| "stderr closed")?;
 
-    let (local, prompts, local_texts, mask_s) = measure_local(&gguf, &requests, &lark)?;
+    let (local, prompts, local_texts, mask_s) = measure_local(&gguf, args.threads, &requests, &lark)?;
     let peer = match args.llama_server.clone().or_else(|| std::env::var_os("TADSL_LLAMA_SERVER").map(PathBuf::from)) {
         Some(server) => Some(measure_server(&server, &gguf, args.threads, &prompts, args.max_tokens, &gbnf)?),
         None => {
@@ -126,8 +124,11 @@ fn run_in(args: &LlmArgs) -> Result<(), String> {
 
 type Local = (Side, Vec<Vec<u32>>, Vec<String>, f64);
 
-fn measure_local(gguf: &Path, requests: &[Request], lark: &str) -> Result<Local, String> {
-    let mut engine = Engine::load(gguf).map_err(|e| e.to_string())?;
+fn measure_local(gguf: &Path, threads: usize, requests: &[Request], lark: &str) -> Result<Local, String> {
+    let mut engine = Engine::load(gguf, threads).map_err(|e| e.to_string())?;
+    let (bytes, kernels) = engine.describe();
+    errln!("tad-local: {:.0} MiB of weights, {kernels} kernels", bytes as f64 / 1048576.0)
+        .map_err(|_| "stderr closed")?;
     // warm-up, not counted
     let mut warm = requests[0].clone();
     warm.max_tokens = 4;
@@ -222,7 +223,9 @@ fn measure_server(
         }
         match http(server.port, "POST", "/completion", Some(&body.to_string()))? {
             (200, text) => serde_json::from_str(&text).map_err(|e| format!("llama-server's answer is not JSON: {e}")),
-            (code, text) => Err(format!("llama-server answered {code}: {}", text.chars().take(300).collect::<String>())),
+            (code, text) => {
+                Err(format!("llama-server answered {code}: {}", text.chars().take(300).collect::<String>()))
+            }
         }
     };
     complete(&prompts[0], 4, None)?; // warm-up

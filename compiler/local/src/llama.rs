@@ -1,0 +1,494 @@
+//! A llama-architecture decoder over ggml's quantized blocks, written for CPU inference of
+//! a small model: the weights stay as they are in the GGUF file (Q4_1 layers, the Q8_0
+//! embedding that is also the output projection), activations are quantized to 8 bits a
+//! block before each product ([`crate::quant`]), and the KV cache is appended in place,
+//! each query head reading its group's key/value head directly (no copies of the cache).
+//!
+//! A prompt is read in chunks of tokens: every weight row is loaded once per chunk and
+//! multiplied with each token's activations while it is in cache, which makes prefill
+//! compute-bound rather than memory-bound. Decoding is the same code with a chunk of one.
+//! Rows are split across `threads` workers (rayon) when there is more than one.
+//!
+//! candle's GGUF reader parses the file; `candle_transformers`' quantized llama is the
+//! reference this module is tested against (`tests::agrees_with_candles_quantized_llama`).
+
+use std::io::{Read, Seek, SeekFrom};
+
+use candle_core::quantized::GgmlDType;
+use candle_core::quantized::gguf_file::Content;
+
+use crate::quant::{self, BLOCK, Heads, Kernels, Q4_1, Q8_0, Q8_1};
+
+/// A weight matrix: `rows` rows of `cols` values, row after row, in blocks.
+enum Matrix {
+    Q4_1 { blocks: Vec<Q4_1>, rows: usize, per_row: usize },
+    Q8_0 { blocks: Vec<Q8_0>, rows: usize, per_row: usize },
+}
+
+impl Matrix {
+    fn rows(&self) -> usize {
+        match self {
+            Matrix::Q4_1 { rows, .. } | Matrix::Q8_0 { rows, .. } => *rows,
+        }
+    }
+
+    fn bytes(&self) -> usize {
+        match self {
+            Matrix::Q4_1 { blocks, .. } => blocks.len() * std::mem::size_of::<Q4_1>(),
+            Matrix::Q8_0 { blocks, .. } => blocks.len() * std::mem::size_of::<Q8_0>(),
+        }
+    }
+
+    fn row(&self, k: &Kernels, r: usize, x: &[Q8_1]) -> f32 {
+        match self {
+            Matrix::Q4_1 { blocks, per_row, .. } => (k.q4_1)(&blocks[r * per_row..(r + 1) * per_row], x),
+            Matrix::Q8_0 { blocks, per_row, .. } => (k.q8_0)(&blocks[r * per_row..(r + 1) * per_row], x),
+        }
+    }
+
+    /// Row `r` against every token of the chunk, four at a time where the kernel can.
+    fn row_all(&self, k: &Kernels, r: usize, x: &[Vec<Q8_1>], out: &mut Vec<f32>) {
+        out.clear();
+        let mut fours = x.chunks_exact(4);
+        if let Matrix::Q4_1 { blocks, per_row, .. } = self {
+            let w = &blocks[r * per_row..(r + 1) * per_row];
+            for four in fours.by_ref() {
+                out.extend((k.q4_1_x4)(w, [&four[0], &four[1], &four[2], &four[3]]));
+            }
+            out.extend(fours.remainder().iter().map(|xt| self.row(k, r, xt)));
+        } else {
+            out.extend(x.iter().map(|xt| self.row(k, r, xt)));
+        }
+    }
+
+    /// `out[t·rows + r] = row r · x[t]` for each token `t` of the chunk; each row is read
+    /// once for all the chunk's tokens. With a pool, workers take ranges of rows.
+    fn product(&self, k: &Kernels, x: &[Vec<Q8_1>], out: &mut [f32], pool: Option<&rayon::ThreadPool>) {
+        let rows = self.rows();
+        let workers = pool.map_or(1, |p| p.current_num_threads()).max(1);
+        if workers == 1 {
+            let mut row = Vec::with_capacity(x.len());
+            for r in 0..rows {
+                self.row_all(k, r, x, &mut row);
+                for (t, v) in row.iter().enumerate() {
+                    out[t * rows + r] = *v;
+                }
+            }
+            return;
+        }
+        let per = rows.div_ceil(workers);
+        let mut parts: Vec<Vec<f32>> = vec![Vec::new(); workers];
+        if let Some(pool) = pool {
+            pool.scope(|s| {
+                for (w, part) in parts.iter_mut().enumerate() {
+                    s.spawn(move |_| {
+                        let mut row = Vec::with_capacity(x.len());
+                        for r in (w * per)..rows.min((w + 1) * per) {
+                            self.row_all(k, r, x, &mut row);
+                            part.extend_from_slice(&row);
+                        }
+                    });
+                }
+            });
+        }
+        for (w, part) in parts.iter().enumerate() {
+            for (i, v) in part.iter().enumerate() {
+                let (r, t) = (w * per + i / x.len(), i % x.len());
+                out[t * rows + r] = *v;
+            }
+        }
+    }
+}
+
+struct Layer {
+    attn_norm: Vec<f32>,
+    q: Matrix,
+    k: Matrix,
+    v: Matrix,
+    o: Matrix,
+    ffn_norm: Vec<f32>,
+    gate: Matrix,
+    up: Matrix,
+    down: Matrix,
+}
+
+/// The shape of the model, from the GGUF metadata.
+#[derive(Clone, Copy, Debug)]
+pub struct Shape {
+    pub layers: usize,
+    pub dim: usize,
+    pub hidden: usize,
+    pub heads: usize,
+    pub kv_heads: usize,
+    pub head_dim: usize,
+    pub context: usize,
+    pub eps: f32,
+    pub rope_base: f32,
+}
+
+pub struct Model {
+    pub shape: Shape,
+    embedding: Matrix,
+    output: Option<Matrix>,
+    output_norm: Vec<f32>,
+    layers: Vec<Layer>,
+    kernels: Kernels,
+    pool: Option<rayon::ThreadPool>,
+    /// cos and sin of each position's angle per pair, filled as far as used.
+    rope: Vec<(f32, f32)>,
+}
+
+/// Keys and values of the positions read so far, per layer: `[position][kv head][dim]`.
+#[derive(Clone, Default)]
+pub struct Cache {
+    k: Vec<Vec<f32>>,
+    v: Vec<Vec<f32>>,
+    pub len: usize,
+}
+
+fn error(what: impl std::fmt::Display) -> String {
+    what.to_string()
+}
+
+impl Model {
+    pub fn load<R: Read + Seek>(content: &Content, file: &mut R, threads: usize) -> Result<Model, String> {
+        let meta = |k: &str| content.metadata.get(k).ok_or_else(|| format!("no `{k}` in the GGUF metadata"));
+        let int = |k: &str| meta(k).and_then(|v| v.to_u32().map_err(error)).map(|v| v as usize);
+        let float = |k: &str| meta(k).and_then(|v| v.to_f32().map_err(error));
+        let arch = meta("general.architecture")?.to_string().map_err(error)?.clone();
+        if arch != "llama" {
+            return Err(format!("a `{arch}` model: only the llama architecture is supported"));
+        }
+        let dim = int("llama.embedding_length")?;
+        let heads = int("llama.attention.head_count")?;
+        let shape = Shape {
+            layers: int("llama.block_count")?,
+            dim,
+            hidden: int("llama.feed_forward_length")?,
+            heads,
+            kv_heads: int("llama.attention.head_count_kv").unwrap_or(heads),
+            head_dim: dim / heads.max(1),
+            context: int("llama.context_length").unwrap_or(2048),
+            eps: float("llama.attention.layer_norm_rms_epsilon").unwrap_or(1e-5),
+            rope_base: float("llama.rope.freq_base").unwrap_or(10_000.0),
+        };
+        if heads == 0 || shape.kv_heads == 0 || heads % shape.kv_heads != 0 || dim % BLOCK != 0 {
+            return Err(format!("an unsupported shape: {shape:?}"));
+        }
+        let embedding = matrix(content, file, "token_embd.weight")?;
+        let output = match content.tensor_infos.contains_key("output.weight") {
+            true => Some(matrix(content, file, "output.weight")?),
+            false => None,
+        };
+        let output_norm = vector(content, file, "output_norm.weight")?;
+        let mut layers = Vec::with_capacity(shape.layers);
+        for i in 0..shape.layers {
+            let name = |part: &str| format!("blk.{i}.{part}.weight");
+            layers.push(Layer {
+                attn_norm: vector(content, file, &name("attn_norm"))?,
+                ffn_norm: vector(content, file, &name("ffn_norm"))?,
+                q: matrix(content, file, &name("attn_q"))?,
+                k: matrix(content, file, &name("attn_k"))?,
+                v: matrix(content, file, &name("attn_v"))?,
+                o: matrix(content, file, &name("attn_output"))?,
+                gate: matrix(content, file, &name("ffn_gate"))?,
+                up: matrix(content, file, &name("ffn_up"))?,
+                down: matrix(content, file, &name("ffn_down"))?,
+            });
+        }
+        let pool = (threads > 1)
+            .then(|| rayon::ThreadPoolBuilder::new().num_threads(threads).build())
+            .transpose()
+            .map_err(error)?;
+        Ok(Model { shape, embedding, output, output_norm, layers, kernels: Kernels::detect(), pool, rope: Vec::new() })
+    }
+
+    /// The bytes the weights take in memory.
+    pub fn weight_bytes(&self) -> usize {
+        let layers: usize = self
+            .layers
+            .iter()
+            .map(|l| [&l.q, &l.k, &l.v, &l.o, &l.gate, &l.up, &l.down].iter().map(|m| m.bytes()).sum::<usize>())
+            .sum();
+        layers + self.embedding.bytes() + self.output.as_ref().map_or(0, Matrix::bytes)
+    }
+
+    pub fn kernels(&self) -> &'static str {
+        self.kernels.name
+    }
+
+    pub fn new_cache(&self) -> Cache {
+        Cache { k: vec![Vec::new(); self.shape.layers], v: vec![Vec::new(); self.shape.layers], len: 0 }
+    }
+
+    fn embed(&self, token: u32, out: &mut [f32]) {
+        if let Matrix::Q8_0 { blocks, per_row, rows } = &self.embedding {
+            let row = (token as usize).min(rows.saturating_sub(1));
+            for (b, block) in blocks[row * per_row..(row + 1) * per_row].iter().enumerate() {
+                for (j, q) in block.qs.iter().enumerate() {
+                    out[b * BLOCK + j] = block.d * *q as f32;
+                }
+            }
+        } else if let Matrix::Q4_1 { blocks, per_row, rows } = &self.embedding {
+            let row = (token as usize).min(rows.saturating_sub(1));
+            for (b, block) in blocks[row * per_row..(row + 1) * per_row].iter().enumerate() {
+                for j in 0..16 {
+                    out[b * BLOCK + j] = block.d * (block.qs[j] & 15) as f32 + block.m;
+                    out[b * BLOCK + j + 16] = block.d * (block.qs[j] >> 4) as f32 + block.m;
+                }
+            }
+        }
+    }
+
+    fn rope_upto(&mut self, positions: usize) {
+        let pairs = self.shape.head_dim / 2;
+        let have = self.rope.len() / pairs.max(1);
+        for pos in have..positions {
+            for i in 0..pairs {
+                let theta = 1.0 / self.shape.rope_base.powf((2 * i) as f32 / self.shape.head_dim as f32);
+                let angle = pos as f32 * theta;
+                self.rope.push((angle.cos(), angle.sin()));
+            }
+        }
+    }
+
+    /// Reads `tokens` after what `cache` holds and returns the logits after the last one.
+    pub fn forward(&mut self, tokens: &[u32], cache: &mut Cache) -> Vec<f32> {
+        const CHUNK: usize = 64;
+        let mut logits = Vec::new();
+        for chunk in tokens.chunks(CHUNK) {
+            logits = self.forward_chunk(chunk, cache);
+        }
+        logits
+    }
+
+    fn forward_chunk(&mut self, tokens: &[u32], cache: &mut Cache) -> Vec<f32> {
+        let Shape { dim, hidden, heads, kv_heads, head_dim, eps, .. } = self.shape;
+        let n = tokens.len();
+        let start = cache.len;
+        self.rope_upto(start + n);
+        let kv_dim = kv_heads * head_dim;
+        let group = heads / kv_heads;
+        let pool = self.pool.as_ref();
+        let k = &self.kernels;
+
+        let mut x = vec![0f32; n * dim];
+        for (t, &token) in tokens.iter().enumerate() {
+            self.embed(token, &mut x[t * dim..(t + 1) * dim]);
+        }
+        let mut normed = vec![0f32; n * dim];
+        let mut xq: Vec<Vec<Q8_1>> = vec![Vec::new(); n];
+        let (mut q, mut kk, mut vv) = (vec![0f32; n * dim], vec![0f32; n * kv_dim], vec![0f32; n * kv_dim]);
+        let mut attn = vec![0f32; n * dim];
+        let mut proj = vec![0f32; n * dim];
+        let (mut gate, mut up) = (vec![0f32; n * hidden], vec![0f32; n * hidden]);
+        let mut hq: Vec<Vec<Q8_1>> = vec![Vec::new(); n];
+        let mut scores = Vec::new();
+        let scale = 1.0 / (head_dim as f32).sqrt();
+        let pairs = head_dim / 2;
+
+        for (li, layer) in self.layers.iter().enumerate() {
+            rms_norm(&x, &layer.attn_norm, eps, dim, &mut normed);
+            for (t, xt) in xq.iter_mut().enumerate() {
+                quant::quantize(&normed[t * dim..(t + 1) * dim], xt);
+            }
+            layer.q.product(k, &xq, &mut q, pool);
+            layer.k.product(k, &xq, &mut kk, pool);
+            layer.v.product(k, &xq, &mut vv, pool);
+            for t in 0..n {
+                let angles = &self.rope[(start + t) * pairs..(start + t + 1) * pairs];
+                for h in 0..heads {
+                    rotate(&mut q[t * dim + h * head_dim..t * dim + (h + 1) * head_dim], angles);
+                }
+                for h in 0..kv_heads {
+                    rotate(&mut kk[t * kv_dim + h * head_dim..t * kv_dim + (h + 1) * head_dim], angles);
+                }
+            }
+            cache.k[li].extend_from_slice(&kk);
+            cache.v[li].extend_from_slice(&vv);
+            let (keys, values) = (&cache.k[li], &cache.v[li]);
+            for t in 0..n {
+                let positions = start + t + 1; // causal: positions 0..=start+t
+                for h in 0..heads {
+                    let kvh = h / group;
+                    let qh = &q[t * dim + h * head_dim..t * dim + (h + 1) * head_dim];
+                    let out = &mut attn[t * dim + h * head_dim..t * dim + (h + 1) * head_dim];
+                    let heads = Heads { keys, values, stride: kv_dim, offset: kvh * head_dim, positions };
+                    (k.attend)(qh, &heads, scale, &mut scores, out);
+                }
+            }
+            for (t, xt) in xq.iter_mut().enumerate() {
+                quant::quantize(&attn[t * dim..(t + 1) * dim], xt);
+            }
+            layer.o.product(k, &xq, &mut proj, pool);
+            for (a, b) in x.iter_mut().zip(&proj) {
+                *a += b;
+            }
+            rms_norm(&x, &layer.ffn_norm, eps, dim, &mut normed);
+            for (t, xt) in xq.iter_mut().enumerate() {
+                quant::quantize(&normed[t * dim..(t + 1) * dim], xt);
+            }
+            layer.gate.product(k, &xq, &mut gate, pool);
+            layer.up.product(k, &xq, &mut up, pool);
+            for (g, u) in gate.iter_mut().zip(&up) {
+                *g = *g / (1.0 + (-*g).exp()) * u;
+            }
+            for (t, ht) in hq.iter_mut().enumerate() {
+                quant::quantize(&gate[t * hidden..(t + 1) * hidden], ht);
+            }
+            layer.down.product(k, &hq, &mut proj, pool);
+            for (a, b) in x.iter_mut().zip(&proj) {
+                *a += b;
+            }
+        }
+        cache.len += n;
+
+        // only the last token's logits are needed
+        let last = &x[(n - 1) * dim..];
+        let mut out = vec![0f32; dim];
+        rms_norm(last, &self.output_norm, eps, dim, &mut out);
+        let mut lq = vec![Vec::new()];
+        quant::quantize(&out, &mut lq[0]);
+        let head = self.output.as_ref().unwrap_or(&self.embedding);
+        let mut logits = vec![0f32; head.rows()];
+        head.product(k, &lq, &mut logits, pool);
+        logits
+    }
+}
+
+/// A tensor's type, shape (outermost first) and bytes.
+fn read<R: Read + Seek>(
+    content: &Content,
+    file: &mut R,
+    name: &str,
+) -> Result<(GgmlDType, Vec<usize>, Vec<u8>), String> {
+    let info = content.tensor_infos.get(name).ok_or_else(|| format!("no tensor `{name}`"))?;
+    let dims = info.shape.dims().to_vec();
+    let count: usize = dims.iter().product();
+    let size = count / info.ggml_dtype.block_size() * info.ggml_dtype.type_size();
+    let mut bytes = vec![0u8; size];
+    file.seek(SeekFrom::Start(content.tensor_data_offset + info.offset)).map_err(error)?;
+    file.read_exact(&mut bytes).map_err(|e| format!("tensor `{name}`: {e}"))?;
+    Ok((info.ggml_dtype, dims, bytes))
+}
+
+fn matrix<R: Read + Seek>(content: &Content, file: &mut R, name: &str) -> Result<Matrix, String> {
+    let (dtype, dims, bytes) = read(content, file, name)?;
+    let (rows, cols) = match dims[..] {
+        [rows, cols] => (rows, cols),
+        _ => return Err(format!("tensor `{name}` is not a matrix: {dims:?}")),
+    };
+    if cols % BLOCK != 0 {
+        return Err(format!("tensor `{name}`: rows of {cols} values are not whole blocks"));
+    }
+    let per_row = cols / BLOCK;
+    match dtype {
+        GgmlDType::Q4_1 => Ok(Matrix::Q4_1 { blocks: quant::read_q4_1(&bytes), rows, per_row }),
+        GgmlDType::Q8_0 => Ok(Matrix::Q8_0 { blocks: quant::read_q8_0(&bytes), rows, per_row }),
+        other => Err(format!("tensor `{name}` is {other:?}: only Q4_1 and Q8_0 matrices are supported")),
+    }
+}
+
+fn vector<R: Read + Seek>(content: &Content, file: &mut R, name: &str) -> Result<Vec<f32>, String> {
+    let (dtype, _, bytes) = read(content, file, name)?;
+    if dtype != GgmlDType::F32 {
+        return Err(format!("tensor `{name}` is {dtype:?}, not F32"));
+    }
+    Ok(bytes.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect())
+}
+
+fn rms_norm(x: &[f32], weight: &[f32], eps: f32, dim: usize, out: &mut [f32]) {
+    for (xt, ot) in x.chunks_exact(dim).zip(out.chunks_exact_mut(dim)) {
+        let mean = xt.iter().map(|v| v * v).sum::<f32>() / dim as f32;
+        let inv = 1.0 / (mean + eps).sqrt();
+        for ((o, v), w) in ot.iter_mut().zip(xt).zip(weight) {
+            *o = v * inv * w;
+        }
+    }
+}
+
+/// Rotates adjacent pairs `(x[2i], x[2i+1])` by the position's angles (GGUF's llama layout).
+fn rotate(x: &mut [f32], angles: &[(f32, f32)]) {
+    for (pair, &(cos, sin)) in x.chunks_exact_mut(2).zip(angles) {
+        let (a, b) = (pair[0], pair[1]);
+        pair[0] = a * cos - b * sin;
+        pair[1] = a * sin + b * cos;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use candle_core::{Device, Tensor};
+    use candle_transformers::models::quantized_llama::ModelWeights;
+
+    /// The default model's file, fetched when `TAD_REQUIRE_MODEL` is set; else `None`.
+    fn gguf() -> Option<std::path::PathBuf> {
+        let model = crate::model(crate::DEFAULT)?;
+        if model.installed().is_none() && std::env::var_os("TAD_REQUIRE_MODEL").is_some() {
+            let python = std::env::var("TADSL_PYTHON").unwrap_or_else(|_| "python3".into());
+            static FETCHED: std::sync::Mutex<()> = std::sync::Mutex::new(());
+            let _one = FETCHED.lock();
+            if model.installed().is_none() {
+                model.fetch(&python, &mut |l| eprintln!("{l}")).expect("TAD_REQUIRE_MODEL: the model is fetched");
+            }
+        }
+        let path = model.installed();
+        if path.is_none() {
+            eprintln!("SKIPPED: the local model is not installed (tadslc model fetch)");
+        }
+        path
+    }
+
+    fn cosine(a: &[f32], b: &[f32]) -> f32 {
+        let dot: f32 = a.iter().zip(b).map(|(x, y)| x * y).sum();
+        let norm = |v: &[f32]| v.iter().map(|x| x * x).sum::<f32>().sqrt();
+        dot / (norm(a) * norm(b))
+    }
+
+    fn argmax(v: &[f32]) -> usize {
+        v.iter().enumerate().fold((0, f32::NEG_INFINITY), |(bi, bv), (i, &x)| if x > bv { (i, x) } else { (bi, bv) }).0
+    }
+
+    #[test]
+    fn agrees_with_candles_quantized_llama() {
+        let Some(path) = gguf() else { return };
+        let mut file = std::fs::File::open(&path).unwrap();
+        let content = Content::read(&mut file).unwrap();
+        let mut ours = Model::load(&content, &mut file, 1).unwrap();
+        let mut file2 = std::fs::File::open(&path).unwrap();
+        let mut reference =
+            ModelWeights::from_gguf(Content::read(&mut file2).unwrap(), &mut file2, &Device::Cpu).unwrap();
+        // "<|im_start|>user\nA bus drives ahead of the ego car.<|im_end|>\n<|im_start|>assistant\n"
+        let tokens: Vec<u32> =
+            vec![1, 4093, 198, 49, 1615, 16520, 4245, 282, 260, 23346, 1345, 30, 2, 198, 1, 520, 9531, 198];
+        let expected =
+            reference.forward(&Tensor::new(tokens.as_slice(), &Device::Cpu).unwrap().unsqueeze(0).unwrap(), 0).unwrap();
+        let expected: Vec<f32> = expected.squeeze(0).unwrap().to_vec1().unwrap();
+
+        let mut cache = ours.new_cache();
+        let chunked = ours.forward(&tokens, &mut cache);
+        assert_eq!(chunked.len(), expected.len());
+        assert_eq!(argmax(&chunked), argmax(&expected));
+        assert!(cosine(&chunked, &expected) > 0.995, "cosine {}", cosine(&chunked, &expected));
+
+        // a token at a time (decoding) reads the same as a chunk (prefill)
+        let mut cache = ours.new_cache();
+        let mut stepped = Vec::new();
+        for &t in &tokens {
+            stepped = ours.forward(&[t], &mut cache);
+        }
+        let diff = stepped.iter().zip(&chunked).map(|(a, b)| (a - b).abs()).fold(0f32, f32::max);
+        assert!(diff < 1e-3, "chunked and stepped differ by {diff}");
+
+        // the next token, continuing from the cache, as candle continues from its own
+        let next = argmax(&expected) as u32;
+        let theirs = reference
+            .forward(&Tensor::new(&[next], &Device::Cpu).unwrap().unsqueeze(0).unwrap(), tokens.len())
+            .unwrap();
+        let theirs: Vec<f32> = theirs.squeeze(0).unwrap().to_vec1().unwrap();
+        let mine = ours.forward(&[next], &mut cache);
+        assert_eq!(argmax(&mine), argmax(&theirs));
+        assert!(cosine(&mine, &theirs) > 0.995, "cosine {}", cosine(&mine, &theirs));
+    }
+}

@@ -1,0 +1,493 @@
+//! Quantized blocks and their dot products, in ggml's formats (32 values a block):
+//! weights in Q4_1 (`d·q + m`, q in 0..16) or Q8_0 (`d·q`, q in −127..=127), activations
+//! quantized on the fly to 8 bits a block with their sum (what llama.cpp calls Q8_1).
+//!
+//! A dot product of a weight row and an activation vector is then integer products summed
+//! a block at a time, scaled once per block. On x86-64 with AVX2 and FMA (detected at run
+//! time) the blocks go through 256-bit integer multiply-adds; elsewhere through the same
+//! arithmetic in scalar code, so both give the same sums up to float rounding.
+
+/// Values in a block.
+pub const BLOCK: usize = 32;
+
+#[derive(Clone, Copy, Debug)]
+#[repr(C)]
+pub struct Q4_1 {
+    pub d: f32,
+    pub m: f32,
+    /// Value `j` in the low nibble of byte `j`, value `j + 16` in its high nibble.
+    pub qs: [u8; 16],
+}
+
+#[derive(Clone, Copy, Debug)]
+#[repr(C)]
+pub struct Q8_0 {
+    pub d: f32,
+    pub qs: [i8; 32],
+}
+
+/// An activation block: `d·q`, and `s = d·Σq` for Q4_1's offset term.
+#[derive(Clone, Copy, Debug)]
+#[repr(C)]
+pub struct Q8_1 {
+    pub d: f32,
+    pub s: f32,
+    pub qs: [i8; 32],
+}
+
+impl Default for Q8_1 {
+    fn default() -> Self {
+        Q8_1 { d: 0.0, s: 0.0, qs: [0; 32] }
+    }
+}
+
+/// IEEE half to single precision (the scales in a GGUF file).
+pub fn f16_to_f32(h: u16) -> f32 {
+    let sign = ((h >> 15) as u32) << 31;
+    let exp = ((h >> 10) & 0x1f) as u32;
+    let frac = (h & 0x3ff) as u32;
+    let bits = match (exp, frac) {
+        (0, 0) => sign,
+        (0, _) => {
+            // subnormal: renormalise
+            let mut e = 127 - 15 + 1;
+            let mut f = frac;
+            while f & 0x400 == 0 {
+                f <<= 1;
+                e -= 1;
+            }
+            sign | (e << 23) | ((f & 0x3ff) << 13)
+        }
+        (0x1f, _) => sign | 0x7f80_0000 | (frac << 13),
+        _ => sign | ((exp + 127 - 15) << 23) | (frac << 13),
+    };
+    f32::from_bits(bits)
+}
+
+/// Q4_1 blocks from a GGUF tensor's bytes (20 bytes a block: d, m as f16, 16 bytes).
+pub fn read_q4_1(bytes: &[u8]) -> Vec<Q4_1> {
+    bytes
+        .chunks_exact(20)
+        .map(|b| Q4_1 {
+            d: f16_to_f32(u16::from_le_bytes([b[0], b[1]])),
+            m: f16_to_f32(u16::from_le_bytes([b[2], b[3]])),
+            qs: b[4..20].try_into().unwrap_or([0; 16]),
+        })
+        .collect()
+}
+
+/// Q8_0 blocks from a GGUF tensor's bytes (34 bytes a block: d as f16, 32 bytes).
+pub fn read_q8_0(bytes: &[u8]) -> Vec<Q8_0> {
+    bytes
+        .chunks_exact(34)
+        .map(|b| {
+            let mut qs = [0i8; 32];
+            for (q, &byte) in qs.iter_mut().zip(&b[2..34]) {
+                *q = byte as i8;
+            }
+            Q8_0 { d: f16_to_f32(u16::from_le_bytes([b[0], b[1]])), qs }
+        })
+        .collect()
+}
+
+/// Quantizes `x` (a multiple of 32 long) into `out`, a block per 32 values.
+pub fn quantize(x: &[f32], out: &mut Vec<Q8_1>) {
+    out.clear();
+    for chunk in x.chunks_exact(BLOCK) {
+        let amax = chunk.iter().fold(0f32, |a, v| a.max(v.abs()));
+        let d = amax / 127.0;
+        let inv = if d > 0.0 { 1.0 / d } else { 0.0 };
+        let mut block = Q8_1 { d, ..Q8_1::default() };
+        let mut sum = 0i32;
+        for (q, v) in block.qs.iter_mut().zip(chunk) {
+            *q = (v * inv).round() as i8;
+            sum += *q as i32;
+        }
+        block.s = d * sum as f32;
+        out.push(block);
+    }
+}
+
+/// The dot products, chosen once for this CPU.
+#[derive(Clone, Copy)]
+pub struct Kernels {
+    pub q4_1: fn(&[Q4_1], &[Q8_1]) -> f32,
+    /// One weight row against four tokens: the row is unpacked once.
+    pub q4_1_x4: fn(&[Q4_1], [&[Q8_1]; 4]) -> [f32; 4],
+    pub q8_0: fn(&[Q8_0], &[Q8_1]) -> f32,
+    /// `out = softmax(q·kᵀ·scale)·v` over a head's positions (`scores` is scratch).
+    pub attend: fn(&[f32], &Heads, f32, &mut Vec<f32>, &mut [f32]),
+    pub name: &'static str,
+}
+
+/// One key/value head of the KV cache: position `p`'s vector at `p·stride + offset`.
+pub struct Heads<'a> {
+    pub keys: &'a [f32],
+    pub values: &'a [f32],
+    pub stride: usize,
+    pub offset: usize,
+    pub positions: usize,
+}
+
+/// Attention written over any dot product and `axpy`.
+#[inline(always)]
+fn attend_with(
+    dot: impl Fn(&[f32], &[f32]) -> f32,
+    axpy: impl Fn(&mut [f32], f32, &[f32]),
+    q: &[f32],
+    heads: &Heads,
+    scale: f32,
+    scores: &mut Vec<f32>,
+    out: &mut [f32],
+) {
+    let d = q.len();
+    scores.clear();
+    scores.extend((0..heads.positions).map(|p| {
+        let at = p * heads.stride + heads.offset;
+        dot(q, &heads.keys[at..at + d]) * scale
+    }));
+    let max = scores.iter().fold(f32::NEG_INFINITY, |a, &b| a.max(b));
+    let mut sum = 0.0;
+    for v in scores.iter_mut() {
+        *v = (*v - max).exp();
+        sum += *v;
+    }
+    out.fill(0.0);
+    for (p, &w) in scores.iter().enumerate() {
+        let at = p * heads.stride + heads.offset;
+        axpy(out, w / sum, &heads.values[at..at + d]);
+    }
+}
+
+impl Kernels {
+    pub fn detect() -> Kernels {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+            return Kernels {
+                q4_1: avx2::q4_1_safe,
+                q4_1_x4: avx2::q4_1_x4_safe,
+                q8_0: avx2::q8_0_safe,
+                attend: avx2::attend_safe,
+                name: "avx2",
+            };
+        }
+        Kernels::scalar()
+    }
+
+    pub fn scalar() -> Kernels {
+        Kernels {
+            q4_1: dot_q4_1_scalar,
+            q4_1_x4: |w, x| x.map(|x| dot_q4_1_scalar(w, x)),
+            q8_0: dot_q8_0_scalar,
+            attend: |q, h, scale, scores, out| attend_with(dot_scalar, axpy_scalar, q, h, scale, scores, out),
+            name: "scalar",
+        }
+    }
+}
+
+pub fn dot_scalar(a: &[f32], b: &[f32]) -> f32 {
+    // eight lanes, so the compiler keeps them in vector registers
+    let mut lanes = [0f32; 8];
+    let (ac, bc) = (a.chunks_exact(8), b.chunks_exact(8));
+    let rest: f32 = ac.remainder().iter().zip(bc.remainder()).map(|(x, y)| x * y).sum();
+    for (x, y) in ac.zip(bc) {
+        for i in 0..8 {
+            lanes[i] += x[i] * y[i];
+        }
+    }
+    lanes.iter().sum::<f32>() + rest
+}
+
+pub fn axpy_scalar(out: &mut [f32], w: f32, v: &[f32]) {
+    for (o, x) in out.iter_mut().zip(v) {
+        *o += w * x;
+    }
+}
+
+pub fn dot_q4_1_scalar(w: &[Q4_1], x: &[Q8_1]) -> f32 {
+    let mut total = 0f32;
+    for (w, x) in w.iter().zip(x) {
+        let mut sum = 0i32;
+        for j in 0..16 {
+            let byte = w.qs[j];
+            sum += (byte & 0x0f) as i32 * x.qs[j] as i32 + (byte >> 4) as i32 * x.qs[j + 16] as i32;
+        }
+        total += w.d * x.d * sum as f32 + w.m * x.s;
+    }
+    total
+}
+
+pub fn dot_q8_0_scalar(w: &[Q8_0], x: &[Q8_1]) -> f32 {
+    let mut total = 0f32;
+    for (w, x) in w.iter().zip(x) {
+        let sum: i32 = w.qs.iter().zip(&x.qs).map(|(&a, &b)| a as i32 * b as i32).sum();
+        total += w.d * x.d * sum as f32;
+    }
+    total
+}
+
+#[cfg(target_arch = "x86_64")]
+mod avx2 {
+    use super::{Heads, Q4_1, Q8_0, Q8_1};
+    use std::arch::x86_64::*;
+
+    pub fn q4_1_safe(w: &[Q4_1], x: &[Q8_1]) -> f32 {
+        // SAFETY: chosen only when the CPU has AVX2 and FMA (Kernels::detect)
+        unsafe { q4_1(w, x) }
+    }
+
+    pub fn q8_0_safe(w: &[Q8_0], x: &[Q8_1]) -> f32 {
+        // SAFETY: as above
+        unsafe { q8_0(w, x) }
+    }
+
+    pub fn q4_1_x4_safe(w: &[Q4_1], x: [&[Q8_1]; 4]) -> [f32; 4] {
+        // SAFETY: as above
+        unsafe { q4_1_x4(w, x) }
+    }
+
+    pub fn attend_safe(q: &[f32], heads: &Heads, scale: f32, scores: &mut Vec<f32>, out: &mut [f32]) {
+        // SAFETY: as above
+        unsafe { attend(q, heads, scale, scores, out) }
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    fn attend(q: &[f32], heads: &Heads, scale: f32, scores: &mut Vec<f32>, out: &mut [f32]) {
+        if q.len() != 64 || out.len() != 64 {
+            return super::attend_with(|a, b| dot(a, b), |o, w, v| axpy(o, w, v), q, heads, scale, scores, out);
+        }
+        // a 64-wide head: the query and the output held in eight registers each
+        let end = heads.positions.saturating_sub(1) * heads.stride + heads.offset + 64;
+        if end > heads.keys.len() || end > heads.values.len() {
+            return super::attend_with(|a, b| dot(a, b), |o, w, v| axpy(o, w, v), q, heads, scale, scores, out);
+        }
+        // SAFETY: every load below is within `end`, checked above; q and out are 64 long
+        unsafe {
+            let qv: [__m256; 8] = std::array::from_fn(|j| _mm256_loadu_ps(q.as_ptr().add(8 * j)));
+            scores.clear();
+            let mut max = f32::NEG_INFINITY;
+            for p in 0..heads.positions {
+                let key = heads.keys.as_ptr().add(p * heads.stride + heads.offset);
+                let mut a = _mm256_mul_ps(qv[0], _mm256_loadu_ps(key));
+                let mut b = _mm256_mul_ps(qv[1], _mm256_loadu_ps(key.add(8)));
+                a = _mm256_fmadd_ps(qv[2], _mm256_loadu_ps(key.add(16)), a);
+                b = _mm256_fmadd_ps(qv[3], _mm256_loadu_ps(key.add(24)), b);
+                a = _mm256_fmadd_ps(qv[4], _mm256_loadu_ps(key.add(32)), a);
+                b = _mm256_fmadd_ps(qv[5], _mm256_loadu_ps(key.add(40)), b);
+                a = _mm256_fmadd_ps(qv[6], _mm256_loadu_ps(key.add(48)), a);
+                b = _mm256_fmadd_ps(qv[7], _mm256_loadu_ps(key.add(56)), b);
+                let score = hsum(_mm256_add_ps(a, b)) * scale;
+                max = max.max(score);
+                scores.push(score);
+            }
+            let mut sum = 0.0;
+            for v in scores.iter_mut() {
+                *v = (*v - max).exp();
+                sum += *v;
+            }
+            let mut o = [_mm256_setzero_ps(); 8];
+            for (p, &w) in scores.iter().enumerate() {
+                let value = heads.values.as_ptr().add(p * heads.stride + heads.offset);
+                let w = _mm256_set1_ps(w);
+                for (j, o) in o.iter_mut().enumerate() {
+                    *o = _mm256_fmadd_ps(w, _mm256_loadu_ps(value.add(8 * j)), *o);
+                }
+            }
+            let inv = _mm256_set1_ps(1.0 / sum);
+            for (j, o) in o.iter().enumerate() {
+                _mm256_storeu_ps(out.as_mut_ptr().add(8 * j), _mm256_mul_ps(*o, inv));
+            }
+        }
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    fn dot(a: &[f32], b: &[f32]) -> f32 {
+        let n = a.len().min(b.len());
+        let mut acc = _mm256_setzero_ps();
+        let mut i = 0;
+        while i + 8 <= n {
+            // SAFETY: i + 8 <= both lengths
+            let (x, y) = unsafe { (_mm256_loadu_ps(a.as_ptr().add(i)), _mm256_loadu_ps(b.as_ptr().add(i))) };
+            acc = _mm256_fmadd_ps(x, y, acc);
+            i += 8;
+        }
+        let mut total = hsum(acc);
+        while i < n {
+            total += a[i] * b[i];
+            i += 1;
+        }
+        total
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    fn axpy(out: &mut [f32], w: f32, v: &[f32]) {
+        let n = out.len().min(v.len());
+        let weight = _mm256_set1_ps(w);
+        let mut i = 0;
+        while i + 8 <= n {
+            // SAFETY: i + 8 <= both lengths
+            unsafe {
+                let o = out.as_mut_ptr().add(i);
+                _mm256_storeu_ps(o, _mm256_fmadd_ps(weight, _mm256_loadu_ps(v.as_ptr().add(i)), _mm256_loadu_ps(o)));
+            }
+            i += 8;
+        }
+        while i < n {
+            out[i] += w * v[i];
+            i += 1;
+        }
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    fn q4_1_x4(w: &[Q4_1], x: [&[Q8_1]; 4]) -> [f32; 4] {
+        let mut acc = [_mm256_setzero_ps(); 4];
+        let mut offsets = [0f32; 4];
+        let low = _mm256_set1_epi8(0x0f);
+        let ones = _mm256_set1_epi16(1);
+        let n = x.iter().map(|x| x.len()).min().unwrap_or(0).min(w.len());
+        for (b, w) in w[..n].iter().enumerate() {
+            // SAFETY: 16 bytes; unaligned load
+            let packed = unsafe { _mm_loadu_si128(w.qs.as_ptr() as *const __m128i) };
+            let nibbles = _mm256_and_si256(_mm256_set_m128i(_mm_srli_epi16(packed, 4), packed), low);
+            for t in 0..4 {
+                let y = &x[t][b];
+                offsets[t] += w.m * y.s;
+                // SAFETY: 32 bytes; unaligned load
+                let q = unsafe { _mm256_loadu_si256(y.qs.as_ptr() as *const __m256i) };
+                let sums = _mm256_cvtepi32_ps(_mm256_madd_epi16(_mm256_maddubs_epi16(nibbles, q), ones));
+                acc[t] = _mm256_fmadd_ps(_mm256_set1_ps(w.d * y.d), sums, acc[t]);
+            }
+        }
+        [0, 1, 2, 3].map(|t| hsum(acc[t]) + offsets[t])
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    fn hsum(v: __m256) -> f32 {
+        let low = _mm256_castps256_ps128(v);
+        let high = _mm256_extractf128_ps(v, 1);
+        let s = _mm_add_ps(low, high);
+        let s = _mm_add_ps(s, _mm_movehl_ps(s, s));
+        let s = _mm_add_ss(s, _mm_movehdup_ps(s));
+        _mm_cvtss_f32(s)
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    fn q4_1(w: &[Q4_1], x: &[Q8_1]) -> f32 {
+        let mut acc = _mm256_setzero_ps();
+        let mut offsets = 0f32;
+        let low = _mm256_set1_epi8(0x0f);
+        let ones = _mm256_set1_epi16(1);
+        for (w, x) in w.iter().zip(x) {
+            offsets += w.m * x.s;
+            // SAFETY: qs are 16 and 32 bytes long; unaligned loads
+            let packed = unsafe { _mm_loadu_si128(w.qs.as_ptr() as *const __m128i) };
+            let nibbles = _mm256_and_si256(_mm256_set_m128i(_mm_srli_epi16(packed, 4), packed), low);
+            let y = unsafe { _mm256_loadu_si256(x.qs.as_ptr() as *const __m256i) };
+            let pairs = _mm256_maddubs_epi16(nibbles, y);
+            let sums = _mm256_cvtepi32_ps(_mm256_madd_epi16(pairs, ones));
+            acc = _mm256_fmadd_ps(_mm256_set1_ps(w.d * x.d), sums, acc);
+        }
+        hsum(acc) + offsets
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    fn q8_0(w: &[Q8_0], x: &[Q8_1]) -> f32 {
+        let mut acc = _mm256_setzero_ps();
+        let ones = _mm256_set1_epi16(1);
+        for (w, x) in w.iter().zip(x) {
+            // SAFETY: 32-byte arrays; unaligned loads
+            let a = unsafe { _mm256_loadu_si256(w.qs.as_ptr() as *const __m256i) };
+            let b = unsafe { _mm256_loadu_si256(x.qs.as_ptr() as *const __m256i) };
+            // |a| · (b with a's sign): unsigned × signed, as maddubs takes them
+            let pairs = _mm256_maddubs_epi16(_mm256_sign_epi8(a, a), _mm256_sign_epi8(b, a));
+            let sums = _mm256_cvtepi32_ps(_mm256_madd_epi16(pairs, ones));
+            acc = _mm256_fmadd_ps(_mm256_set1_ps(w.d * x.d), sums, acc);
+        }
+        hsum(acc)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn seeded(n: usize, seed: u64) -> Vec<f32> {
+        let mut state = seed;
+        (0..n)
+            .map(|_| {
+                state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                ((state >> 33) as f32 / (1u64 << 31) as f32) * 2.0 - 1.0
+            })
+            .collect()
+    }
+
+    #[test]
+    fn half_precision_converts_exactly() {
+        assert_eq!(f16_to_f32(0x3c00), 1.0);
+        assert_eq!(f16_to_f32(0xc000), -2.0);
+        assert_eq!(f16_to_f32(0x7bff), 65504.0);
+        assert_eq!(f16_to_f32(0x0001), 2f32.powi(-24));
+        assert!(f16_to_f32(0x7e00).is_nan());
+    }
+
+    #[test]
+    fn kernels_agree_with_the_float_dot_product() {
+        let x = seeded(256, 1);
+        let mut xq = Vec::new();
+        quantize(&x, &mut xq);
+        // Q4_1 weights with known values
+        let w: Vec<Q4_1> = (0..8)
+            .map(|b| {
+                let mut qs = [0u8; 16];
+                for (j, q) in qs.iter_mut().enumerate() {
+                    *q = ((j + b) % 16) as u8 | ((((j * 7 + b) % 16) as u8) << 4);
+                }
+                Q4_1 { d: 0.01 * (b as f32 + 1.0), m: -0.05, qs }
+            })
+            .collect();
+        let exact: f32 = (0..256)
+            .map(|i| {
+                let (b, j) = (i / 32, i % 32);
+                let q = if j < 16 { w[b].qs[j] & 15 } else { w[b].qs[j - 16] >> 4 };
+                (w[b].d * q as f32 + w[b].m) * x[i]
+            })
+            .sum();
+        for k in [Kernels::scalar(), Kernels::detect()] {
+            let got = (k.q4_1)(&w, &xq);
+            assert!((got - exact).abs() < 0.02 * exact.abs().max(1.0), "{}: {got} vs {exact}", k.name);
+        }
+        let w8: Vec<Q8_0> = (0..8)
+            .map(|b| {
+                let mut qs = [0i8; 32];
+                for (j, q) in qs.iter_mut().enumerate() {
+                    *q = ((j as i32 * 13 + b * 31) % 255 - 127) as i8;
+                }
+                Q8_0 { d: 0.003, qs }
+            })
+            .collect();
+        let exact8: f32 = (0..256).map(|i| w8[i / 32].d * w8[i / 32].qs[i % 32] as f32 * x[i]).sum();
+        let four = [xq.as_slice(); 4];
+        for k in [Kernels::scalar(), Kernels::detect()] {
+            let single = (k.q4_1)(&w, &xq);
+            assert!((k.q4_1_x4)(&w, four).iter().all(|v| (v - single).abs() <= 1e-4 * single.abs().max(1.0)));
+            // attention over 5 positions of a 2-head cache: a 12-wide head and a 64-wide one
+            for d in [12, 64] {
+                let (q, keys, values) = (seeded(d, 2), seeded(10 * d, 3), seeded(10 * d, 4));
+                let heads = Heads { keys: &keys, values: &values, stride: 2 * d, offset: d, positions: 5 };
+                let mut out = vec![0.0; d];
+                (k.attend)(&q, &heads, 0.5, &mut Vec::new(), &mut out);
+                let scores: Vec<f32> =
+                    (0..5).map(|p| (0..d).map(|i| q[i] * keys[p * 2 * d + d + i]).sum::<f32>() * 0.5).collect();
+                let total: f32 = scores.iter().map(|s| s.exp()).sum();
+                for (i, o) in out.iter().enumerate() {
+                    let exact: f32 = (0..5).map(|p| scores[p].exp() / total * values[p * 2 * d + d + i]).sum();
+                    assert!((o - exact).abs() < 1e-5, "{} d={d}: {o} vs {exact}", k.name);
+                }
+            }
+        }
+        let scalar = (Kernels::scalar().q8_0)(&w8, &xq);
+        let fast = (Kernels::detect().q8_0)(&w8, &xq);
+        assert!((scalar - exact8).abs() < 0.02 * exact8.abs().max(1.0), "{scalar} vs {exact8}");
+        assert!((fast - scalar).abs() <= 1e-4 * scalar.abs().max(1.0), "{fast} vs {scalar}");
+    }
+}
