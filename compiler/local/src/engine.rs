@@ -21,15 +21,16 @@ use crate::llama::{Cache, Model};
 use toktrie::{TokEnv, TokRxInfo, TokTrie, TokenId, TokenizerEnv};
 
 /// The model after reading a prompt's system message: the next request with the same
-/// system message starts from here (its KV cache is shared, not copied).
+/// system message starts from here: the cache is cut back to its length, nothing copied.
 struct Prefix {
     tokens: Vec<u32>,
-    cache: Cache,
 }
 
 pub struct Engine {
     model: Model,
     prefix: Option<Prefix>,
+    /// The keys and values of the last prompt and answer, from the first position.
+    cache: Cache,
     tokenizer: Arc<Tokenizer>,
     /// `<|im_start|>`, `<|im_end|>`, and the end-of-text token.
     im_start: u32,
@@ -86,6 +87,7 @@ impl Engine {
         ])));
         let model = Model::load(&content, &mut file, threads).map_err(|e| failed("cannot be loaded", e))?;
         let context = model.shape.context;
+        let cache = model.new_cache();
         let id = |t: &str| tokenizer.token_to_id(t);
         let (Some(im_start), Some(im_end)) = (id("<|im_start|>"), id("<|im_end|>")) else {
             return Err(failed("has no ChatML tokens", "<|im_start|>/<|im_end|> missing"));
@@ -94,6 +96,7 @@ impl Engine {
         Ok(Engine {
             model,
             prefix: None,
+            cache,
             tokenizer: Arc::new(tokenizer),
             im_start,
             im_end,
@@ -163,23 +166,23 @@ impl Engine {
         self.prefix = None;
     }
 
-    /// The cache after reading `prompt`, and the logits after it: from the cached system
-    /// message when the prompt starts with it, else caching this prompt's first message on
-    /// the way.
-    fn prefill(&mut self, prompt: &[u32], first: usize) -> (Cache, Vec<f32>) {
+    /// Reads `prompt` into the cache and returns the logits after it: from the cached
+    /// system message when the prompt starts with it, else from the start, remembering
+    /// this prompt's first message as the new prefix.
+    fn prefill(&mut self, prompt: &[u32], first: usize) -> Vec<f32> {
         let cached = self.prefix.as_ref().filter(|p| prompt.len() > p.tokens.len() && prompt.starts_with(&p.tokens));
-        let (mut cache, done) = match cached {
-            Some(p) => (p.cache.clone(), p.tokens.len()),
-            None if first > 0 && first < prompt.len() => {
-                let mut cache = self.model.new_cache();
-                self.model.forward(&prompt[..first], &mut cache);
-                self.prefix = Some(Prefix { tokens: prompt[..first].to_vec(), cache: cache.clone() });
-                (cache, first)
+        let done = match cached {
+            Some(p) => {
+                self.cache.truncate(p.tokens.len());
+                p.tokens.len()
             }
-            None => (self.model.new_cache(), 0),
+            None => {
+                self.cache = self.model.new_cache();
+                self.prefix = (first > 0 && first < prompt.len()).then(|| Prefix { tokens: prompt[..first].to_vec() });
+                0
+            }
         };
-        let logits = self.model.forward(&prompt[done..], &mut cache);
-        (cache, logits)
+        self.model.forward(&prompt[done..], &mut self.cache)
     }
 
     /// The model's weights in memory, and the dot-product kernels chosen for this CPU.
@@ -248,7 +251,7 @@ impl Engine {
         let mut sampler = LogitsProcessor::new(request.seed.unwrap_or(0), temperature, None);
 
         let start = Instant::now();
-        let (mut cache, mut logits) = self.prefill(&prompt, first);
+        let mut logits = self.prefill(&prompt, first);
         self.timing.prefill_tokens += prompt.len() as u64;
         self.timing.prefill_s += start.elapsed().as_secs_f64();
 
@@ -286,7 +289,7 @@ impl Engine {
             }
             out.push(token);
             emitted = self.stream_text(&out, emitted, on_text);
-            logits = self.model.forward(&[token], &mut cache);
+            logits = self.model.forward(&[token], &mut self.cache);
         }
         self.timing.decode_tokens += out.len() as u64;
         self.timing.decode_s += decode_start.elapsed().as_secs_f64();

@@ -139,7 +139,7 @@ pub struct Model {
 }
 
 /// Keys and values of the positions read so far, per layer: `[position][kv head][dim]`.
-#[derive(Clone, Default)]
+#[derive(Clone)]
 pub struct Cache {
     k: Vec<Vec<f32>>,
     v: Vec<Vec<f32>>,
@@ -148,6 +148,21 @@ pub struct Cache {
 
 fn error(what: impl std::fmt::Display) -> String {
     what.to_string()
+}
+
+impl Cache {
+    /// Forgets every position from `len` on.
+    pub fn truncate(&mut self, len: usize) {
+        if len >= self.len {
+            return;
+        }
+        for (k, v) in self.k.iter_mut().zip(&mut self.v) {
+            let per = k.len() / self.len.max(1);
+            k.truncate(len * per);
+            v.truncate(len * per);
+        }
+        self.len = len;
+    }
 }
 
 impl Model {
@@ -472,6 +487,12 @@ mod tests {
         assert_eq!(argmax(&chunked), argmax(&expected));
         assert!(cosine(&chunked, &expected) > 0.995, "cosine {}", cosine(&chunked, &expected));
 
+        // two threads split the rows and change nothing
+        let mut file3 = std::fs::File::open(&path).unwrap();
+        let mut two = Model::load(&Content::read(&mut file3).unwrap(), &mut file3, 2).unwrap();
+        let mut cache = two.new_cache();
+        assert_eq!(two.forward(&tokens, &mut cache), chunked);
+
         // a token at a time (decoding) reads the same as a chunk (prefill)
         let mut cache = ours.new_cache();
         let mut stepped = Vec::new();
@@ -480,6 +501,15 @@ mod tests {
         }
         let diff = stepped.iter().zip(&chunked).map(|(a, b)| (a - b).abs()).fold(0f32, f32::max);
         assert!(diff < 1e-3, "chunked and stepped differ by {diff}");
+
+        // cut back and read again: the same as reading once
+        let mut cut = ours.new_cache();
+        ours.forward(&tokens[..10], &mut cut);
+        ours.forward(&[5, 6, 7], &mut cut);
+        cut.truncate(10);
+        let again = ours.forward(&tokens[10..], &mut cut);
+        let diff = again.iter().zip(&chunked).map(|(a, b)| (a - b).abs()).fold(0f32, f32::max);
+        assert!(diff < 1e-3, "read again after cutting back: {diff}");
 
         // the next token, continuing from the cache, as candle continues from its own
         let next = argmax(&expected) as u32;

@@ -20,7 +20,16 @@ fn run(args: &[&str], env: &[(&str, &str)]) -> Output {
     let home = scratch("llm-home");
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_tadslc"));
     cmd.args(args).current_dir(repo()).env("HOME", &home).env("XDG_CONFIG_HOME", home.join(".config"));
-    for var in ["TADSL_LLM_BASE_URL", "TADSL_LLM_API_KEY", "TADSL_LLM_MODEL", "TADSL_LLM_DIALECT", "TADSL_LLM_CONFIG"] {
+    // no server and no local model unless the test gives one
+    for var in [
+        "TADSL_LLM_BASE_URL",
+        "TADSL_LLM_API_KEY",
+        "TADSL_LLM_MODEL",
+        "TADSL_LLM_DIALECT",
+        "TADSL_LLM_CONFIG",
+        "TADSL_MODEL_DIR",
+        "XDG_CACHE_HOME",
+    ] {
         cmd.env_remove(var);
     }
     for (k, v) in env {
