@@ -16,19 +16,15 @@ use llguidance::api::TopLevelGrammar;
 use llguidance::{Matcher, ParserFactory};
 use tad_llm::{Answer, Constraint, Error, ErrorKind, Finish, Part, Request, Usage};
 use tokenizers::Tokenizer;
-
-use crate::llama::{Cache, Model};
 use toktrie::{TokEnv, TokRxInfo, TokTrie, TokenId, TokenizerEnv};
 
-/// The model after reading a prompt's system message: the next request with the same
-/// system message starts from here: the cache is cut back to its length, nothing copied.
-struct Prefix {
-    tokens: Vec<u32>,
-}
+use crate::llama::{Cache, Model};
 
 pub struct Engine {
     model: Model,
-    prefix: Option<Prefix>,
+    /// The last prompt's system message: a request that starts with it reads on from the
+    /// cache cut back to its length, nothing copied.
+    prefix: Option<Vec<u32>>,
     /// The keys and values of the last prompt and answer, from the first position.
     cache: Cache,
     tokenizer: Arc<Tokenizer>,
@@ -44,11 +40,25 @@ pub struct Engine {
 
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Timing {
+    /// Prompt tokens read (a cached system message is not read again).
     pub prefill_tokens: u64,
     pub prefill_s: f64,
     pub decode_tokens: u64,
     pub decode_s: f64,
     pub mask_s: f64,
+}
+
+impl Timing {
+    /// What was spent after `before`.
+    pub fn since(&self, before: &Timing) -> Timing {
+        Timing {
+            prefill_tokens: self.prefill_tokens - before.prefill_tokens,
+            prefill_s: self.prefill_s - before.prefill_s,
+            decode_tokens: self.decode_tokens - before.decode_tokens,
+            decode_s: self.decode_s - before.decode_s,
+            mask_s: self.mask_s - before.mask_s,
+        }
+    }
 }
 
 fn failed(what: &str, e: impl std::fmt::Display) -> Error {
@@ -168,21 +178,22 @@ impl Engine {
 
     /// Reads `prompt` into the cache and returns the logits after it: from the cached
     /// system message when the prompt starts with it, else from the start, remembering
-    /// this prompt's first message as the new prefix.
-    fn prefill(&mut self, prompt: &[u32], first: usize) -> Vec<f32> {
-        let cached = self.prefix.as_ref().filter(|p| prompt.len() > p.tokens.len() && prompt.starts_with(&p.tokens));
+    /// this prompt's first message as the new prefix. Also returns how many tokens were read.
+    fn prefill(&mut self, prompt: &[u32], first: usize) -> (Vec<f32>, usize) {
+        let cached = self.prefix.as_ref().filter(|p| prompt.len() > p.len() && prompt.starts_with(p));
         let done = match cached {
             Some(p) => {
-                self.cache.truncate(p.tokens.len());
-                p.tokens.len()
+                let done = p.len();
+                self.cache.truncate(done);
+                done
             }
             None => {
                 self.cache = self.model.new_cache();
-                self.prefix = (first > 0 && first < prompt.len()).then(|| Prefix { tokens: prompt[..first].to_vec() });
+                self.prefix = (first > 0 && first < prompt.len()).then(|| prompt[..first].to_vec());
                 0
             }
         };
-        self.model.forward(&prompt[done..], &mut self.cache)
+        (self.model.forward(&prompt[done..], &mut self.cache), prompt.len() - done)
     }
 
     /// The model's weights in memory, and the dot-product kernels chosen for this CPU.
@@ -209,12 +220,16 @@ impl Engine {
 
     /// Answers `request` (`max_tokens`, `temperature`, `seed` and the constraint honoured).
     pub fn generate(&mut self, request: &Request) -> Result<Answer, Error> {
-        self.generate_streaming(request, &mut |_| {})
+        self.run(request, None)
     }
 
     /// As [`Engine::generate`], giving `on_text` the answer's text as tokens are decided
     /// (a piece ends on a whole character; the pieces concatenate to the answer's text).
     pub fn generate_streaming(&mut self, request: &Request, on_text: &mut dyn FnMut(&str)) -> Result<Answer, Error> {
+        self.run(request, Some(on_text))
+    }
+
+    fn run(&mut self, request: &Request, mut on_text: Option<&mut dyn FnMut(&str)>) -> Result<Answer, Error> {
         let (prompt, first) = self.prompt(request)?;
         if prompt.len() + request.max_tokens as usize > self.context {
             return Err(Error::new(
@@ -251,8 +266,8 @@ impl Engine {
         let mut sampler = LogitsProcessor::new(request.seed.unwrap_or(0), temperature, None);
 
         let start = Instant::now();
-        let mut logits = self.prefill(&prompt, first);
-        self.timing.prefill_tokens += prompt.len() as u64;
+        let (mut logits, read) = self.prefill(&prompt, first);
+        self.timing.prefill_tokens += read as u64;
         self.timing.prefill_s += start.elapsed().as_secs_f64();
 
         let decode_start = Instant::now();
@@ -288,14 +303,16 @@ impl Engine {
                 break;
             }
             out.push(token);
-            emitted = self.stream_text(&out, emitted, on_text);
+            if let Some(f) = on_text.as_mut() {
+                emitted = self.stream_text(&out, emitted, *f);
+            }
             logits = self.model.forward(&[token], &mut self.cache);
         }
         self.timing.decode_tokens += out.len() as u64;
         self.timing.decode_s += decode_start.elapsed().as_secs_f64();
         let text = self.tokenizer.decode(&out, true).map_err(|e| failed("tokenizer", e))?;
-        if let Some(rest) = text.get(emitted..).filter(|r| !r.is_empty()) {
-            on_text(rest);
+        if let (Some(f), Some(rest)) = (on_text, text.get(emitted..).filter(|r| !r.is_empty())) {
+            f(rest);
         }
         Ok(Answer {
             text,

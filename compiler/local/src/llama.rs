@@ -65,8 +65,7 @@ impl Matrix {
     /// once for all the chunk's tokens. With a pool, workers take ranges of rows.
     fn product(&self, k: &Kernels, x: &[Vec<Q8_1>], out: &mut [f32], pool: Option<&rayon::ThreadPool>) {
         let rows = self.rows();
-        let workers = pool.map_or(1, |p| p.current_num_threads()).max(1);
-        if workers == 1 {
+        let Some(pool) = pool.filter(|p| p.current_num_threads() > 1) else {
             let mut row = Vec::with_capacity(x.len());
             for r in 0..rows {
                 self.row_all(k, r, x, &mut row);
@@ -75,22 +74,21 @@ impl Matrix {
                 }
             }
             return;
-        }
+        };
+        let workers = pool.current_num_threads();
         let per = rows.div_ceil(workers);
         let mut parts: Vec<Vec<f32>> = vec![Vec::new(); workers];
-        if let Some(pool) = pool {
-            pool.scope(|s| {
-                for (w, part) in parts.iter_mut().enumerate() {
-                    s.spawn(move |_| {
-                        let mut row = Vec::with_capacity(x.len());
-                        for r in (w * per)..rows.min((w + 1) * per) {
-                            self.row_all(k, r, x, &mut row);
-                            part.extend_from_slice(&row);
-                        }
-                    });
-                }
-            });
-        }
+        pool.scope(|s| {
+            for (w, part) in parts.iter_mut().enumerate() {
+                s.spawn(move |_| {
+                    let mut row = Vec::with_capacity(x.len());
+                    for r in (w * per)..rows.min((w + 1) * per) {
+                        self.row_all(k, r, x, &mut row);
+                        part.extend_from_slice(&row);
+                    }
+                });
+            }
+        });
         for (w, part) in parts.iter().enumerate() {
             for (i, v) in part.iter().enumerate() {
                 let (r, t) = (w * per + i / x.len(), i % x.len());
@@ -146,10 +144,6 @@ pub struct Cache {
     pub len: usize,
 }
 
-fn error(what: impl std::fmt::Display) -> String {
-    what.to_string()
-}
-
 impl Cache {
     /// Forgets every position from `len` on.
     pub fn truncate(&mut self, len: usize) {
@@ -187,28 +181,39 @@ impl Model {
             eps: float("llama.attention.layer_norm_rms_epsilon").unwrap_or(1e-5),
             rope_base: float("llama.rope.freq_base").unwrap_or(10_000.0),
         };
-        if heads == 0 || shape.kv_heads == 0 || heads % shape.kv_heads != 0 || dim % BLOCK != 0 {
+        if heads == 0
+            || shape.kv_heads == 0
+            || !heads.is_multiple_of(shape.kv_heads)
+            || !dim.is_multiple_of(heads)
+            || !shape.head_dim.is_multiple_of(2)
+            || !dim.is_multiple_of(BLOCK)
+            || !shape.hidden.is_multiple_of(BLOCK)
+        {
             return Err(format!("an unsupported shape: {shape:?}"));
         }
-        let embedding = matrix(content, file, "token_embd.weight")?;
+        // every tensor is checked against the shape, so a malformed file is a load error
+        // rather than an out-of-bounds slice later
+        let (kv_dim, hidden) = (shape.kv_heads * shape.head_dim, shape.hidden);
+        let embedding = matrix(content, file, "token_embd.weight", None, dim)?;
+        let vocab = embedding.rows();
         let output = match content.tensor_infos.contains_key("output.weight") {
-            true => Some(matrix(content, file, "output.weight")?),
+            true => Some(matrix(content, file, "output.weight", Some(vocab), dim)?),
             false => None,
         };
-        let output_norm = vector(content, file, "output_norm.weight")?;
+        let output_norm = vector(content, file, "output_norm.weight", dim)?;
         let mut layers = Vec::with_capacity(shape.layers);
         for i in 0..shape.layers {
             let name = |part: &str| format!("blk.{i}.{part}.weight");
             layers.push(Layer {
-                attn_norm: vector(content, file, &name("attn_norm"))?,
-                ffn_norm: vector(content, file, &name("ffn_norm"))?,
-                q: matrix(content, file, &name("attn_q"))?,
-                k: matrix(content, file, &name("attn_k"))?,
-                v: matrix(content, file, &name("attn_v"))?,
-                o: matrix(content, file, &name("attn_output"))?,
-                gate: matrix(content, file, &name("ffn_gate"))?,
-                up: matrix(content, file, &name("ffn_up"))?,
-                down: matrix(content, file, &name("ffn_down"))?,
+                attn_norm: vector(content, file, &name("attn_norm"), dim)?,
+                ffn_norm: vector(content, file, &name("ffn_norm"), dim)?,
+                q: matrix(content, file, &name("attn_q"), Some(dim), dim)?,
+                k: matrix(content, file, &name("attn_k"), Some(kv_dim), dim)?,
+                v: matrix(content, file, &name("attn_v"), Some(kv_dim), dim)?,
+                o: matrix(content, file, &name("attn_output"), Some(dim), dim)?,
+                gate: matrix(content, file, &name("ffn_gate"), Some(hidden), dim)?,
+                up: matrix(content, file, &name("ffn_up"), Some(hidden), dim)?,
+                down: matrix(content, file, &name("ffn_down"), Some(dim), hidden)?,
             });
         }
         let pool = (threads > 1)
@@ -371,6 +376,10 @@ impl Model {
     }
 }
 
+fn error(what: impl std::fmt::Display) -> String {
+    what.to_string()
+}
+
 /// A tensor's type, shape (outermost first) and bytes.
 fn read<R: Read + Seek>(
     content: &Content,
@@ -387,15 +396,20 @@ fn read<R: Read + Seek>(
     Ok((info.ggml_dtype, dims, bytes))
 }
 
-fn matrix<R: Read + Seek>(content: &Content, file: &mut R, name: &str) -> Result<Matrix, String> {
+/// A matrix of `cols` columns (and `rows` rows, when given).
+fn matrix<R: Read + Seek>(
+    content: &Content,
+    file: &mut R,
+    name: &str,
+    rows: Option<usize>,
+    cols: usize,
+) -> Result<Matrix, String> {
     let (dtype, dims, bytes) = read(content, file, name)?;
-    let (rows, cols) = match dims[..] {
-        [rows, cols] => (rows, cols),
-        _ => return Err(format!("tensor `{name}` is not a matrix: {dims:?}")),
+    let rows = match (dims.as_slice(), rows) {
+        (&[r, c], Some(want)) if r == want && c == cols => r,
+        (&[r, c], None) if r > 0 && c == cols => r,
+        _ => return Err(format!("tensor `{name}` is {dims:?}, not a matrix of {cols} columns fitting the model")),
     };
-    if cols % BLOCK != 0 {
-        return Err(format!("tensor `{name}`: rows of {cols} values are not whole blocks"));
-    }
     let per_row = cols / BLOCK;
     match dtype {
         GgmlDType::Q4_1 => Ok(Matrix::Q4_1 { blocks: quant::read_q4_1(&bytes), rows, per_row }),
@@ -404,10 +418,10 @@ fn matrix<R: Read + Seek>(content: &Content, file: &mut R, name: &str) -> Result
     }
 }
 
-fn vector<R: Read + Seek>(content: &Content, file: &mut R, name: &str) -> Result<Vec<f32>, String> {
-    let (dtype, _, bytes) = read(content, file, name)?;
-    if dtype != GgmlDType::F32 {
-        return Err(format!("tensor `{name}` is {dtype:?}, not F32"));
+fn vector<R: Read + Seek>(content: &Content, file: &mut R, name: &str, len: usize) -> Result<Vec<f32>, String> {
+    let (dtype, dims, bytes) = read(content, file, name)?;
+    if dtype != GgmlDType::F32 || dims != [len] {
+        return Err(format!("tensor `{name}` is {dtype:?} {dims:?}, not F32 [{len}]"));
     }
     Ok(bytes.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect())
 }
@@ -463,6 +477,59 @@ mod tests {
 
     fn argmax(v: &[f32]) -> usize {
         v.iter().enumerate().fold((0, f32::NEG_INFINITY), |(bi, bv), (i, &x)| if x > bv { (i, x) } else { (bi, bv) }).0
+    }
+
+    /// A one-layer llama GGUF in memory whose `attn_q` has `q_rows` rows.
+    fn tiny_gguf(q_rows: usize) -> std::io::Cursor<Vec<u8>> {
+        use candle_core::quantized::{QTensor, gguf_file::Value};
+        let (dim, hidden, vocab) = (64usize, 64usize, 32usize);
+        let meta: Vec<(&str, Value)> = vec![
+            ("general.architecture", Value::String("llama".into())),
+            ("llama.block_count", Value::U32(1)),
+            ("llama.embedding_length", Value::U32(dim as u32)),
+            ("llama.feed_forward_length", Value::U32(hidden as u32)),
+            ("llama.attention.head_count", Value::U32(2)),
+            ("llama.attention.head_count_kv", Value::U32(1)),
+        ];
+        let matrix = |rows: usize, cols: usize, dtype| {
+            let t = Tensor::ones((rows, cols), candle_core::DType::F32, &Device::Cpu).unwrap();
+            QTensor::quantize(&t, dtype).unwrap()
+        };
+        let vector = |n: usize| {
+            QTensor::quantize(&Tensor::ones(n, candle_core::DType::F32, &Device::Cpu).unwrap(), GgmlDType::F32).unwrap()
+        };
+        let tensors = vec![
+            ("token_embd.weight", matrix(vocab, dim, GgmlDType::Q8_0)),
+            ("output_norm.weight", vector(dim)),
+            ("blk.0.attn_norm.weight", vector(dim)),
+            ("blk.0.ffn_norm.weight", vector(dim)),
+            ("blk.0.attn_q.weight", matrix(q_rows, dim, GgmlDType::Q4_1)),
+            ("blk.0.attn_k.weight", matrix(32, dim, GgmlDType::Q4_1)),
+            ("blk.0.attn_v.weight", matrix(32, dim, GgmlDType::Q4_1)),
+            ("blk.0.attn_output.weight", matrix(dim, dim, GgmlDType::Q4_1)),
+            ("blk.0.ffn_gate.weight", matrix(hidden, dim, GgmlDType::Q4_1)),
+            ("blk.0.ffn_up.weight", matrix(hidden, dim, GgmlDType::Q4_1)),
+            ("blk.0.ffn_down.weight", matrix(dim, hidden, GgmlDType::Q4_1)),
+        ];
+        let mut out = std::io::Cursor::new(Vec::new());
+        let meta: Vec<(&str, &Value)> = meta.iter().map(|(k, v)| (*k, v)).collect();
+        let tensors: Vec<(&str, &QTensor)> = tensors.iter().map(|(k, v)| (*k, v)).collect();
+        candle_core::quantized::gguf_file::write(&mut out, &meta, &tensors).unwrap();
+        out.set_position(0);
+        out
+    }
+
+    #[test]
+    fn a_tensor_that_does_not_fit_the_shape_is_a_load_error() {
+        let mut good = tiny_gguf(64);
+        let content = Content::read(&mut good).unwrap();
+        let mut model = Model::load(&content, &mut good, 1).unwrap();
+        let mut cache = model.new_cache();
+        assert_eq!(model.forward(&[1, 2, 3], &mut cache).len(), 32);
+        let mut bad = tiny_gguf(96);
+        let content = Content::read(&mut bad).unwrap();
+        let error = Model::load(&content, &mut bad, 1).err().expect("a 96-row attn_q does not fit a 64-wide model");
+        assert!(error.contains("blk.0.attn_q.weight"), "{error}");
     }
 
     #[test]

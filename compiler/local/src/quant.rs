@@ -5,7 +5,8 @@
 //! A dot product of a weight row and an activation vector is then integer products summed
 //! a block at a time, scaled once per block. On x86-64 with AVX2 and FMA (detected at run
 //! time) the blocks go through 256-bit integer multiply-adds; elsewhere through the same
-//! arithmetic in scalar code, so both give the same sums up to float rounding.
+//! arithmetic in scalar code, so both give the same sums up to float rounding. Attention
+//! over the KV cache (scores, softmax, the weighted sum of values) is chosen the same way.
 
 /// Values in a block.
 pub const BLOCK: usize = 32;
@@ -185,7 +186,7 @@ impl Kernels {
     }
 }
 
-pub fn dot_scalar(a: &[f32], b: &[f32]) -> f32 {
+fn dot_scalar(a: &[f32], b: &[f32]) -> f32 {
     // eight lanes, so the compiler keeps them in vector registers
     let mut lanes = [0f32; 8];
     let (ac, bc) = (a.chunks_exact(8), b.chunks_exact(8));
@@ -198,7 +199,7 @@ pub fn dot_scalar(a: &[f32], b: &[f32]) -> f32 {
     lanes.iter().sum::<f32>() + rest
 }
 
-pub fn axpy_scalar(out: &mut [f32], w: f32, v: &[f32]) {
+fn axpy_scalar(out: &mut [f32], w: f32, v: &[f32]) {
     for (o, x) in out.iter_mut().zip(v) {
         *o += w * x;
     }

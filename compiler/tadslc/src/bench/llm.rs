@@ -41,6 +41,8 @@ struct Side {
     decode_s: f64,
     constrained_tokens: f64,
     constrained_s: f64,
+    /// llguidance's masks (the local model only).
+    mask_s: f64,
     peak_kib: Option<u64>,
 }
 
@@ -105,7 +107,7 @@ fn run_in(args: &LlmArgs) -> Result<(), String> {
     )
     .map_err(|_| "stderr closed")?;
 
-    let (local, prompts, local_texts, mask_s) = measure_local(&gguf, args.threads, &requests, &lark)?;
+    let (local, prompts, local_texts) = measure_local(&gguf, args.threads, &requests, &lark)?;
     let peer = match args.llama_server.clone().or_else(|| std::env::var_os("TADSL_LLAMA_SERVER").map(PathBuf::from)) {
         Some(server) => Some(measure_server(&server, &gguf, args.threads, &prompts, args.max_tokens, &gbnf)?),
         None => {
@@ -114,7 +116,7 @@ fn run_in(args: &LlmArgs) -> Result<(), String> {
             None
         }
     };
-    print(&local, mask_s, peer.as_ref().map(|(s, _)| s), &prompts).map_err(|_| "stdout closed")?;
+    print(&local, peer.as_ref().map(|(s, _)| s), &prompts).map_err(|_| "stdout closed")?;
     if let Some((_, texts)) = &peer {
         let same = local_texts.iter().zip(texts).filter(|(a, b)| a.trim() == b.trim()).count();
         outln!("greedy answers identical to llama-server's: {same}/{}", texts.len()).map_err(|_| "stdout closed")?;
@@ -122,7 +124,7 @@ fn run_in(args: &LlmArgs) -> Result<(), String> {
     Ok(())
 }
 
-type Local = (Side, Vec<Vec<u32>>, Vec<String>, f64);
+type Local = (Side, Vec<Vec<u32>>, Vec<String>);
 
 fn measure_local(gguf: &Path, threads: usize, requests: &[Request], lark: &str) -> Result<Local, String> {
     let mut engine = Engine::load(gguf, threads).map_err(|e| e.to_string())?;
@@ -133,35 +135,37 @@ fn measure_local(gguf: &Path, threads: usize, requests: &[Request], lark: &str) 
     let mut warm = requests[0].clone();
     warm.max_tokens = 4;
     engine.generate(&warm).map_err(|e| e.to_string())?;
+    // each request read whole: no cached system message
+    let mut timed = |request: &Request| -> Result<(tad_local::Timing, String), String> {
+        engine.forget_prefix();
+        let before = engine.timing;
+        let answer = engine.generate(request).map_err(|e| e.to_string())?;
+        Ok((engine.timing.since(&before), answer.text))
+    };
 
     let mut side = Side::default();
     let mut prompts = Vec::new();
     let mut texts = Vec::new();
-    let mut mask_s = 0.0;
     for request in requests {
-        prompts.push(engine.prompt_tokens(request).map_err(|e| e.to_string())?);
-        engine.forget_prefix();
-        let before = engine.timing;
-        let answer = engine.generate(request).map_err(|e| e.to_string())?;
-        let after = engine.timing;
-        side.prefill_tokens += (after.prefill_tokens - before.prefill_tokens) as f64;
-        side.prefill_s += after.prefill_s - before.prefill_s;
-        side.decode_tokens += (after.decode_tokens - before.decode_tokens) as f64;
-        side.decode_s += after.decode_s - before.decode_s;
-        texts.push(answer.text);
+        let (spent, text) = timed(request)?;
+        side.prefill_tokens += spent.prefill_tokens as f64;
+        side.prefill_s += spent.prefill_s;
+        side.decode_tokens += spent.decode_tokens as f64;
+        side.decode_s += spent.decode_s;
+        texts.push(text);
 
         let mut constrained = request.clone();
         constrained.constraint = Constraint::Lark(lark.to_string());
-        engine.forget_prefix();
-        let before = engine.timing;
-        engine.generate(&constrained).map_err(|e| e.to_string())?;
-        let after = engine.timing;
-        side.constrained_tokens += (after.decode_tokens - before.decode_tokens) as f64;
-        side.constrained_s += after.decode_s - before.decode_s;
-        mask_s += after.mask_s - before.mask_s;
+        let (spent, _) = timed(&constrained)?;
+        side.constrained_tokens += spent.decode_tokens as f64;
+        side.constrained_s += spent.decode_s;
+        side.mask_s += spent.mask_s;
+    }
+    for request in requests {
+        prompts.push(engine.prompt_tokens(request).map_err(|e| e.to_string())?);
     }
     side.peak_kib = proc_status_kib("self", "VmHWM");
-    Ok((side, prompts, texts, mask_s))
+    Ok((side, prompts, texts))
 }
 
 /// llama-server on a free port, stopped when dropped.
@@ -280,7 +284,7 @@ fn dechunk(mut rest: &str) -> String {
     out
 }
 
-fn print(local: &Side, mask_s: f64, peer: Option<&Side>, prompts: &[Vec<u32>]) -> Result<(), Closed> {
+fn print(local: &Side, peer: Option<&Side>, prompts: &[Vec<u32>]) -> Result<(), Closed> {
     let mean = prompts.iter().map(Vec::len).sum::<usize>() as f64 / prompts.len().max(1) as f64;
     outln!("prompts: {}, {mean:.0} tokens on average, read whole on both sides", prompts.len())?;
     outln!("{:<34} {:>12} {:>14} {:>9}", "", "tad-local", "llama-server", "ratio")?;
@@ -298,7 +302,7 @@ fn print(local: &Side, mask_s: f64, peer: Option<&Side>, prompts: &[Vec<u32>]) -
     outln!(
         "{:<34} {:>12.2} {:>14} {:>9}",
         "mask ms/token (llguidance)",
-        1e3 * mask_s / local.constrained_tokens.max(1.0),
+        1e3 * local.mask_s / local.constrained_tokens.max(1.0),
         "-",
         "-"
     )?;
