@@ -18,6 +18,7 @@ use tad_llm::{Answer, Constraint, Error, ErrorKind, Finish, Part, Request, Usage
 use tokenizers::Tokenizer;
 use toktrie::{TokEnv, TokRxInfo, TokTrie, TokenId, TokenizerEnv};
 
+use crate::adapter::Adapter;
 use crate::llama::{Cache, Model};
 
 pub struct Engine {
@@ -28,8 +29,7 @@ pub struct Engine {
     /// The keys and values of the last prompt and answer, from the first position.
     cache: Cache,
     tokenizer: Arc<Tokenizer>,
-    /// `<|im_start|>`, `<|im_end|>`, and the end-of-text token.
-    im_start: u32,
+    /// `<|im_end|>`, and the end-of-text token.
     im_end: u32,
     end_of_text: Option<u32>,
     factory: Option<Arc<ParserFactory>>,
@@ -82,24 +82,66 @@ impl TokenizerEnv for Env {
     }
 }
 
+/// The GGUF's tokenizer, with SmolLM2's pre-tokenizer ("smollm": digits one by one,
+/// byte-level without a prefix space).
+pub fn tokenizer(content: &gguf_file::Content) -> Result<Tokenizer, String> {
+    let mut tokenizer = Tokenizer::from_gguf(content).map_err(|e| e.to_string())?;
+    use tokenizers::pre_tokenizers::{byte_level::ByteLevel, digits::Digits, sequence::Sequence};
+    tokenizer.with_pre_tokenizer(Some(Sequence::new(vec![
+        Digits::new(true).into(),
+        ByteLevel::new(false, true, false).into(),
+    ])));
+    Ok(tokenizer)
+}
+
+/// ChatML's tokens as the local model reads them: `turns` as `(role, text)`, then the
+/// opening of the assistant's turn; also how many tokens the first turn takes. What the
+/// model answers after them ends with `<|im_end|>`.
+pub fn chatml(tokenizer: &Tokenizer, turns: &[(&str, &str)]) -> Result<(Vec<u32>, usize), String> {
+    let id = |t: &str| tokenizer.token_to_id(t).ok_or_else(|| format!("the tokenizer has no `{t}`"));
+    let (im_start, im_end) = (id("<|im_start|>")?, id("<|im_end|>")?);
+    let encode = |text: &str| -> Result<Vec<u32>, String> {
+        Ok(tokenizer.encode(text, false).map_err(|e| e.to_string())?.get_ids().to_vec())
+    };
+    let newline = encode("\n")?;
+    let mut ids = Vec::new();
+    let mut first = 0;
+    for (i, (role, text)) in turns.iter().enumerate() {
+        ids.push(im_start);
+        ids.extend(encode(&format!("{role}\n{text}"))?);
+        ids.push(im_end);
+        ids.extend(&newline);
+        if i == 0 {
+            first = ids.len();
+        }
+    }
+    ids.push(im_start);
+    ids.extend(encode("assistant\n")?);
+    Ok((ids, first))
+}
+
 impl Engine {
     /// Loads the GGUF file at `path`, to run on `threads` threads.
     pub fn load(path: &std::path::Path, threads: usize) -> Result<Engine, Error> {
+        Engine::load_with(path, threads, None)
+    }
+
+    /// As [`Engine::load`], with a LoRA adapter applied to the projections it targets.
+    pub fn load_with(path: &std::path::Path, threads: usize, adapter: Option<&Adapter>) -> Result<Engine, Error> {
         let mut file =
             std::fs::File::open(path).map_err(|e| failed(&format!("cannot be read from {}", path.display()), e))?;
         let content = gguf_file::Content::read(&mut file).map_err(|e| failed("is not a GGUF file", e))?;
-        let mut tokenizer = Tokenizer::from_gguf(&content).map_err(|e| failed("has no usable tokenizer", e))?;
-        // SmolLM2's pre-tokenizer ("smollm"): digits one by one, byte-level without a prefix space
-        use tokenizers::pre_tokenizers::{byte_level::ByteLevel, digits::Digits, sequence::Sequence};
-        tokenizer.with_pre_tokenizer(Some(Sequence::new(vec![
-            Digits::new(true).into(),
-            ByteLevel::new(false, true, false).into(),
-        ])));
-        let model = Model::load(&content, &mut file, threads).map_err(|e| failed("cannot be loaded", e))?;
+        let tokenizer = tokenizer(&content).map_err(|e| failed("has no usable tokenizer", e))?;
+        let mut model = Model::load(&content, &mut file, threads).map_err(|e| failed("cannot be loaded", e))?;
+        if let Some(adapter) = adapter {
+            model.attach(adapter).map_err(|e| {
+                Error::new(ErrorKind::Request, format!("the adapter does not fit the local model: {e}"))
+            })?;
+        }
         let context = model.shape.context;
         let cache = model.new_cache();
         let id = |t: &str| tokenizer.token_to_id(t);
-        let (Some(im_start), Some(im_end)) = (id("<|im_start|>"), id("<|im_end|>")) else {
+        let (Some(_), Some(im_end)) = (id("<|im_start|>"), id("<|im_end|>")) else {
             return Err(failed("has no ChatML tokens", "<|im_start|>/<|im_end|> missing"));
         };
         let end_of_text = id("<|endoftext|>");
@@ -108,7 +150,6 @@ impl Engine {
             prefix: None,
             cache,
             tokenizer: Arc::new(tokenizer),
-            im_start,
             im_end,
             end_of_text,
             factory: None,
@@ -137,10 +178,8 @@ impl Engine {
     /// The prompt's tokens (ChatML turns, then the opening of the assistant's), and how
     /// many of them are the first message's.
     fn prompt(&self, request: &Request) -> Result<(Vec<u32>, usize), Error> {
-        let newline = self.encode("\n")?;
-        let mut ids = Vec::new();
-        let mut first = 0;
-        for (i, message) in request.messages.iter().enumerate() {
+        let mut turns = Vec::new();
+        for message in &request.messages {
             let mut text = String::new();
             for part in &message.parts {
                 match part {
@@ -153,17 +192,18 @@ impl Engine {
                     }
                 }
             }
-            ids.push(self.im_start);
-            ids.extend(self.encode(&format!("{}\n{text}", message.role.name()))?);
-            ids.push(self.im_end);
-            ids.extend(&newline);
-            if i == 0 {
-                first = ids.len();
-            }
+            turns.push((message.role.name(), text));
         }
-        ids.push(self.im_start);
-        ids.extend(self.encode("assistant\n")?);
-        Ok((ids, first))
+        let turns: Vec<(&str, &str)> = turns.iter().map(|(r, t)| (*r, t.as_str())).collect();
+        chatml(&self.tokenizer, &turns).map_err(|e| failed("tokenizer", e))
+    }
+
+    /// The logits after `tokens`, read from the first position (the cached system
+    /// message is dropped).
+    pub fn logits(&mut self, tokens: &[u32]) -> Vec<f32> {
+        self.prefix = None;
+        self.cache = self.model.new_cache();
+        self.model.forward(tokens, &mut self.cache)
     }
 
     /// The tokens the model reads for `request` (for a peer fed the same input).
@@ -199,10 +239,6 @@ impl Engine {
     /// The model's weights in memory, and the dot-product kernels chosen for this CPU.
     pub fn describe(&self) -> (usize, &'static str) {
         (self.model.weight_bytes(), self.model.kernels())
-    }
-
-    fn encode(&self, text: &str) -> Result<Vec<u32>, Error> {
-        Ok(self.tokenizer.encode(text, false).map_err(|e| failed("tokenizer", e))?.get_ids().to_vec())
     }
 
     /// Gives `on_text` what `out` decodes to beyond the `emitted` bytes, unless it ends in

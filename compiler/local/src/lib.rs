@@ -9,6 +9,7 @@
 //! Weights only come inside packages from the registry, pinned by sha256; nothing is
 //! downloaded at run time: a missing model is an error naming `tadslc model fetch`.
 
+mod adapter;
 mod engine;
 mod llama;
 mod quant;
@@ -20,7 +21,9 @@ use std::sync::{Arc, Mutex};
 
 use tad_llm::{Chat, ChatFuture, Error, ErrorKind, OnText, Request};
 
-pub use engine::{Engine, Timing};
+pub use adapter::{Adapter, BASE_MODEL, Lora, Target, gguf_to_hf_rows, hf_to_gguf_rows};
+pub use engine::{Engine, Timing, chatml, tokenizer};
+pub use llama::Shape;
 
 /// A model TADSL can fetch and run.
 #[derive(Clone, Copy, Debug)]
@@ -175,8 +178,13 @@ pub struct LocalChat {
 
 impl LocalChat {
     pub fn load(model: &Model, threads: usize) -> Result<LocalChat, String> {
+        LocalChat::load_with(model, threads, None)
+    }
+
+    /// As [`LocalChat::load`], with a LoRA adapter applied.
+    pub fn load_with(model: &Model, threads: usize, adapter: Option<&Adapter>) -> Result<LocalChat, String> {
         let path = model.require()?;
-        let engine = Engine::load(&path, threads).map_err(|e| e.to_string())?;
+        let engine = Engine::load_with(&path, threads, adapter).map_err(|e| e.to_string())?;
         Ok(LocalChat { engine: Arc::new(Mutex::new(engine)), name: model.name.to_string() })
     }
 

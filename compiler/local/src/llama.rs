@@ -17,6 +17,7 @@ use std::io::{Read, Seek, SeekFrom};
 use candle_core::quantized::GgmlDType;
 use candle_core::quantized::gguf_file::Content;
 
+use crate::adapter::{Adapter, Target, hf_to_gguf_rows};
 use crate::quant::{self, BLOCK, Heads, Kernels, Q4_1, Q8_0, Q8_1};
 
 /// A weight matrix: `rows` rows of `cols` values, row after row, in blocks.
@@ -134,33 +135,37 @@ pub struct Model {
     pool: Option<rayon::ThreadPool>,
     /// cos and sin of each position's angle per pair, filled as far as used.
     rope: Vec<(f32, f32)>,
+    /// A LoRA adapter's pairs per layer, indexed by [`Target`] (q and k rows in the
+    /// GGUF's order), and its scale.
+    lora: Option<(Vec<[Option<LoraPair>; 7]>, f32)>,
 }
 
-/// Keys and values of the positions read so far, per layer: `[position][kv head][dim]`.
-#[derive(Clone)]
-pub struct Cache {
-    k: Vec<Vec<f32>>,
-    v: Vec<Vec<f32>>,
-    pub len: usize,
+/// `a`: `[rank, in]`, `b`: `[out, rank]`, row-major.
+struct LoraPair {
+    a: Vec<f32>,
+    b: Vec<f32>,
+    rank: usize,
 }
 
-impl Cache {
-    /// Forgets every position from `len` on.
-    pub fn truncate(&mut self, len: usize) {
-        if len >= self.len {
-            return;
+impl LoraPair {
+    /// `out[t] += scale · B (A x[t])` for each token of the chunk.
+    fn add(&self, scale: f32, x: &[f32], out: &mut [f32], n: usize) {
+        let (inputs, outputs) = (x.len() / n, out.len() / n);
+        let mut h = vec![0f32; self.rank];
+        for (xt, ot) in x.chunks_exact(inputs).zip(out.chunks_exact_mut(outputs)) {
+            for (hr, ar) in h.iter_mut().zip(self.a.chunks_exact(inputs)) {
+                *hr = scale * ar.iter().zip(xt).map(|(a, v)| a * v).sum::<f32>();
+            }
+            for (o, br) in ot.iter_mut().zip(self.b.chunks_exact(self.rank)) {
+                *o += br.iter().zip(&h).map(|(b, v)| b * v).sum::<f32>();
+            }
         }
-        for (k, v) in self.k.iter_mut().zip(&mut self.v) {
-            let per = k.len() / self.len.max(1);
-            k.truncate(len * per);
-            v.truncate(len * per);
-        }
-        self.len = len;
     }
 }
 
-impl Model {
-    pub fn load<R: Read + Seek>(content: &Content, file: &mut R, threads: usize) -> Result<Model, String> {
+impl Shape {
+    /// The shape in a llama GGUF's metadata, checked for what the decoder needs.
+    pub fn from_gguf(content: &Content) -> Result<Shape, String> {
         let meta = |k: &str| content.metadata.get(k).ok_or_else(|| format!("no `{k}` in the GGUF metadata"));
         let int = |k: &str| meta(k).and_then(|v| v.to_u32().map_err(error)).map(|v| v as usize);
         let float = |k: &str| meta(k).and_then(|v| v.to_f32().map_err(error));
@@ -191,6 +196,37 @@ impl Model {
         {
             return Err(format!("an unsupported shape: {shape:?}"));
         }
+        Ok(shape)
+    }
+}
+
+/// Keys and values of the positions read so far, per layer: `[position][kv head][dim]`.
+#[derive(Clone)]
+pub struct Cache {
+    k: Vec<Vec<f32>>,
+    v: Vec<Vec<f32>>,
+    pub len: usize,
+}
+
+impl Cache {
+    /// Forgets every position from `len` on.
+    pub fn truncate(&mut self, len: usize) {
+        if len >= self.len {
+            return;
+        }
+        for (k, v) in self.k.iter_mut().zip(&mut self.v) {
+            let per = k.len() / self.len.max(1);
+            k.truncate(len * per);
+            v.truncate(len * per);
+        }
+        self.len = len;
+    }
+}
+
+impl Model {
+    pub fn load<R: Read + Seek>(content: &Content, file: &mut R, threads: usize) -> Result<Model, String> {
+        let shape = Shape::from_gguf(content)?;
+        let dim = shape.dim;
         // every tensor is checked against the shape, so a malformed file is a load error
         // rather than an out-of-bounds slice later
         let (kv_dim, hidden) = (shape.kv_heads * shape.head_dim, shape.hidden);
@@ -220,7 +256,33 @@ impl Model {
             .then(|| rayon::ThreadPoolBuilder::new().num_threads(threads).build())
             .transpose()
             .map_err(error)?;
-        Ok(Model { shape, embedding, output, output_norm, layers, kernels: Kernels::detect(), pool, rope: Vec::new() })
+        Ok(Model {
+            shape,
+            embedding,
+            output,
+            output_norm,
+            layers,
+            kernels: Kernels::detect(),
+            pool,
+            rope: Vec::new(),
+            lora: None,
+        })
+    }
+
+    /// Applies `adapter` from now on (in f32, beside the quantized products); checked
+    /// against the model's shape first.
+    pub fn attach(&mut self, adapter: &Adapter) -> Result<(), String> {
+        adapter.check(&self.shape)?;
+        let mut layers: Vec<[Option<LoraPair>; 7]> = (0..self.shape.layers).map(|_| Default::default()).collect();
+        for (&(layer, target), lora) in &adapter.layers {
+            let b = match target.roped() {
+                true => hf_to_gguf_rows(&lora.b, adapter.rank, self.shape.head_dim),
+                false => lora.b.clone(),
+            };
+            layers[layer][target as usize] = Some(LoraPair { a: lora.a.clone(), b, rank: adapter.rank });
+        }
+        self.lora = Some((layers, adapter.scale()));
+        Ok(())
     }
 
     /// The bytes the weights take in memory.
@@ -308,6 +370,7 @@ impl Model {
         let pairs = head_dim / 2;
 
         for (li, layer) in self.layers.iter().enumerate() {
+            let lora = |t: Target| self.lora.as_ref().and_then(|(l, s)| Some((l[li][t as usize].as_ref()?, *s)));
             rms_norm(&x, &layer.attn_norm, eps, dim, &mut normed);
             for (t, xt) in xq.iter_mut().enumerate() {
                 quant::quantize(&normed[t * dim..(t + 1) * dim], xt);
@@ -315,6 +378,11 @@ impl Model {
             layer.q.product(k, &xq, &mut q, pool);
             layer.k.product(k, &xq, &mut kk, pool);
             layer.v.product(k, &xq, &mut vv, pool);
+            for (target, out) in [(Target::Q, &mut q), (Target::K, &mut kk), (Target::V, &mut vv)] {
+                if let Some((pair, scale)) = lora(target) {
+                    pair.add(scale, &normed, out, n);
+                }
+            }
             for t in 0..n {
                 let angles = &self.rope[(start + t) * pairs..(start + t + 1) * pairs];
                 for h in 0..heads {
@@ -341,6 +409,9 @@ impl Model {
                 quant::quantize(&attn[t * dim..(t + 1) * dim], xt);
             }
             layer.o.product(k, &xq, &mut proj, pool);
+            if let Some((pair, scale)) = lora(Target::O) {
+                pair.add(scale, &attn, &mut proj, n);
+            }
             for (a, b) in x.iter_mut().zip(&proj) {
                 *a += b;
             }
@@ -350,6 +421,12 @@ impl Model {
             }
             layer.gate.product(k, &xq, &mut gate, pool);
             layer.up.product(k, &xq, &mut up, pool);
+            if let Some((pair, scale)) = lora(Target::Gate) {
+                pair.add(scale, &normed, &mut gate, n);
+            }
+            if let Some((pair, scale)) = lora(Target::Up) {
+                pair.add(scale, &normed, &mut up, n);
+            }
             for (g, u) in gate.iter_mut().zip(&up) {
                 *g = *g / (1.0 + (-*g).exp()) * u;
             }
@@ -357,6 +434,9 @@ impl Model {
                 quant::quantize(&gate[t * hidden..(t + 1) * hidden], ht);
             }
             layer.down.product(k, &hq, &mut proj, pool);
+            if let Some((pair, scale)) = lora(Target::Down) {
+                pair.add(scale, &gate, &mut proj, n);
+            }
             for (a, b) in x.iter_mut().zip(&proj) {
                 *a += b;
             }

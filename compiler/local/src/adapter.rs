@@ -1,0 +1,382 @@
+//! LoRA adapters in PEFT's format: a directory with `adapter_config.json` and
+//! `adapter_model.safetensors`, tensors named as Hugging Face's llama names them
+//! (`base_model.model.model.layers.{i}.self_attn.q_proj.lora_A.weight`, `[r, in]`, and
+//! `lora_B.weight`, `[out, r]`).
+//!
+//! An adapter is untrusted input: [`Adapter::load`] reads the files and checks that the
+//! config and the tensors agree with each other, [`Adapter::check`] that every tensor fits
+//! the model; neither panics on any file.
+//!
+//! Hugging Face's q and k rows are in the order its rotary embedding wants (each head's
+//! first halves, then its second halves); llama.cpp's converter interleaves them per head
+//! so that rope rotates adjacent pairs, which is the order of the GGUF's `attn_q`/`attn_k`
+//! rows and of this crate's decoder. An adapter is kept in Hugging Face's order (as it is
+//! on disk); [`hf_to_gguf_rows`] and [`gguf_to_hf_rows`] convert `lora_B` of q and k.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use candle_core::{DType, Device, Tensor};
+
+use crate::llama::Shape;
+
+/// A projection LoRA can target, in PEFT's names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Target {
+    Q,
+    K,
+    V,
+    O,
+    Gate,
+    Up,
+    Down,
+}
+
+impl Target {
+    pub const ALL: [Target; 7] = [Target::Q, Target::K, Target::V, Target::O, Target::Gate, Target::Up, Target::Down];
+
+    /// PEFT's module name (`q_proj`, …).
+    pub fn module(self) -> &'static str {
+        match self {
+            Target::Q => "q_proj",
+            Target::K => "k_proj",
+            Target::V => "v_proj",
+            Target::O => "o_proj",
+            Target::Gate => "gate_proj",
+            Target::Up => "up_proj",
+            Target::Down => "down_proj",
+        }
+    }
+
+    /// The block the module is in (`self_attn` or `mlp`).
+    pub fn block(self) -> &'static str {
+        match self {
+            Target::Q | Target::K | Target::V | Target::O => "self_attn",
+            Target::Gate | Target::Up | Target::Down => "mlp",
+        }
+    }
+
+    /// Reads `q`, `q_proj`, `gate`, `gate_proj`, ….
+    pub fn parse(name: &str) -> Option<Target> {
+        let name = name.strip_suffix("_proj").unwrap_or(name);
+        Target::ALL.into_iter().find(|t| t.module().strip_suffix("_proj") == Some(name))
+    }
+
+    /// `(in, out)` features of the projection in a model of `shape`.
+    pub fn dims(self, shape: &Shape) -> (usize, usize) {
+        let (q, kv) = (shape.heads * shape.head_dim, shape.kv_heads * shape.head_dim);
+        match self {
+            Target::Q => (shape.dim, q),
+            Target::K | Target::V => (shape.dim, kv),
+            Target::O => (q, shape.dim),
+            Target::Gate | Target::Up => (shape.dim, shape.hidden),
+            Target::Down => (shape.hidden, shape.dim),
+        }
+    }
+
+    /// Whether rope reads the projection's rows (their order differs between HF and GGUF).
+    pub fn roped(self) -> bool {
+        matches!(self, Target::Q | Target::K)
+    }
+}
+
+/// The name of a LoRA tensor in PEFT's file.
+pub fn tensor_name(layer: usize, target: Target, b: bool) -> String {
+    format!(
+        "base_model.model.model.layers.{layer}.{}.{}.lora_{}.weight",
+        target.block(),
+        target.module(),
+        if b { "B" } else { "A" }
+    )
+}
+
+fn parse_name(name: &str) -> Option<(usize, Target, bool)> {
+    let rest = name.strip_prefix("base_model.model.model.layers.")?;
+    let (layer, rest) = rest.split_once('.')?;
+    let layer: usize = layer.parse().ok()?;
+    let (block, rest) = rest.split_once('.')?;
+    let (module, rest) = rest.split_once('.')?;
+    let target = Target::parse(module).filter(|t| t.block() == block && t.module() == module)?;
+    let b = match rest {
+        "lora_A.weight" => false,
+        "lora_B.weight" => true,
+        _ => return None,
+    };
+    Some((layer, target, b))
+}
+
+/// One projection's pair: `a` is `[rank, in]`, `b` is `[out, rank]`, row-major f32, in
+/// Hugging Face's row order.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Lora {
+    pub a: Vec<f32>,
+    pub b: Vec<f32>,
+    pub inputs: usize,
+    pub outputs: usize,
+}
+
+/// A LoRA adapter: `y += scale · B (A x)` on each targeted projection of each layer.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Adapter {
+    pub rank: usize,
+    pub alpha: f32,
+    /// `alpha / sqrt(rank)` instead of `alpha / rank` (PEFT's `use_rslora`).
+    pub rslora: bool,
+    pub targets: Vec<Target>,
+    pub base_model: String,
+    pub layers: BTreeMap<(usize, Target), Lora>,
+}
+
+/// The base model adapters are trained for.
+pub const BASE_MODEL: &str = "HuggingFaceTB/SmolLM2-135M-Instruct";
+
+/// The adapter's files.
+pub const CONFIG_FILE: &str = "adapter_config.json";
+pub const WEIGHTS_FILE: &str = "adapter_model.safetensors";
+
+impl Adapter {
+    pub fn scale(&self) -> f32 {
+        match self.rslora {
+            true => self.alpha / (self.rank as f32).sqrt(),
+            false => self.alpha / self.rank as f32,
+        }
+    }
+
+    /// Reads a PEFT adapter directory; checks the config, and that the tensors are the
+    /// config's (every one named as PEFT names it, `A` of `rank` rows, `B` of `rank`
+    /// columns, A and B in pairs, every targeted module of every layer present once).
+    pub fn load(dir: &Path) -> Result<Adapter, String> {
+        let config_path = dir.join(CONFIG_FILE);
+        let text = std::fs::read_to_string(&config_path)
+            .map_err(|e| format!("cannot read the adapter's config {}: {e}", config_path.display()))?;
+        let config: serde_json::Value =
+            serde_json::from_str(&text).map_err(|e| format!("{}: not JSON: {e}", config_path.display()))?;
+        let bad = |what: &str| format!("{}: {what}", config_path.display());
+        let get = |k: &str| config.get(k).filter(|v| !v.is_null());
+        match get("peft_type").and_then(|v| v.as_str()) {
+            Some("LORA") => {}
+            other => return Err(bad(&format!("peft_type is {other:?}, not \"LORA\""))),
+        }
+        let rank = get("r")
+            .and_then(|v| v.as_u64())
+            .filter(|r| (1..=4096).contains(r))
+            .ok_or_else(|| bad("`r` is not a rank from 1 to 4096"))? as usize;
+        let alpha = get("lora_alpha")
+            .and_then(|v| v.as_f64())
+            .filter(|a| a.is_finite())
+            .ok_or_else(|| bad("`lora_alpha` is not a number"))? as f32;
+        let rslora = get("use_rslora").and_then(|v| v.as_bool()).unwrap_or(false);
+        if get("use_dora").and_then(|v| v.as_bool()) == Some(true) {
+            return Err(bad("DoRA adapters are not supported"));
+        }
+        if get("fan_in_fan_out").and_then(|v| v.as_bool()) == Some(true) {
+            return Err(bad("fan_in_fan_out adapters are not supported"));
+        }
+        if let Some(bias) = get("bias").and_then(|v| v.as_str())
+            && bias != "none"
+        {
+            return Err(bad(&format!("bias \"{bias}\": only \"none\" is supported")));
+        }
+        for pattern in ["rank_pattern", "alpha_pattern"] {
+            if get(pattern).and_then(|v| v.as_object()).is_some_and(|o| !o.is_empty()) {
+                return Err(bad(&format!("`{pattern}` is not supported")));
+            }
+        }
+        if get("layers_to_transform").is_some() {
+            return Err(bad("`layers_to_transform` is not supported"));
+        }
+        let targets: Vec<Target> = match get("target_modules") {
+            Some(serde_json::Value::String(s)) if s == "all-linear" => Target::ALL.to_vec(),
+            Some(serde_json::Value::Array(names)) => {
+                let mut out = Vec::new();
+                for n in names {
+                    let name = n.as_str().ok_or_else(|| bad("`target_modules` holds a non-string"))?;
+                    let t = Target::parse(name)
+                        .filter(|t| t.module() == name)
+                        .ok_or_else(|| bad(&format!("unsupported target module `{name}` (q_proj, k_proj, v_proj, o_proj, gate_proj, up_proj, down_proj)")))?;
+                    if !out.contains(&t) {
+                        out.push(t);
+                    }
+                }
+                out.sort();
+                out
+            }
+            _ => return Err(bad("`target_modules` is not a list of module names")),
+        };
+        if targets.is_empty() {
+            return Err(bad("`target_modules` is empty"));
+        }
+        let base_model = get("base_model_name_or_path").and_then(|v| v.as_str()).unwrap_or_default().to_string();
+
+        let weights_path = dir.join(WEIGHTS_FILE);
+        let bytes = std::fs::read(&weights_path)
+            .map_err(|e| format!("cannot read the adapter's weights {}: {e}", weights_path.display()))?;
+        let tensors = candle_core::safetensors::load_buffer(&bytes, &Device::Cpu)
+            .map_err(|e| format!("{}: not a safetensors file: {e}", weights_path.display()))?;
+        let bad = |what: String| format!("{}: {what}", weights_path.display());
+        let mut halves: BTreeMap<(usize, Target), (Option<Tensor>, Option<Tensor>)> = BTreeMap::new();
+        for (name, tensor) in tensors {
+            let (layer, target, b) = parse_name(&name).ok_or_else(|| bad(format!("unexpected tensor `{name}`")))?;
+            if !targets.contains(&target) {
+                return Err(bad(format!("tensor `{name}` is for a module the config does not target")));
+            }
+            let dims = tensor.dims().to_vec();
+            let fits =
+                dims.len() == 2 && dims[0] > 0 && dims[1] > 0 && if b { dims[1] == rank } else { dims[0] == rank };
+            if !fits {
+                return Err(bad(format!(
+                    "tensor `{name}` is {dims:?}, not {} of rank {rank}",
+                    if b { "[out, r]" } else { "[r, in]" }
+                )));
+            }
+            let entry = halves.entry((layer, target)).or_default();
+            let slot = if b { &mut entry.1 } else { &mut entry.0 };
+            *slot = Some(tensor);
+        }
+        let mut layers = BTreeMap::new();
+        for ((layer, target), pair) in halves {
+            let (Some(a), Some(b)) = pair else {
+                return Err(bad(format!("layer {layer}'s {} has only one of lora_A and lora_B", target.module())));
+            };
+            let values = |t: &Tensor| -> Result<Vec<f32>, String> {
+                let v: Vec<f32> = t
+                    .to_dtype(DType::F32)
+                    .and_then(|t| t.flatten_all())
+                    .and_then(|t| t.to_vec1())
+                    .map_err(|e| bad(format!("layer {layer}'s {}: {e}", target.module())))?;
+                match v.iter().all(|x| x.is_finite()) {
+                    true => Ok(v),
+                    false => Err(bad(format!("layer {layer}'s {} holds a NaN or an infinity", target.module()))),
+                }
+            };
+            let lora = Lora { inputs: a.dims()[1], outputs: b.dims()[0], a: values(&a)?, b: values(&b)? };
+            layers.insert((layer, target), lora);
+        }
+        let count = layers.keys().map(|(l, _)| l + 1).max().unwrap_or(0);
+        for layer in 0..count {
+            for &t in &targets {
+                if !layers.contains_key(&(layer, t)) {
+                    return Err(bad(format!("layer {layer} has no {}", t.module())));
+                }
+            }
+        }
+        if layers.is_empty() {
+            return Err(bad("no LoRA tensors".into()));
+        }
+        Ok(Adapter { rank, alpha, rslora, targets, base_model, layers })
+    }
+
+    /// The number of layers the adapter covers.
+    pub fn layer_count(&self) -> usize {
+        self.layers.keys().map(|(l, _)| l + 1).max().unwrap_or(0)
+    }
+
+    /// Checks that the adapter fits a model of `shape`: the same number of layers, and
+    /// every pair's `in` and `out` the projection's.
+    pub fn check(&self, shape: &Shape) -> Result<(), String> {
+        if self.layer_count() != shape.layers {
+            return Err(format!("the adapter has {} layers, the model {}", self.layer_count(), shape.layers));
+        }
+        for (&(layer, target), lora) in &self.layers {
+            let (inputs, outputs) = target.dims(shape);
+            if (lora.inputs, lora.outputs) != (inputs, outputs) {
+                return Err(format!(
+                    "the adapter's layer {layer} {} maps {} to {} features, the model's {inputs} to {outputs}",
+                    target.module(),
+                    lora.inputs,
+                    lora.outputs
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Writes the adapter in PEFT's format into `dir` (created if needed).
+    pub fn save(&self, dir: &Path) -> Result<(), String> {
+        std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+        let mut tensors = std::collections::HashMap::new();
+        let tensor = |v: &[f32], rows: usize, cols: usize| {
+            Tensor::from_slice(v, (rows, cols), &Device::Cpu).map_err(|e| e.to_string())
+        };
+        for (&(layer, target), lora) in &self.layers {
+            tensors.insert(tensor_name(layer, target, false), tensor(&lora.a, self.rank, lora.inputs)?);
+            tensors.insert(tensor_name(layer, target, true), tensor(&lora.b, lora.outputs, self.rank)?);
+        }
+        let config = serde_json::json!({
+            "peft_type": "LORA",
+            "task_type": "CAUSAL_LM",
+            "base_model_name_or_path": self.base_model,
+            "r": self.rank,
+            "lora_alpha": self.alpha,
+            "lora_dropout": 0.0,
+            "bias": "none",
+            "use_rslora": self.rslora,
+            "use_dora": false,
+            "fan_in_fan_out": false,
+            "init_lora_weights": true,
+            "inference_mode": true,
+            "target_modules": self.targets.iter().map(|t| t.module()).collect::<Vec<_>>(),
+        });
+        let weights = dir.join(WEIGHTS_FILE);
+        let partial = dir.join(format!("{WEIGHTS_FILE}.part"));
+        candle_core::safetensors::save(&tensors, &partial)
+            .map_err(|e| format!("cannot write {}: {e}", partial.display()))?;
+        std::fs::rename(&partial, &weights).map_err(|e| format!("cannot write {}: {e}", weights.display()))?;
+        let text = serde_json::to_string_pretty(&config).map_err(|e| e.to_string())?;
+        std::fs::write(dir.join(CONFIG_FILE), text + "\n")
+            .map_err(|e| format!("cannot write {}: {e}", dir.join(CONFIG_FILE).display()))
+    }
+}
+
+/// The GGUF row of Hugging Face's row `row` in a q or k projection with heads of
+/// `head_dim`: within a head, HF's `s·half + i` is GGUF's `2i + s`.
+fn gguf_row(row: usize, head_dim: usize) -> usize {
+    let half = head_dim / 2;
+    let (head, within) = (row / head_dim, row % head_dim);
+    let (s, i) = (within / half, within % half);
+    head * head_dim + 2 * i + s
+}
+
+/// `b`'s rows (`[out, cols]`) from Hugging Face's order to the GGUF's.
+pub fn hf_to_gguf_rows(b: &[f32], cols: usize, head_dim: usize) -> Vec<f32> {
+    let mut out = vec![0f32; b.len()];
+    for (row, values) in b.chunks_exact(cols).enumerate() {
+        let to = gguf_row(row, head_dim);
+        out[to * cols..(to + 1) * cols].copy_from_slice(values);
+    }
+    out
+}
+
+/// `b`'s rows (`[out, cols]`) from the GGUF's order to Hugging Face's.
+pub fn gguf_to_hf_rows(b: &[f32], cols: usize, head_dim: usize) -> Vec<f32> {
+    let mut out = vec![0f32; b.len()];
+    for (row, values) in out.chunks_exact_mut(cols).enumerate() {
+        let from = gguf_row(row, head_dim);
+        values.copy_from_slice(&b[from * cols..(from + 1) * cols]);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn row_orders_round_trip() {
+        let b: Vec<f32> = (0..16 * 3).map(|x| x as f32).collect();
+        let g = hf_to_gguf_rows(&b, 3, 8);
+        assert_ne!(g, b);
+        assert_eq!(gguf_to_hf_rows(&g, 3, 8), b);
+        // HF's row 4 (the second half's first) of head 0 is GGUF's row 1
+        assert_eq!(&g[3..6], &b[12..15]);
+    }
+
+    #[test]
+    fn names_round_trip() {
+        for t in Target::ALL {
+            assert_eq!(parse_name(&tensor_name(7, t, true)), Some((7, t, true)));
+            assert_eq!(parse_name(&tensor_name(0, t, false)), Some((0, t, false)));
+        }
+        assert_eq!(parse_name("base_model.model.model.layers.0.mlp.q_proj.lora_A.weight"), None);
+    }
+}
