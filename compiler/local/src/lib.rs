@@ -21,9 +21,10 @@ use std::sync::{Arc, Mutex};
 
 use tad_llm::{Chat, ChatFuture, Error, ErrorKind, OnText, Request};
 
-pub use adapter::{Adapter, BASE_MODEL, Lora, Target, gguf_to_hf_rows, hf_to_gguf_rows};
+pub use adapter::{Adapter, BASE_MODEL, Lora, Target, gguf_to_hf_rows, hf_to_gguf_rows, tensor_name};
 pub use engine::{Engine, Timing, chatml, tokenizer};
 pub use llama::Shape;
+pub use tokenizers::Tokenizer;
 
 /// A model TADSL can fetch and run.
 #[derive(Clone, Copy, Debug)]

@@ -1,0 +1,440 @@
+//! LoRA training: on a tiny random llama built in memory (the loss falls, the adapter
+//! round-trips, B = 0 is the base model, gradients match finite differences, malformed
+//! adapters are errors), and on the real local model when it is installed (or
+//! `TAD_REQUIRE_MODEL=1`): the f32 training forward pass against tad-local's quantized
+//! decoder, with and without an adapter, and a few steps of training.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use tad_finetune::{Adapter, Config, Example, LoraSet, Message, Progress, Rng, Sample, Target, Weights};
+use tad_local::{Lora, Shape};
+
+fn tiny_shape() -> Shape {
+    Shape {
+        layers: 2,
+        dim: 32,
+        hidden: 64,
+        heads: 4,
+        kv_heads: 2,
+        head_dim: 8,
+        context: 256,
+        eps: 1e-5,
+        rope_base: 10_000.0,
+    }
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tad-finetune-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn cosine(a: &[f32], b: &[f32]) -> f32 {
+    let dot: f32 = a.iter().zip(b).map(|(x, y)| x * y).sum();
+    let norm = |v: &[f32]| v.iter().map(|x| x * x).sum::<f32>().sqrt();
+    dot / (norm(a) * norm(b))
+}
+
+fn argmax(v: &[f32]) -> usize {
+    v.iter().enumerate().fold((0, f32::NEG_INFINITY), |(bi, bv), (i, &x)| if x > bv { (i, x) } else { (bi, bv) }).0
+}
+
+/// An adapter with random A and B (so it changes the model), in PEFT's layout.
+fn random_adapter(shape: &Shape, rank: usize, targets: &[Target], seed: u64, bound: f32) -> Adapter {
+    let mut rng = Rng(seed);
+    let mut layers = BTreeMap::new();
+    for layer in 0..shape.layers {
+        for &t in targets {
+            let (inputs, outputs) = t.dims(shape);
+            let a = (0..rank * inputs).map(|_| rng.uniform(1.0 / (inputs as f32).sqrt())).collect();
+            let b = (0..outputs * rank).map(|_| rng.uniform(bound)).collect();
+            layers.insert((layer, t), Lora { a, b, inputs, outputs });
+        }
+    }
+    Adapter {
+        rank,
+        alpha: 2.0 * rank as f32,
+        rslora: false,
+        targets: targets.to_vec(),
+        base_model: tad_local::BASE_MODEL.into(),
+        layers,
+    }
+}
+
+#[test]
+fn the_loss_falls_on_a_repeated_example_and_the_adapter_reloads() {
+    let shape = tiny_shape();
+    let weights = Weights::random(shape, 40, 7).unwrap();
+    let sample = Sample { tokens: vec![1, 5, 9, 3, 12, 30, 2, 8, 17, 25, 4, 33, 6, 21, 11, 39], answer: 6 };
+    let samples = vec![sample.clone(); 4];
+    let config =
+        Config { rank: 4, alpha: 8.0, learning_rate: 1e-2, epochs: 6, max_len: 64, seed: 3, ..Config::default() };
+    let out = scratch("tiny");
+    let mut seen = Vec::new();
+    let report =
+        tad_finetune::train_samples(&weights, &samples, &config, &out, &mut |p: &Progress| seen.push(p.clone()))
+            .unwrap();
+    assert_eq!(report.steps, 24);
+    assert_eq!(seen.len(), 24);
+    assert_eq!(seen.last().unwrap().epoch, 5);
+    let (first, last) = (report.losses[0], *report.losses.last().unwrap());
+    assert!(last < 0.5 * first, "the loss went from {first} to {last}: {:?}", report.losses);
+
+    // the files hold what was trained: reloaded, the loss is the trained one
+    let adapter = Adapter::load(&out).unwrap();
+    assert_eq!(adapter.rank, 4);
+    assert_eq!(adapter.targets, Target::ALL.to_vec());
+    let lora = LoraSet::from_adapter(&adapter, &shape).unwrap();
+    let rope = tad_finetune::Rope::new(&shape, 64).unwrap();
+    let reloaded = weights.loss(&sample.tokens, sample.answer, Some(&lora), &rope).unwrap().to_scalar::<f32>().unwrap();
+    let base = weights.loss(&sample.tokens, sample.answer, None, &rope).unwrap().to_scalar::<f32>().unwrap();
+    assert!((base - first).abs() < 1e-4, "step 1's loss {first} is the base model's {base}");
+    assert!(reloaded < last * 1.01 + 1e-3, "reloaded {reloaded}, trained {last}");
+    // and written again, the same tensors
+    let again = scratch("tiny-again");
+    lora.to_adapter(&shape).unwrap().save(&again).unwrap();
+    assert_eq!(Adapter::load(&again).unwrap(), adapter);
+    let raw = candle_core::safetensors::load(out.join("adapter_model.safetensors"), &candle_core::Device::Cpu).unwrap();
+    assert_eq!(raw.len(), 2 * 7 * shape.layers);
+    let q_b = &raw["base_model.model.model.layers.1.self_attn.q_proj.lora_B.weight"];
+    assert_eq!(q_b.dims(), &[32, 4]);
+    let values: Vec<f32> = q_b.flatten_all().unwrap().to_vec1().unwrap();
+    assert_eq!(values, adapter.layers[&(1, Target::Q)].b);
+    let config: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("adapter_config.json")).unwrap()).unwrap();
+    assert_eq!(config["peft_type"], "LORA");
+    assert_eq!(config["task_type"], "CAUSAL_LM");
+    assert_eq!(config["r"], 4);
+    assert_eq!(config["base_model_name_or_path"], "HuggingFaceTB/SmolLM2-135M-Instruct");
+}
+
+#[test]
+fn a_resumed_run_ends_where_an_uninterrupted_one_does() {
+    let shape = tiny_shape();
+    let weights = Weights::random(shape, 40, 11).unwrap();
+    let samples: Vec<Sample> = (0..5u32)
+        .map(|i| Sample { tokens: (0..12).map(|j| (i * 7 + j * 3) % 40).collect(), answer: 4 + i as usize % 3 })
+        .collect();
+    let config = Config {
+        rank: 2,
+        alpha: 4.0,
+        targets: vec![Target::Q, Target::V, Target::Down],
+        learning_rate: 5e-3,
+        epochs: 2,
+        accumulate: 2,
+        max_len: 64,
+        seed: 9,
+        checkpoint_every: 2,
+        ..Config::default()
+    };
+    let whole = scratch("whole");
+    let full = tad_finetune::train_samples(&weights, &samples, &config, &whole, &mut |_| {}).unwrap();
+    assert_eq!(full.steps, 6); // 3 steps an epoch (2 + 2 + 1 examples)
+
+    // stop after the checkpoint at step 4, then resume
+    let part = scratch("part");
+    let stopped = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        tad_finetune::train_samples(&weights, &samples, &config, &part, &mut |p| {
+            if p.step == 4 {
+                assert!(p.checkpoint.is_some());
+                panic!("interrupted after step 4");
+            }
+        })
+    }));
+    assert!(stopped.is_err());
+    assert!(!part.join("adapter_model.safetensors").exists());
+    let resume = Config { resume: true, ..config.clone() };
+    let rest = tad_finetune::train_samples(&weights, &samples, &resume, &part, &mut |_| {}).unwrap();
+    assert_eq!(rest.resumed_at, Some(4));
+    assert_eq!(rest.steps_run, 2);
+    assert_eq!(rest.losses.len(), 6);
+    for (a, b) in rest.losses.iter().zip(&full.losses) {
+        assert!((a - b).abs() < 1e-5, "{:?} vs {:?}", rest.losses, full.losses);
+    }
+    let (a, b) = (Adapter::load(&whole).unwrap(), Adapter::load(&part).unwrap());
+    for (key, lora) in &a.layers {
+        let other = &b.layers[key];
+        let diff = lora.b.iter().zip(&other.b).map(|(x, y)| (x - y).abs()).fold(0f32, f32::max);
+        assert!(diff < 1e-5, "{key:?} differs by {diff}");
+    }
+    // a checkpoint of another run is refused
+    let other = Config { seed: 10, ..resume };
+    assert!(
+        tad_finetune::train_samples(&weights, &samples, &other, &part, &mut |_| {})
+            .unwrap_err()
+            .contains("another run")
+    );
+}
+
+#[test]
+fn with_b_zero_the_adapter_is_the_base_model_and_gradients_match_finite_differences() {
+    let shape = tiny_shape();
+    let weights = Weights::random(shape, 40, 5).unwrap();
+    let tokens = [3u32, 14, 15, 9, 26, 5, 35, 8, 9, 7];
+    let zero = LoraSet::new(&shape, 4, 8.0, &Target::ALL, 1).unwrap();
+    assert_eq!(weights.logits(&tokens, Some(&zero)).unwrap(), weights.logits(&tokens, None).unwrap());
+
+    // the loss's gradient in one element of B and of A against central differences
+    let adapter = random_adapter(&shape, 4, &Target::ALL, 2, 0.2);
+    let lora = LoraSet::from_adapter(&adapter, &shape).unwrap();
+    let rope = tad_finetune::Rope::new(&shape, tokens.len()).unwrap();
+    let loss = weights.loss(&tokens, 4, Some(&lora), &rope).unwrap();
+    let grads = loss.backward().unwrap();
+    for (name, index) in [
+        ("base_model.model.model.layers.0.self_attn.q_proj.lora_B.weight", 5),
+        ("base_model.model.model.layers.1.self_attn.k_proj.lora_A.weight", 17),
+        ("base_model.model.model.layers.1.mlp.down_proj.lora_B.weight", 3),
+    ] {
+        let var = lora.named().into_iter().find(|(n, _)| n == name).unwrap().1;
+        let analytic: Vec<f32> = grads.get(var.as_tensor()).unwrap().flatten_all().unwrap().to_vec1().unwrap();
+        let original: Vec<f32> = var.as_tensor().flatten_all().unwrap().to_vec1().unwrap();
+        let at = |delta: f32| {
+            let mut v = original.clone();
+            v[index] += delta;
+            var.set(&candle_core::Tensor::from_vec(v, var.shape(), &candle_core::Device::Cpu).unwrap()).unwrap();
+            weights.loss(&tokens, 4, Some(&lora), &rope).unwrap().to_scalar::<f32>().unwrap() as f64
+        };
+        let h = 1e-2;
+        let numeric = (at(h) - at(-h)) / (2.0 * h as f64);
+        at(0.0);
+        let a = analytic[index] as f64;
+        assert!((a - numeric).abs() < 0.02 * a.abs().max(numeric.abs()) + 1e-4, "{name}[{index}]: {a} vs {numeric}");
+        assert!(a.abs() > 1e-5, "{name}[{index}]: a zero gradient proves nothing");
+    }
+}
+
+fn edit_tensors(d: &Path, edit: &dyn Fn(&mut std::collections::HashMap<String, candle_core::Tensor>)) {
+    let path = d.join("adapter_model.safetensors");
+    let mut t = candle_core::safetensors::load(&path, &candle_core::Device::Cpu).unwrap();
+    edit(&mut t);
+    candle_core::safetensors::save(&t, &path).unwrap();
+}
+
+fn write_adapter(dir: &Path, adapter: &Adapter) {
+    adapter.save(dir).unwrap();
+}
+
+#[test]
+fn a_malformed_adapter_is_an_error() {
+    let shape = tiny_shape();
+    let good = random_adapter(&shape, 4, &[Target::Q, Target::Up], 1, 0.1);
+    let dir = scratch("malformed");
+    write_adapter(&dir, &good);
+    let loaded = Adapter::load(&dir).unwrap();
+    loaded.check(&shape).unwrap();
+    assert_eq!(loaded, good);
+
+    // another model's shape
+    let wider = Shape { dim: 64, ..shape };
+    assert!(loaded.check(&wider).unwrap_err().contains("features"));
+    let deeper = Shape { layers: 3, ..shape };
+    assert!(loaded.check(&deeper).unwrap_err().contains("layers"));
+    assert!(LoraSet::from_adapter(&loaded, &wider).is_err());
+
+    // a missing config, a garbage config, a config of another kind
+    let case = |name: &str, edit: &dyn Fn(&Path)| -> String {
+        let d = scratch(name);
+        write_adapter(&d, &good);
+        edit(&d);
+        Adapter::load(&d).expect_err(name)
+    };
+    case("no-config", &|d| std::fs::remove_file(d.join("adapter_config.json")).unwrap());
+    case("bad-config", &|d| std::fs::write(d.join("adapter_config.json"), "{not json").unwrap());
+    case("not-lora", &|d| {
+        std::fs::write(
+            d.join("adapter_config.json"),
+            r#"{"peft_type":"IA3","r":4,"lora_alpha":8,"target_modules":["q_proj"]}"#,
+        )
+        .unwrap()
+    });
+    let text = |r: u64, targets: &str| {
+        format!(r#"{{"peft_type":"LORA","r":{r},"lora_alpha":8,"target_modules":{targets},"bias":"none"}}"#)
+    };
+    // a rank the tensors do not have
+    let e =
+        case("rank", &|d| std::fs::write(d.join("adapter_config.json"), text(8, r#"["q_proj","up_proj"]"#)).unwrap());
+    assert!(e.contains("rank 8"), "{e}");
+    // tensors for a module the config does not name
+    case("targets", &|d| std::fs::write(d.join("adapter_config.json"), text(4, r#"["q_proj"]"#)).unwrap());
+    case("unknown-target", &|d| std::fs::write(d.join("adapter_config.json"), text(4, r#"["lm_head"]"#)).unwrap());
+    // garbage, truncated or missing weights
+    case("garbage", &|d| std::fs::write(d.join("adapter_model.safetensors"), b"\x10\0\0\0\0\0\0\0garbage").unwrap());
+    case("empty", &|d| std::fs::write(d.join("adapter_model.safetensors"), b"").unwrap());
+    case("huge-header", &|d| std::fs::write(d.join("adapter_model.safetensors"), u64::MAX.to_le_bytes()).unwrap());
+    case("truncated", &|d| {
+        let bytes = std::fs::read(d.join("adapter_model.safetensors")).unwrap();
+        std::fs::write(d.join("adapter_model.safetensors"), &bytes[..bytes.len() / 2]).unwrap()
+    });
+    case("no-weights", &|d| std::fs::remove_file(d.join("adapter_model.safetensors")).unwrap());
+    // a layer without one of its pairs, one half of a pair, a wrong shape, a NaN
+    let e = case("missing-pair", &|d| {
+        edit_tensors(d, &|t| {
+            t.retain(|k, _| !k.contains("layers.0.mlp.up_proj"));
+        })
+    });
+    assert!(e.contains("layer 0 has no up_proj"), "{e}");
+    case("half", &|d| {
+        edit_tensors(d, &|t| {
+            t.remove("base_model.model.model.layers.1.self_attn.q_proj.lora_B.weight");
+        })
+    });
+    case("shape", &|d| {
+        edit_tensors(d, &|t| {
+            let wrong =
+                candle_core::Tensor::zeros((4, 4, 2), candle_core::DType::F32, &candle_core::Device::Cpu).unwrap();
+            t.insert("base_model.model.model.layers.1.self_attn.q_proj.lora_A.weight".into(), wrong);
+        })
+    });
+    case("nan", &|d| {
+        edit_tensors(d, &|t| {
+            let nan = candle_core::Tensor::full(f32::NAN, (4, 32), &candle_core::Device::Cpu).unwrap();
+            t.insert("base_model.model.model.layers.1.self_attn.q_proj.lora_A.weight".into(), nan);
+        })
+    });
+    case("stray", &|d| {
+        edit_tensors(d, &|t| {
+            let x = candle_core::Tensor::zeros((4, 32), candle_core::DType::F32, &candle_core::Device::Cpu).unwrap();
+            t.insert("base_model.model.lm_head.lora_A.weight".into(), x);
+        })
+    });
+    // a dimension that does not fit the model is caught by check, not by a panic later
+    let d = scratch("wide-in");
+    let mut wide = good.clone();
+    for lora in wide.layers.values_mut() {
+        lora.inputs *= 2;
+        lora.a = vec![0.0; lora.a.len() * 2];
+    }
+    write_adapter(&d, &wide);
+    assert!(Adapter::load(&d).unwrap().check(&shape).is_err());
+}
+
+#[test]
+fn examples_are_tokenized_as_the_engine_reads_them() {
+    let Some(path) = gguf() else { return };
+    let mut file = std::fs::File::open(&path).unwrap();
+    let content = candle_core::quantized::gguf_file::Content::read(&mut file).unwrap();
+    let tokenizer = tad_local::tokenizer(&content).unwrap();
+    let example = Example {
+        prompt: vec![
+            Message { role: "system".into(), content: "Write TAD.".into() },
+            Message { role: "user".into(), content: "A bus drives ahead of the ego car.".into() },
+        ],
+        completion: "scenario bus_ahead {}".into(),
+    };
+    let (sample, warning) = tad_finetune::tokenize(&tokenizer, &example, 1024).unwrap();
+    let sample = sample.unwrap();
+    assert!(warning.is_none());
+    let (prompt, _) =
+        tad_local::chatml(&tokenizer, &[("system", "Write TAD."), ("user", "A bus drives ahead of the ego car.")])
+            .unwrap();
+    assert_eq!(&sample.tokens[..sample.answer], prompt.as_slice());
+    assert_eq!(*sample.tokens.last().unwrap(), tokenizer.token_to_id("<|im_end|>").unwrap());
+    let text = tokenizer.decode(&sample.tokens[sample.answer..], false).unwrap();
+    assert_eq!(text, "scenario bus_ahead {}<|im_end|>");
+    let (cut, warning) = tad_finetune::tokenize(&tokenizer, &example, sample.answer + 2).unwrap();
+    assert_eq!(cut.unwrap().tokens.len(), sample.answer + 2);
+    assert!(warning.unwrap().contains("cut"));
+    let (none, warning) = tad_finetune::tokenize(&tokenizer, &example, sample.answer).unwrap();
+    assert!(none.is_none() && warning.unwrap().contains("dropped"));
+}
+
+/// The default model's file, fetched when `TAD_REQUIRE_MODEL` is set; else `None`.
+fn gguf() -> Option<PathBuf> {
+    let model = tad_local::model(tad_local::DEFAULT)?;
+    if model.installed().is_none() && std::env::var_os("TAD_REQUIRE_MODEL").is_some() {
+        let python = std::env::var("TADSL_PYTHON").unwrap_or_else(|_| "python3".into());
+        static FETCHED: std::sync::Mutex<()> = std::sync::Mutex::new(());
+        let _one = FETCHED.lock();
+        if model.installed().is_none() {
+            model.fetch(&python, &mut |l| eprintln!("{l}")).expect("TAD_REQUIRE_MODEL: the model is fetched");
+        }
+    }
+    let path = model.installed();
+    if path.is_none() {
+        eprintln!("SKIPPED: the local model is not installed (tadslc model fetch)");
+    }
+    path
+}
+
+fn prompt_tokens(path: &Path) -> Vec<u32> {
+    let mut file = std::fs::File::open(path).unwrap();
+    let content = candle_core::quantized::gguf_file::Content::read(&mut file).unwrap();
+    let tokenizer = tad_local::tokenizer(&content).unwrap();
+    tad_local::chatml(&tokenizer, &[("user", "A bus drives ahead of the ego car.")]).unwrap().0
+}
+
+#[test]
+fn the_training_forward_pass_agrees_with_the_quantized_decoder() {
+    let Some(path) = gguf() else { return };
+    let tokens = prompt_tokens(&path);
+    let (weights, _) = Weights::load(&path).unwrap();
+    let ours = weights.logits(&tokens, None).unwrap();
+    let mut engine = tad_local::Engine::load(&path, 1).unwrap();
+    let theirs = engine.logits(&tokens);
+    assert_eq!(ours.len(), theirs.len());
+    assert_eq!(argmax(&ours), argmax(&theirs));
+    assert!(cosine(&ours, &theirs) > 0.99, "cosine {}", cosine(&ours, &theirs));
+}
+
+#[test]
+fn an_adapter_in_the_decoder_agrees_with_the_training_forward_pass() {
+    let Some(path) = gguf() else { return };
+    let tokens = prompt_tokens(&path);
+    let (weights, _) = Weights::load(&path).unwrap();
+    let shape = weights.shape;
+    let base = weights.logits(&tokens, None).unwrap();
+    // q and k alone first: a wrong row order between HF's layout and the GGUF's shows here
+    for (targets, bound) in [(vec![Target::Q, Target::K], 2.0), (Target::ALL.to_vec(), 0.5)] {
+        let adapter = random_adapter(&shape, 8, &targets, 4, bound);
+        let dir = scratch(&format!("real-{}", targets.len()));
+        adapter.save(&dir).unwrap();
+        let adapter = Adapter::load(&dir).unwrap();
+        let lora = LoraSet::from_adapter(&adapter, &shape).unwrap();
+        let trained = weights.logits(&tokens, Some(&lora)).unwrap();
+        let changed = cosine(&trained, &base);
+        let mut engine = tad_local::Engine::load_with(&path, 1, Some(&adapter)).unwrap();
+        let decoded = engine.logits(&tokens);
+        let c = cosine(&trained, &decoded);
+        eprintln!("{targets:?}: cosine with the base {changed}, with the decoder {c}");
+        assert!(changed < 0.995, "the adapter barely changes the model: {changed}");
+        assert!(c > 0.995, "{targets:?}: cosine {c}");
+        assert_eq!(argmax(&trained), argmax(&decoded), "{targets:?}");
+        if targets.len() == 2 {
+            // the control: B's q/k rows in the other order disagree clearly
+            let mut wrong = adapter.clone();
+            for ((_, t), lora) in wrong.layers.iter_mut() {
+                if t.roped() {
+                    lora.b = tad_local::hf_to_gguf_rows(&lora.b, 8, shape.head_dim);
+                }
+            }
+            let mut engine = tad_local::Engine::load_with(&path, 1, Some(&wrong)).unwrap();
+            let w = cosine(&trained, &engine.logits(&tokens));
+            eprintln!("rows in the wrong order: cosine {w}");
+            assert!(1.0 - w > 4.0 * (1.0 - c), "the wrong order agrees as well: {w} vs {c}");
+        }
+    }
+}
+
+#[test]
+fn a_few_steps_on_the_real_model() {
+    let Some(path) = gguf() else { return };
+    let example = |region: &str| Example {
+        prompt: vec![
+            Message { role: "system".into(), content: "You write TAD scenarios.".into() },
+            Message { role: "user".into(), content: format!("Write a TAD scenario for the region {region}.") },
+        ],
+        completion: format!("scenario {region}_cut_in {{\n  road: straight_road\n}}\n"),
+    };
+    let examples = vec![example("urban"), example("highway")];
+    let config = Config { rank: 4, alpha: 8.0, epochs: 2, max_len: 128, learning_rate: 1e-3, ..Config::default() };
+    let out = scratch("real-train");
+    let report = tad_finetune::train(&path, &examples, &config, &out, &mut |_| {}).unwrap();
+    assert_eq!(report.steps, 4);
+    assert!(report.losses.iter().all(|l| l.is_finite()));
+    assert!(report.losses[3] < report.losses[0], "{:?}", report.losses);
+    let adapter = Adapter::load(&out).unwrap();
+    let mut engine = tad_local::Engine::load_with(&path, 1, Some(&adapter)).unwrap();
+    assert_eq!(engine.logits(&prompt_tokens(&path)).len(), 49_152);
+}
