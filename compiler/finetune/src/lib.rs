@@ -311,7 +311,7 @@ pub fn train_samples(
         step: 0,
         epoch: 0,
         position: 0,
-        rng: config.seed ^ 0x5EED_0F_0DE5,
+        rng: config.seed ^ 0x005E_ED0F_0DE5,
         losses: Vec::new(),
         seed: config.seed,
         rank: config.rank,
