@@ -63,6 +63,9 @@ pub struct LlmArgs {
     /// Threads of the local model
     #[arg(long, value_name = "N", default_value_t = 1)]
     pub threads: usize,
+    /// A LoRA adapter for the local model (a PEFT directory, as `tadslc finetune` writes)
+    #[arg(long, value_name = "DIR")]
+    pub adapter: Option<PathBuf>,
     /// Seed of the requests (and of the client's backoff)
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
@@ -104,6 +107,9 @@ impl LlmArgs {
         let config = Config::resolve(&cli, &env, file.as_ref().map(|(n, t)| (n.as_str(), t.as_str())), self.seed)
             .map_err(|e| e.to_string())?;
         match config {
+            Some(_) if self.adapter.is_some() => {
+                Err("--adapter applies to the local model only, and a server is configured (pass --model local)".into())
+            }
             Some(config) => Ok(Backend::Server(Client::new(config).map_err(|e| e.to_string())?)),
             None => self.local(
                 tad_local::DEFAULT,
@@ -117,7 +123,9 @@ impl LlmArgs {
             let names: Vec<&str> = tad_local::MODELS.iter().map(|m| m.name).collect();
             format!("unknown local model `{name}` (the local models are: {})", names.join(", "))
         })?;
-        let chat = tad_local::LocalChat::load(model, self.threads).map_err(|e| format!("{e}{}", why.unwrap_or("")))?;
+        let adapter = self.adapter.as_deref().map(tad_local::Adapter::load).transpose()?;
+        let chat = tad_local::LocalChat::load_with(model, self.threads, adapter.as_ref())
+            .map_err(|e| format!("{e}{}", why.unwrap_or("")))?;
         Ok(Backend::Local(chat))
     }
 

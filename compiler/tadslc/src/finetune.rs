@@ -1,0 +1,190 @@
+//! `tadslc finetune`: LoRA fine-tuning of the local model on chat examples (`tad-finetune`),
+//! with a progress bar; the adapter is a PEFT directory `--adapter` reads back.
+
+use std::path::{Path, PathBuf};
+
+use tad_finetune::{Config, Progress, Target};
+
+/// Fine-tune the local model with LoRA on chat examples
+#[derive(clap::Args, Debug, Clone)]
+pub struct FinetuneArgs {
+    /// Examples: a JSONL file (TRL's `messages`, or `prompt` and `completion`), or a
+    /// directory holding train.jsonl
+    pub data: PathBuf,
+    /// The adapter's directory (PEFT: adapter_model.safetensors, adapter_config.json)
+    #[arg(short, long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// LoRA rank
+    #[arg(long, value_name = "R", default_value_t = 16)]
+    pub rank: usize,
+    /// LoRA alpha (the update is scaled by alpha / rank)
+    #[arg(long, default_value_t = 32.0)]
+    pub alpha: f32,
+    /// Projections to adapt, from q,k,v,o,gate,up,down
+    #[arg(long, value_delimiter = ',', default_value = "q,k,v,o,gate,up,down")]
+    pub targets: Vec<String>,
+    /// AdamW's learning rate
+    #[arg(long, default_value_t = 2e-4)]
+    pub lr: f64,
+    /// Passes over the examples
+    #[arg(long, value_name = "N", default_value_t = 2)]
+    pub epochs: usize,
+    /// Tokens per example (longer answers are cut, with a warning)
+    #[arg(long, value_name = "N", default_value_t = 1024)]
+    pub max_len: usize,
+    /// Examples per optimizer step (gradients averaged)
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub accumulate: usize,
+    /// Seed of the initialisation and of the examples' order
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Write a checkpoint every N steps (0: never)
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub checkpoint_every: usize,
+    /// Continue from the checkpoint in the output directory
+    #[arg(long)]
+    pub resume: bool,
+    /// The local model to adapt
+    #[arg(long, default_value = tad_local::DEFAULT)]
+    pub model: String,
+}
+
+/// The examples' file: `data` itself, or `data/train.jsonl`.
+fn data_file(data: &Path) -> PathBuf {
+    match data.is_dir() {
+        true => data.join("train.jsonl"),
+        false => data.to_path_buf(),
+    }
+}
+
+impl FinetuneArgs {
+    fn config(&self) -> Result<Config, String> {
+        let mut targets = Vec::new();
+        for name in &self.targets {
+            let t = Target::parse(name.trim())
+                .ok_or_else(|| format!("unknown target `{name}` (the targets are q, k, v, o, gate, up, down)"))?;
+            targets.push(t);
+        }
+        if self.rank == 0 || self.epochs == 0 || self.max_len < 2 || targets.is_empty() {
+            return Err("--rank, --epochs and --targets must not be zero or empty, --max-len at least 2".into());
+        }
+        if !(self.lr.is_finite() && self.lr > 0.0) || !self.alpha.is_finite() {
+            return Err("--lr must be a positive number and --alpha a number".into());
+        }
+        Ok(Config {
+            rank: self.rank,
+            alpha: self.alpha,
+            targets,
+            learning_rate: self.lr,
+            epochs: self.epochs,
+            max_len: self.max_len,
+            accumulate: self.accumulate.max(1),
+            seed: self.seed,
+            checkpoint_every: self.checkpoint_every,
+            resume: self.resume,
+            ..Config::default()
+        })
+    }
+}
+
+fn bar(steps: usize) -> indicatif::ProgressBar {
+    use std::io::IsTerminal;
+    if !std::io::stderr().is_terminal() {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new(steps as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} steps {msg} [{elapsed}, eta {eta}]")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar
+}
+
+/// Runs `tadslc finetune`: 0 when the adapter is written, 2 for a usage or I/O error (bad
+/// flags, unreadable examples, no model), 1 when training fails.
+pub fn finetune(args: &FinetuneArgs) -> i32 {
+    let config = match args.config() {
+        Ok(c) => c,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    };
+    let file = data_file(&args.data);
+    let examples = match std::fs::read_to_string(&file)
+        .map_err(|e| format!("cannot read {}: {e}", file.display()))
+        .and_then(|text| tad_finetune::read_jsonl(&text).map_err(|e| format!("{}: {e}", file.display())))
+    {
+        Ok(x) if x.is_empty() => {
+            eprintln!("error: {} holds no examples", file.display());
+            return 2;
+        }
+        Ok(x) => x,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    };
+    let gguf = match tad_local::model(&args.model) {
+        Some(model) => model.require(),
+        None => Err(format!("unknown local model `{}`", args.model)),
+    };
+    let gguf = match gguf {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    };
+    let mut progress: Option<indicatif::ProgressBar> = None;
+    let terminal = {
+        use std::io::IsTerminal;
+        std::io::stderr().is_terminal()
+    };
+    let result = tad_finetune::train(&gguf, &examples, &config, &args.out, &mut |p: &Progress| {
+        let bar = progress.get_or_insert_with(|| bar(p.steps));
+        bar.set_position(p.step as u64);
+        bar.set_message(format!("epoch {} loss {:.4} {:.0} tokens/s", p.epoch + 1, p.loss, p.tokens_per_s));
+        if !terminal {
+            eprintln!(
+                "step {}/{} epoch {} loss {:.4} {:.1} tokens/s",
+                p.step,
+                p.steps,
+                p.epoch + 1,
+                p.loss,
+                p.tokens_per_s
+            );
+        }
+        if let Some(dir) = &p.checkpoint {
+            bar.suspend(|| eprintln!("checkpoint: {}", dir.display()));
+        }
+    });
+    if let Some(bar) = progress {
+        bar.finish_and_clear();
+    }
+    match result {
+        Ok(report) => {
+            for w in &report.warnings {
+                eprintln!("warning: {w}");
+            }
+            if let Some(step) = report.resumed_at {
+                eprintln!("resumed after step {step}");
+            }
+            let first = report.losses.first().copied().unwrap_or(f32::NAN);
+            let last = report.losses.last().copied().unwrap_or(f32::NAN);
+            println!(
+                "wrote the adapter to {}: {} examples, {} steps, loss {first:.4} -> {last:.4}, {:.1} tokens/s",
+                report.adapter.display(),
+                report.examples,
+                report.steps,
+                report.tokens_per_s
+            );
+            0
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            // what could not be read or written is the caller's to fix
+            if e.starts_with("cannot ") || e.contains("another run") || e.contains("no examples") { 2 } else { 1 }
+        }
+    }
+}
