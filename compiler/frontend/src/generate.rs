@@ -19,6 +19,9 @@ pub struct Spec<'a> {
     pub n: usize,
     pub seed: u64,
     pub baseline: bool,
+    /// Ask with the short prompt a fine-tuned model was trained on (`generate-tuned.v1`):
+    /// the region's name only, the rest is in the model's weights.
+    pub tuned: bool,
     pub vocabulary: &'a Vocabulary,
     pub region_description: Option<String>,
     /// Scenarios of the region shown as examples (aligned mode), at most two used.
@@ -42,7 +45,20 @@ pub struct Record {
     pub outcome: Outcome,
 }
 
+/// The tuned prompt of item `index` for `region`: what `tadslc sft-export` trains on and
+/// `gen --adapter` asks.
+pub fn tuned_messages(region: &str, index: usize) -> Vec<tad_llm::Message> {
+    prompt::GENERATE_TUNED.messages(&[("region", region), ("index", &(index + 1).to_string())])
+}
+
+fn template(spec: &Spec) -> prompt::Template {
+    if spec.tuned { prompt::GENERATE_TUNED } else { prompt::GENERATE }
+}
+
 pub fn messages(spec: &Spec, index: usize) -> Vec<tad_llm::Message> {
+    if spec.tuned {
+        return tuned_messages(spec.region, index);
+    }
     let vocabulary = prompt::vocabulary(spec.vocabulary);
     let (clause, examples) = if spec.baseline {
         (String::new(), String::new())
@@ -75,7 +91,14 @@ pub async fn run(
         Some(dir) => Some(store::Jsonl::append(&dir.join("gen.jsonl"))?),
         None => None,
     };
-    let mode = if spec.baseline { "baseline" } else { "aligned" };
+    let mode = if spec.tuned {
+        "tuned"
+    } else if spec.baseline {
+        "baseline"
+    } else {
+        "aligned"
+    };
+    let template = template(spec);
     let rounds = std::sync::Mutex::new(Vec::<Round>::new());
     let mut items = futures_util::stream::iter(0..spec.n)
         .map(|i| {
@@ -84,7 +107,7 @@ pub async fn run(
                 let item_session = session.with_seed(spec.seed.wrapping_add(i as u64));
                 let id = format!("{}-{mode}-{i}", spec.region);
                 let outcome = item_session
-                    .run(&id, messages(spec, i), prompt::GENERATE.id, &mut |r| rounds.lock().unwrap().push(r.clone()))
+                    .run(&id, messages(spec, i), template.id, &mut |r| rounds.lock().unwrap().push(r.clone()))
                     .await;
                 (i, outcome)
             }
@@ -106,7 +129,7 @@ pub async fn run(
                     spec.seed.wrapping_add(i as u64),
                     outcome.rounds,
                     if outcome.rounds == 1 { "" } else { "s" },
-                    prompt::GENERATE.id
+                    template.id
                 )],
                 region: Some(spec.region.to_string()),
                 ..Default::default()
@@ -126,7 +149,7 @@ pub async fn run(
             region: spec.region.to_string(),
             seed: spec.seed.wrapping_add(i as u64),
             model: spec.model.clone(),
-            prompt: prompt::GENERATE.id,
+            prompt: template.id,
             outcome,
         };
         if let Some(m) = manifest.as_mut() {

@@ -1,0 +1,221 @@
+//! Plots as standalone SVG: grouped bar charts of histograms, and a scatter of embeddings
+//! projected to two dimensions (PCA over the pooled points, like the paper's Figure 3,
+//! which uses UMAP). Colours are the Okabe–Ito palette (distinguishable with colour
+//! blindness); text is escaped; the output is deterministic.
+
+use std::fmt::Write;
+
+use crate::stats::Histogram;
+
+const COLOURS: &[&str] = &["#0072B2", "#E69F00", "#009E73", "#CC79A7", "#56B4E9", "#D55E00", "#F0E442", "#000000"];
+const FONT: &str = "font-family=\"Helvetica, Arial, sans-serif\"";
+
+fn escape(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+}
+
+fn legend(out: &mut String, names: &[&str], x: f64, y: f64) {
+    for (i, name) in names.iter().enumerate() {
+        let yy = y + i as f64 * 18.0;
+        let _ = write!(
+            out,
+            "<rect x=\"{x}\" y=\"{}\" width=\"12\" height=\"12\" fill=\"{}\"/><text x=\"{}\" y=\"{}\" font-size=\"12\" {FONT}>{}</text>",
+            yy - 10.0,
+            COLOURS[i % COLOURS.len()],
+            x + 18.0,
+            yy,
+            escape(name)
+        );
+    }
+}
+
+/// Shares of each value per corpus, bars side by side; values by total share, at most
+/// `max_values` of them.
+pub fn bars(title: &str, corpora: &[(&str, &Histogram)], max_values: usize) -> String {
+    let tables: Vec<std::collections::BTreeMap<&str, f64>> = corpora
+        .iter()
+        .map(|(_, h)| {
+            let total = h.values().sum::<u32>().max(1) as f64;
+            h.iter().map(|(v, c)| (v.as_str(), *c as f64 / total)).collect()
+        })
+        .collect();
+    let share = |c: usize, v: &str| tables[c].get(v).copied().unwrap_or(0.0);
+    let mut values: Vec<(String, f64)> = Vec::new();
+    for (_, h) in corpora {
+        for v in h.keys() {
+            if !values.iter().any(|(x, _)| x == v) {
+                values.push((v.clone(), (0..corpora.len()).map(|c| share(c, v)).sum()));
+            }
+        }
+    }
+    values.sort_by(|a, b| b.1.total_cmp(&a.1).then_with(|| a.0.cmp(&b.0)));
+    values.truncate(max_values.max(1));
+    let top = values.iter().flat_map(|(v, _)| (0..corpora.len()).map(|c| share(c, v))).fold(0.0f64, f64::max).max(0.01);
+    let top = (top * 10.0).ceil() / 10.0;
+    let (left, right, upper, lower) = (60.0, 170.0, 40.0, 120.0);
+    let group = (corpora.len() as f64 * 14.0 + 10.0).max(24.0);
+    let width = left + right + group * values.len().max(1) as f64;
+    let height = 360.0;
+    let plot_h = height - upper - lower;
+    let mut out = format!(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{width}\" height=\"{height}\" viewBox=\"0 0 {width} {height}\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
+    );
+    let _ = writeln!(out, "<text x=\"{left}\" y=\"24\" font-size=\"16\" {FONT}>{}</text>", escape(title));
+    for tick in 0..=5 {
+        let share = top * tick as f64 / 5.0;
+        let y = upper + plot_h * (1.0 - share / top);
+        let _ = writeln!(
+            out,
+            "<line x1=\"{left}\" x2=\"{}\" y1=\"{y}\" y2=\"{y}\" stroke=\"#ddd\"/><text x=\"{}\" y=\"{}\" font-size=\"11\" text-anchor=\"end\" {FONT}>{:.0}%</text>",
+            width - right,
+            left - 6.0,
+            y + 4.0,
+            share * 100.0
+        );
+    }
+    for (i, (v, _)) in values.iter().enumerate() {
+        let x0 = left + i as f64 * group + 5.0;
+        for c in 0..corpora.len() {
+            let p = share(c, v);
+            let h = plot_h * p / top;
+            let _ = write!(
+                out,
+                "<rect x=\"{}\" y=\"{}\" width=\"12\" height=\"{h}\" fill=\"{}\"><title>{}: {:.1}%</title></rect>",
+                x0 + c as f64 * 14.0,
+                upper + plot_h - h,
+                COLOURS[c % COLOURS.len()],
+                escape(&format!("{} {v}", corpora[c].0)),
+                p * 100.0
+            );
+        }
+        let cx = x0 + corpora.len() as f64 * 7.0;
+        let _ = writeln!(
+            out,
+            "<text transform=\"translate({cx},{}) rotate(-45)\" font-size=\"11\" text-anchor=\"end\" {FONT}>{}</text>",
+            upper + plot_h + 14.0,
+            escape(&v.replace('_', " "))
+        );
+    }
+    let _ = writeln!(
+        out,
+        "<line x1=\"{left}\" x2=\"{}\" y1=\"{}\" y2=\"{}\" stroke=\"black\"/>",
+        width - right,
+        upper + plot_h,
+        upper + plot_h
+    );
+    let names: Vec<&str> = corpora.iter().map(|(n, _)| *n).collect();
+    legend(&mut out, &names, width - right + 16.0, upper + 10.0);
+    out.push_str("</svg>\n");
+    out
+}
+
+/// The first two principal components of `points` (rows), as coordinates.
+pub fn pca(points: &[Vec<f32>]) -> Vec<[f64; 2]> {
+    let n = points.len();
+    if n == 0 {
+        return Vec::new();
+    }
+    let d = points[0].len();
+    let mut mean = vec![0f64; d];
+    for p in points {
+        for (m, x) in mean.iter_mut().zip(p) {
+            *m += *x as f64 / n as f64;
+        }
+    }
+    let x = nalgebra::DMatrix::from_fn(n, d, |i, j| points[i][j] as f64 - mean[j]);
+    // the principal directions are the top eigenvectors of the n×n Gram matrix mapped back
+    let gram = &x * x.transpose();
+    let eigen = gram.symmetric_eigen();
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&a, &b| eigen.eigenvalues[b].total_cmp(&eigen.eigenvalues[a]));
+    let component = |k: usize| -> Vec<f64> {
+        let Some(&i) = order.get(k) else { return vec![0.0; n] };
+        let v = eigen.eigenvectors.column(i);
+        let scale = eigen.eigenvalues[i].max(0.0).sqrt();
+        // a deterministic sign: the largest coordinate positive
+        let sign = if v.iter().fold(0.0f64, |m, x| if x.abs() > m.abs() { *x } else { m }) < 0.0 { -1.0 } else { 1.0 };
+        v.iter().map(|x| x * scale * sign).collect()
+    };
+    let (c1, c2) = (component(0), component(1));
+    (0..n).map(|i| [c1[i], c2[i]]).collect()
+}
+
+/// A scatter plot of labelled 2-D point sets.
+pub fn scatter(title: &str, sets: &[(&str, Vec<[f64; 2]>)]) -> String {
+    let all: Vec<[f64; 2]> = sets.iter().flat_map(|(_, p)| p.iter().copied()).collect();
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for [x, y] in &all {
+        x0 = x0.min(*x);
+        x1 = x1.max(*x);
+        y0 = y0.min(*y);
+        y1 = y1.max(*y);
+    }
+    if all.is_empty() {
+        (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
+    }
+    let (sx, sy) = ((x1 - x0).max(1e-9), (y1 - y0).max(1e-9));
+    let (size, margin, legend_w) = (480.0, 40.0, 170.0);
+    let width = size + 2.0 * margin + legend_w;
+    let height = size + 2.0 * margin;
+    let mut out = format!(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{width}\" height=\"{height}\" viewBox=\"0 0 {width} {height}\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
+    );
+    let _ = writeln!(out, "<text x=\"{margin}\" y=\"24\" font-size=\"16\" {FONT}>{}</text>", escape(title));
+    let _ = writeln!(
+        out,
+        "<rect x=\"{margin}\" y=\"{margin}\" width=\"{size}\" height=\"{size}\" fill=\"none\" stroke=\"#999\"/>"
+    );
+    for (c, (name, points)) in sets.iter().enumerate() {
+        let _ = write!(
+            out,
+            "<g fill=\"{}\" fill-opacity=\"0.6\"><title>{}</title>",
+            COLOURS[c % COLOURS.len()],
+            escape(name)
+        );
+        for [x, y] in points {
+            let px = margin + 8.0 + (size - 16.0) * (x - x0) / sx;
+            let py = margin + 8.0 + (size - 16.0) * (1.0 - (y - y0) / sy);
+            let _ = write!(out, "<circle cx=\"{px:.1}\" cy=\"{py:.1}\" r=\"4\"/>");
+        }
+        out.push_str("</g>\n");
+    }
+    let _ = writeln!(
+        out,
+        "<text x=\"{}\" y=\"{}\" font-size=\"11\" text-anchor=\"middle\" {FONT}>first principal component</text>",
+        margin + size / 2.0,
+        height - 12.0
+    );
+    let names: Vec<&str> = sets.iter().map(|(n, _)| *n).collect();
+    legend(&mut out, &names, margin + size + 16.0, margin + 10.0);
+    out.push_str("</svg>\n");
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pca_finds_the_spread_direction() {
+        // points along (1, 1, 0) with a little noise in z
+        let pts: Vec<Vec<f32>> = (0..10).map(|i| vec![i as f32, i as f32, (i % 2) as f32 * 0.1]).collect();
+        let p = pca(&pts);
+        let spread1 = p.iter().map(|q| q[0].abs()).fold(0.0, f64::max);
+        let spread2 = p.iter().map(|q| q[1].abs()).fold(0.0, f64::max);
+        assert!(spread1 > 6.0 && spread2 < 0.2, "{spread1} {spread2}");
+        // first component ordered like the points
+        assert!(p.windows(2).all(|w| w[0][0] < w[1][0]) || p.windows(2).all(|w| w[0][0] > w[1][0]));
+    }
+
+    #[test]
+    fn svg_is_escaped_and_well_formed() {
+        let mut h = Histogram::new();
+        h.insert("a<b".into(), 2);
+        let svg = bars("x & y", &[("one", &h), ("two", &h)], 10);
+        assert!(svg.contains("a&lt;b") && svg.contains("x &amp; y"));
+        assert_eq!(svg.matches("<svg").count(), 1);
+        assert!(svg.trim_end().ends_with("</svg>"));
+        let s = scatter("t", &[("a", vec![[0.0, 0.0], [1.0, 2.0]]), ("b", vec![])]);
+        assert_eq!(s.matches("<circle").count(), 2);
+    }
+}
