@@ -6,8 +6,10 @@
 //! language server do; the incremental row edits one line of a 2,000-line file and
 //! re-checks it, against checking that file from scratch. `bench --runtime` measures the
 //! runtime instead ([`runtime`]), `bench --lsp` the language server ([`lsp`]), `bench --llm`
-//! the local model against llama-server ([`llm`]).
+//! the local model against llama-server ([`llm`]); `bench --align` runs the alignment
+//! recovery experiment ([`align`]).
 
+pub mod align;
 pub mod llm;
 pub mod lsp;
 pub mod runtime;

@@ -9,7 +9,7 @@ use tad_finetune::{Config, Progress, Target};
 #[derive(clap::Args, Debug, Clone)]
 pub struct FinetuneArgs {
     /// Examples: a JSONL file (TRL's `messages`, or `prompt` and `completion`), or a
-    /// directory holding train.jsonl
+    /// directory holding messages.jsonl (as `tadslc sft-export` writes) or train.jsonl
     pub data: PathBuf,
     /// The adapter's directory (PEFT: adapter_model.safetensors, adapter_config.json)
     #[arg(short, long, value_name = "DIR")]
@@ -17,8 +17,8 @@ pub struct FinetuneArgs {
     /// LoRA rank
     #[arg(long, value_name = "R", default_value_t = 16)]
     pub rank: usize,
-    /// LoRA alpha (the update is scaled by alpha / rank)
-    #[arg(long, default_value_t = 32.0)]
+    /// LoRA alpha (the update is scaled by alpha / rank; the paper's r = alpha = 16)
+    #[arg(long, default_value_t = 16.0)]
     pub alpha: f32,
     /// Projections to adapt, from q,k,v,o,gate,up,down
     #[arg(long, value_delimiter = ',', default_value = "q,k,v,o,gate,up,down")]
@@ -49,12 +49,13 @@ pub struct FinetuneArgs {
     pub model: String,
 }
 
-/// The examples' file: `data` itself, or `data/train.jsonl`.
+/// The examples' file: `data` itself, or `data/messages.jsonl`, or `data/train.jsonl`.
 fn data_file(data: &Path) -> PathBuf {
-    match data.is_dir() {
-        true => data.join("train.jsonl"),
-        false => data.to_path_buf(),
+    if !data.is_dir() {
+        return data.to_path_buf();
     }
+    let exported = data.join("messages.jsonl");
+    if exported.is_file() { exported } else { data.join("train.jsonl") }
 }
 
 impl FinetuneArgs {

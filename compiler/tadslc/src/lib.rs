@@ -4,6 +4,7 @@
 //! unformatted files with `fmt --check`), 2 usage or I/O failure; `translate` adds 3
 //! (incomplete), 4 (non-scenario) and 5 (the model's server could not be used).
 
+pub mod align;
 pub mod bench;
 pub mod build;
 pub mod bytecode;
@@ -11,6 +12,7 @@ pub mod check;
 pub mod corpus;
 pub mod explain;
 pub mod files;
+pub mod finetune;
 pub mod fmt;
 pub mod interchange;
 pub mod llm;

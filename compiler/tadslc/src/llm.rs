@@ -446,6 +446,8 @@ pub struct GenArgs<'a> {
     pub n: usize,
     pub out: Option<&'a Path>,
     pub baseline: bool,
+    /// The short prompt of a fine-tuned model (`generate-tuned.v1`).
+    pub tuned: bool,
     pub corpus: &'a [PathBuf],
     pub jobs: usize,
 }
@@ -479,6 +481,7 @@ pub fn generate(g: &GenArgs, args: &LlmArgs) -> Status {
             n: g.n,
             seed: args.seed,
             baseline: g.baseline,
+            tuned: g.tuned,
             vocabulary,
             region_description: tad_frontend::description(&general, "region", g.region),
             examples,

@@ -177,9 +177,9 @@ enum Command {
     /// safety examples; on one core.
     Bench {
         /// Number of generated scenarios
-        #[arg(long, default_value_t = 10_000, conflicts_with_all = ["runtime", "lsp", "llm"])]
+        #[arg(long, default_value_t = 10_000, conflicts_with_all = ["runtime", "lsp", "llm", "align"])]
         scenarios: usize,
-        /// Seed of the corpus generator
+        /// Seed of the corpus generator (and of the alignment experiment)
         #[arg(long, default_value_t = 1, conflicts_with_all = ["runtime", "lsp", "llm"])]
         seed: u64,
         /// Directory of real scenarios to measure as well
@@ -234,6 +234,28 @@ enum Command {
         /// Steps per episode (fewer for tests)
         #[arg(long, default_value_t = 300, requires = "runtime", hide = true)]
         steps: u32,
+        /// Run the alignment recovery experiment instead: labelled synthetic regions, the
+        /// fitted generator against the unaligned baseline on held-out samples
+        #[arg(long, conflicts_with_all = ["runtime", "lsp", "llm"])]
+        align: bool,
+        /// Scenarios per sample (training, held-out, generated)
+        #[arg(long, value_name = "N", default_value_t = 100, requires = "align")]
+        per_region: usize,
+        /// The embedding of the MMD and Fréchet columns
+        #[arg(long, value_enum, default_value_t = tadslc::align::Embedding::Features, requires = "align")]
+        embedding: tadslc::align::Embedding,
+        /// Bootstrap resamples
+        #[arg(long, value_name = "N", default_value_t = 200, requires = "align")]
+        resamples: usize,
+        /// Where the corpora are written (default: a directory under the system's temporary one)
+        #[arg(long, value_name = "DIR", requires = "align")]
+        out: Option<PathBuf>,
+        /// Another generator's output to compare with a region's held-out sample
+        #[arg(long = "corpus", value_name = "LABEL=REGION:DIR", value_parser = tadslc::bench::align::parse_extra, requires = "align")]
+        extra: Vec<(String, String, PathBuf)>,
+        /// Print the rows as JSON
+        #[arg(long, requires = "align")]
+        json: bool,
     },
     /// Translate a description into a TAD program with a language model, the compiler in
     /// the loop
@@ -296,12 +318,20 @@ enum Command {
         #[command(flatten)]
         llm: tadslc::llm::LlmArgs,
     },
-    /// Generate scenarios for a region with a language model, through the same
-    /// check-and-repair loop
+    /// Generate scenarios for a region: with the fitted generator, or with a language
+    /// model through the same check-and-repair loop
+    ///
+    /// `--generator fitted:MODEL` samples a model made by `tadslc fit` (no language model,
+    /// no GPU; each scenario drawn again until it checks without errors); `--generator llm`
+    /// (the default) asks the language model, with the region's examples (aligned), its
+    /// name only (`--baseline`), or the short prompt a fine-tuned model learnt (`--tuned`).
     Gen {
-        /// The region
+        /// The region (for `llm`; a fitted model knows its own)
         #[arg(long, value_name = "REGION")]
-        region: String,
+        region: Option<String>,
+        /// `llm`, or `fitted:MODEL` (a file written by `tadslc fit`)
+        #[arg(long, value_name = "GENERATOR", default_value = "llm")]
+        generator: String,
         /// How many scenarios
         #[arg(short = 'n', long = "count", value_name = "N", default_value_t = 40)]
         count: usize,
@@ -310,17 +340,95 @@ enum Command {
         out: Option<PathBuf>,
         /// The paper's unaligned baseline: the region's name only, no examples, the general
         /// vocabulary
-        #[arg(long)]
+        #[arg(long, conflicts_with = "tuned")]
         baseline: bool,
+        /// Ask with the short prompt of `tadslc sft-export` (for a fine-tuned model)
+        #[arg(long)]
+        tuned: bool,
         /// Scenarios of the region to show as examples (default: examples/regions)
         #[arg(long, value_name = "PATH")]
         corpus: Vec<PathBuf>,
         /// Requests under way at once
         #[arg(long, value_name = "N", default_value_t = 1)]
         jobs: usize,
+        /// With a fitted generator: draws per scenario before giving up on it
+        #[arg(long, value_name = "N", default_value_t = 50)]
+        attempts: usize,
         #[command(flatten)]
         llm: tadslc::llm::LlmArgs,
     },
+    /// The statistics of corpora: the corpus table and a histogram per attribute
+    ///
+    /// Each path is one corpus (a directory of scenarios, e.g. one per region); only
+    /// scenarios without errors count.
+    Stats {
+        /// The corpora
+        #[arg(required = true)]
+        corpora: Vec<PathBuf>,
+        /// Markdown tables, long-form CSV, or JSON
+        #[arg(long, value_enum, default_value_t = tadslc::align::TableFormat::Table)]
+        format: tadslc::align::TableFormat,
+        /// Also write an SVG bar chart per attribute into this directory
+        #[arg(long, value_name = "DIR")]
+        plot: Option<PathBuf>,
+    },
+    /// Distances between two corpora, each with a bootstrap interval
+    ///
+    /// Jensen-Shannon divergence per attribute (and their mean), the Wasserstein distance of
+    /// actors per scenario, and the MMD² and Fréchet distance of sentence embeddings of the
+    /// scenarios.
+    Compare {
+        /// The first corpus
+        a: PathBuf,
+        /// The second corpus
+        b: PathBuf,
+        /// The embedding model (fetched with `tadslc model fetch NAME`)
+        #[arg(long, value_enum, default_value_t = tadslc::align::Embedding::Minilm)]
+        embedding: tadslc::align::Embedding,
+        /// Bootstrap resamples for the intervals
+        #[arg(long, value_name = "N", default_value_t = 200)]
+        resamples: usize,
+        /// Seed of the resampling
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// A table, or one JSON object
+        #[arg(long, value_enum, default_value_t = tadslc::align::CompareFormat::Table)]
+        format: tadslc::align::CompareFormat,
+        /// Write both corpora's embeddings projected to 2-D (PCA) as an SVG scatter plot
+        #[arg(long, value_name = "FILE")]
+        plot: Option<PathBuf>,
+    },
+    /// Fit the generator to a corpus: a probabilistic model of its choices, for
+    /// `tadslc gen --generator fitted:MODEL`
+    Fit {
+        /// The corpus (directories or files of scenarios)
+        #[arg(required = true)]
+        corpus: Vec<PathBuf>,
+        /// The model file to write
+        #[arg(short, long, value_name = "FILE")]
+        output: PathBuf,
+    },
+    /// Write a corpus as fine-tuning data: TRL's messages and prompt/completion JSONL
+    ///
+    /// Each scenario is the answer to the short generation prompt (`generate-tuned.v1`),
+    /// which `tadslc gen --tuned` asks; for `tadslc finetune`, or Unsloth and TRL.
+    SftExport {
+        /// The corpus (directories or files of scenarios)
+        #[arg(required = true)]
+        corpus: Vec<PathBuf>,
+        /// The output directory
+        #[arg(short, long, value_name = "DIR")]
+        output: PathBuf,
+        /// The region of scenarios that state none (and of every scenario, if given)
+        #[arg(long, value_name = "REGION")]
+        region: Option<String>,
+    },
+    /// Fine-tune the local model on a corpus with LoRA (in process, on the CPU), saving a
+    /// PEFT adapter for `tadslc gen --tuned --adapter DIR`
+    ///
+    /// The data is what `tadslc sft-export` writes (TRL's messages or prompt/completion
+    /// JSONL); the loss is on the answers only. Checkpoints let a stopped run resume.
+    Finetune(tadslc::finetune::FinetuneArgs),
     /// Fetch or list the local models (TADSL's default language model, run in process)
     Model {
         #[command(subcommand)]
@@ -506,6 +614,17 @@ fn main() -> ExitCode {
                 tadslc::Status::Usage
             }
         },
+        Command::Bench { align: true, seed, per_region, embedding, resamples, out, extra, json, .. } => {
+            bench::align::run(&bench::align::AlignArgs {
+                n: per_region,
+                seed,
+                resamples,
+                embedding,
+                out: out.unwrap_or_else(|| std::env::temp_dir().join("tadsl-bench-align")),
+                extra,
+                json,
+            })
+        }
         Command::Bench { lsp: true, samples, runs, .. } => bench::lsp::run(samples, runs),
         Command::Bench { llm: true, llama_server, threads, prompts, max_tokens, descriptions, .. } => {
             bench::llm::run(&bench::llm::LlmArgs { llama_server, threads, prompts, max_tokens, descriptions })
@@ -539,10 +658,53 @@ fn main() -> ExitCode {
             },
             &llm,
         ),
-        Command::Gen { region, count, out, baseline, corpus, jobs, llm } => tadslc::llm::generate(
-            &tadslc::llm::GenArgs { region: &region, n: count, out: out.as_deref(), baseline, corpus: &corpus, jobs },
-            &llm,
-        ),
+        Command::Gen { region, generator, count, out, baseline, tuned, corpus, jobs, attempts, llm } => {
+            if let Some(model) = generator.strip_prefix("fitted:") {
+                tadslc::align::generate_fitted(&tadslc::align::FittedGen {
+                    model: std::path::Path::new(model),
+                    n: count,
+                    seed: llm.seed,
+                    out: out.as_deref(),
+                    attempts,
+                })
+            } else if generator != "llm" {
+                eprintln!("error: unknown generator `{generator}` (expected `llm` or `fitted:MODEL`)");
+                tadslc::Status::Usage
+            } else if let Some(region) = region {
+                tadslc::llm::generate(
+                    &tadslc::llm::GenArgs {
+                        region: &region,
+                        n: count,
+                        out: out.as_deref(),
+                        baseline,
+                        tuned,
+                        corpus: &corpus,
+                        jobs,
+                    },
+                    &llm,
+                )
+            } else {
+                eprintln!("error: `--generator llm` needs `--region REGION`");
+                tadslc::Status::Usage
+            }
+        }
+        Command::Finetune(args) => return std::process::ExitCode::from(tadslc::finetune::finetune(&args) as u8),
+        Command::Stats { corpora, format, plot } => {
+            tadslc::align::stats(&tadslc::align::StatsArgs { corpora: &corpora, format, plot: plot.as_deref() })
+        }
+        Command::Compare { a, b, embedding, resamples, seed, format, plot } => {
+            tadslc::align::compare(&tadslc::align::CompareArgs {
+                a: std::slice::from_ref(&a),
+                b: std::slice::from_ref(&b),
+                embedding,
+                resamples,
+                seed,
+                format,
+                plot: plot.as_deref(),
+            })
+        }
+        Command::Fit { corpus, output } => tadslc::align::fit(&corpus, &output),
+        Command::SftExport { corpus, output, region } => tadslc::align::sft_export(&corpus, &output, region.as_deref()),
         Command::Model { action: ModelAction::List } => tadslc::llm::model_list(),
         Command::Model { action: ModelAction::Fetch { name, python } } => {
             tadslc::llm::model_fetch(name.as_deref(), python.as_deref())
