@@ -69,7 +69,7 @@ impl FinetuneArgs {
         if self.rank == 0 || self.epochs == 0 || self.max_len < 2 || targets.is_empty() {
             return Err("--rank, --epochs and --targets must not be zero or empty, --max-len at least 2".into());
         }
-        if !(self.lr.is_finite() && self.lr > 0.0) || !self.alpha.is_finite() {
+        if !(self.lr.is_finite() && self.lr > 0.0 && self.alpha.is_finite()) {
             return Err("--lr must be a positive number and --alpha a number".into());
         }
         Ok(Config {
