@@ -194,3 +194,37 @@ fn the_fitted_generator_recovers_each_synthetic_region() {
         }
     }
 }
+
+/// Whether an embedding model is installed; with `TAD_REQUIRE_MODEL` set it is fetched
+/// first (CI), otherwise a missing model skips the test with a message.
+fn embedding_installed(name: &str) -> bool {
+    let model = tad_models::model(name).expect("a known model");
+    if model.installed().is_none() && std::env::var_os("TAD_REQUIRE_MODEL").is_some() {
+        let python = std::env::var("TADSL_PYTHON").unwrap_or_else(|_| "python3".into());
+        if let Err(e) = model.fetch(&python, &mut |line| eprintln!("{line}")) {
+            panic!("{name} is required (TAD_REQUIRE_MODEL is set) and could not be fetched: {e}");
+        }
+    }
+    let ok = model.installed().is_some();
+    if !ok {
+        eprintln!("SKIPPED: {name} is not installed (tadslc model fetch {name})");
+    }
+    ok
+}
+
+#[test]
+fn compare_with_minilm_sentence_embeddings() {
+    if !embedding_installed("all-minilm-l6-v2") {
+        return;
+    }
+    let out = tadslc(&["compare", "examples/regions", "examples/safety", "--format", "json", "--resamples", "20"], "");
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    let c = json(&out);
+    assert_eq!(c["embedding"], "all-minilm-l6-v2");
+    let frechet = c["frechet"]["value"].as_f64().unwrap();
+    assert!(frechet > 0.01, "{frechet}");
+    let out = tadslc(&["compare", "examples/regions", "examples/regions", "--format", "json", "--resamples", "20"], "");
+    let same = json(&out);
+    assert!(same["frechet"]["value"].as_f64().unwrap() < 1e-3, "{}", same["frechet"]);
+    assert!(same["mmd"]["value"].as_f64().unwrap() < c["mmd"]["value"].as_f64().unwrap());
+}
