@@ -3,7 +3,7 @@
 //! (`tadslc model fetch minilm`, `tadslc model fetch mpnet`); without them these tests skip
 //! with a message, unless `TAD_REQUIRE_MODEL=1` (CI sets it), which fetches them first.
 
-use std::sync::{Mutex, OnceLock};
+use std::sync::OnceLock;
 
 use tad_embed::{Embedder, cosine};
 
@@ -12,22 +12,10 @@ use tad_embed::{Embedder, cosine};
 fn embedder(name: &str) -> Option<&'static Embedder> {
     static MINILM: OnceLock<Option<Embedder>> = OnceLock::new();
     static MPNET: OnceLock<Option<Embedder>> = OnceLock::new();
-    // one fetch at a time: fetching works in a directory named by the process
-    static FETCHING: Mutex<()> = Mutex::new(());
     let model = tad_models::model(name).unwrap();
     let cell = if model.name == "all-minilm-l6-v2" { &MINILM } else { &MPNET };
     cell.get_or_init(|| {
-        if model.installed().is_none() && std::env::var_os("TAD_REQUIRE_MODEL").is_some() {
-            let _one = FETCHING.lock().unwrap_or_else(|e| e.into_inner());
-            let python = std::env::var("TADSL_PYTHON").unwrap_or_else(|_| "python3".into());
-            if let Err(e) = model.fetch(&python, &mut |line| eprintln!("{line}")) {
-                panic!("{} is required (TAD_REQUIRE_MODEL is set) and could not be fetched: {e}", model.name);
-            }
-        }
-        if model.installed().is_none() {
-            eprintln!("SKIPPED: {} is not installed (tadslc model fetch {})", model.name, model.aliases[0]);
-            return None;
-        }
+        tad_models::for_tests(name)?;
         Some(Embedder::load(model).unwrap_or_else(|e| panic!("{e}")))
     })
     .as_ref()

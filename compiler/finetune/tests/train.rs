@@ -340,22 +340,8 @@ fn examples_are_tokenized_as_the_engine_reads_them() {
     assert!(none.is_none() && warning.unwrap().contains("dropped"));
 }
 
-/// The default model's file, fetched when `TAD_REQUIRE_MODEL` is set; else `None`.
 fn gguf() -> Option<PathBuf> {
-    let model = tad_local::model(tad_local::DEFAULT)?;
-    if model.installed().is_none() && std::env::var_os("TAD_REQUIRE_MODEL").is_some() {
-        let python = std::env::var("TADSL_PYTHON").unwrap_or_else(|_| "python3".into());
-        static FETCHED: std::sync::Mutex<()> = std::sync::Mutex::new(());
-        let _one = FETCHED.lock();
-        if model.installed().is_none() {
-            model.fetch(&python, &mut |l| eprintln!("{l}")).expect("TAD_REQUIRE_MODEL: the model is fetched");
-        }
-    }
-    let path = model.installed();
-    if path.is_none() {
-        eprintln!("SKIPPED: the local model is not installed (tadslc model fetch)");
-    }
-    path
+    tad_local::for_tests(tad_local::DEFAULT)
 }
 
 fn prompt_tokens(path: &Path) -> Vec<u32> {

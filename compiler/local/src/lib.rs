@@ -24,7 +24,7 @@ pub use llama::Shape;
 pub use tokenizers::Tokenizer;
 
 // The table of models and their fetching live in `tad-models`, shared with `tad-embed`.
-pub use tad_models::{DEFAULT, File, Kind, Layout, MODELS, Model, Source, cache_dir, model, sha256_file};
+pub use tad_models::{DEFAULT, File, Kind, Layout, MODELS, Model, Source, cache_dir, for_tests, model, sha256_file};
 
 /// The engine as a [`Chat`] backend: requests run one at a time on a blocking thread.
 #[derive(Clone)]

@@ -531,22 +531,8 @@ mod tests {
     use candle_core::{Device, Tensor};
     use candle_transformers::models::quantized_llama::ModelWeights;
 
-    /// The default model's file, fetched when `TAD_REQUIRE_MODEL` is set; else `None`.
     fn gguf() -> Option<std::path::PathBuf> {
-        let model = crate::model(crate::DEFAULT)?;
-        if model.installed().is_none() && std::env::var_os("TAD_REQUIRE_MODEL").is_some() {
-            let python = std::env::var("TADSL_PYTHON").unwrap_or_else(|_| "python3".into());
-            static FETCHED: std::sync::Mutex<()> = std::sync::Mutex::new(());
-            let _one = FETCHED.lock();
-            if model.installed().is_none() {
-                model.fetch(&python, &mut |l| eprintln!("{l}")).expect("TAD_REQUIRE_MODEL: the model is fetched");
-            }
-        }
-        let path = model.installed();
-        if path.is_none() {
-            eprintln!("SKIPPED: the local model is not installed (tadslc model fetch)");
-        }
-        path
+        tad_models::for_tests(crate::DEFAULT)
     }
 
     fn cosine(a: &[f32], b: &[f32]) -> f32 {

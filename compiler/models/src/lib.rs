@@ -175,6 +175,33 @@ pub fn model(name: &str) -> Option<&'static Model> {
     MODELS.iter().find(|m| m.name == name || m.aliases.contains(&name))
 }
 
+/// The installed files of model `name` for a test suite: when missing and
+/// `TAD_REQUIRE_MODEL` is set (CI), fetched first (one fetch at a time in the process;
+/// failing to is a panic); otherwise `None`, with a `SKIPPED` note on standard error. The
+/// one place the test suites' convention lives.
+pub fn for_tests(name: &str) -> Option<PathBuf> {
+    static FETCHING: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    let model = model(name).unwrap_or_else(|| panic!("no model `{name}` in MODELS"));
+    if model.installed().is_none() && std::env::var_os("TAD_REQUIRE_MODEL").is_some() {
+        let _one = FETCHING.lock().unwrap_or_else(|e| e.into_inner());
+        if model.installed().is_none() {
+            let python = std::env::var("TADSL_PYTHON").unwrap_or_else(|_| "python3".into());
+            if let Err(e) = model.fetch(&python, &mut |line| eprintln!("{line}")) {
+                panic!("{} is required (TAD_REQUIRE_MODEL is set) and could not be fetched: {e}", model.name);
+            }
+        }
+    }
+    let installed = model.installed();
+    if installed.is_none() {
+        eprintln!(
+            "SKIPPED: {} is not installed (tadslc model fetch {})",
+            model.name,
+            model.aliases.first().unwrap_or(&model.name)
+        );
+    }
+    installed
+}
+
 /// Where models are cached: `$TADSL_MODEL_DIR`, else `$XDG_CACHE_HOME/tadsl/models`, else
 /// `~/.cache/tadsl/models`.
 pub fn cache_dir() -> PathBuf {

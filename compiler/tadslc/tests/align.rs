@@ -195,26 +195,9 @@ fn the_fitted_generator_recovers_each_synthetic_region() {
     }
 }
 
-/// Whether an embedding model is installed; with `TAD_REQUIRE_MODEL` set it is fetched
-/// first (CI), otherwise a missing model skips the test with a message.
-fn embedding_installed(name: &str) -> bool {
-    let model = tad_models::model(name).expect("a known model");
-    if model.installed().is_none() && std::env::var_os("TAD_REQUIRE_MODEL").is_some() {
-        let python = std::env::var("TADSL_PYTHON").unwrap_or_else(|_| "python3".into());
-        if let Err(e) = model.fetch(&python, &mut |line| eprintln!("{line}")) {
-            panic!("{name} is required (TAD_REQUIRE_MODEL is set) and could not be fetched: {e}");
-        }
-    }
-    let ok = model.installed().is_some();
-    if !ok {
-        eprintln!("SKIPPED: {name} is not installed (tadslc model fetch {name})");
-    }
-    ok
-}
-
 #[test]
 fn compare_with_minilm_sentence_embeddings() {
-    if !embedding_installed("all-minilm-l6-v2") {
+    if tad_models::for_tests("all-minilm-l6-v2").is_none() {
         return;
     }
     let out = tadslc(&["compare", "examples/regions", "examples/safety", "--format", "json", "--resamples", "20"], "");

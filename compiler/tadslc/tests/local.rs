@@ -23,23 +23,9 @@ fn run(args: &[&str]) -> Output {
     cmd.stdin(Stdio::null()).output().expect("tadslc runs")
 }
 
-/// Whether the model is installed; with `TAD_REQUIRE_MODEL` set, it is fetched (once, by
-/// the same code as `tadslc model fetch`) when missing.
+/// Whether the model is installed (fetched first in CI; `tad_models::for_tests`).
 fn installed() -> bool {
-    static FETCHED: std::sync::OnceLock<Result<(), String>> = std::sync::OnceLock::new();
-    let model = tad_local::model(tad_local::DEFAULT).unwrap();
-    if model.installed().is_none() && std::env::var_os("TAD_REQUIRE_MODEL").is_some() {
-        let python = std::env::var("TADSL_PYTHON").unwrap_or_else(|_| "python3".into());
-        let fetched = FETCHED.get_or_init(|| model.fetch(&python, &mut |line| eprintln!("{line}")).map(|_| ()));
-        if let Err(e) = fetched {
-            panic!("the local model is required (TAD_REQUIRE_MODEL is set) and could not be fetched: {e}");
-        }
-    }
-    let ok = model.installed().is_some();
-    if !ok {
-        eprintln!("SKIPPED: the local model is not installed (tadslc model fetch)");
-    }
-    ok
+    tad_local::for_tests(tad_local::DEFAULT).is_some()
 }
 
 #[test]
