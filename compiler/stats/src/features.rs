@@ -103,33 +103,22 @@ pub const ATTRIBUTES: &[Attribute] = &[
         key: "actor_type",
         title: "Actor types",
         per: Per::Actor,
-        extract: |s, v| {
-            for g in &s.groups {
-                let t = named(&s.entries, &g.actor_type);
-                v.extend(std::iter::repeat_n(t, actors(g) as usize));
-            }
-        },
+        extract: |s, v| each_actor(s, v, |g| named(&s.entries, &g.actor_type)),
     },
     Attribute {
         key: "behavior",
         title: "Actor behaviors",
         per: Per::Actor,
-        extract: |s, v| {
-            for g in &s.groups {
-                let b = param_name(&s.entries, &g.behavior);
-                v.extend(std::iter::repeat_n(b, actors(g) as usize));
-            }
-        },
+        extract: |s, v| each_actor(s, v, |g| param_name(&s.entries, &g.behavior)),
     },
     Attribute {
         key: "type_behavior",
         title: "Actor type and behavior",
         per: Per::Actor,
         extract: |s, v| {
-            for g in &s.groups {
-                let tb = format!("{} {}", named(&s.entries, &g.actor_type), param_name(&s.entries, &g.behavior));
-                v.extend(std::iter::repeat_n(tb, actors(g) as usize));
-            }
+            each_actor(s, v, |g| {
+                format!("{} {}", named(&s.entries, &g.actor_type), param_name(&s.entries, &g.behavior))
+            })
         },
     },
     Attribute {
@@ -137,21 +126,18 @@ pub const ATTRIBUTES: &[Attribute] = &[
         title: "Group positions",
         per: Per::Actor,
         extract: |s, v| {
-            for g in &s.groups {
-                let p = match g.position.given() {
-                    Some(p) => {
-                        let to = match &p.reference.value {
-                            Reference::Ego => "ego",
-                            Reference::Group(_) => "group",
-                            Reference::RoadElement(_) => "road",
-                            Reference::Unknown(_) => "?",
-                        };
-                        format!("{} of {to}", s.entries.name(&p.relation.value))
-                    }
-                    None => MISSING.into(),
-                };
-                v.extend(std::iter::repeat_n(p, actors(g) as usize));
-            }
+            each_actor(s, v, |g| match g.position.given() {
+                Some(p) => {
+                    let to = match &p.reference.value {
+                        Reference::Ego => "ego",
+                        Reference::Group(_) => "group",
+                        Reference::RoadElement(_) => "road",
+                        Reference::Unknown(_) => "?",
+                    };
+                    format!("{} of {to}", s.entries.name(&p.relation.value))
+                }
+                None => MISSING.into(),
+            })
         },
     },
 ];
@@ -193,6 +179,13 @@ impl Features {
             groups: s.groups.len() as u32,
             sentence: sentence(s),
         }
+    }
+}
+
+/// `value(group)` once per actor of every group.
+fn each_actor(s: &Scenario, v: &mut Vec<String>, value: impl Fn(&tad_ir::Group) -> String) {
+    for g in &s.groups {
+        v.extend(std::iter::repeat_n(value(g), actors(g) as usize));
     }
 }
 
