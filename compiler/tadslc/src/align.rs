@@ -423,8 +423,9 @@ pub fn generate_fitted(g: &FittedGen) -> Status {
 }
 
 /// `tadslc sft-export DIR... -o OUT`: the corpus as supervised fine-tuning data, each
-/// scenario the answer to the tuned generation prompt (`generate-tuned.v1`): TRL's
-/// conversational `messages.jsonl` and prompt/completion `prompt_completion.jsonl`.
+/// scenario (the bare program) the answer to the tuned generation prompt
+/// (`generate-tuned.v1`): TRL's conversational `messages.jsonl` and prompt/completion
+/// `prompt_completion.jsonl`.
 pub fn sft_export(paths: &[PathBuf], output: &Path, region: Option<&str>) -> Status {
     crate::output::run(|status| {
         let corpus = load(paths, status)?;
@@ -452,7 +453,8 @@ pub fn sft_export(paths: &[PathBuf], output: &Path, region: Option<&str>) -> Sta
                 &tad_frontend::Provenance { region: Some(r.clone()), ..Default::default() },
             );
             let prompt = tad_frontend::generate::tuned_messages(&r, i);
-            let answer = format!("```tad\n{program}```");
+            // the bare program: what the grammar-constrained decoder writes (no code fence)
+            let answer = program;
             let json = |m: &tad_llm::Message| serde_json::json!({"role": m.role.name(), "content": m.plain()});
             let prompt_json: Vec<serde_json::Value> = prompt.iter().map(json).collect();
             let assistant = serde_json::json!({"role": "assistant", "content": answer});
