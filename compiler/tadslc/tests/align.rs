@@ -211,3 +211,23 @@ fn compare_with_minilm_sentence_embeddings() {
     assert!(same["frechet"]["value"].as_f64().unwrap() < 1e-3, "{}", same["frechet"]);
     assert!(same["mmd"]["value"].as_f64().unwrap() < c["mmd"]["value"].as_f64().unwrap());
 }
+
+#[test]
+fn finetune_and_adapters_refuse_bad_input_with_status_2() {
+    let dir = scratch("align-finetune");
+    let out = tadslc(&["finetune", path(&dir.join("missing.jsonl")), "-o", path(&dir.join("a"))], "");
+    assert_eq!(code(&out), 2, "{}", stderr(&out));
+    assert!(stderr(&out).contains("missing.jsonl"), "{}", stderr(&out));
+    std::fs::write(dir.join("data.jsonl"), "{\"messages\": []}\n").unwrap();
+    let out =
+        tadslc(&["finetune", path(&dir.join("data.jsonl")), "-o", path(&dir.join("a")), "--targets", "q,wrong"], "");
+    assert_eq!(code(&out), 2, "{}", stderr(&out));
+    assert!(stderr(&out).contains("wrong"), "{}", stderr(&out));
+    // an adapter directory that is not one: an error before any model is loaded
+    let adapter = dir.join("not-an-adapter");
+    std::fs::create_dir_all(&adapter).unwrap();
+    std::fs::write(adapter.join("adapter_config.json"), "{ nonsense").unwrap();
+    let out = tadslc(&["gen", "--region", "yellowstone", "--tuned", "--adapter", path(&adapter), "-n", "1"], "");
+    assert_eq!(code(&out), 2, "{}", stderr(&out));
+    assert!(stderr(&out).contains("adapter_config.json"), "{}", stderr(&out));
+}

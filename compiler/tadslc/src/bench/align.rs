@@ -210,6 +210,8 @@ pub fn table(rows: &[Row]) -> String {
         let (Some(f), Some(b)) = (find("fitted"), find("unaligned baseline")) else { continue };
         let ratio = |x: Option<f64>, y: Option<f64>| match (x, y) {
             (Some(x), Some(y)) if y > 0.0 => format!("{:.1}×", x / y),
+            // an unbiased MMD² at or below 0: no difference measured at all
+            (Some(x), Some(_)) if x > 0.0 => "∞".into(),
             _ => "–".into(),
         };
         let (fc, bc) = (&f.comparison, &b.comparison);
