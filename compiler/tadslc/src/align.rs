@@ -210,7 +210,8 @@ pub fn embed(kind: Embedding, a: &[Features], b: &[Features]) -> Result<Option<E
         Embedding::Minilm | Embedding::Mpnet => {
             let name = if kind == Embedding::Minilm { "all-minilm-l6-v2" } else { "all-mpnet-base-v2" };
             let model = tad_models::model(name).ok_or_else(|| format!("no model `{name}`"))?;
-            let embedder = tad_embed::Embedder::load(model)?;
+            let embedder = tad_embed::Embedder::load(model)
+                .map_err(|e| format!("{e}; or compare without a language model: --embedding features"))?;
             let texts = |s: &[Features]| -> Result<Vec<Vec<f32>>, String> {
                 let sentences: Vec<&str> = s.iter().map(|x| x.sentence.as_str()).collect();
                 let mut out = Vec::with_capacity(sentences.len());
