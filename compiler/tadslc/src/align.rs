@@ -31,6 +31,11 @@ pub struct Corpus {
     pub items: Vec<Item>,
 }
 
+/// Whether a checked file counts as a scenario of a corpus: no errors, complete or not.
+pub fn counts(class: Option<Class>) -> bool {
+    matches!(class, Some(Class::Complete | Class::Incomplete))
+}
+
 /// The corpus's name: the directory's or file's name.
 fn corpus_name(path: &Path) -> String {
     let base = if path.is_dir() { path.file_name() } else { path.file_stem() };
@@ -46,16 +51,13 @@ pub fn load(paths: &[PathBuf], status: &mut Status) -> Result<Corpus, Closed> {
     for input in files::load(paths, Search::Scenarios, status)? {
         let file = crate::check::register(&mut db, &input);
         let class = tad_db::check(&db, file).class;
-        match class {
-            Some(Class::Complete | Class::Incomplete) => {}
-            Some(Class::Invalid) => {
+        if !counts(class) {
+            if class == Some(Class::Invalid) {
                 invalid += 1;
-                continue;
-            }
-            _ => {
+            } else {
                 non_scenarios += 1;
-                continue;
             }
+            continue;
         }
         let Some(scenario) = tad_db::resolve(&db, file) else { continue };
         let tad = if file.language(&db) == Language::Yaml {
@@ -362,13 +364,12 @@ pub fn generate_fitted(g: &FittedGen) -> Status {
                 summary.draws += 1;
                 let text = fitted.sample(&name, &mut rng);
                 let file = db.set_source(PathBuf::from(format!("{name}.tad")), text.clone(), Language::Tad, &RealFs);
-                match tad_db::check(&db, file).class {
-                    Some(class @ (Class::Complete | Class::Incomplete)) => {
-                        accepted = Some((text, class));
-                        break;
-                    }
-                    _ => summary.rejected += 1,
+                let class = tad_db::check(&db, file).class;
+                if let Some(class) = class.filter(|_| counts(class)) {
+                    accepted = Some((text, class));
+                    break;
                 }
+                summary.rejected += 1;
             }
             let Some((text, class)) = accepted else {
                 *status = (*status).max(Status::Failed);
