@@ -142,10 +142,6 @@ pub const ATTRIBUTES: &[Attribute] = &[
     },
 ];
 
-pub fn attribute(key: &str) -> Option<&'static Attribute> {
-    ATTRIBUTES.iter().find(|a| a.key == key)
-}
-
 /// One scenario, as the statistics see it.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Features {

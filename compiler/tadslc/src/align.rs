@@ -22,7 +22,6 @@ pub struct Item {
     pub name: String,
     /// Its TAD text (a YAML answer converted).
     pub tad: String,
-    pub class: Class,
     pub features: Features,
 }
 
@@ -70,12 +69,7 @@ pub fn load(paths: &[PathBuf], status: &mut Status) -> Result<Corpus, Closed> {
             .as_deref()
             .and_then(|p| p.file_stem())
             .map_or(input.name.clone(), |s| s.to_string_lossy().into_owned());
-        items.push(Item {
-            features: Features::of(&short, scenario),
-            name: short,
-            tad,
-            class: class.unwrap_or(Class::Invalid),
-        });
+        items.push(Item { features: Features::of(&short, scenario), name: short, tad });
     }
     if invalid + non_scenarios > 0 {
         errln!(
