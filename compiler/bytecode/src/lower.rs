@@ -154,7 +154,18 @@ pub fn lower(scenario: &Scenario, layout: &Layout, source: &str) -> Program {
     let mut scripts: Vec<Vec<Instr>> = Vec::new();
     'groups: for gl in &layout.groups {
         let Some(group) = scenario.group(gl.group) else { continue };
-        let along_slot = b.along_slot(scenario, layout, gl, &group.name);
+        let (moved, along_slot) = match group.offset.given() {
+            Some(offset) => {
+                let (low, high) = (offset.min().0, offset.max().0);
+                if high > low && low.is_finite() && high.is_finite() {
+                    let slot = b.slot(Some(gl.group), &group.name, "offset", (low, high, 0.0_f64.clamp(low, high)));
+                    (0.0, slot)
+                } else {
+                    (if low.is_finite() { low } else { 0.0 }, None)
+                }
+            }
+            None => (0.0, b.along_slot(scenario, layout, gl, &group.name)),
+        };
         let entry = group.actor_type.given().and_then(|t| scenario.entries.resolved(t));
         let class = group
             .actor_type
@@ -177,7 +188,7 @@ pub fn lower(scenario: &Scenario, layout: &Layout, source: &str) -> Program {
                 arm: agent.station.arm,
                 lane: agent.lane,
                 place: agent.place,
-                along: Value { base: agent.station.along, slot: along_slot },
+                along: Value { base: agent.station.along + moved, slot: along_slot },
                 lateral: agent.lateral,
                 facing: agent.facing,
                 yaw: agent.pose.yaw,

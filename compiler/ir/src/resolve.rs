@@ -98,6 +98,7 @@ pub fn resolve(module: &Module, vocabulary: &Vocabulary) -> Option<Scenario> {
             distance: r.field(g.attr("distance"), |v| quantity_param(v, ValueType::Length, Metres)),
             delay: r.field(g.attr("delay"), |v| quantity_param(v, ValueType::Duration, Seconds)),
             trigger: r.field(g.attr("trigger"), |v| quantity_param(v, ValueType::Length, Metres)),
+            offset: r.field(g.attr("offset"), |v| quantity_param(v, ValueType::Length, Metres)),
         })
         .collect();
     Some(Scenario {

@@ -181,6 +181,9 @@ pub struct Group {
     pub delay: Field<Param<Seconds>>,
     /// The group starts its behavior when the ego vehicle is within this distance.
     pub trigger: Field<Param<Metres>>,
+    /// A move of the whole group along its lane from where the layout puts it, in the
+    /// direction its arm's stations grow; a range is a search parameter.
+    pub offset: Field<Param<Metres>>,
 }
 
 impl Group {

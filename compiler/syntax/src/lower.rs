@@ -547,9 +547,10 @@ impl Lowerer<'_> {
         );
     }
 
-    /// E0216: a distance, delay or trigger distance below 0 (speeds are the checker's).
+    /// E0216: a distance, delay or trigger distance below 0 (speeds are the checker's; a
+    /// signed field such as `offset` may be negative).
     fn not_negative(&mut self, def: &FieldDef, value: f64, number: Span) -> Option<()> {
-        if value >= 0.0 || !def.param || def.ty == ValueType::Speed {
+        if value >= 0.0 || !def.param || def.signed || def.ty == ValueType::Speed {
             return Some(());
         }
         let unit = if def.ty == ValueType::Duration { "s" } else { "m" };

@@ -196,6 +196,8 @@ pub struct FieldDef {
     /// Whether it takes a parameter: a range (`30..40 km/h`) for a quantity, a choice
     /// (`a | b`) for a name. Other fields take single values only (E0205).
     pub param: bool,
+    /// Whether a length or duration below 0 means something (else E0216).
+    pub signed: bool,
 }
 
 #[derive(Debug, PartialEq, Eq, Hash)]
@@ -226,6 +228,7 @@ macro_rules! field {
             doc: $doc,
             essential: false,
             param: false,
+            signed: false,
         }
     };
     ($name:literal, $ty:ident in $vocabulary:literal, $example:literal, $doc:literal) => {
@@ -237,6 +240,7 @@ macro_rules! field {
             doc: $doc,
             essential: false,
             param: false,
+            signed: false,
         }
     };
     (essential $($rest:tt)*) => {
@@ -244,6 +248,9 @@ macro_rules! field {
     };
     (param $($rest:tt)*) => {
         FieldDef { param: true, ..field!($($rest)*) }
+    };
+    (signed $($rest:tt)*) => {
+        FieldDef { signed: true, ..field!($($rest)*) }
     };
     ($name:literal, one of $set:ident, $example:literal, $doc:literal) => {
         FieldDef {
@@ -254,6 +261,7 @@ macro_rules! field {
             doc: $doc,
             essential: false,
             param: false,
+            signed: false,
         }
     };
 }
@@ -325,6 +333,12 @@ pub const ACTOR: SectionDef = SectionDef {
         ),
         field!(param "delay", Duration, "2 s", "the time before the group starts its behavior"),
         field!(param "trigger", Length, "30 m", "the group starts its behavior when the ego vehicle is this close"),
+        field!(
+            signed param "offset",
+            Length,
+            "1.5 m",
+            "how far the group is moved along its lane from where the layout puts it; a range is searched"
+        ),
     ],
 };
 

@@ -268,7 +268,7 @@ fn range((low, high): (f64, f64)) -> String {
 
 /// The variables of a group's (or the ego's) ranges and choices, sampled once per scene
 /// and shared by its actors: `tadSpeedTAG`, `tadPickTAG`, `tadShiftTAG`, `tadDelayTAG`,
-/// `tadTriggerTAG`.
+/// `tadTriggerTAG`, `tadJitterTAG`, `tadOffsetTAG`.
 fn params(out: &mut String, p: &Sampled) {
     let tag = &p.tag;
     if let Some(speed) = p.speed {
@@ -288,6 +288,9 @@ fn params(out: &mut String, p: &Sampled) {
     }
     if let Some(jitter) = p.jitter {
         let _ = writeln!(out, "tadJitter{tag} = Range({}, {})", number(-jitter), number(jitter));
+    }
+    if let Some(offset) = p.offset {
+        let _ = writeln!(out, "tadOffset{tag} = {}", range(offset));
     }
 }
 
@@ -309,6 +312,9 @@ fn actor(out: &mut String, a: &Actor, spot: &str, needs: &maps::Needs) {
     };
     if p.jitter.is_some() {
         offset = format!("{offset} + tadJitter{}", p.tag);
+    }
+    if p.offset.is_some() {
+        offset = format!("{offset} + tadOffset{}", p.tag);
     }
     let junction = needs.junction.is_some();
     let call = match (a.arm, a.cross) {

@@ -88,7 +88,9 @@ pub fn build(
             tag: (i + 1).to_string(),
             speed: g.speed_range,
             motions: g.motions.clone(),
-            shift: if let Some((low, high)) = g.distance.filter(|(low, high)| low < high) {
+            shift: if g.offset.is_some() {
+                None
+            } else if let Some((low, high)) = g.distance.filter(|(low, high)| low < high) {
                 Some((high - low, -away))
             } else if conflict.is_none() {
                 Some((gl.shift_room(), -away)).filter(|(s, _)| *s >= 0.5)
@@ -97,8 +99,11 @@ pub fn build(
             },
             delay: g.delay.or_else(|| first.map(|f| f.start.delay).filter(|d| *d > 0.05).map(|d| (d, d))),
             trigger: g.trigger,
-            jitter: first.map(|f| laid.conflict_spread(f)).filter(|j| *j >= 0.3),
+            jitter: first.map(|f| laid.conflict_spread(f)).filter(|j| *j >= 0.3 && g.offset.is_none()),
+            offset: g.offset.filter(|(low, high)| low < high),
         };
+        // a single written offset moves the group's place
+        let moved_by = g.offset.filter(|(low, high)| low >= high).map_or(0.0, |(low, _)| low);
         let row_start = first.map_or(0.0, |f| f.lateral);
         let mut actors = Vec::new();
         let n = kept.get(i).copied().unwrap_or(gl.agents.len());
@@ -111,10 +116,11 @@ pub fn build(
             let (arm, offset) = if junction || a.station.arm == Arm::Ego {
                 // on another arm a spot is never inside the junction (a walker's may be)
                 let inside = a.station.arm != Arm::Ego && a.facing == Facing::Along;
-                (a.station.arm, if inside { a.station.along.max(0.0) } else { a.station.along })
+                let along = a.station.along + moved_by;
+                (a.station.arm, if inside { along.max(0.0) } else { along })
             } else {
                 // no junction on the map: beyond where it would be, on the ego's road
-                (Arm::Ego, laid.road.approach + a.station.along + 10.0)
+                (Arm::Ego, laid.road.approach + a.station.along + moved_by + 10.0)
             };
             let lane =
                 if a.station.arm == Arm::Ego && a.lane == first.map_or(a.lane, |f| f.lane) { g.lane } else { a.lane };

@@ -61,6 +61,8 @@ pub struct Resolved {
     pub delay: Option<(f64, f64)>,
     /// The ego's distance at which the group starts its behavior, m.
     pub trigger: Option<(f64, f64)>,
+    /// The written move along the lane from the layout's place, m: `(low, high)`.
+    pub offset: Option<(f64, f64)>,
 }
 
 /// What stands for an actor type: its own declared simulation, else its kind's (W0703 with
@@ -241,6 +243,7 @@ pub fn resolve(scenario: &Scenario, report: &mut Report) -> Vec<Resolved> {
             distance: ends(&group.distance, |m| m.0.max(0.0)),
             delay: ends(&group.delay, |s| s.0.max(0.0)).filter(|_| !debris),
             trigger: ends(&group.trigger, |m| m.0.max(0.0)).filter(|_| !debris),
+            offset: ends(&group.offset, |m| m.0).filter(|(low, high)| low.is_finite() && high.is_finite()),
         });
     }
     out

@@ -110,6 +110,9 @@ pub struct Sampled {
     /// An adversary timed to meet the ego: its place varies by up to this much either way
     /// (`tadJitterTAG = Range(-j, j)`).
     pub jitter: Option<f64>,
+    /// A written `offset` range: `tadOffsetTAG = Range(low, high)` added to its place (it
+    /// replaces the shift and the jitter; a single offset is in the place already).
+    pub offset: Option<(f64, f64)>,
 }
 
 impl Sampled {
@@ -214,8 +217,9 @@ pub fn plan(scenario: &Scenario, options: &EmitOptions) -> (Plan, Vec<Diagnostic
     for a in actors.groups.iter().flat_map(|g| &g.actors).filter(|a| a.arm == tad_layout::Arm::Ego) {
         let reach = a.length.max(a.width) / 2.0 + a.params.jitter.unwrap_or(0.0) + 1.0;
         let shift = a.params.shift.map_or(0.0, |(s, _)| s);
-        needs.ahead = needs.ahead.max((a.offset + reach + shift).ceil());
-        needs.behind = needs.behind.max((reach + shift - a.offset).ceil());
+        let (back, on) = a.params.offset.map_or((0.0, 0.0), |(low, high)| ((-low).max(0.0), high.max(0.0)));
+        needs.ahead = needs.ahead.max((a.offset + reach + shift + on).ceil());
+        needs.behind = needs.behind.max((reach + shift + back - a.offset).ceil());
     }
     let environment = environment::plan(scenario, &road, options.simulator, &mut report);
 
