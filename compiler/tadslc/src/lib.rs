@@ -19,6 +19,8 @@ pub mod llm;
 pub mod manual;
 pub mod output;
 pub mod run;
+pub mod search;
+pub mod shard;
 
 /// Output format of `check`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]

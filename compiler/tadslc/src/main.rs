@@ -147,6 +147,41 @@ enum Command {
         #[arg(long)]
         compat: bool,
     },
+    /// Search each scenario's parameters for the scenes that challenge an ego most
+    /// (ChatScene's adversarial search) and write them as TAD with the parameters fixed
+    ///
+    /// Per scenario: 50 scenes sampled in rounds of 10; after each round every parameter's
+    /// range is re-fitted to mean ± std of the colliding scenes so far; the 2 kept are the
+    /// colliding ones with the lowest OS, then the lowest-OS others. Also writes
+    /// `search.json` (ranges by round, collision rates, the chosen scenes).
+    Search {
+        /// Scenario files or directories (searched recursively), or `.tadc` files
+        #[arg(required = true)]
+        paths: Vec<PathBuf>,
+        /// The ego the scenes are searched against: `idm`, `naive`, `learned:PATH`
+        #[arg(long, default_value = "idm")]
+        ego: String,
+        /// The directory the chosen scenes and `search.json` are written to
+        #[arg(short, long, value_name = "DIR")]
+        out: PathBuf,
+        /// Scenes sampled per scenario
+        #[arg(long, default_value_t = 50)]
+        samples: usize,
+        /// Ranges are re-fitted after every this many scenes
+        #[arg(long, default_value_t = 10)]
+        round: usize,
+        /// Scenes kept per scenario
+        #[arg(long, default_value_t = 2)]
+        keep: usize,
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Search every N-th input from I (a job array's index I of N jobs, from 0)
+        #[arg(long, value_name = "I/N", default_value = "0/1", value_parser = tadslc::shard::parse)]
+        shard: tadslc::shard::Shard,
+        /// Score as SafeBench's scorer does, quirks included
+        #[arg(long)]
+        compat: bool,
+    },
     /// Print the listing of a bytecode program (`.tadc`), checking every byte
     Disasm {
         /// The `.tadc` file
@@ -602,6 +637,10 @@ fn main() -> ExitCode {
         Command::Run { paths, ego, seeds, format, trace, render, compat } => {
             tadslc::run::run(&tadslc::run::RunArgs { paths, egos: ego, seeds, format, trace, render, compat }, color)
         }
+        Command::Search { paths, ego, out, samples, round, keep, seed, shard, compat } => tadslc::search::run(
+            &tadslc::search::SearchArgs { paths, ego, out, samples, round, keep, seed, shard, compat },
+            color,
+        ),
         Command::Import { path, output } => tadslc::interchange::run_import(&path, output.as_deref(), color),
         Command::Export { format: ExportFormat::Yaml, yaml: _, path, output } => {
             tadslc::interchange::run_export(&path, output.as_deref(), color)

@@ -55,10 +55,40 @@ pub fn parse_seeds(text: &str) -> Result<Range<u64>, String> {
     Ok(range)
 }
 
+/// An ego policy by its command-line name, made afresh for every episode (a learned
+/// actor is read once and copied).
+pub enum Ego {
+    Idm,
+    Naive,
+    Learned(tad_policy::Learned),
+}
+
+impl Ego {
+    pub fn parse(spec: &str) -> Result<Ego, tad_policy::PolicyError> {
+        match spec.split_once(':') {
+            Some(("learned", path)) if !path.is_empty() => Ok(Ego::Learned(tad_policy::Learned::load(path)?)),
+            _ => {
+                let policy = tad_policy::parse_policy(spec)?;
+                Ok(if policy.name() == "idm" { Ego::Idm } else { Ego::Naive })
+            }
+        }
+    }
+
+    pub fn make(&self) -> Box<dyn tad_policy::EgoPolicy> {
+        match self {
+            Ego::Idm => Box::new(tad_policy::Idm::default()),
+            Ego::Naive => Box::new(tad_policy::Naive::default()),
+            Ego::Learned(actor) => Box::new(actor.clone()),
+        }
+    }
+}
+
 /// One scenario ready to run, named for people.
 pub struct Loaded {
     pub name: String,
     pub scene: Scene,
+    /// The source it was compiled from (`None` for a `.tadc` file).
+    pub source: Option<files::Input>,
 }
 
 /// Every input as a scene: sources compiled, `.tadc` files loaded.
@@ -74,7 +104,7 @@ pub fn load(paths: &[PathBuf], color: bool, status: &mut Status) -> Result<Vec<L
                 continue;
             };
             match Scene::new(&program) {
-                Ok(scene) => loaded.push(Loaded { name: input.name.clone(), scene }),
+                Ok(scene) => loaded.push(Loaded { name: input.name.clone(), scene, source: Some(input.clone()) }),
                 Err(e) => {
                     *status = (*status).max(Status::Failed);
                     errln!("{}: not run: {e}", input.name)?;
@@ -89,7 +119,7 @@ pub fn load(paths: &[PathBuf], color: bool, status: &mut Status) -> Result<Vec<L
             Err(e) => Err(format!("cannot read it: {e}")),
         };
         match program.and_then(|p| Scene::new(&p).map_err(|e| e.to_string())) {
-            Ok(scene) => loaded.push(Loaded { name, scene }),
+            Ok(scene) => loaded.push(Loaded { name, scene, source: None }),
             Err(e) => {
                 *status = (*status).max(Status::Usage);
                 errln!("error: {name}: {e}")?;
@@ -131,7 +161,7 @@ fn run_in(args: &RunArgs, color: bool, status: &mut Status) -> Result<(), Closed
     let keep_frames = args.trace.is_some() || args.render.is_some();
     let opts = Options { mode, keep_frames, ..Options::default() };
     let total = scenes.len() * policies.len() * (args.seeds.end - args.seeds.start) as usize;
-    let progress = Progress::new(total);
+    let progress = Progress::new(total, "episodes");
     let mut trace = match &args.trace {
         Some(path) => match std::fs::File::create(path) {
             Ok(f) => Some(std::io::BufWriter::new(f)),
@@ -373,28 +403,30 @@ fn print_table(scenes: &[Loaded], egos: &[String], done: &[Done], mode: Mode) ->
 }
 
 /// A progress bar on standard error for long batches at a terminal.
-struct Progress(Option<indicatif::ProgressBar>);
+pub struct Progress(Option<indicatif::ProgressBar>);
 
 impl Progress {
-    fn new(total: usize) -> Progress {
+    /// `total` units, named `unit` (`episodes`).
+    pub fn new(total: usize, unit: &str) -> Progress {
         use std::io::IsTerminal;
         let show = total >= 20 && std::io::stderr().is_terminal();
         Progress(show.then(|| {
             let bar = indicatif::ProgressBar::new(total as u64);
-            if let Ok(style) = indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} episodes {eta}") {
+            let template = format!("{{bar:40}} {{pos}}/{{len}} {unit} {{eta}}");
+            if let Ok(style) = indicatif::ProgressStyle::with_template(&template) {
                 bar.set_style(style);
             }
             bar
         }))
     }
 
-    fn tick(&self) {
+    pub fn tick(&self) {
         if let Some(bar) = &self.0 {
             bar.inc(1);
         }
     }
 
-    fn finish(&self) {
+    pub fn finish(&self) {
         if let Some(bar) = &self.0 {
             bar.finish_and_clear();
         }
