@@ -29,6 +29,70 @@ fn legend(out: &mut String, names: &[&str], x: f64, y: f64) {
     }
 }
 
+/// Values in `[0, 1]` as bars: one cluster per group (the first item), one colour per
+/// series (the second), like the paper's bar charts of OS by method and agent.
+pub fn grouped(title: &str, bars: &[(String, String, f64)]) -> String {
+    let mut groups: Vec<&str> = Vec::new();
+    let mut series: Vec<&str> = Vec::new();
+    for (g, s, _) in bars {
+        if !groups.contains(&g.as_str()) {
+            groups.push(g);
+        }
+        if !series.contains(&s.as_str()) {
+            series.push(s);
+        }
+    }
+    let (left, top, height, bar) = (50.0, 40.0, 240.0, 18.0);
+    let cluster = bar * series.len().max(1) as f64 + 24.0;
+    let width = left + cluster * groups.len().max(1) as f64 + 160.0;
+    let mut out = String::new();
+    let _ = write!(
+        out,
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{width}\" height=\"{}\" viewBox=\"0 0 {width} {}\"><rect width=\"100%\" height=\"100%\" fill=\"white\"/><text x=\"{left}\" y=\"22\" font-size=\"15\" {FONT}>{}</text>",
+        top + height + 110.0,
+        top + height + 110.0,
+        escape(title)
+    );
+    for k in 0..=4 {
+        let v = k as f64 / 4.0;
+        let y = top + height * (1.0 - v);
+        let _ = write!(
+            out,
+            "<line x1=\"{left}\" y1=\"{y}\" x2=\"{}\" y2=\"{y}\" stroke=\"#ddd\"/><text x=\"{}\" y=\"{}\" font-size=\"11\" text-anchor=\"end\" {FONT}>{v:.2}</text>",
+            width - 160.0,
+            left - 6.0,
+            y + 4.0
+        );
+    }
+    for (gi, g) in groups.iter().enumerate() {
+        let x0 = left + 12.0 + gi as f64 * cluster;
+        for (si, s) in series.iter().enumerate() {
+            let Some(v) = bars.iter().find(|(a, b, _)| a == g && b == s).map(|b| b.2.clamp(0.0, 1.0)) else { continue };
+            let _ = write!(
+                out,
+                "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"{}\"><title>{}: {v:.3}</title></rect>",
+                x0 + si as f64 * bar,
+                top + height * (1.0 - v),
+                bar - 2.0,
+                height * v,
+                COLOURS[si % COLOURS.len()],
+                escape(&format!("{g} · {s}"))
+            );
+        }
+        let cx = x0 + bar * series.len() as f64 / 2.0;
+        let _ = write!(
+            out,
+            "<text x=\"{cx}\" y=\"{}\" font-size=\"11\" text-anchor=\"end\" transform=\"rotate(-35 {cx} {})\" {FONT}>{}</text>",
+            top + height + 16.0,
+            top + height + 16.0,
+            escape(g)
+        );
+    }
+    legend(&mut out, &series, width - 140.0, top + 10.0);
+    out.push_str("</svg>\n");
+    out
+}
+
 /// Shares of each value per corpus, bars side by side; values by total share, at most
 /// `max_values` of them.
 pub fn bars(title: &str, corpora: &[(&str, &Histogram)], max_values: usize) -> String {

@@ -322,6 +322,27 @@ struct GenSummary<'a> {
 
 /// `tadslc gen --generator fitted:MODEL`: item `i` is drawn with seed `seed + i`, again
 /// until it checks without errors (at most `attempts` draws).
+/// Scenario `name` drawn from `fitted` with `seed` and checked, drawn again while it has
+/// errors (at most `attempts` draws): the text and its class, and the number of draws.
+pub fn draw_fitted(
+    db: &mut Database,
+    fitted: &tad_fit::Fitted,
+    name: &str,
+    seed: u64,
+    attempts: usize,
+) -> (Option<(String, Class)>, usize) {
+    let mut rng = tad_ir::SplitMix64::new(seed);
+    for draw in 1..=attempts.max(1) {
+        let text = fitted.sample(name, &mut rng);
+        let file = db.set_source(PathBuf::from(format!("{name}.tad")), text.clone(), Language::Tad, &RealFs);
+        let class = tad_db::check(db, file).class;
+        if let Some(class) = class.filter(|_| counts(class)) {
+            return (Some((text, class)), draw);
+        }
+    }
+    (None, attempts.max(1))
+}
+
 pub fn generate_fitted(g: &FittedGen) -> Status {
     crate::output::run(|status| {
         let fitted = match std::fs::read_to_string(g.model)
@@ -351,20 +372,10 @@ pub fn generate_fitted(g: &FittedGen) -> Status {
         };
         for i in 0..g.n {
             let seed = g.seed.wrapping_add(i as u64);
-            let mut rng = tad_ir::SplitMix64::new(seed);
             let name = format!("{stem}_fitted_{:03}", i + 1);
-            let mut accepted = None;
-            for _ in 0..g.attempts.max(1) {
-                summary.draws += 1;
-                let text = fitted.sample(&name, &mut rng);
-                let file = db.set_source(PathBuf::from(format!("{name}.tad")), text.clone(), Language::Tad, &RealFs);
-                let class = tad_db::check(&db, file).class;
-                if let Some(class) = class.filter(|_| counts(class)) {
-                    accepted = Some((text, class));
-                    break;
-                }
-                summary.rejected += 1;
-            }
+            let (accepted, draws) = draw_fitted(&mut db, &fitted, &name, seed, g.attempts);
+            summary.draws += draws;
+            summary.rejected += draws - usize::from(accepted.is_some());
             let Some((text, class)) = accepted else {
                 *status = (*status).max(Status::Failed);
                 errln!("warning: scenario {} not generated: {} drawn, none valid", i + 1, g.attempts)?;

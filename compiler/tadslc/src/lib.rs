@@ -10,6 +10,7 @@ pub mod build;
 pub mod bytecode;
 pub mod check;
 pub mod corpus;
+pub mod eval;
 pub mod explain;
 pub mod files;
 pub mod finetune;

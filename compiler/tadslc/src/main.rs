@@ -146,6 +146,13 @@ enum Command {
         /// yaw not unwrapped, off-road never ends an episode)
         #[arg(long)]
         compat: bool,
+        /// Run every N-th input from I (a job array's index I of N jobs, from 0)
+        #[arg(long, value_name = "I/N", default_value = "0/1", value_parser = tadslc::shard::parse)]
+        shard: tadslc::shard::Shard,
+        /// Write the scored episodes to DIR/results.json (DIR/results.I-of-N.json with
+        /// --shard), for `tadslc merge`
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
     },
     /// Search each scenario's parameters for the scenes that challenge an ego most
     /// (ChatScene's adversarial search) and write them as TAD with the parameters fixed
@@ -181,6 +188,63 @@ enum Command {
         /// Score as SafeBench's scorer does, quirks included
         #[arg(long)]
         compat: bool,
+    },
+    /// The paper's results table: generators × egos × SafeBench's ten metrics and OS,
+    /// per region
+    ///
+    /// For each region (default: every region of the corpus with 3 scenarios or more) and
+    /// generator: scenarios generated (`fitted` on the region's scenarios, `baseline` the
+    /// region-agnostic generator) or taken from a directory, checked, searched against the
+    /// search ego (ChatScene's search), and the kept scenes run by every ego.
+    Eval {
+        /// The corpus the regions and the fitted generators come from
+        #[arg(default_value = "examples")]
+        corpus: Vec<PathBuf>,
+        /// Regions, comma-separated or repeated
+        #[arg(long = "region", value_delimiter = ',')]
+        regions: Vec<String>,
+        /// Generators: `fitted`, `baseline`, or a directory of scenarios (from `tadslc gen`)
+        #[arg(long, value_delimiter = ',', default_values_t = ["fitted".to_string(), "baseline".to_string()])]
+        generators: Vec<String>,
+        /// The egos evaluated: `idm`, `naive`, `learned:PATH`
+        #[arg(long, value_delimiter = ',', default_values_t = ["idm".to_string(), "naive".to_string()])]
+        egos: Vec<String>,
+        /// The ego the scenes are searched against (ChatScene's surrogate)
+        #[arg(long, default_value = "idm")]
+        search_ego: String,
+        /// Scenarios per region and generator
+        #[arg(short, default_value_t = 10)]
+        n: usize,
+        /// Scenes sampled per scenario by the search
+        #[arg(long, default_value_t = 50)]
+        samples: usize,
+        /// Scenes kept per scenario
+        #[arg(long, default_value_t = 2)]
+        keep: usize,
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        #[arg(long, value_enum, default_value_t = tadslc::eval::EvalFormat::Markdown)]
+        format: tadslc::eval::EvalFormat,
+        /// Write the scored episodes to DIR/results.json (DIR/results.I-of-N.json with --shard)
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+        /// Draw the OS of each generator and ego as an SVG bar chart
+        #[arg(long, value_name = "FILE")]
+        plot: Option<PathBuf>,
+        /// Evaluate every N-th scenario from I (a job array's index I of N jobs, from 0)
+        #[arg(long, value_name = "I/N", default_value = "0/1", value_parser = tadslc::shard::parse)]
+        shard: tadslc::shard::Shard,
+    },
+    /// Combine the results files of `eval --shard` (or `run --shard --out`) into one table
+    Merge {
+        /// The results files
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        #[arg(long, value_enum, default_value_t = tadslc::eval::EvalFormat::Markdown)]
+        format: tadslc::eval::EvalFormat,
+        /// Draw the OS of each generator and ego as an SVG bar chart
+        #[arg(long, value_name = "FILE")]
+        plot: Option<PathBuf>,
     },
     /// Print the listing of a bytecode program (`.tadc`), checking every byte
     Disasm {
@@ -634,13 +698,47 @@ fn main() -> ExitCode {
             tadslc::bytecode::build(&paths, output.as_deref(), map_dir.is_some() || map.is_some(), color)
         }
         Command::Disasm { path } => tadslc::bytecode::disasm(&path),
-        Command::Run { paths, ego, seeds, format, trace, render, compat } => {
-            tadslc::run::run(&tadslc::run::RunArgs { paths, egos: ego, seeds, format, trace, render, compat }, color)
-        }
+        Command::Run { paths, ego, seeds, format, trace, render, compat, shard, out } => tadslc::run::run(
+            &tadslc::run::RunArgs { paths, egos: ego, seeds, format, trace, render, compat, shard, out },
+            color,
+        ),
         Command::Search { paths, ego, out, samples, round, keep, seed, shard, compat } => tadslc::search::run(
             &tadslc::search::SearchArgs { paths, ego, out, samples, round, keep, seed, shard, compat },
             color,
         ),
+        Command::Eval {
+            corpus,
+            regions,
+            generators,
+            egos,
+            search_ego,
+            n,
+            samples,
+            keep,
+            seed,
+            format,
+            out,
+            plot,
+            shard,
+        } => tadslc::eval::eval(
+            &tadslc::eval::EvalArgs {
+                corpus,
+                regions,
+                generators,
+                egos,
+                search_ego,
+                n,
+                samples,
+                keep,
+                seed,
+                format,
+                out,
+                plot,
+                shard,
+            },
+            color,
+        ),
+        Command::Merge { files, format, plot } => tadslc::eval::merge(&files, format, plot.as_deref()),
         Command::Import { path, output } => tadslc::interchange::run_import(&path, output.as_deref(), color),
         Command::Export { format: ExportFormat::Yaml, yaml: _, path, output } => {
             tadslc::interchange::run_export(&path, output.as_deref(), color)

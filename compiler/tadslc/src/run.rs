@@ -34,6 +34,8 @@ pub struct RunArgs {
     pub trace: Option<PathBuf>,
     pub render: Option<PathBuf>,
     pub compat: bool,
+    pub shard: crate::shard::Shard,
+    pub out: Option<PathBuf>,
 }
 
 /// `A..B` (B excluded, as in Rust), `A..=B` (B included) or a single seed `A`.
@@ -152,7 +154,12 @@ fn run_in(args: &RunArgs, color: bool, status: &mut Status) -> Result<(), Closed
             }
         }
     }
-    let scenes = load(&args.paths, color, status)?;
+    let scenes: Vec<Loaded> = load(&args.paths, color, status)?
+        .into_iter()
+        .enumerate()
+        .filter(|(k, _)| args.shard.takes(*k))
+        .map(|(_, l)| l)
+        .collect();
     if scenes.is_empty() {
         *status = (*status).max(Status::Usage);
         return errln!("error: nothing to run");
@@ -205,6 +212,12 @@ fn run_in(args: &RunArgs, color: bool, status: &mut Status) -> Result<(), Closed
         errln!("error: cannot write the trace: {e}")?;
     }
     let names: Vec<String> = policies.iter().map(|p| p.name().to_string()).collect();
+    if let Some(dir) = &args.out
+        && let Err(e) = write_results(dir, args, &scenes, &done)
+    {
+        *status = Status::Usage;
+        errln!("error: cannot write the results to `{}`: {e}", dir.display())?;
+    }
     match args.format {
         RunFormat::Json => {
             for (e, name) in names.iter().enumerate() {
@@ -244,6 +257,42 @@ fn run_in(args: &RunArgs, color: bool, status: &mut Status) -> Result<(), Closed
         }
     }
     Ok(())
+}
+
+/// The episodes as a results file of `eval`'s form (one region `all`, one generator
+/// `files`), for `tadslc merge`.
+fn write_results(dir: &Path, args: &RunArgs, scenes: &[Loaded], done: &[Done]) -> std::io::Result<()> {
+    use crate::eval::{Results, Row, Setup};
+    let rows: Vec<Row> = done
+        .iter()
+        .map(|d| Row {
+            region: "all".into(),
+            generator: "files".into(),
+            ego: args.egos[d.ego].clone(),
+            scenario: scenes[d.file].name.clone(),
+            trial: 0,
+            seed: d.episode.seed.unwrap_or(0),
+            score: d.score.clone(),
+        })
+        .collect();
+    let results = Results {
+        format: crate::eval::FORMAT.into(),
+        setup: Setup {
+            regions: vec!["all".into()],
+            generators: vec!["files".into()],
+            egos: args.egos.clone(),
+            search_ego: String::new(),
+            n: 0,
+            samples: (args.seeds.end - args.seeds.start) as usize,
+            keep: 0,
+            seed: args.seeds.start,
+        },
+        shard: args.shard,
+        scenarios: [("all/files".to_string(), scenes.len())].into_iter().collect(),
+        rows,
+    };
+    std::fs::create_dir_all(dir)?;
+    std::fs::write(dir.join(args.shard.file_name("results", "json")), serde_json::to_string(&results)? + "\n")
 }
 
 fn episode_json(file: &str, ego: &str, e: &Episode, score: &tad_metrics::EpisodeScore) -> serde_json::Value {
