@@ -1,0 +1,219 @@
+//! The evaluation harness from the command line: `search` (scenes written with fixed
+//! parameters, ranges moving towards collisions), `eval` (the table's shape in every format,
+//! determinism), `--shard` with `merge` (the same table as one run), `run --shard --out`.
+
+mod common;
+use common::*;
+
+use std::path::Path;
+
+use serde_json::Value;
+
+fn path(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn lines(text: &str) -> Vec<Value> {
+    text.lines().map(|l| serde_json::from_str(l).unwrap_or_else(|e| panic!("{e}: {l}"))).collect()
+}
+
+/// A naive ego behind a car whose speed is searched: only a slow car is hit.
+const SLOW_LEAD: &str = "scenario slow_lead {
+  environment {
+    weather: clear
+    time: daytime
+  }
+  road {
+    type: straight_road
+    context: urban
+    lanes: 2
+    direction: two_way
+    light: none
+  }
+  ego {
+    behavior: move_forward
+    speed: 30 km/h
+    lane: 1
+  }
+  actor lead: car {
+    behavior: move_forward
+    speed: 0..60 km/h
+    position: front of ego
+    lane: 1
+  }
+}
+";
+
+#[test]
+fn search_writes_fixed_scenes_that_reproduce_and_moves_ranges_to_collisions() {
+    let dir = scratch("eval-search");
+    let input = dir.join("slow_lead.tad");
+    std::fs::write(&input, SLOW_LEAD).unwrap();
+    let out_dir = dir.join("adv");
+    let out = tadslc(&["search", path(&input), "--ego", "naive", "-o", path(&out_dir), "--seed", "4"], "");
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    assert!(stdout(&out).contains("slow_lead"), "{}", stdout(&out));
+    let summary: Value = serde_json::from_str(&std::fs::read_to_string(out_dir.join("search.json")).unwrap()).unwrap();
+    let scenario = &summary["scenarios"][0];
+    let rates: Vec<f64> = scenario["collision_rates"].as_array().unwrap().iter().map(|r| r.as_f64().unwrap()).collect();
+    assert_eq!(rates.len(), 5);
+    assert!(rates[4] > rates[0], "later rounds collide more: {rates:?}");
+    let chosen = scenario["chosen"].as_array().unwrap();
+    assert_eq!(chosen.len(), 2);
+    for c in chosen {
+        assert_eq!(c["collision"], true, "{c}");
+        assert_eq!(c["reproduced"], true, "{c}");
+        let written = out_dir.join(c["file"].as_str().unwrap());
+        let text = std::fs::read_to_string(&written).unwrap();
+        assert!(text.starts_with("// tadslc search: scene "), "{text}");
+        assert!(!text.contains(".."), "every parameter fixed:\n{text}");
+        let check = tadslc(&["check", path(&written)], "");
+        assert_eq!(code(&check), 0, "{}", stderr(&check));
+    }
+    // the same seed writes the same scenes
+    let again = dir.join("again");
+    let out = tadslc(&["search", path(&input), "--ego", "naive", "-o", path(&again), "--seed", "4"], "");
+    assert_eq!(code(&out), 0);
+    for name in ["slow_lead.adv1.tad", "slow_lead.adv2.tad"] {
+        assert_eq!(std::fs::read(out_dir.join(name)).unwrap(), std::fs::read(again.join(name)).unwrap());
+    }
+}
+
+#[test]
+fn search_usage_errors() {
+    let dir = scratch("eval-search-usage");
+    let out = tadslc(&["search", "examples/safety", "--ego", "reckless", "-o", path(&dir)], "");
+    assert_eq!(code(&out), 2);
+    assert!(stderr(&out).contains("unknown policy `reckless`"), "{}", stderr(&out));
+    let out = tadslc(&["search", "examples/safety", "--shard", "2/2", "-o", path(&dir)], "");
+    assert_eq!(code(&out), 2);
+    assert!(stderr(&out).contains("is not a shard"), "{}", stderr(&out));
+}
+
+#[test]
+fn eval_prints_the_table_in_every_format_deterministically() {
+    let args = ["eval", "examples", "--region", "los_angeles,new_york_city", "-n", "3", "--samples", "20"];
+    let out = tadslc(&[&args[..], &["--format", "json"]].concat(), "");
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    let rows = lines(&stdout(&out));
+    // 2 regions × 2 generators × 2 egos
+    assert_eq!(rows.len(), 8, "{}", stdout(&out));
+    for row in &rows {
+        for key in ["CR", "RR", "SS", "OR", "RF", "Comp", "TS", "ACC", "YV", "LI", "OS"] {
+            assert!(row["metrics"].get(key).is_some(), "{key} in {row}");
+        }
+        let os = row["OS"].as_f64().unwrap();
+        assert!((0.0..=1.0).contains(&os), "{row}");
+        assert!(row["episodes"].as_u64().unwrap() >= 1);
+    }
+    let pairs: Vec<(String, String, String)> =
+        rows.iter().map(|r| (r["region"].to_string(), r["generator"].to_string(), r["ego"].to_string())).collect();
+    assert_eq!(pairs[0], ("\"los_angeles\"".into(), "\"fitted\"".into(), "\"idm\"".into()));
+    assert_eq!(pairs[7], ("\"new_york_city\"".into(), "\"baseline\"".into(), "\"naive\"".into()));
+    // the naive ego, blind to everything, collides at least as often as IDM overall
+    let collisions = |ego: &str| -> f64 {
+        rows.iter().filter(|r| r["ego"] == ego).map(|r| r["metrics"]["CR"].as_f64().unwrap()).sum()
+    };
+    assert!(collisions("naive") >= collisions("idm"), "{}", stdout(&out));
+    let again = tadslc(&[&args[..], &["--format", "json"]].concat(), "");
+    assert_eq!(stdout(&out), stdout(&again), "seeded: the same table twice");
+
+    let dir = scratch("eval-table");
+    let plot = dir.join("os.svg");
+    let md = tadslc(&[&args[..], &["--plot", path(&plot)]].concat(), "");
+    let table = stdout(&md);
+    assert!(
+        table.starts_with(
+            "| region | generator | ego | scenes | CR | RR | SS | OR | RF | Comp | TS | ACC | YV | LI | OS |"
+        ),
+        "{table}"
+    );
+    assert_eq!(table.lines().filter(|l| l.starts_with("| los_angeles") || l.starts_with("| new_york_city")).count(), 8);
+    let svg = std::fs::read_to_string(&plot).unwrap();
+    assert!(svg.starts_with("<svg") && svg.contains("los_angeles · fitted") && svg.contains("naive"), "{svg}");
+    let csv = stdout(&tadslc(&[&args[..], &["--format", "csv"]].concat(), ""));
+    assert_eq!(csv.lines().next(), Some("region,generator,ego,scenarios,episodes,CR,RR,SS,OR,RF,Comp,TS,ACC,YV,LI,OS"));
+    assert_eq!(csv.lines().count(), 9);
+}
+
+#[test]
+fn shards_merge_into_the_table_of_one_run() {
+    let dir = scratch("eval-shards");
+    let args = ["eval", "examples", "--region", "los_angeles", "-n", "3", "--samples", "10", "--format", "csv"];
+    let whole = tadslc(&[&args[..], &["--out", path(&dir.join("whole"))]].concat(), "");
+    assert_eq!(code(&whole), 0, "{}", stderr(&whole));
+    let mut files = Vec::new();
+    for i in 0..3 {
+        let shard = format!("{i}/3");
+        let out = tadslc(&[&args[..], &["--shard", &shard, "--out", path(&dir)]].concat(), "");
+        assert_eq!(code(&out), 0, "{}", stderr(&out));
+        files.push(dir.join(format!("results.{i}-of-3.json")));
+    }
+    let names: Vec<&str> = files.iter().map(|f| path(f)).collect();
+    let merged = tadslc(&[&["merge"][..], &names, &["--format", "csv"]].concat(), "");
+    assert_eq!(code(&merged), 0, "{}", stderr(&merged));
+    assert_eq!(stdout(&merged), stdout(&whole), "the shards' table is the whole run's");
+    // a missing shard is a warning and status 1; a repeated one, or another command's, an error
+    let part = tadslc(&["merge", names[0], names[1]], "");
+    assert_eq!(code(&part), 1);
+    assert!(stderr(&part).contains("shards 2/3 are missing"), "{}", stderr(&part));
+    let twice = tadslc(&["merge", names[0], names[0]], "");
+    assert_eq!(code(&twice), 2);
+    let other = tadslc(
+        &[
+            "eval",
+            "examples",
+            "--region",
+            "los_angeles",
+            "-n",
+            "2",
+            "--samples",
+            "10",
+            "--out",
+            path(&dir.join("other")),
+        ],
+        "",
+    );
+    assert_eq!(code(&other), 0);
+    let mixed = tadslc(&["merge", names[0], path(&dir.join("other/results.json"))], "");
+    assert_eq!(code(&mixed), 2);
+    assert!(stderr(&mixed).contains("comes from another command"), "{}", stderr(&mixed));
+    std::fs::write(dir.join("bad.json"), "{}").unwrap();
+    let bad = tadslc(&["merge", path(&dir.join("bad.json"))], "");
+    assert_eq!(code(&bad), 2);
+    assert!(stderr(&bad).contains("not a results file"), "{}", stderr(&bad));
+}
+
+#[test]
+fn run_shards_write_results_that_merge() {
+    let dir = scratch("run-shards");
+    for i in 0..2 {
+        let shard = format!("{i}/2");
+        let out = tadslc(&["run", "examples/safety", "--seeds", "0..2", "--shard", &shard, "--out", path(&dir)], "");
+        assert_eq!(code(&out), 0, "{}", stderr(&out));
+    }
+    let merged = tadslc(
+        &["merge", path(&dir.join("results.0-of-2.json")), path(&dir.join("results.1-of-2.json")), "--format", "json"],
+        "",
+    );
+    assert_eq!(code(&merged), 0, "{}", stderr(&merged));
+    let rows = lines(&stdout(&merged));
+    assert_eq!(rows.len(), 2);
+    // 8 safety scenarios × 2 seeds per ego
+    assert!(rows.iter().all(|r| r["episodes"] == 16), "{}", stdout(&merged));
+}
+
+#[test]
+fn eval_usage_errors() {
+    let out = tadslc(&["eval", "examples", "--generators", "llm", "--region", "los_angeles"], "");
+    assert_eq!(code(&out), 2);
+    assert!(stderr(&out).contains("tadslc gen --region los_angeles"), "{}", stderr(&out));
+    let out = tadslc(&["eval", "examples", "--generators", "nowhere/"], "");
+    assert_eq!(code(&out), 2);
+    assert!(stderr(&out).contains("is not `fitted`, `baseline`, `llm` or a directory"), "{}", stderr(&out));
+    let dir = scratch("eval-no-region");
+    std::fs::write(dir.join("slow_lead.tad"), SLOW_LEAD).unwrap();
+    let out = tadslc(&["eval", path(&dir)], "");
+    assert_eq!(code(&out), 2);
+    assert!(stderr(&out).contains("no region with 3 scenarios or more"), "{}", stderr(&out));
+}
