@@ -50,6 +50,9 @@ pub struct EvalArgs {
     pub out: Option<PathBuf>,
     pub plot: Option<PathBuf>,
     pub shard: Shard,
+    /// Requests in flight for the `llm` generators.
+    pub jobs: usize,
+    pub llm: crate::llm::LlmArgs,
 }
 
 /// What produced a results file: shards merge only when these agree.
@@ -155,7 +158,7 @@ fn eval_in(args: &EvalArgs, _color: bool, status: &mut Status) -> Result<(), Clo
     for region in &regions {
         let own: &[&crate::align::Item] = by_region.get(region).map_or(&[], |v| v.as_slice());
         for generator in &args.generators {
-            let texts = match scenarios(&mut db, generator, region, own, args.n, args.seed, status)? {
+            let texts = match scenarios(&mut db, args, generator, region, own, status)? {
                 Some(texts) => texts,
                 None => return Ok(()),
             };
@@ -254,13 +257,68 @@ fn region_of(text: &str) -> Option<String> {
 /// error that stops the command.
 fn scenarios(
     db: &mut Database,
+    args: &EvalArgs,
     generator: &str,
     region: &str,
     own: &[&crate::align::Item],
-    n: usize,
-    seed: u64,
     status: &mut Status,
 ) -> Result<Option<Vec<(String, String)>>, Closed> {
+    let (n, seed) = (args.n, args.seed);
+    let dir = match generator {
+        "llm" | "llm-baseline" | "llm-tuned" => {
+            // through `tadslc gen`'s loop, into the results directory or a temporary one
+            let base = args
+                .out
+                .clone()
+                .unwrap_or_else(|| std::env::temp_dir().join(format!("tadsl-eval-{}", std::process::id())));
+            let dir = base.join("generated").join(region).join(generator);
+            if let Err(e) = std::fs::create_dir_all(&dir) {
+                *status = Status::Usage;
+                errln!("error: cannot create `{}`: {e}", dir.display())?;
+                return Ok(None);
+            }
+            errln!(
+                "{region}: generating {} with the language model ({generator}) into {}",
+                plural(n, "scenario"),
+                dir.display()
+            )?;
+            let request = crate::llm::GenArgs {
+                region,
+                n,
+                out: Some(&dir),
+                baseline: generator == "llm-baseline",
+                tuned: generator == "llm-tuned",
+                corpus: &args.corpus,
+                jobs: args.jobs,
+            };
+            let done = crate::llm::generate(&request, &args.llm);
+            if done != Status::Ok {
+                *status = (*status).max(done);
+                errln!("error: {region}: the language model generated nothing usable ({generator})")?;
+                return Ok(None);
+            }
+            Some(dir)
+        }
+        "fitted" | "baseline" => None,
+        path => Some(PathBuf::from(path)),
+    };
+    if let Some(dir) = dir {
+        if !dir.is_dir() {
+            *status = Status::Usage;
+            errln!(
+                "error: generator `{generator}` is not `fitted`, `baseline`, `llm`, `llm-baseline`, `llm-tuned` or a directory of scenarios"
+            )?;
+            return Ok(None);
+        }
+        let corpus = crate::align::load(std::slice::from_ref(&dir), status)?;
+        let mut out: Vec<(String, String)> = corpus.items.into_iter().map(|i| (i.name, i.tad)).collect();
+        out.retain(|(name, text)| {
+            let file =
+                db.set_source(PathBuf::from(format!("{generator}/{name}.tad")), text.clone(), Language::Tad, &RealFs);
+            tad_db::check(db, file).class.is_some_and(|c| c != Class::Invalid)
+        });
+        return Ok(Some(out));
+    }
     match generator {
         "fitted" => {
             if own.is_empty() {
@@ -297,29 +355,7 @@ fn scenarios(
             }
             Ok(Some(out))
         }
-        "llm" => {
-            *status = Status::Usage;
-            errln!(
-                "error: the LLM generator runs through `tadslc gen --region {region} -n {n} --out DIR` (a server or the local model); pass DIR to --generators"
-            )?;
-            Ok(None)
-        }
-        path => {
-            let dir = Path::new(path);
-            if !dir.exists() {
-                *status = Status::Usage;
-                errln!("error: generator `{path}` is not `fitted`, `baseline`, `llm` or a directory of scenarios")?;
-                return Ok(None);
-            }
-            let corpus = crate::align::load(&[dir.to_path_buf()], status)?;
-            let mut out: Vec<(String, String)> = corpus.items.into_iter().map(|i| (i.name, i.tad)).collect();
-            out.retain(|(name, text)| {
-                let file =
-                    db.set_source(PathBuf::from(format!("{path}/{name}.tad")), text.clone(), Language::Tad, &RealFs);
-                tad_db::check(db, file).class.is_some_and(|c| c != Class::Invalid)
-            });
-            Ok(Some(out))
-        }
+        _ => Ok(Some(Vec::new())),
     }
 }
 

@@ -203,7 +203,10 @@ enum Command {
         /// Regions, comma-separated or repeated
         #[arg(long = "region", value_delimiter = ',')]
         regions: Vec<String>,
-        /// Generators: `fitted`, `baseline`, or a directory of scenarios (from `tadslc gen`)
+        /// Generators: `fitted` (fitted on the region's scenarios), `baseline` (region-agnostic),
+        /// `llm`, `llm-baseline`, `llm-tuned` (a language model through `tadslc gen`'s loop:
+        /// the aligned prompt, the paper's unaligned region prompt, the fine-tuned model's
+        /// prompt with `--adapter`), or a directory of scenarios
         #[arg(long, value_delimiter = ',', default_values_t = ["fitted".to_string(), "baseline".to_string()])]
         generators: Vec<String>,
         /// The egos evaluated: `idm`, `naive`, `learned:PATH`
@@ -221,8 +224,9 @@ enum Command {
         /// Scenes kept per scenario
         #[arg(long, default_value_t = 2)]
         keep: usize,
-        #[arg(long, default_value_t = 0)]
-        seed: u64,
+        /// Requests in flight to the model's server, for the `llm` generators
+        #[arg(long, default_value_t = 1)]
+        jobs: usize,
         #[arg(long, value_enum, default_value_t = tadslc::eval::EvalFormat::Markdown)]
         format: tadslc::eval::EvalFormat,
         /// Write the scored episodes to DIR/results.json (DIR/results.I-of-N.json with --shard)
@@ -234,6 +238,9 @@ enum Command {
         /// Evaluate every N-th scenario from I (a job array's index I of N jobs, from 0)
         #[arg(long, value_name = "I/N", default_value = "0/1", value_parser = tadslc::shard::parse)]
         shard: tadslc::shard::Shard,
+        /// The model for the `llm` generators (`--seed` seeds every generator and the search)
+        #[command(flatten)]
+        llm: tadslc::llm::LlmArgs,
     },
     /// Combine the results files of `eval --shard` (or `run --shard --out`) into one table
     Merge {
@@ -715,11 +722,12 @@ fn main() -> ExitCode {
             n,
             samples,
             keep,
-            seed,
+            jobs,
             format,
             out,
             plot,
             shard,
+            llm,
         } => tadslc::eval::eval(
             &tadslc::eval::EvalArgs {
                 corpus,
@@ -730,11 +738,13 @@ fn main() -> ExitCode {
                 n,
                 samples,
                 keep,
-                seed,
+                seed: llm.seed,
                 format,
                 out,
                 plot,
                 shard,
+                jobs,
+                llm,
             },
             color,
         ),

@@ -205,12 +205,13 @@ fn run_shards_write_results_that_merge() {
 
 #[test]
 fn eval_usage_errors() {
-    let out = tadslc(&["eval", "examples", "--generators", "llm", "--region", "los_angeles"], "");
-    assert_eq!(code(&out), 2);
-    assert!(stderr(&out).contains("tadslc gen --region los_angeles"), "{}", stderr(&out));
     let out = tadslc(&["eval", "examples", "--generators", "nowhere/"], "");
     assert_eq!(code(&out), 2);
-    assert!(stderr(&out).contains("is not `fitted`, `baseline`, `llm` or a directory"), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("is not `fitted`, `baseline`, `llm`, `llm-baseline`, `llm-tuned` or a directory"),
+        "{}",
+        stderr(&out)
+    );
     let dir = scratch("eval-no-region");
     std::fs::write(dir.join("slow_lead.tad"), SLOW_LEAD).unwrap();
     let out = tadslc(&["eval", path(&dir)], "");

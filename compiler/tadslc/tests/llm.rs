@@ -369,6 +369,44 @@ fn gen_writes_checked_scenarios_and_the_baseline_names_the_region_only() {
 }
 
 #[test]
+fn eval_generates_with_the_model_and_tables_its_scenarios() {
+    let dir = scratch("llm-eval");
+    let server = FakeLlm::script(vec![fenced(&COMPLETE.replace("speed: 25 km/h", "speed: 10..40 km/h"))]);
+    let args = [
+        "eval",
+        "examples",
+        "--region",
+        "los_angeles",
+        "--generators",
+        "llm,llm-baseline,fitted",
+        "-n",
+        "2",
+        "--samples",
+        "10",
+        "--format",
+        "json",
+        "--out",
+        dir.to_str().unwrap(),
+    ];
+    let out = run(&args, &env_of(&served(&server)));
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    let rows: Vec<Value> = stdout(&out).lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    let generators: Vec<&str> = rows.iter().map(|r| r["generator"].as_str().unwrap()).collect();
+    assert_eq!(generators, ["llm", "llm", "llm-baseline", "llm-baseline", "fitted", "fitted"]);
+    // each model scenario has a speed range: the search keeps two scenes of each
+    assert_eq!(rows[0]["episodes"], 4, "{}", rows[0]);
+    assert_eq!(tad_files(&dir.join("generated/los_angeles/llm")).len(), 2);
+    let systems: Vec<String> =
+        server.requests().iter().map(|r| r["messages"][0]["content"].as_str().unwrap().to_string()).collect();
+    assert_eq!(systems.iter().filter(|s| s.contains("A scenario of this region")).count(), 2, "two aligned prompts");
+
+    // without a server or a local model the command stops with the model's error
+    let out = run(&["eval", "examples", "--region", "los_angeles", "--generators", "llm", "-n", "1"], &[]);
+    assert_ne!(code(&out), 0);
+    assert!(stderr(&out).contains("the language model generated nothing usable"), "{}", stderr(&out));
+}
+
+#[test]
 fn grammar_prints_each_notation() {
     for (format, marker) in [("gbnf", "root ::= "), ("lark", "start: "), ("json-schema", "\"$schema\"")] {
         let out = run(&["grammar", "--format", format], &[]);
