@@ -22,6 +22,7 @@ pub mod output;
 pub mod run;
 pub mod search;
 pub mod shard;
+pub mod train_ego;
 
 /// Output format of `check`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]

@@ -535,6 +535,9 @@ enum Command {
     /// The data is what `tadslc sft-export` writes (TRL's messages or prompt/completion
     /// JSONL); the loss is on the answers only. Checkpoints let a stopped run resume.
     Finetune(tadslc::finetune::FinetuneArgs),
+    /// Train a learned ego with SAC (SafeBench's actor and critics) on scenarios; use it as
+    /// `--ego learned:OUT`
+    TrainEgo(tadslc::train_ego::TrainEgoArgs),
     /// Fetch or list the local models (TADSL's default language model, run in process)
     Model {
         #[command(subcommand)]
@@ -836,6 +839,7 @@ fn main() -> ExitCode {
             }
         }
         Command::Finetune(args) => return std::process::ExitCode::from(tadslc::finetune::finetune(&args) as u8),
+        Command::TrainEgo(args) => tadslc::train_ego::train_ego(&args, color),
         Command::Stats { corpora, format, plot } => {
             tadslc::align::stats(&tadslc::align::StatsArgs { corpora: &corpora, format, plot: plot.as_deref() })
         }

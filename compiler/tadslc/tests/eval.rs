@@ -218,3 +218,51 @@ fn eval_usage_errors() {
     assert_eq!(code(&out), 2);
     assert!(stderr(&out).contains("no region with 3 scenarios or more"), "{}", stderr(&out));
 }
+
+#[test]
+fn train_ego_splits_checkpoints_resumes_and_drives() {
+    let dir = scratch("train-ego");
+    let out = dir.join("ego.safetensors");
+    let small = ["--hidden", "16,16", "--batch", "32", "--start-training", "100", "--updates-per-episode", "2"];
+    let args = |episodes: &str, extra: &[&str]| -> Vec<String> {
+        let mut a: Vec<String> =
+            ["train-ego", "examples/safety", "-o", path(&out), "--split", "--episodes", episodes, "--every", "2"]
+                .iter()
+                .map(|s| s.to_string())
+                .collect();
+        a.extend(small.iter().chain(extra).map(|s| s.to_string()));
+        a
+    };
+    let run = |a: Vec<String>| {
+        let refs: Vec<&str> = a.iter().map(String::as_str).collect();
+        tadslc(&refs, "")
+    };
+    let first = run(args("4", &[]));
+    assert_eq!(code(&first), 0, "{}", stderr(&first));
+    assert!(stderr(&first).contains("episode 4/4: return"), "{}", stderr(&first));
+    assert!(stdout(&first).contains("on the held-out scenarios"), "{}", stdout(&first));
+    let split: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("ego.safetensors.split.json")).unwrap()).unwrap();
+    let (train, test) = (split["train"].as_array().unwrap().len(), split["test"].as_array().unwrap().len());
+    assert_eq!(train + test, 8);
+    assert!(test >= 1 && train > test, "3/5 of each behaviour trains: {split}");
+    let whole = std::fs::read(&out).unwrap();
+    // 2 episodes, then a resume to 4, gives the same actor
+    std::fs::remove_dir_all(dir.join("ego.safetensors.ckpt")).unwrap();
+    assert_eq!(code(&run(args("2", &[]))), 0);
+    let resumed = run(args("4", &["--resume"]));
+    assert_eq!(code(&resumed), 0, "{}", stderr(&resumed));
+    assert!(stderr(&resumed).contains("resumed from"), "{}", stderr(&resumed));
+    assert_eq!(std::fs::read(&out).unwrap(), whole, "a resumed run is the unbroken one");
+    // the actor drives in the runtime
+    let ego = format!("learned:{}", path(&out));
+    let drive = tadslc(&["run", "examples/safety/straight_obstacle.tad", "--ego", &ego, "--seeds", "0"], "");
+    assert_eq!(code(&drive), 0, "{}", stderr(&drive));
+    assert!(stdout(&drive).contains("ego.safetensors"), "{}", stdout(&drive));
+    // a different seed cannot resume this checkpoint; bad settings are usage errors
+    let other = run(args("6", &["--resume", "--seed", "9"]));
+    assert_eq!(code(&other), 2);
+    assert!(stderr(&other).contains("another seed"), "{}", stderr(&other));
+    let bad = run(args("4", &["--lr", "-1"]));
+    assert_eq!(code(&bad), 2);
+}

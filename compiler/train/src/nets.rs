@@ -1,0 +1,327 @@
+//! The networks as candle `Var`s (for gradients), their plain `f32` copy (for acting), Adam
+//! with its moments kept by name (for checkpoints), and the seeded draws (initialisation,
+//! Gaussian noise).
+
+use std::collections::HashMap;
+
+use candle_core::{D, DType, Device, Tensor, Var};
+use tad_ir::{Rng, SplitMix64};
+
+use crate::TrainError;
+
+/// The observation's length (SafeBench's `ego_state_dim`) and the action's.
+pub(crate) const OBS: usize = 4;
+pub(crate) const ACT: usize = 2;
+/// Spinning Up's (and ChatScene's) bounds on the actor's log standard deviation.
+pub(crate) const LOG_STD_MIN: f32 = -20.0;
+pub(crate) const LOG_STD_MAX: f32 = 2.0;
+
+pub(crate) fn tensor_error(e: candle_core::Error) -> TrainError {
+    TrainError::Tensor(e.to_string())
+}
+
+/// One `nn.Linear`: `weight` `[out, in]`, `bias` `[out]`.
+#[derive(Clone, Debug)]
+pub(crate) struct Layer {
+    pub name: String,
+    pub weight: Var,
+    pub bias: Var,
+}
+
+impl Layer {
+    /// PyTorch's default initialisation: weights and biases uniform in `±1/√fan_in`.
+    fn random(name: &str, outputs: usize, inputs: usize, rng: &mut SplitMix64) -> Result<Layer, TrainError> {
+        let bound = 1.0 / (inputs as f64).sqrt();
+        let mut draw = |n: usize| -> Vec<f32> { (0..n).map(|_| ((rng.unit() * 2.0 - 1.0) * bound) as f32).collect() };
+        let weight = Tensor::from_vec(draw(outputs * inputs), (outputs, inputs), &Device::Cpu).map_err(tensor_error)?;
+        let bias = Tensor::from_vec(draw(outputs), outputs, &Device::Cpu).map_err(tensor_error)?;
+        Ok(Layer {
+            name: name.to_string(),
+            weight: Var::from_tensor(&weight).map_err(tensor_error)?,
+            bias: Var::from_tensor(&bias).map_err(tensor_error)?,
+        })
+    }
+
+    fn forward(&self, x: &Tensor) -> candle_core::Result<Tensor> {
+        x.matmul(&self.weight.as_tensor().t()?)?.broadcast_add(self.bias.as_tensor())
+    }
+
+    fn outputs(&self) -> usize {
+        self.bias.dims()[0]
+    }
+}
+
+/// An MLP: hidden layers `fc1 … fcN` with ReLU, then linear heads on the last hidden layer.
+#[derive(Clone, Debug)]
+pub(crate) struct Net {
+    pub hidden: Vec<Layer>,
+    pub heads: Vec<Layer>,
+}
+
+impl Net {
+    pub fn random(
+        inputs: usize,
+        hidden: &[usize],
+        heads: &[(&str, usize)],
+        rng: &mut SplitMix64,
+    ) -> Result<Net, TrainError> {
+        if hidden.is_empty() || hidden.contains(&0) {
+            return Err(TrainError::Config(format!(
+                "the networks need at least one hidden layer, each of at least one unit (got {hidden:?})"
+            )));
+        }
+        let mut layers = Vec::new();
+        let mut width = inputs;
+        for (k, &h) in hidden.iter().enumerate() {
+            layers.push(Layer::random(&format!("fc{}", k + 1), h, width, rng)?);
+            width = h;
+        }
+        let heads = heads.iter().map(|&(name, n)| Layer::random(name, n, width, rng)).collect::<Result<_, _>>()?;
+        Ok(Net { hidden: layers, heads })
+    }
+
+    pub fn widths(&self) -> Vec<usize> {
+        self.hidden.iter().map(Layer::outputs).collect()
+    }
+
+    /// Each head's output for a batch `x` `[B, inputs]`.
+    pub fn forward(&self, x: &Tensor) -> candle_core::Result<Vec<Tensor>> {
+        let mut x = x.clone();
+        for layer in &self.hidden {
+            x = layer.forward(&x)?.relu()?;
+        }
+        self.heads.iter().map(|h| h.forward(&x)).collect()
+    }
+
+    fn layers(&self) -> impl Iterator<Item = &Layer> {
+        self.hidden.iter().chain(&self.heads)
+    }
+
+    /// Every parameter by name (`fc1.weight`, …), in a fixed order.
+    pub fn vars(&self) -> Vec<(String, Var)> {
+        self.layers()
+            .flat_map(|l| {
+                [(format!("{}.weight", l.name), l.weight.clone()), (format!("{}.bias", l.name), l.bias.clone())]
+            })
+            .collect()
+    }
+
+    /// The parameters' current values under `prefix` + their names.
+    pub fn tensors(&self, prefix: &str) -> HashMap<String, Tensor> {
+        self.vars().into_iter().map(|(name, var)| (format!("{prefix}{name}"), var.as_tensor().clone())).collect()
+    }
+
+    /// Set every parameter from `tensors[prefix + name]`, which must have its shape.
+    pub fn set(&self, tensors: &HashMap<String, Tensor>, prefix: &str, source: &str) -> Result<(), TrainError> {
+        for (name, var) in self.vars() {
+            let full = format!("{prefix}{name}");
+            let t = tensors.get(&full).ok_or_else(|| TrainError::Checkpoint {
+                path: source.to_string(),
+                message: format!("no tensor `{full}`"),
+            })?;
+            if t.dims() != var.dims() {
+                return Err(TrainError::Checkpoint {
+                    path: source.to_string(),
+                    message: format!("tensor `{full}` has shape {:?}, expected {:?}", t.dims(), var.dims()),
+                });
+            }
+            let t = t.to_dtype(DType::F32).map_err(tensor_error)?;
+            var.set(&t).map_err(tensor_error)?;
+        }
+        Ok(())
+    }
+
+    /// A copy whose parameters are new `Var`s with the same values (a target network).
+    pub fn copy(&self) -> Result<Net, TrainError> {
+        let copy = |l: &Layer| -> Result<Layer, TrainError> {
+            Ok(Layer {
+                name: l.name.clone(),
+                weight: Var::from_tensor(&l.weight.as_tensor().copy().map_err(tensor_error)?).map_err(tensor_error)?,
+                bias: Var::from_tensor(&l.bias.as_tensor().copy().map_err(tensor_error)?).map_err(tensor_error)?,
+            })
+        };
+        Ok(Net {
+            hidden: self.hidden.iter().map(copy).collect::<Result<_, _>>()?,
+            heads: self.heads.iter().map(copy).collect::<Result<_, _>>()?,
+        })
+    }
+
+    /// `self ← polyak·self + (1 − polyak)·source`, parameter by parameter.
+    pub fn polyak_from(&self, source: &Net, polyak: f64) -> candle_core::Result<()> {
+        for ((_, target), (_, var)) in self.vars().iter().zip(source.vars()) {
+            let next = (target.as_tensor().affine(polyak, 0.0)? + var.as_tensor().affine(1.0 - polyak, 0.0)?)?;
+            target.set(&next)?;
+        }
+        Ok(())
+    }
+}
+
+/// One layer as plain numbers, row-major `[out, in]`.
+#[derive(Clone, Debug, Default)]
+struct Dense {
+    inputs: usize,
+    weight: Vec<f32>,
+    bias: Vec<f32>,
+}
+
+impl Dense {
+    fn of(layer: &Layer) -> candle_core::Result<Dense> {
+        Ok(Dense {
+            inputs: layer.weight.dims()[1],
+            weight: layer.weight.as_tensor().flatten_all()?.to_vec1::<f32>()?,
+            bias: layer.bias.as_tensor().to_vec1::<f32>()?,
+        })
+    }
+
+    fn forward(&self, x: &[f32], out: &mut Vec<f32>) {
+        out.clear();
+        let rows = self.weight.chunks_exact(self.inputs);
+        out.extend(rows.zip(&self.bias).map(|(row, b)| row.iter().zip(x).map(|(w, v)| w * v).sum::<f32>() + b));
+    }
+}
+
+/// The actor as plain `f32` arithmetic, for acting step by step: the same sums as
+/// `tad_policy::Learned::mu`, so the deterministic action is the saved actor's.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct PlainActor {
+    hidden: Vec<Dense>,
+    mu: Dense,
+    log_std: Dense,
+}
+
+impl PlainActor {
+    pub fn of(actor: &Net) -> Result<PlainActor, TrainError> {
+        let dense = |l: &Layer| Dense::of(l).map_err(tensor_error);
+        Ok(PlainActor {
+            hidden: actor.hidden.iter().map(dense).collect::<Result<_, _>>()?,
+            mu: dense(&actor.heads[0])?,
+            log_std: dense(&actor.heads[1])?,
+        })
+    }
+
+    /// `(mu, log_std)` before squashing (log_std clamped).
+    pub fn heads(&self, obs: [f64; OBS]) -> ([f32; ACT], [f32; ACT]) {
+        let mut x: Vec<f32> = obs.iter().map(|&v| v as f32).collect();
+        let mut y = Vec::new();
+        for layer in &self.hidden {
+            layer.forward(&x, &mut y);
+            x.clear();
+            x.extend(y.iter().map(|v| v.max(0.0)));
+        }
+        self.mu.forward(&x, &mut y);
+        let mu = [y[0], y[1]];
+        self.log_std.forward(&x, &mut y);
+        let ls = [y[0].clamp(LOG_STD_MIN, LOG_STD_MAX), y[1].clamp(LOG_STD_MIN, LOG_STD_MAX)];
+        (mu, ls)
+    }
+}
+
+/// A standard normal pair by Box–Muller from two uniform draws.
+pub(crate) fn normal_pair(rng: &mut SplitMix64) -> [f64; 2] {
+    let u1 = 1.0 - rng.unit(); // (0, 1]
+    let u2 = rng.unit();
+    let r = (-2.0 * u1.ln()).sqrt();
+    let a = 2.0 * std::f64::consts::PI * u2;
+    [r * a.cos(), r * a.sin()]
+}
+
+/// `n` standard normal draws as `f32`.
+pub(crate) fn normals(rng: &mut SplitMix64, n: usize) -> Vec<f32> {
+    let mut out = Vec::with_capacity(n + 1);
+    while out.len() < n {
+        let [a, b] = normal_pair(rng);
+        out.push(a as f32);
+        out.push(b as f32);
+    }
+    out.truncate(n);
+    out
+}
+
+/// The squashed Gaussian policy on a batch `obs` `[B, 4]` with noise `eps` `[B, 2]`:
+/// the action `tanh(mu + σ·ε)` and its log-density with the tanh correction
+/// (`log N(u) − Σ log(1 − tanh²u)`, the latter as `2(log 2 − u − softplus(−2u))`), `[B, 1]`.
+pub(crate) fn sample_actions(actor: &Net, obs: &Tensor, eps: &Tensor) -> candle_core::Result<(Tensor, Tensor)> {
+    let heads = actor.forward(obs)?;
+    let (mu, log_std) = (&heads[0], heads[1].clamp(LOG_STD_MIN, LOG_STD_MAX)?);
+    let u = (mu + (log_std.exp()? * eps)?)?;
+    let action = u.tanh()?;
+    let half_log_2pi = 0.5 * (2.0 * std::f64::consts::PI).ln();
+    // log N(u; mu, σ) with u − mu = σ·ε: −ε²/2 − log σ − ½ log 2π
+    let gauss = ((eps.sqr()?.affine(-0.5, -half_log_2pi))? - &log_std)?;
+    let minus_2u = u.affine(-2.0, 0.0)?;
+    let softplus = (minus_2u.relu()? + (minus_2u.abs()?.neg()?.exp()? + 1.0)?.log()?)?;
+    let correction = ((u.neg()? + std::f64::consts::LN_2)? - softplus)?.affine(2.0, 0.0)?;
+    let logp = (gauss - correction)?.sum_keepdim(D::Minus1)?;
+    Ok((action, logp))
+}
+
+/// The smaller of two critics' values of `(obs, action)`, and each, `[B, 1]`.
+pub(crate) fn q_values(q1: &Net, q2: &Net, obs: &Tensor, action: &Tensor) -> candle_core::Result<(Tensor, Tensor)> {
+    let x = Tensor::cat(&[obs, action], 1)?;
+    let a = q1.forward(&x)?.remove(0);
+    let b = q2.forward(&x)?.remove(0);
+    Ok((a, b))
+}
+
+/// Adam (PyTorch's, bias-corrected, no weight decay) with its moments kept by name, so a
+/// checkpoint holds them: candle-nn's optimizers keep theirs private.
+pub(crate) struct Adam {
+    pub vars: Vec<(String, Var)>,
+    pub m: Vec<Tensor>,
+    pub v: Vec<Tensor>,
+    pub step: u64,
+    pub lr: f64,
+}
+
+impl Adam {
+    const BETA1: f64 = 0.9;
+    const BETA2: f64 = 0.999;
+    const EPS: f64 = 1e-8;
+
+    pub fn new(vars: Vec<(String, Var)>, lr: f64) -> Result<Adam, TrainError> {
+        let zeros = |v: &Var| v.zeros_like().map_err(tensor_error);
+        let m = vars.iter().map(|(_, v)| zeros(v)).collect::<Result<_, _>>()?;
+        let v = vars.iter().map(|(_, v)| zeros(v)).collect::<Result<_, _>>()?;
+        Ok(Adam { vars, m, v, step: 0, lr })
+    }
+
+    /// One step from the gradients of `loss` (those of other parameters are ignored).
+    pub fn minimise(&mut self, loss: &Tensor) -> candle_core::Result<()> {
+        let grads = loss.backward()?;
+        self.step += 1;
+        let step = i32::try_from(self.step).unwrap_or(i32::MAX);
+        let scale_m = 1.0 / (1.0 - Self::BETA1.powi(step));
+        let scale_v = 1.0 / (1.0 - Self::BETA2.powi(step));
+        for (i, (_, theta)) in self.vars.iter().enumerate() {
+            let Some(g) = grads.get(theta.as_tensor()) else { continue };
+            let m = ((&self.m[i] * Self::BETA1)? + (g * (1.0 - Self::BETA1))?)?;
+            let v = ((&self.v[i] * Self::BETA2)? + (g.sqr()? * (1.0 - Self::BETA2))?)?;
+            let adjusted = ((&m * scale_m)? / ((&v * scale_v)?.sqrt()? + Self::EPS)?)?;
+            theta.set(&(theta.as_tensor() - (adjusted * self.lr)?)?)?;
+            self.m[i] = m;
+            self.v[i] = v;
+        }
+        Ok(())
+    }
+
+    /// The moments as `{prefix}{name}.m` / `.v`.
+    pub fn tensors(&self, prefix: &str, into: &mut HashMap<String, Tensor>) {
+        for (i, (name, _)) in self.vars.iter().enumerate() {
+            into.insert(format!("{prefix}{name}.m"), self.m[i].clone());
+            into.insert(format!("{prefix}{name}.v"), self.v[i].clone());
+        }
+    }
+
+    pub fn set(&mut self, tensors: &HashMap<String, Tensor>, prefix: &str, source: &str) -> Result<(), TrainError> {
+        for (i, (name, var)) in self.vars.iter().enumerate() {
+            for (suffix, slot) in [("m", &mut self.m[i]), ("v", &mut self.v[i])] {
+                let full = format!("{prefix}{name}.{suffix}");
+                let t = tensors.get(&full).filter(|t| t.dims() == var.dims()).ok_or_else(|| {
+                    TrainError::Checkpoint { path: source.to_string(), message: format!("no fitting moment `{full}`") }
+                })?;
+                *slot = t.to_dtype(DType::F32).map_err(tensor_error)?;
+            }
+        }
+        Ok(())
+    }
+}
