@@ -52,6 +52,10 @@ pub struct EvalArgs {
     pub shard: Shard,
     /// Requests in flight for the `llm` generators.
     pub jobs: usize,
+    /// Episodes of the "after fine-tuning" stage (0: none).
+    pub finetune: usize,
+    pub finetune_updates: usize,
+    pub finetune_from: Option<PathBuf>,
     pub llm: crate::llm::LlmArgs,
 }
 
@@ -100,6 +104,8 @@ struct Unit {
     generator: String,
     name: String,
     scene: tad_runtime::Scene,
+    /// Its behaviour, for the fine-tuning split (`train_ego::behaviour_of`).
+    key: String,
 }
 
 pub fn eval(args: &EvalArgs, color: bool) -> Status {
@@ -118,6 +124,10 @@ fn eval_in(args: &EvalArgs, _color: bool, status: &mut Status) -> Result<(), Clo
         }
     }
     let surrogate = egos.pop().expect("the search ego was pushed last");
+    if args.finetune > 0 && args.shard != Shard::ALL {
+        *status = Status::Usage;
+        return errln!("error: --finetune trains on every kept scene: run it without --shard");
+    }
     let corpus = crate::align::load(&args.corpus, status)?;
     if corpus.items.is_empty() {
         return Ok(());
@@ -163,13 +173,16 @@ fn eval_in(args: &EvalArgs, _color: bool, status: &mut Status) -> Result<(), Clo
                 None => return Ok(()),
             };
             for (name, text) in texts {
+                let key = crate::train_ego::behaviour_of(&text);
                 let file =
                     db.set_source(PathBuf::from(format!("{generator}/{name}.tad")), text, Language::Tad, &RealFs);
                 let Some(scenario) = tad_db::resolve(&db, file) else { continue };
                 let layout = tad_layout::lay_out(scenario);
                 let program = tad_bytecode::lower(scenario, &layout, &name);
                 match tad_runtime::Scene::new(&program) {
-                    Ok(scene) => units.push(Unit { region: region.clone(), generator: generator.clone(), name, scene }),
+                    Ok(scene) => {
+                        units.push(Unit { region: region.clone(), generator: generator.clone(), name, scene, key })
+                    }
                     Err(e) => errln!("note: {generator}/{name}: not run: {e}")?,
                 }
             }
@@ -184,11 +197,16 @@ fn eval_in(args: &EvalArgs, _color: bool, status: &mut Status) -> Result<(), Clo
     let per_unit = args.samples.max(1) + args.keep * egos.len();
     let progress = crate::run::Progress::new(mine.len() * per_unit, "episodes");
     let started = std::time::Instant::now();
-    let rows: Vec<Row> = mine
+    let searched: Vec<(Vec<Row>, Vec<Scene>)> = mine
         .par_iter()
-        .flat_map_iter(|u| {
+        .map(|u| {
             let make = || surrogate.make();
             let outcome = tad_search::search(&u.scene, &make, &config, &|| progress.tick());
+            let kept: Vec<Scene> = outcome
+                .chosen
+                .iter()
+                .map(|&i| Scene { unit: u, params: outcome.trials[i].params.clone(), seed: outcome.trials[i].seed })
+                .collect();
             let mut rows = Vec::new();
             for &i in &outcome.chosen {
                 let trial = &outcome.trials[i];
@@ -215,10 +233,13 @@ fn eval_in(args: &EvalArgs, _color: bool, status: &mut Status) -> Result<(), Clo
                     }
                 }
             }
-            rows
+            (rows, kept)
         })
         .collect();
     progress.finish();
+    let (rows, kept): (Vec<Vec<Row>>, Vec<Vec<Scene>>) = searched.into_iter().unzip();
+    let rows: Vec<Row> = rows.into_iter().flatten().collect();
+    let kept: Vec<Scene> = kept.into_iter().flatten().collect();
     let results = Results { format: FORMAT.into(), setup, shard: args.shard, scenarios, rows };
     if let Some(dir) = &args.out {
         let path = dir.join(args.shard.file_name("results", "json"));
@@ -238,7 +259,161 @@ fn eval_in(args: &EvalArgs, _color: bool, status: &mut Status) -> Result<(), Clo
         started.elapsed().as_secs_f64(),
         rayon::current_num_threads()
     )?;
-    print(&[results], args.format, args.plot.as_deref(), status)
+    print(&[results], args.format, args.plot.as_deref(), status)?;
+    if args.finetune > 0 {
+        finetune(args, &egos, &kept, status)?;
+    }
+    Ok(())
+}
+
+/// A kept scene: its unit with the search's parameters and seed.
+struct Scene<'a> {
+    unit: &'a Unit,
+    params: Vec<f64>,
+    seed: u64,
+}
+
+/// The "after fine-tuning" table: a learned ego trained with SAC on 3/5 of each
+/// behaviour's kept scenes (from `--finetune-from`, else from scratch), then it, the ego
+/// it started from and the `--egos` on the held-out 2/5.
+fn finetune(args: &EvalArgs, egos: &[Ego], kept: &[Scene], status: &mut Status) -> Result<(), Closed> {
+    let keys: Vec<String> = kept.iter().map(|k| k.unit.key.clone()).collect();
+    let (train, test) = tad_train::split(&keys, args.seed);
+    if train.is_empty() || test.is_empty() {
+        *status = (*status).max(Status::Failed);
+        return errln!("warning: no fine-tuning: {} kept scenes are too few to hold some out", kept.len());
+    }
+    let config = tad_train::Config {
+        episodes: args.finetune,
+        updates_per_episode: args.finetune_updates,
+        seed: args.seed,
+        ..tad_train::Config::default()
+    };
+    let before = match &args.finetune_from {
+        Some(path) => match tad_policy::Learned::load(path) {
+            Ok(actor) => Some(actor),
+            Err(e) => {
+                *status = Status::Usage;
+                return errln!("error: --finetune-from: {e}");
+            }
+        },
+        None => None,
+    };
+    let trainer = tad_train::Trainer::new(config).and_then(|mut t| {
+        if let Some(actor) = &before {
+            t.init_actor(actor)?;
+        }
+        Ok(t)
+    });
+    let mut trainer = match trainer {
+        Ok(t) => t,
+        Err(e) => {
+            *status = Status::Usage;
+            return errln!("error: {e}");
+        }
+    };
+    errln!(
+        "fine-tuning a learned ego on {} ({} held out), {}",
+        plural(train.len(), "scene"),
+        test.len(),
+        plural(args.finetune, "episode")
+    )?;
+    let progress = crate::run::Progress::new(args.finetune, "episodes");
+    while (trainer.episodes() as usize) < args.finetune {
+        let task = trainer.task(train.len());
+        let scene = &kept[train[task.scenario]];
+        if let Err(e) = trainer.step(&scene.unit.scene, scene.params.clone(), scene.seed) {
+            *status = Status::Failed;
+            return errln!("error: fine-tuning stopped: {e}");
+        }
+        progress.tick();
+    }
+    progress.finish();
+    let after = match trainer.actor() {
+        Ok(a) => a,
+        Err(e) => {
+            *status = Status::Failed;
+            return errln!("error: {e}");
+        }
+    };
+    if let Some(dir) = &args.out {
+        let path = dir.join("finetuned.safetensors");
+        if let Err(e) = after.save(&path) {
+            *status = Status::Usage;
+            return errln!("error: {e}");
+        }
+        errln!("the fine-tuned ego in {}", path.display())?;
+    }
+    // the held-out scenes, every ego
+    let mut drivers: Vec<(String, Ego)> = Vec::new();
+    if let Some(actor) = before {
+        drivers.push(("learned (before)".into(), Ego::Learned(actor)));
+    }
+    drivers.push(("learned (fine-tuned)".into(), Ego::Learned(after)));
+    for (spec, ego) in args.egos.iter().zip(egos) {
+        drivers.push((spec.clone(), ego.copy()));
+    }
+    let rows: Vec<Row> = test
+        .par_iter()
+        .flat_map_iter(|&i| {
+            let scene = &kept[i];
+            drivers
+                .iter()
+                .filter_map(|(name, ego)| {
+                    let mut policy = ego.make();
+                    let episode = tad_runtime::run(
+                        &scene.unit.scene,
+                        Some(scene.seed),
+                        scene.params.clone(),
+                        policy.as_mut(),
+                        &tad_runtime::Options::default(),
+                    );
+                    let score = tad_metrics::score_episode(&episode.records, Mode::Fixed).ok()?;
+                    Some(Row {
+                        region: "held-out".into(),
+                        generator: "searched".into(),
+                        ego: name.clone(),
+                        scenario: scene.unit.name.clone(),
+                        trial: 0,
+                        seed: scene.seed,
+                        score,
+                    })
+                })
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    let collision_rate = |name: &str| {
+        let mine: Vec<&Row> = rows.iter().filter(|r| r.ego == name).collect();
+        mine.iter().filter(|r| r.score.metrics.cr > 0.0).count() as f64 / mine.len().max(1) as f64
+    };
+    let setup = Setup {
+        regions: vec!["held-out".into()],
+        generators: vec!["searched".into()],
+        egos: drivers.iter().map(|(n, _)| n.clone()).collect(),
+        search_ego: args.search_ego.clone(),
+        n: args.n,
+        samples: args.samples,
+        keep: args.keep,
+        seed: args.seed,
+    };
+    let scenarios = [("held-out/searched".to_string(), test.len())].into_iter().collect();
+    if args.format == EvalFormat::Markdown {
+        outln!()?;
+        outln!(
+            "After fine-tuning: the learned ego trained on {} kept scenes (3/5 of each behaviour's), all egos on the {} held out:",
+            train.len(),
+            test.len()
+        )?;
+        outln!()?;
+    }
+    let (was, now) = (collision_rate("learned (before)"), collision_rate("learned (fine-tuned)"));
+    let results = Results { format: FORMAT.into(), setup, shard: Shard::ALL, scenarios, rows };
+    print(&[results], args.format, None, status)?;
+    if drivers.iter().any(|(n, _)| n == "learned (before)") {
+        let change = if was > 0.0 { format!("{:+.0} %", 100.0 * (now - was) / was) } else { "–".into() };
+        errln!("held-out collision rate of the learned ego: {was:.3} before, {now:.3} after fine-tuning ({change})")?;
+    }
+    Ok(())
 }
 
 /// The baseline's seed for a region: each region draws its own sample of the same

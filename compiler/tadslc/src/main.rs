@@ -238,6 +238,16 @@ enum Command {
         /// Evaluate every N-th scenario from I (a job array's index I of N jobs, from 0)
         #[arg(long, value_name = "I/N", default_value = "0/1", value_parser = tadslc::shard::parse)]
         shard: tadslc::shard::Shard,
+        /// Also the "after fine-tuning" table: a learned ego trained with SAC for this many
+        /// episodes on 3/5 of each behaviour's kept scenes, every ego on the other 2/5
+        #[arg(long, value_name = "EPISODES", default_value_t = 0)]
+        finetune: usize,
+        /// Learning steps per fine-tuning episode (ChatScene: 1)
+        #[arg(long, value_name = "N", default_value_t = 1)]
+        finetune_updates: usize,
+        /// The learned ego fine-tuning starts from (SafeBench's checkpoint, or `train-ego`'s)
+        #[arg(long, value_name = "FILE")]
+        finetune_from: Option<PathBuf>,
         /// The model for the `llm` generators (`--seed` seeds every generator and the search)
         #[command(flatten)]
         llm: tadslc::llm::LlmArgs,
@@ -730,6 +740,9 @@ fn main() -> ExitCode {
             out,
             plot,
             shard,
+            finetune,
+            finetune_updates,
+            finetune_from,
             llm,
         } => tadslc::eval::eval(
             &tadslc::eval::EvalArgs {
@@ -747,6 +760,9 @@ fn main() -> ExitCode {
                 plot,
                 shard,
                 jobs,
+                finetune,
+                finetune_updates,
+                finetune_from,
                 llm,
             },
             color,

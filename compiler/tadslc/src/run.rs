@@ -76,6 +76,14 @@ impl Ego {
         }
     }
 
+    pub fn copy(&self) -> Ego {
+        match self {
+            Ego::Idm => Ego::Idm,
+            Ego::Naive => Ego::Naive,
+            Ego::Learned(actor) => Ego::Learned(actor.clone()),
+        }
+    }
+
     pub fn make(&self) -> Box<dyn tad_policy::EgoPolicy> {
         match self {
             Ego::Idm => Box::new(tad_policy::Idm::default()),

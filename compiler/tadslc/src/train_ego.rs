@@ -78,8 +78,12 @@ impl TrainEgoArgs {
 /// A scenario's behaviour for the split: its first actor group's behaviour (the adversary
 /// of ChatScene's scenarios), else its ego's, else `none`.
 pub fn behaviour_key(loaded: &Loaded) -> String {
-    let Some(input) = &loaded.source else { return "none".into() };
-    let module = tad_syntax::analyze(&input.text).0;
+    loaded.source.as_ref().map_or_else(|| "none".into(), |input| behaviour_of(&input.text))
+}
+
+/// [`behaviour_key`] of a scenario's text.
+pub fn behaviour_of(text: &str) -> String {
+    let module = tad_syntax::analyze(text).0;
     let Some(scenario) = module.scenario else { return "none".into() };
     let name = |attr: Option<&tad_syntax::model::Attr>| attr.and_then(|a| a.symbol()).map(|s| s.name.clone());
     scenario

@@ -266,3 +266,48 @@ fn train_ego_splits_checkpoints_resumes_and_drives() {
     let bad = run(args("4", &["--lr", "-1"]));
     assert_eq!(code(&bad), 2);
 }
+
+#[test]
+fn eval_adds_the_after_fine_tuning_table_when_asked() {
+    let dir = scratch("eval-finetune");
+    let args = [
+        "eval",
+        "examples",
+        "--region",
+        "los_angeles,new_york_city",
+        "-n",
+        "4",
+        "--samples",
+        "10",
+        "--finetune",
+        "6",
+        "--format",
+        "json",
+        "--out",
+        path(&dir),
+    ];
+    let out = tadslc(&args, "");
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    let rows = lines(&stdout(&out));
+    let held: Vec<&Value> = rows.iter().filter(|r| r["region"] == "held-out").collect();
+    let egos: Vec<&str> = held.iter().map(|r| r["ego"].as_str().unwrap()).collect();
+    assert_eq!(egos, ["learned (fine-tuned)", "idm", "naive"], "{}", stdout(&out));
+    // the held-out scenes are 2/5 of the kept ones, the same for every ego
+    let kept: u64 = rows
+        .iter()
+        .filter(|r| r["region"] != "held-out" && r["ego"] == "idm")
+        .map(|r| r["episodes"].as_u64().unwrap())
+        .sum();
+    let test = held[0]["episodes"].as_u64().unwrap();
+    assert!(held.iter().all(|r| r["episodes"] == test));
+    assert!(test * 5 >= kept && test * 5 <= kept * 3, "{test} held out of {kept}");
+    let actor = dir.join("finetuned.safetensors");
+    let again = tadslc(
+        &["run", "examples/safety/right_turn.tad", "--ego", &format!("learned:{}", path(&actor)), "--seeds", "0"],
+        "",
+    );
+    assert_eq!(code(&again), 0, "{}", stderr(&again));
+    let sharded = tadslc(&["eval", "examples", "--finetune", "5", "--shard", "0/2"], "");
+    assert_eq!(code(&sharded), 2);
+    assert!(stderr(&sharded).contains("without --shard"), "{}", stderr(&sharded));
+}
