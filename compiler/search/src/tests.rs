@@ -1,34 +1,12 @@
 use super::*;
 use tad_policy::parse_policy;
 
-/// A naive ego at 30 km/h behind a car whose speed and place are searched: the ego hits it
-/// only when it is slow enough.
-const SLOW_LEAD: &str = "scenario slow_lead {
-  environment {
-    weather: clear
-    time: daytime
-  }
-  road {
-    type: straight_road
-    context: urban
-    lanes: 2
-    direction: two_way
-    light: none
-  }
-  ego {
-    behavior: move_forward
-    speed: 30 km/h
-    lane: 1
-  }
-  actor lead: car {
-    behavior: move_forward
-    speed: 0..60 km/h
-    position: front of ego
-    lane: 1
-    offset: -5..10 m
-  }
+/// A naive ego at 30 km/h behind a car whose speed (0..60 km/h) and place are searched:
+/// the ego hits it only when it is slow enough.
+fn slow_lead() -> String {
+    let text = std::fs::read_to_string(tad_test_support::repo().join("tests/eval/slow_lead.tad")).unwrap();
+    text.replace("    lane: 1\n  }\n}", "    lane: 1\n    offset: -5..10 m\n  }\n}")
 }
-";
 
 fn compile(src: &str) -> Option<tad_bytecode::Program> {
     let mut db = tad_db::Database::new(tad_check::Options::default());
@@ -48,7 +26,7 @@ fn naive() -> Box<dyn EgoPolicy> {
 
 #[test]
 fn ranges_move_towards_collisions() {
-    let scene = scene(SLOW_LEAD);
+    let scene = scene(&slow_lead());
     assert_eq!(scene.program.params.iter().map(|p| p.name.as_str()).collect::<Vec<_>>(), ["lead.offset", "lead.speed"]);
     let out = search(&scene, &naive, &Config { seed: 3, ..Config::default() }, &|| {});
     assert_eq!(out.trials.len(), 50);
@@ -70,7 +48,7 @@ fn ranges_move_towards_collisions() {
 
 #[test]
 fn seeded_and_independent_of_threads() {
-    let scene = scene(SLOW_LEAD);
+    let scene = scene(&slow_lead());
     let config = Config { samples: 20, seed: 9, ..Config::default() };
     let run = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
@@ -115,11 +93,11 @@ fn refit_is_mean_plus_minus_std_clipped() {
 
 #[test]
 fn chosen_scenes_written_with_fixed_parameters_run_as_searched() {
-    let searched = scene(SLOW_LEAD);
+    let searched = scene(&slow_lead());
     let out = search(&searched, &naive, &Config { samples: 20, seed: 5, ..Config::default() }, &|| {});
     for &i in &out.chosen {
         let trial = &out.trials[i];
-        let text = fix(SLOW_LEAD, &searched.program, &trial.params, &compile).unwrap();
+        let text = fix(&slow_lead(), &searched.program, &trial.params, &compile).unwrap();
         assert!(!text.contains(".."), "no range is left:\n{text}");
         assert!(text.contains("offset: "), "{text}");
         let fixed = scene(&text);
@@ -135,7 +113,7 @@ fn chosen_scenes_written_with_fixed_parameters_run_as_searched() {
 #[test]
 fn layout_room_becomes_an_offset() {
     // no offset written: the layout's free room is the slot, written back as `offset`
-    let src = SLOW_LEAD.replace("    offset: -5..10 m\n", "");
+    let src = slow_lead().replace("    offset: -5..10 m\n", "");
     let searched = scene(&src);
     let names: Vec<&str> = searched.program.params.iter().map(|p| p.name.as_str()).collect();
     assert_eq!(names, ["lead.shift", "lead.speed"]);
@@ -159,19 +137,22 @@ fn layout_room_becomes_an_offset() {
 fn unknown_slots_are_errors() {
     let slot = |name: &str| ParamSlot { name: name.into(), min: 0.0, max: 1.0, default: 0.0 };
     let program = |names: &[&str]| {
-        let mut p = compile(SLOW_LEAD).unwrap();
+        let mut p = compile(&slow_lead()).unwrap();
         p.params = names.iter().map(|n| slot(n)).collect();
         p
     };
     assert_eq!(
-        fix(SLOW_LEAD, &program(&["nobody.speed"]), &[1.0], &compile),
+        fix(&slow_lead(), &program(&["nobody.speed"]), &[1.0], &compile),
         Err(FixError::UnknownSlot { slot: "nobody.speed".into() })
     );
-    assert!(matches!(fix(SLOW_LEAD, &program(&["lead.colour"]), &[1.0], &compile), Err(FixError::UnknownSlot { .. })));
+    assert!(matches!(
+        fix(&slow_lead(), &program(&["lead.colour"]), &[1.0], &compile),
+        Err(FixError::UnknownSlot { .. })
+    ));
     assert_eq!(fix("scenario {", &program(&[]), &[], &compile), Err(FixError::NoScenario));
     assert_eq!(
-        fix(SLOW_LEAD, &program(&["lead.speed"]), &[], &compile),
+        fix(&slow_lead(), &program(&["lead.speed"]), &[], &compile),
         Err(FixError::Mismatch { slots: 1, values: 0 })
     );
-    assert_eq!(fix(SLOW_LEAD, &program(&[]), &[], &|_| None), Err(FixError::Recompile));
+    assert_eq!(fix(&slow_lead(), &program(&[]), &[], &|_| None), Err(FixError::Recompile));
 }

@@ -139,6 +139,16 @@ pub fn load(paths: &[PathBuf], color: bool, status: &mut Status) -> Result<Vec<L
     Ok(loaded)
 }
 
+/// The inputs of one shard: every N-th loaded scenario from I.
+pub fn load_shard(
+    paths: &[PathBuf],
+    shard: crate::shard::Shard,
+    color: bool,
+    status: &mut Status,
+) -> Result<Vec<Loaded>, Closed> {
+    Ok(load(paths, color, status)?.into_iter().enumerate().filter(|(k, _)| shard.takes(*k)).map(|(_, l)| l).collect())
+}
+
 pub fn run(args: &RunArgs, color: bool) -> Status {
     crate::output::run(|status| run_in(args, color, status))
 }
@@ -162,12 +172,7 @@ fn run_in(args: &RunArgs, color: bool, status: &mut Status) -> Result<(), Closed
             }
         }
     }
-    let scenes: Vec<Loaded> = load(&args.paths, color, status)?
-        .into_iter()
-        .enumerate()
-        .filter(|(k, _)| args.shard.takes(*k))
-        .map(|(_, l)| l)
-        .collect();
+    let scenes = load_shard(&args.paths, args.shard, color, status)?;
     if scenes.is_empty() {
         *status = (*status).max(Status::Usage);
         return errln!("error: nothing to run");

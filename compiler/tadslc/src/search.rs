@@ -57,12 +57,7 @@ fn search_in(args: &SearchArgs, color: bool, status: &mut Status) -> Result<(), 
             return errln!("error: --ego {}: {e}", args.ego);
         }
     };
-    let scenes: Vec<Loaded> = crate::run::load(&args.paths, color, status)?
-        .into_iter()
-        .enumerate()
-        .filter(|(k, _)| args.shard.takes(*k))
-        .map(|(_, l)| l)
-        .collect();
+    let scenes = crate::run::load_shard(&args.paths, args.shard, color, status)?;
     if scenes.is_empty() {
         *status = (*status).max(Status::Usage);
         return errln!("error: nothing to search");

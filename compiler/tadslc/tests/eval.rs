@@ -17,38 +17,11 @@ fn lines(text: &str) -> Vec<Value> {
     text.lines().map(|l| serde_json::from_str(l).unwrap_or_else(|e| panic!("{e}: {l}"))).collect()
 }
 
-/// A naive ego behind a car whose speed is searched: only a slow car is hit.
-const SLOW_LEAD: &str = "scenario slow_lead {
-  environment {
-    weather: clear
-    time: daytime
-  }
-  road {
-    type: straight_road
-    context: urban
-    lanes: 2
-    direction: two_way
-    light: none
-  }
-  ego {
-    behavior: move_forward
-    speed: 30 km/h
-    lane: 1
-  }
-  actor lead: car {
-    behavior: move_forward
-    speed: 0..60 km/h
-    position: front of ego
-    lane: 1
-  }
-}
-";
-
 #[test]
 fn search_writes_fixed_scenes_that_reproduce_and_moves_ranges_to_collisions() {
     let dir = scratch("eval-search");
     let input = dir.join("slow_lead.tad");
-    std::fs::write(&input, SLOW_LEAD).unwrap();
+    std::fs::copy(tad_test_support::repo().join("tests/eval/slow_lead.tad"), &input).unwrap();
     let out_dir = dir.join("adv");
     let out = tadslc(&["search", path(&input), "--ego", "naive", "-o", path(&out_dir), "--seed", "4"], "");
     assert_eq!(code(&out), 0, "{}", stderr(&out));
@@ -213,7 +186,7 @@ fn eval_usage_errors() {
         stderr(&out)
     );
     let dir = scratch("eval-no-region");
-    std::fs::write(dir.join("slow_lead.tad"), SLOW_LEAD).unwrap();
+    std::fs::copy(tad_test_support::repo().join("tests/eval/slow_lead.tad"), dir.join("slow_lead.tad")).unwrap();
     let out = tadslc(&["eval", path(&dir)], "");
     assert_eq!(code(&out), 2);
     assert!(stderr(&out).contains("no region with 3 scenarios or more"), "{}", stderr(&out));
