@@ -252,12 +252,12 @@ fn eval_in(args: &EvalArgs, _color: bool, status: &mut Status) -> Result<(), Clo
         errln!("rows in {}", path.display())?;
     }
     errln!(
-        "evaluated {} ({} of {}) in {:.1} s on {} threads",
+        "evaluated {} ({} of {}) in {:.1} s on {}",
         plural(mine.len(), "scenario"),
         plural(results.rows.len(), "episode"),
         plural(args.egos.len(), "ego"),
         started.elapsed().as_secs_f64(),
-        rayon::current_num_threads()
+        plural(rayon::current_num_threads(), "thread")
     )?;
     print(&[results], args.format, args.plot.as_deref(), status)?;
     if args.finetune > 0 {

@@ -160,10 +160,10 @@ fn search_in(args: &SearchArgs, color: bool, status: &mut Status) -> Result<(), 
         return errln!("error: cannot write `{}`: {e}", file.display());
     }
     errln!(
-        "searched {} with {}: {episodes} episodes in {seconds:.1} s on {} threads; scenes and {} in {}",
+        "searched {} with {}: {episodes} episodes in {seconds:.1} s on {}; scenes and {} in {}",
         crate::plural(scenes.len(), "scenario"),
         args.ego,
-        rayon::current_num_threads(),
+        crate::plural(rayon::current_num_threads(), "thread"),
         file.file_name().map_or(String::new(), |f| f.to_string_lossy().into_owned()),
         args.out.display()
     )
