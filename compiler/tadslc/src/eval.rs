@@ -289,29 +289,28 @@ fn finetune(args: &EvalArgs, egos: &[Ego], kept: &[Scene], status: &mut Status) 
         seed: args.seed,
         ..tad_train::Config::default()
     };
-    let before = match &args.finetune_from {
-        Some(path) => match tad_policy::Learned::load(path) {
-            Ok(actor) => Some(actor),
-            Err(e) => {
-                *status = Status::Usage;
-                return errln!("error: --finetune-from: {e}");
-            }
-        },
-        None => None,
+    // from a training checkpoint (actor, critics, optimizers, replay: as ChatScene resumes
+    // SafeBench's), from an actor alone, or from scratch
+    let made = match &args.finetune_from {
+        Some(path) if path.is_dir() => tad_train::Trainer::load_checkpoint(path).and_then(|t| {
+            let actor = t.actor()?;
+            Ok((t, Some(actor)))
+        }),
+        Some(path) => tad_policy::Learned::load(path).map_err(tad_train::TrainError::from).and_then(|actor| {
+            let mut t = tad_train::Trainer::new(config)?;
+            t.init_actor(&actor)?;
+            Ok((t, Some(actor)))
+        }),
+        None => tad_train::Trainer::new(config).map(|t| (t, None)),
     };
-    let trainer = tad_train::Trainer::new(config).and_then(|mut t| {
-        if let Some(actor) = &before {
-            t.init_actor(actor)?;
-        }
-        Ok(t)
-    });
-    let mut trainer = match trainer {
-        Ok(t) => t,
+    let (mut trainer, before) = match made {
+        Ok(made) => made,
         Err(e) => {
             *status = Status::Usage;
-            return errln!("error: {e}");
+            return errln!("error: --finetune-from: {e}");
         }
     };
+    let start = trainer.episodes() as usize;
     errln!(
         "fine-tuning a learned ego on {} ({} held out), {}",
         plural(train.len(), "scene"),
@@ -319,7 +318,7 @@ fn finetune(args: &EvalArgs, egos: &[Ego], kept: &[Scene], status: &mut Status) 
         plural(args.finetune, "episode")
     )?;
     let progress = crate::run::Progress::new(args.finetune, "episodes");
-    while (trainer.episodes() as usize) < args.finetune {
+    while (trainer.episodes() as usize) < start + args.finetune {
         let task = trainer.task(train.len());
         let scene = &kept[train[task.scenario]];
         if let Err(e) = trainer.step(&scene.unit.scene, scene.params.clone(), scene.seed) {

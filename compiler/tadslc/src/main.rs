@@ -245,7 +245,8 @@ enum Command {
         /// Learning steps per fine-tuning episode (ChatScene: 1)
         #[arg(long, value_name = "N", default_value_t = 1)]
         finetune_updates: usize,
-        /// The learned ego fine-tuning starts from (SafeBench's checkpoint, or `train-ego`'s)
+        /// Where fine-tuning starts: a `train-ego` checkpoint directory (actor, critics, replay),
+        /// or an actor alone (a safetensors file, as `learned:PATH` reads)
         #[arg(long, value_name = "FILE")]
         finetune_from: Option<PathBuf>,
         /// The model for the `llm` generators (`--seed` seeds every generator and the search)

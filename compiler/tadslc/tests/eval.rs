@@ -280,6 +280,37 @@ fn eval_adds_the_after_fine_tuning_table_when_asked() {
         "",
     );
     assert_eq!(code(&again), 0, "{}", stderr(&again));
+    // from a train-ego checkpoint: the ego it was is in the table too
+    let pre = dir.join("pre.safetensors");
+    let trained = tadslc(
+        &["train-ego", "examples/safety", "-o", path(&pre), "--episodes", "2", "--hidden", "16,16", "--batch", "32"],
+        "",
+    );
+    assert_eq!(code(&trained), 0, "{}", stderr(&trained));
+    let ckpt = dir.join("pre.safetensors.ckpt");
+    let args = [
+        "eval",
+        "examples",
+        "--region",
+        "los_angeles",
+        "-n",
+        "3",
+        "--samples",
+        "5",
+        "--finetune",
+        "2",
+        "--format",
+        "json",
+        "--finetune-from",
+        path(&ckpt),
+    ];
+    let out = tadslc(&args, "");
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    let rows = lines(&stdout(&out));
+    let egos: Vec<&str> =
+        rows.iter().filter(|r| r["region"] == "held-out").map(|r| r["ego"].as_str().unwrap()).collect();
+    assert_eq!(egos, ["learned (before)", "learned (fine-tuned)", "idm", "naive"], "{}", stdout(&out));
+    assert!(stderr(&out).contains("held-out collision rate of the learned ego"), "{}", stderr(&out));
     let sharded = tadslc(&["eval", "examples", "--finetune", "5", "--shard", "0/2"], "");
     assert_eq!(code(&sharded), 2);
     assert!(stderr(&sharded).contains("without --shard"), "{}", stderr(&sharded));
