@@ -1,0 +1,355 @@
+//! SAC on hand-built straight-road scenes: learning, exact resume, the split, the saved
+//! actor, damaged checkpoints. Small networks and short episodes so a debug build runs
+//! them in about a minute; the settings' defaults are checked separately.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use tad_bytecode::{Instr, ParamSlot, Polyline, Program, Size, Value};
+use tad_layout::road::LANE_WIDTH;
+use tad_layout::{Arm, Body, Facing, Place, Road, Shape, Turn};
+use tad_policy::{EgoPolicy, EgoView, Learned};
+use tad_runtime::Scene;
+use tad_train::{Config, Trainer, split};
+
+const CAR: Size = Size { length: 4.5, width: 1.8, height: 1.5 };
+
+/// A straight two-lane road, the ego in lane 1 at 8 m/s (a slot shifts it by up to
+/// ±1 m/s), alone or with a car ahead at 4 m/s (40 m ahead: within the observation's 15 m
+/// only near the end of a long episode).
+fn scene(max_steps: u32, lead: bool) -> Scene {
+    let road = Road {
+        shape: Shape::Straight,
+        lanes: 2,
+        opposite: 1,
+        cross_lanes: 0,
+        lane_width: LANE_WIDTH,
+        sidewalks: true,
+        crosswalks: false,
+        signal: None,
+        junction: None,
+        approach: 0.0,
+    };
+    let (path, start) = road.vehicle_path(tad_layout::Station { arm: Arm::Ego, along: 0.0 }, 1, Turn::Straight);
+    let mut code = vec![
+        Instr::Road(road),
+        Instr::Limits { dt: 0.1, max_steps, max_distance: 200.0, timeout: 60.0 },
+        Instr::Ego {
+            class: "car".into(),
+            size: CAR,
+            lane: 1,
+            turn: Turn::Straight,
+            path: 0,
+            start,
+            route_length: 150.0,
+            speed: Value { base: 8.0, slot: Some(0) },
+        },
+    ];
+    if lead {
+        code.push(Instr::Spawn {
+            actor: 0,
+            group: "lead".into(),
+            index: 0,
+            body: Body::Vehicle,
+            class: "sedan".into(),
+            size: CAR,
+            arm: Arm::Ego,
+            lane: 1,
+            place: Place::Lane,
+            along: Value::lit(40.0),
+            lateral: -0.5 * LANE_WIDTH,
+            facing: Facing::Along,
+            yaw: 0.0,
+            speed: 4.0,
+        });
+        code.push(Instr::Drive { actor: 0, speed: Value::lit(4.0), turn: Turn::Straight });
+    }
+    let program = Program {
+        name: if lead { "lead".into() } else { "alone".into() },
+        source: "hand.tad".into(),
+        params: vec![ParamSlot { name: "ego.speed".into(), min: -1.0, max: 1.0, default: 0.0 }],
+        paths: vec![Polyline(path.points().iter().map(|p| [p.x, p.y]).collect())],
+        code,
+    };
+    Scene::new(&program).expect("the hand-built program sets up")
+}
+
+fn small(seed: u64) -> Config {
+    Config {
+        hidden: vec![32, 32],
+        actor_lr: 3e-3,
+        critic_lr: 3e-3,
+        batch: 64,
+        buffer: 5000,
+        start_training: 200,
+        updates_per_episode: 25,
+        seed,
+        ..Config::default()
+    }
+}
+
+fn params(scene: &Scene, seed: u64) -> Vec<f64> {
+    tad_runtime::sample::sample(&scene.program.params, Some(seed))
+}
+
+/// `n` training episodes on `scenes`, each chosen by the trainer.
+fn train(trainer: &mut Trainer, scenes: &[Scene], until: u64) {
+    while trainer.episodes() < until {
+        let task = trainer.task(scenes.len());
+        let scene = &scenes[task.scenario];
+        trainer.step(scene, params(scene, task.seed), task.seed).expect("a learning step");
+    }
+}
+
+/// The deterministic actor's mean return over a few seeds of each scene.
+fn mean_return(trainer: &Trainer, scenes: &[Scene]) -> f64 {
+    let mut total = 0.0;
+    let mut n = 0.0;
+    for scene in scenes {
+        for seed in 100..103 {
+            total += trainer.evaluate(scene, params(scene, seed), seed).episode_return;
+            n += 1.0;
+        }
+    }
+    total / n
+}
+
+fn temp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tad-train-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("a temporary directory");
+    dir
+}
+
+#[test]
+fn training_improves_the_return_on_two_scenes_with_a_parameter() {
+    let scenes = [scene(80, false), scene(80, true)];
+    let mut trainer = Trainer::new(small(3)).expect("a trainer");
+    let before = mean_return(&trainer, &scenes);
+    let started = Instant::now();
+    train(&mut trainer, &scenes, 100);
+    let elapsed = started.elapsed().as_secs_f64();
+    let after = mean_return(&trainer, &scenes);
+    eprintln!(
+        "return {before:.1} -> {after:.1} after {} episodes, {} updates, {elapsed:.1} s",
+        trainer.episodes(),
+        trainer.updates()
+    );
+    assert!(trainer.updates() > 0, "learning started");
+    assert!(after > before + 100.0, "return {before:.1} -> {after:.1}");
+}
+
+#[test]
+fn a_resumed_run_ends_with_the_same_bytes() {
+    let scenes = [scene(30, false), scene(30, true)];
+    let config = Config { start_training: 40, updates_per_episode: 2, batch: 32, ..small(9) };
+    let dir = temp("resume");
+
+    let mut whole = Trainer::new(config.clone()).expect("a trainer");
+    train(&mut whole, &scenes, 8);
+    whole.save_actor(dir.join("whole.safetensors")).expect("saved");
+    whole.save_checkpoint(dir.join("whole.ckpt")).expect("saved");
+
+    let mut first = Trainer::new(config.clone()).expect("a trainer");
+    first.set_note("scenes: alone, lead");
+    train(&mut first, &scenes, 4);
+    assert!(first.updates() > 0, "the first half learns already");
+    first.save_checkpoint(dir.join("half.ckpt")).expect("saved");
+    drop(first);
+    let mut second = Trainer::load_checkpoint(dir.join("half.ckpt")).expect("loaded");
+    assert_eq!(second.episodes(), 4);
+    assert_eq!(second.note(), "scenes: alone, lead");
+    train(&mut second, &scenes, 8);
+    second.save_actor(dir.join("resumed.safetensors")).expect("saved");
+    second.save_checkpoint(dir.join("resumed.ckpt")).expect("saved");
+
+    let read = |name: &str| std::fs::read(dir.join(name)).expect("written");
+    assert_eq!(read("whole.safetensors"), read("resumed.safetensors"), "the actors' bytes");
+    for file in ["critics.safetensors", "optimizer.safetensors", "replay.safetensors"] {
+        assert_eq!(read(&format!("whole.ckpt/{file}")), read(&format!("resumed.ckpt/{file}")), "{file}");
+    }
+    assert_eq!(whole.updates(), second.updates());
+
+    // the same seed again: the same bytes; another seed: others
+    let mut again = Trainer::new(config.clone()).expect("a trainer");
+    train(&mut again, &scenes, 8);
+    again.save_actor(dir.join("again.safetensors")).expect("saved");
+    assert_eq!(read("whole.safetensors"), read("again.safetensors"));
+    let mut other = Trainer::new(Config { seed: 10, ..config }).expect("a trainer");
+    train(&mut other, &scenes, 8);
+    other.save_actor(dir.join("other.safetensors")).expect("saved");
+    assert_ne!(read("whole.safetensors"), read("other.safetensors"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Keeps the views it was shown.
+struct Both {
+    a: Learned,
+    b: Learned,
+    differ: usize,
+    steps: usize,
+}
+
+impl EgoPolicy for Both {
+    fn name(&self) -> &str {
+        "both"
+    }
+    fn act(&mut self, view: &EgoView) -> tad_policy::Action {
+        let (x, y) = (self.a.act(view), self.b.act(view));
+        self.steps += 1;
+        if x != y {
+            self.differ += 1;
+        }
+        x
+    }
+}
+
+#[test]
+fn the_saved_actor_loads_as_learned_and_acts_the_same() {
+    let scenes = [scene(40, true)];
+    let config = Config { start_training: 30, updates_per_episode: 3, batch: 32, ..small(5) };
+    let mut trainer = Trainer::new(config.clone()).expect("a trainer");
+    train(&mut trainer, &scenes, 3);
+    assert!(trainer.updates() > 0);
+    let dir = temp("actor");
+    let path = dir.join("actor.safetensors");
+    trainer.save_actor(&path).expect("saved");
+    let loaded = Learned::load(&path).expect("loads as the learned policy");
+    let spec = format!("learned:{}", path.display());
+    assert!(tad_policy::parse_policy(&spec).is_ok(), "--ego {spec}");
+    let actor = trainer.actor().expect("the actor");
+    assert_eq!(loaded.hidden(), vec![32, 32]);
+    let mut both = Both { a: loaded, b: actor, differ: 0, steps: 0 };
+    let scene = &scenes[0];
+    let stats = tad_train::evaluate(scene, params(scene, 1), 1, &mut both, &config);
+    assert!(both.steps > 10 && both.differ == 0, "{} of {} steps differ", both.differ, both.steps);
+    // the trainer's own deterministic episode is the loaded actor's
+    let own = trainer.evaluate(scene, params(scene, 1), 1);
+    assert_eq!(own, stats);
+    // and the checkpoint's actor file is the same actor
+    trainer.save_checkpoint(dir.join("ckpt")).expect("saved");
+    let from_checkpoint = Learned::load(dir.join("ckpt/actor.safetensors")).expect("loads");
+    assert_eq!(from_checkpoint.mu([0.3, -0.1, 7.0, 1.0]), trainer.actor().expect("actor").mu([0.3, -0.1, 7.0, 1.0]));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn an_existing_actor_is_fine_tuned() {
+    let start = Learned::random(&[16, 24], 4).expect("an actor");
+    let mut trainer =
+        Trainer::new(Config { start_training: 20, batch: 16, updates_per_episode: 1, ..small(1) }).expect("a trainer");
+    trainer.init_actor(&start).expect("takes the actor");
+    assert_eq!(trainer.actor().expect("actor").mu([0.0, 0.0, 8.0, 0.0]), start.mu([0.0, 0.0, 8.0, 0.0]));
+    assert_eq!(trainer.actor().expect("actor").hidden(), vec![16, 24]);
+    let scenes = [scene(30, false)];
+    train(&mut trainer, &scenes, 2);
+    assert!(trainer.updates() > 0);
+    assert_ne!(trainer.actor().expect("actor").mu([0.0, 0.0, 8.0, 0.0]), start.mu([0.0, 0.0, 8.0, 0.0]));
+}
+
+#[test]
+fn the_split_keeps_three_fifths_of_each_behaviour() {
+    let mut keys = Vec::new();
+    for (key, n) in [("cut_in", 10), ("crossing", 5), ("pair", 2), ("single", 1), ("three", 3), ("four", 4)] {
+        keys.extend((0..n).map(|_| key.to_string()));
+    }
+    let (train, test) = split(&keys, 7);
+    assert_eq!(train.len() + test.len(), keys.len());
+    let count = |list: &[usize], key: &str| list.iter().filter(|&&i| keys[i] == key).count();
+    for (key, expected) in [("cut_in", 6), ("crossing", 3), ("pair", 1), ("single", 1), ("three", 2), ("four", 2)] {
+        assert_eq!(count(&train, key), expected, "{key}");
+    }
+    let mut all: Vec<usize> = train.iter().chain(&test).copied().collect();
+    all.sort_unstable();
+    assert_eq!(all, (0..keys.len()).collect::<Vec<_>>(), "every item once");
+    assert_eq!(split(&keys, 7), (train.clone(), test.clone()), "seeded");
+    let others: Vec<_> = (0..20).map(|s| split(&keys, s).0).collect();
+    assert!(others.iter().any(|t| *t != train), "another seed, another split");
+    // another key's items change nothing in this key's split
+    let mut more = keys.clone();
+    more.extend((0..4).map(|_| "extra".to_string()));
+    let (train_more, _) = split(&more, 7);
+    assert!(train.iter().all(|i| train_more.contains(i)));
+    assert_eq!(split(&[], 1), (vec![], vec![]));
+}
+
+#[test]
+fn a_damaged_checkpoint_is_an_error() {
+    let dir = temp("damaged");
+    let scenes = [scene(20, false)];
+    let mut trainer = Trainer::new(Config { start_training: 10, batch: 8, ..small(2) }).expect("a trainer");
+    train(&mut trainer, &scenes, 1);
+    let good = dir.join("good");
+    trainer.save_checkpoint(&good).expect("saved");
+    assert!(Trainer::load_checkpoint(&good).is_ok());
+    assert!(!dir.join("good.part").exists(), "no partial directory is left");
+
+    let missing = Trainer::load_checkpoint(dir.join("nowhere")).err().expect("an error");
+    assert!(missing.to_string().contains("state.json"), "{missing}");
+
+    let damage = |name: &str, file: &str, bytes: &[u8]| {
+        let copy = dir.join(name);
+        std::fs::create_dir_all(&copy).expect("a directory");
+        for entry in std::fs::read_dir(&good).expect("listed") {
+            let entry = entry.expect("an entry");
+            std::fs::copy(entry.path(), copy.join(entry.file_name())).expect("copied");
+        }
+        std::fs::write(copy.join(file), bytes).expect("written");
+        Trainer::load_checkpoint(&copy).err().unwrap_or_else(|| panic!("{name}: loaded"))
+    };
+    let e = damage("json", "state.json", b"{ not json");
+    assert!(e.to_string().contains("not a usable checkpoint"), "{e}");
+    damage("actor", "actor.safetensors", b"garbage");
+    damage("critics", "critics.safetensors", b"");
+    damage("optimizer", "optimizer.safetensors", &[0u8; 64]);
+    damage("replay", "replay.safetensors", b"\x08\x00\x00\x00\x00\x00\x00\x00{}      ");
+    // a real safetensors file of the wrong contents
+    let other = std::fs::read(good.join("actor.safetensors")).expect("read");
+    let e = damage("swapped", "critics.safetensors", &other);
+    assert!(e.to_string().contains("q1."), "{e}");
+    let state = std::fs::read_to_string(good.join("state.json")).expect("read");
+    damage("format", "state.json", state.replace("checkpoint 1", "checkpoint 9").as_bytes());
+    damage("widths", "state.json", state.replacen("32", "33", 1).as_bytes());
+    damage("position", "state.json", state.replace("\"replay_next\": ", "\"replay_next\": 9999").as_bytes());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn bad_settings_are_errors() {
+    for config in [
+        Config { hidden: vec![], ..Config::default() },
+        Config { hidden: vec![8, 0], ..Config::default() },
+        Config { actor_lr: 0.0, ..Config::default() },
+        Config { critic_lr: f64::NAN, ..Config::default() },
+        Config { gamma: 1.5, ..Config::default() },
+        Config { batch: 0, ..Config::default() },
+        Config { desired_speed: Some(-1.0), ..Config::default() },
+    ] {
+        assert!(Trainer::new(config.clone()).is_err(), "{config:?}");
+    }
+    let d = Config::default();
+    assert_eq!((d.hidden.clone(), d.actor_lr, d.critic_lr, d.alpha), (vec![256, 256], 1e-4, 1e-4, 0.01));
+    assert_eq!((d.gamma, d.polyak, d.batch, d.buffer, d.start_training), (0.99, 0.995, 512, 30_000, 1000));
+    assert_eq!((d.episodes, d.updates_per_episode), (600, 1));
+}
+
+/// Figures for the record (run with `--ignored --nocapture`): ms per episode and per update
+/// at ChatScene's sizes.
+#[test]
+#[ignore]
+fn timings() {
+    let scenes = [scene(300, true)];
+    let mut trainer = Trainer::new(Config { start_training: 1, ..Config::default() }).expect("a trainer");
+    let t = Instant::now();
+    let mut steps = 0;
+    for seed in 0..5 {
+        steps += trainer.episode(&scenes[0], params(&scenes[0], seed), seed).steps;
+    }
+    let per_episode = t.elapsed().as_secs_f64() * 1e3 / 5.0;
+    let t = Instant::now();
+    for _ in 0..5 {
+        trainer.update().expect("an update");
+    }
+    let per_update = t.elapsed().as_secs_f64() * 1e3 / 5.0;
+    eprintln!("{per_episode:.1} ms per episode ({} steps), {per_update:.1} ms per update at batch 512", steps / 5);
+}
