@@ -2,10 +2,13 @@
 //!
 //! ```text
 //! corpus (examples/) ─▶ regions ─▶ per region, per generator: scenarios (fitted: tad-fit on
-//!   the region's scenarios; baseline: the region-agnostic generator; DIR: the files given)
+//!   the region's scenarios; baseline: the region-agnostic generator; llm*: `gen`'s loop;
+//!   DIR: the files given)
 //!   ─▶ checked, compiled ─▶ tad-search with the surrogate ego (the scenes kept per scenario)
 //!   ─▶ every ego runs every kept scene ─▶ rows (one scored episode each)
 //!   ─▶ aggregated per region × generator × ego: SafeBench's ten metrics and OS
+//! with --finetune: kept scenes ─split 3/5 per behaviour─▶ tad-train (SAC) ─▶ every ego and
+//!   the learned one before and after on the held-out 2/5 ─▶ the "after fine-tuning" table
 //! ```
 //!
 //! Units of work are (region, generator, scenario) in a fixed order, so `--shard I/N` takes
