@@ -278,9 +278,7 @@ pub fn fit(paths: &[PathBuf], output: &Path) -> Status {
         if corpus.items.is_empty() {
             return Ok(());
         }
-        let examples: Vec<tad_fit::Example> =
-            corpus.items.iter().filter_map(|i| tad_fit::Example::of(&i.tad, &tad_syntax::analyze(&i.tad).0)).collect();
-        let fitted = tad_fit::Fitted::fit(&examples);
+        let (fitted, fitted_from) = fit_items(corpus.items.iter());
         if let Err(e) = tad_frontend::store::write_atomic(output, fitted.to_json().as_bytes()) {
             *status = Status::Usage;
             errln!("error: cannot write {}: {e}", output.display())?;
@@ -288,7 +286,7 @@ pub fn fit(paths: &[PathBuf], output: &Path) -> Status {
         }
         errln!(
             "fitted {} of {} ({} fields, region {}) into {}",
-            plural(examples.len(), "scenario"),
+            plural(fitted_from, "scenario"),
             corpus.name,
             fitted.tables.len(),
             fitted.region.as_deref().unwrap_or("none"),
@@ -322,6 +320,16 @@ struct GenSummary<'a> {
 
 /// `tadslc gen --generator fitted:MODEL`: item `i` is drawn with seed `seed + i`, again
 /// until it checks without errors (at most `attempts` draws).
+/// Draws per scenario before the fitted generator gives up on it (`gen --attempts`).
+pub const ATTEMPTS: usize = 50;
+
+/// The generator fitted to `items`, and how many of them it was fitted on.
+pub fn fit_items<'a>(items: impl Iterator<Item = &'a Item>) -> (tad_fit::Fitted, usize) {
+    let examples: Vec<tad_fit::Example> =
+        items.filter_map(|i| tad_fit::Example::of(&i.tad, &tad_syntax::analyze(&i.tad).0)).collect();
+    (tad_fit::Fitted::fit(&examples), examples.len())
+}
+
 /// Scenario `name` drawn from `fitted` with `seed` and checked, drawn again while it has
 /// errors (at most `attempts` draws): the text and its class, and the number of draws.
 pub fn draw_fitted(

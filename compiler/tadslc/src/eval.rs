@@ -214,16 +214,9 @@ fn eval_in(args: &EvalArgs, _color: bool, status: &mut Status) -> Result<(), Clo
             for &i in &outcome.chosen {
                 let trial = &outcome.trials[i];
                 for (spec, ego) in args.egos.iter().zip(&egos) {
-                    let mut policy = ego.make();
-                    let episode = tad_runtime::run(
-                        &u.scene,
-                        Some(trial.seed),
-                        trial.params.clone(),
-                        policy.as_mut(),
-                        &tad_runtime::Options::default(),
-                    );
+                    let score = play(&u.scene, &trial.params, trial.seed, ego);
                     progress.tick();
-                    if let Ok(score) = tad_metrics::score_episode(&episode.records, Mode::Fixed) {
+                    if let Some(score) = score {
                         rows.push(Row {
                             region: u.region.clone(),
                             generator: u.generator.clone(),
@@ -267,6 +260,15 @@ fn eval_in(args: &EvalArgs, _color: bool, status: &mut Status) -> Result<(), Clo
         finetune(args, &egos, &kept, status)?;
     }
     Ok(())
+}
+
+/// One episode of `ego` on a scene with fixed parameters, scored on its own (fixed mode);
+/// `None` for an episode without a step.
+fn play(scene: &tad_runtime::Scene, params: &[f64], seed: u64, ego: &Ego) -> Option<EpisodeScore> {
+    let mut policy = ego.make();
+    let episode =
+        tad_runtime::run(scene, Some(seed), params.to_vec(), policy.as_mut(), &tad_runtime::Options::default());
+    tad_metrics::score_episode(&episode.records, Mode::Fixed).ok()
 }
 
 /// A kept scene: its unit with the search's parameters and seed.
@@ -362,15 +364,7 @@ fn finetune(args: &EvalArgs, egos: &[Ego], kept: &[Scene], status: &mut Status) 
             drivers
                 .iter()
                 .filter_map(|(name, ego)| {
-                    let mut policy = ego.make();
-                    let episode = tad_runtime::run(
-                        &scene.unit.scene,
-                        Some(scene.seed),
-                        scene.params.clone(),
-                        policy.as_mut(),
-                        &tad_runtime::Options::default(),
-                    );
-                    let score = tad_metrics::score_episode(&episode.records, Mode::Fixed).ok()?;
+                    let score = play(&scene.unit.scene, &scene.params, scene.seed, ego)?;
                     Some(Row {
                         region: "held-out".into(),
                         generator: "searched".into(),
@@ -502,14 +496,12 @@ fn scenarios(
                 errln!("note: region `{region}` has no scenario to fit: no fitted scenarios")?;
                 return Ok(Some(Vec::new()));
             }
-            let examples: Vec<tad_fit::Example> =
-                own.iter().filter_map(|i| tad_fit::Example::of(&i.tad, &tad_syntax::analyze(&i.tad).0)).collect();
-            let fitted = tad_fit::Fitted::fit(&examples);
+            let (fitted, _) = crate::align::fit_items(own.iter().copied());
             let mut out = Vec::new();
             for i in 0..n {
                 let name = format!("{region}_fitted_{:03}", i + 1);
                 if let (Some((text, _)), _) =
-                    crate::align::draw_fitted(db, &fitted, &name, seed.wrapping_add(i as u64), 50)
+                    crate::align::draw_fitted(db, &fitted, &name, seed.wrapping_add(i as u64), crate::align::ATTEMPTS)
                 {
                     out.push((name, text));
                 }

@@ -469,7 +469,7 @@ enum Command {
         #[arg(long, value_name = "N", default_value_t = 1)]
         jobs: usize,
         /// With a fitted generator: draws per scenario before giving up on it
-        #[arg(long, value_name = "N", default_value_t = 50)]
+        #[arg(long, value_name = "N", default_value_t = tadslc::align::ATTEMPTS)]
         attempts: usize,
         #[command(flatten)]
         llm: tadslc::llm::LlmArgs,
