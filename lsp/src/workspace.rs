@@ -209,12 +209,8 @@ pub fn path_of(uri: &Uri) -> PathBuf {
 /// Write every embedded standard module, read-only, into a folder named by a hash of
 /// their texts (so two versions of the server never share one).
 fn write_stdlib() -> Option<PathBuf> {
-    let mut hash: u64 = 0xcbf2_9ce4_8422_2325;
-    for (name, text) in tad_db::stdlib::MODULES {
-        for byte in name.bytes().chain(text.bytes()) {
-            hash = (hash ^ u64::from(byte)).wrapping_mul(0x0100_0000_01b3);
-        }
-    }
+    let hash =
+        tad_base::fnv1a(tad_db::stdlib::MODULES.iter().flat_map(|(name, text)| name.bytes().chain(text.bytes())));
     let dir = std::env::temp_dir().join(format!("tadsl-stdlib-{hash:016x}"));
     for (name, text) in tad_db::stdlib::MODULES {
         let path = dir.join(name.split('.').collect::<PathBuf>().with_extension("tad"));

@@ -37,8 +37,8 @@ pub struct Spec {
     pub out: PathBuf,
     /// Seconds between frames of a video.
     pub every: f64,
-    /// `(i, n)`: this run does the frames whose index is `i` modulo `n`.
-    pub shard: (usize, usize),
+    /// This run does the frames whose index the shard takes.
+    pub shard: tad_base::Shard,
     pub jobs: usize,
     /// How often an incomplete scenario's frame is described again.
     pub max_refinements: u32,
@@ -89,10 +89,7 @@ fn io(what: &str, e: std::io::Error) -> Error {
 
 /// The manifest of this shard.
 pub fn manifest_path(spec: &Spec) -> PathBuf {
-    match spec.shard {
-        (_, 1) => spec.out.join("manifest.jsonl"),
-        (i, n) => spec.out.join(format!("manifest.shard-{i}-of-{n}.jsonl")),
-    }
+    spec.out.join(spec.shard.file_name("manifest", "jsonl"))
 }
 
 /// Every frame of the input, in order.
@@ -234,11 +231,10 @@ pub async fn run(
     on_round: &mut dyn FnMut(&Round),
 ) -> Result<Report, Error> {
     let all = frames(spec)?;
-    let (shard, shards) = spec.shard;
     let manifest = manifest_path(spec);
     let done: std::collections::HashSet<String> =
         store::read_jsonl(&manifest).iter().filter_map(|r| r["frame"].as_str().map(String::from)).collect();
-    let mine: Vec<Frame> = all.into_iter().filter(|f| f.index % shards == shard).collect();
+    let mine: Vec<Frame> = all.into_iter().filter(|f| spec.shard.takes(f.index)).collect();
     let total = mine.len();
     let todo: Vec<Frame> = mine.into_iter().filter(|f| !done.contains(&f.id)).collect();
     let mut report = Report { done_before: total - todo.len(), total, ..Default::default() };

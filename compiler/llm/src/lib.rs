@@ -230,11 +230,8 @@ async fn read_bounded(mut response: reqwest::Response) -> Result<String, Error> 
     Ok(String::from_utf8_lossy(&bytes).into_owned())
 }
 
-/// A number in [0, 1) from a seed (SplitMix64).
+/// A number in [0, 1) from a seed.
 fn unit_random(seed: u64) -> f64 {
-    let mut z = seed.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^= z >> 31;
-    (z >> 11) as f64 / (1u64 << 53) as f64
+    use tad_base::Rng as _;
+    tad_base::SplitMix64::new(seed).unit()
 }

@@ -329,8 +329,8 @@ fn synth_shards_split_the_frames() {
             .map(|l| serde_json::from_str::<Value>(l).unwrap()["frame"].as_str().unwrap().to_string())
             .collect()
     };
-    assert_eq!(frames("manifest.shard-0-of-2.jsonl"), ["dash_cam_1_t00000", "dash_cam_1_t00030"]);
-    assert_eq!(frames("manifest.shard-1-of-2.jsonl"), ["dash_cam_1_t00015"]);
+    assert_eq!(frames("manifest.0-of-2.jsonl"), ["dash_cam_1_t00000", "dash_cam_1_t00030"]);
+    assert_eq!(frames("manifest.1-of-2.jsonl"), ["dash_cam_1_t00015"]);
     let bad = run(&["synth", "--video", "x.mp4", "--region", "los_angeles", "--out", "o", "--shard", "2/2"], &[]);
     assert_eq!(code(&bad), 2);
 }

@@ -784,12 +784,8 @@ pub fn split(keys: &[String], seed: u64) -> (Vec<usize>, Vec<usize>) {
     }
     let (mut train, mut test) = (Vec::new(), Vec::new());
     for (key, mut items) in groups {
-        // FNV-1a of the key, stable across runs and platforms
-        let hash = key.bytes().fold(0xCBF2_9CE4_8422_2325u64, |h, b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01B3));
-        let mut rng = SplitMix64::new(seed ^ hash);
-        for i in (1..items.len()).rev() {
-            items.swap(i, rng.below(i + 1));
-        }
+        let mut rng = SplitMix64::new(seed ^ tad_base::fnv1a(key.bytes()));
+        rng.shuffle(&mut items);
         let n = items.len();
         let keep = if n >= 2 { ((n as f64 * 0.6).round() as usize).clamp(1, n - 1) } else { n };
         train.extend_from_slice(&items[..keep]);
@@ -802,7 +798,13 @@ pub fn split(keys: &[String], seed: u64) -> (Vec<usize>, Vec<usize>) {
 
 /// Where a run's checkpoints go by default: `<out>.ckpt`.
 pub fn default_checkpoint_dir(out: &Path) -> PathBuf {
+    beside(out, ".ckpt")
+}
+
+/// `OUT` with `suffix` added to its name (`actor.safetensors.split.json`), in the same
+/// directory; `actor` when `out` has no name.
+pub fn beside(out: &Path, suffix: &str) -> PathBuf {
     let mut name = out.file_name().map(|n| n.to_os_string()).unwrap_or_else(|| "actor".into());
-    name.push(".ckpt");
+    name.push(suffix);
     out.with_file_name(name)
 }

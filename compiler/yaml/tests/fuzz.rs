@@ -4,22 +4,7 @@
 mod common;
 use common::*;
 
-/// SplitMix64 (Steele, Lea, Flood 2014): small, seeded, good enough to pick mutations.
-struct SplitMix64(u64);
-
-impl SplitMix64 {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-
-    fn below(&mut self, n: usize) -> usize {
-        if n == 0 { 0 } else { (self.next() % n as u64) as usize }
-    }
-}
+use tad_base::{Rng, SplitMix64};
 
 const PIECES: &[&str] = &[
     ":",
@@ -136,7 +121,7 @@ fn mutate(rng: &mut SplitMix64, text: &str) -> String {
             }
             _ => {
                 let a = boundary(&out, rng.below(len + 1));
-                let byte = (rng.next() & 0x7f) as u8;
+                let byte = (rng.next_u64() & 0x7f) as u8;
                 out.insert(a, byte as char);
             }
         }

@@ -1,3 +1,5 @@
+//! Helpers shared by the YAML importer's integration tests.
+
 #![allow(dead_code)]
 
 use tad_diagnostics::{Diagnostic, LineIndex, Severity};

@@ -1,10 +1,11 @@
-//! `--shard I/N`: one job of an array (Slurm's `$SLURM_ARRAY_TASK_ID`, a Kubernetes indexed
-//! job's `$JOB_COMPLETION_INDEX`) takes every N-th unit of work from I, counting from 0.
-//! Units are numbered the same way in every job (inputs in their sorted order, generated
-//! scenarios by their seed), so the shards of one command cover its work exactly once and
-//! `tadslc merge` puts their results files back together.
+//! `--shard I/N`: one job of an array (Slurm's `$SLURM_ARRAY_TASK_ID`, a Kubernetes Indexed
+//! Job's `$JOB_COMPLETION_INDEX`) takes every N-th unit of work from I, counting from 0.
+//!
+//! Units are numbered the same way in every job, so the shards of one command cover its work
+//! exactly once; each writes its own files, named by [`Shard::file_name`].
 
 use std::fmt;
+use std::str::FromStr;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Shard {
@@ -33,16 +34,21 @@ impl fmt::Display for Shard {
     }
 }
 
-/// `I/N` with `0 <= I < N`.
-pub fn parse(text: &str) -> Result<Shard, String> {
-    let bad =
-        || format!("`{text}` is not a shard: write I/N, the job's index from 0 and the number of jobs (0/4 … 3/4)");
-    let (i, n) = text.split_once('/').ok_or_else(bad)?;
-    let (index, count) = (i.trim().parse::<usize>().map_err(|_| bad())?, n.trim().parse::<usize>().map_err(|_| bad())?);
-    if count == 0 || index >= count {
-        return Err(bad());
+/// `I/N` with `0 <= I < N`; the error says how to write one.
+impl FromStr for Shard {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<Shard, String> {
+        let bad =
+            || format!("`{text}` is not a shard: write I/N, the job's index from 0 and the number of jobs (0/4 … 3/4)");
+        let (i, n) = text.split_once('/').ok_or_else(bad)?;
+        let (index, count) =
+            (i.trim().parse::<usize>().map_err(|_| bad())?, n.trim().parse::<usize>().map_err(|_| bad())?);
+        if count == 0 || index >= count {
+            return Err(bad());
+        }
+        Ok(Shard { index, count })
     }
-    Ok(Shard { index, count })
 }
 
 #[cfg(test)]
@@ -51,8 +57,10 @@ mod tests {
 
     #[test]
     fn shards_cover_the_work_once() {
-        assert_eq!(parse("1/3"), Ok(Shard { index: 1, count: 3 }));
-        assert!(parse("3/3").is_err() && parse("0/0").is_err() && parse("a/2").is_err() && parse("2").is_err());
+        assert_eq!("1/3".parse(), Ok(Shard { index: 1, count: 3 }));
+        for bad in ["3/3", "0/0", "a/2", "2", ""] {
+            assert!(bad.parse::<Shard>().is_err(), "{bad}");
+        }
         let shards: Vec<Shard> = (0..3).map(|index| Shard { index, count: 3 }).collect();
         for k in 0..20 {
             assert_eq!(shards.iter().filter(|s| s.takes(k)).count(), 1);

@@ -1,0 +1,18 @@
+//! The workspace's leaf crate: small helpers that many crates need and that say nothing
+//! about traffic scenarios.
+//!
+//! - [`SplitMix64`] and [`Rng`]: the one seeded generator (every random choice in the
+//!   workspace takes a seed and draws from it);
+//! - [`fnv1a`]: the one stable hash (FNV-1a, 64 bits), for names turned into seeds and
+//!   content-addressed folders;
+//! - [`Shard`]: one job of a job array (`--shard I/N`) and its files' names.
+//!
+//! Each is written once here and read everywhere else; the crate depends on serde only.
+
+mod hash;
+mod rng;
+mod shard;
+
+pub use hash::{fnv1a, fnv1a_seeded};
+pub use rng::{Rng, SplitMix64};
+pub use shard::Shard;
