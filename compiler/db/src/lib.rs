@@ -293,6 +293,12 @@ pub fn check(db: &dyn Db, file: SourceFile) -> Checked {
     checked
 }
 
+/// The standard module a region's scenarios see: the `module` its declaration names (the
+/// one place the region → module map is read).
+pub fn region_module(vocabulary: &tad_check::Vocabulary, region: &str) -> Option<String> {
+    vocabulary.get("region", region).and_then(|r| r.symbol("module")).map(str::to_string)
+}
+
 /// The scenario of `file`, resolved: names to typed entries, quantities to SI, groups in
 /// placement order. `None` when the file has no scenario. Every later stage (backends,
 /// layout, runtime) reads this, never the string-keyed model.
@@ -461,11 +467,7 @@ impl Database {
             stated.or_else(|| self.settings().options(self).region.clone())
         });
         let region_module = match (region, prelude) {
-            (Some(region), Some(prelude)) => vocabulary(self, prelude)
-                .vocabulary
-                .get("region", &region)
-                .and_then(|r| r.symbol("module"))
-                .map(str::to_string),
+            (Some(region), Some(prelude)) => region_module(&vocabulary(self, prelude).vocabulary, &region),
             _ => None,
         };
         let mut modules = BTreeMap::new();

@@ -30,10 +30,13 @@ pub fn scope(region: Option<&str>) -> Result<(Vocabulary, Vec<String>), String> 
     let modules = match region {
         None => all,
         Some(region) => {
-            let entry = core.get("region", region).ok_or_else(|| {
-                format!("unknown region `{region}` (the regions are: {})", core.names("region").join(", "))
-            })?;
-            entry.symbol("module").map(|m| vec![m.to_string()]).unwrap_or_default()
+            if core.get("region", region).is_none() {
+                return Err(format!(
+                    "unknown region `{region}` (the regions are: {})",
+                    core.names("region").join(", ")
+                ));
+            }
+            tad_db::region_module(&core, region).into_iter().collect()
         }
     };
     let text: String = modules.iter().map(|m| format!("use {m}\n")).collect();

@@ -221,16 +221,40 @@ impl fmt::Display for PolicyError {
 
 impl std::error::Error for PolicyError {}
 
+/// An ego by its command-line name (`idm`, `naive` or `learned:PATH`), read once and made
+/// afresh for every episode: a learned actor is loaded when the spec is parsed and copied.
+#[derive(Clone, Debug)]
+pub enum EgoSpec {
+    Idm,
+    Naive,
+    Learned(Learned),
+}
+
+impl EgoSpec {
+    pub fn parse(spec: &str) -> Result<EgoSpec, PolicyError> {
+        match spec.split_once(':') {
+            None if spec == "idm" => Ok(EgoSpec::Idm),
+            None if spec == "naive" => Ok(EgoSpec::Naive),
+            None if spec == "learned" => Err(PolicyError::MissingPath),
+            Some(("learned", "")) => Err(PolicyError::MissingPath),
+            Some(("learned", path)) => Ok(EgoSpec::Learned(Learned::load(path)?)),
+            _ => Err(PolicyError::UnknownPolicy { spec: spec.to_string() }),
+        }
+    }
+
+    /// A fresh policy for one episode.
+    pub fn make(&self) -> Box<dyn EgoPolicy> {
+        match self {
+            EgoSpec::Idm => Box::new(Idm::default()),
+            EgoSpec::Naive => Box::new(Naive::default()),
+            EgoSpec::Learned(actor) => Box::new(actor.clone()),
+        }
+    }
+}
+
 /// A policy by its command-line name: `idm`, `naive` or `learned:PATH`.
 pub fn parse_policy(spec: &str) -> Result<Box<dyn EgoPolicy>, PolicyError> {
-    match spec.split_once(':') {
-        None if spec == "idm" => Ok(Box::new(Idm::default())),
-        None if spec == "naive" => Ok(Box::new(Naive::default())),
-        None if spec == "learned" => Err(PolicyError::MissingPath),
-        Some(("learned", "")) => Err(PolicyError::MissingPath),
-        Some(("learned", path)) => Ok(Box::new(Learned::load(path)?)),
-        _ => Err(PolicyError::UnknownPolicy { spec: spec.to_string() }),
-    }
+    EgoSpec::parse(spec).map(|ego| ego.make())
 }
 
 #[cfg(test)]

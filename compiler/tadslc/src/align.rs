@@ -10,30 +10,13 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 use tad_check::{Class, Options};
-use tad_db::{Database, Language, RealFs};
+use tad_db::Database;
+use tad_eval::Corpus;
 use tad_stats::{Features, Stats};
 
 use crate::files::{self, Search};
 use crate::output::Closed;
 use crate::{Status, errln, out, outln, plural};
-
-/// One checked scenario of a corpus.
-pub struct Item {
-    pub name: String,
-    /// Its TAD text (a YAML answer converted).
-    pub tad: String,
-    pub features: Features,
-}
-
-pub struct Corpus {
-    pub name: String,
-    pub items: Vec<Item>,
-}
-
-/// Whether a checked file counts as a scenario of a corpus: no errors, complete or not.
-pub fn counts(class: Option<Class>) -> bool {
-    matches!(class, Some(Class::Complete | Class::Incomplete))
-}
 
 /// The corpus's name: the directory's or file's name.
 fn corpus_name(path: &Path) -> String {
@@ -41,47 +24,42 @@ fn corpus_name(path: &Path) -> String {
     base.map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| path.display().to_string())
 }
 
-/// Every valid scenario under `paths`, as one corpus named after the first.
-pub fn load(paths: &[PathBuf], status: &mut Status) -> Result<Corpus, Closed> {
+/// Every scenario under `paths` that counts, as one corpus named after the first; files
+/// that cannot be read are reported.
+pub fn read(paths: &[PathBuf], status: &mut Status) -> Result<Corpus, Closed> {
     let name = paths.first().map(|p| corpus_name(p)).unwrap_or_default();
-    let mut db = Database::new(Options::default());
-    let mut items = Vec::new();
-    let (mut invalid, mut non_scenarios) = (0, 0);
-    for input in files::load(paths, Search::Scenarios, status)? {
-        let file = crate::check::register(&mut db, &input);
-        let class = tad_db::check(&db, file).class;
-        if !counts(class) {
-            if class == Some(Class::Invalid) {
-                invalid += 1;
-            } else {
-                non_scenarios += 1;
-            }
-            continue;
-        }
-        let Some(scenario) = tad_db::resolve(&db, file) else { continue };
-        let tad = if file.language(&db) == Language::Yaml {
-            tad_yaml::to_tad(&tad_db::analyze(&db, file).module)
-        } else {
-            input.text.clone()
-        };
-        let short = input
-            .path
-            .as_deref()
-            .and_then(|p| p.file_stem())
-            .map_or(input.name.clone(), |s| s.to_string_lossy().into_owned());
-        items.push(Item { features: Features::of(&short, scenario), name: short, tad });
-    }
-    if invalid + non_scenarios > 0 {
+    let sources = files::load(paths, Search::Scenarios, status)?
+        .into_iter()
+        .map(|input| tad_eval::corpus::Source {
+            path: input.path.unwrap_or_else(|| PathBuf::from(input.name)),
+            text: input.text,
+        })
+        .collect();
+    Ok(Corpus::new(name, sources))
+}
+
+/// [`read`], then a note on the files that did not count and an error when none did.
+pub fn load(paths: &[PathBuf], status: &mut Status) -> Result<Corpus, Closed> {
+    let corpus = read(paths, status)?;
+    report(corpus, status)
+}
+
+/// A note on `corpus`'s files that did not count, and an error (status 2) when none did.
+pub fn report(corpus: Corpus, status: &mut Status) -> Result<Corpus, Closed> {
+    if corpus.skipped() > 0 {
         errln!(
-            "note: corpus `{name}`: {} skipped ({invalid} with errors, {non_scenarios} not scenarios; `tadslc check` says why)",
-            plural(invalid + non_scenarios, "file")
+            "note: corpus `{}`: {} skipped ({} with errors, {} not scenarios; `tadslc check` says why)",
+            corpus.name,
+            plural(corpus.skipped(), "file"),
+            corpus.invalid,
+            corpus.non_scenarios
         )?;
     }
-    if items.is_empty() {
+    if corpus.items.is_empty() {
         *status = (*status).max(Status::Usage);
-        errln!("error: corpus `{name}` has no valid scenario")?;
+        errln!("error: corpus `{}` has no valid scenario", corpus.name)?;
     }
-    Ok(Corpus { name, items })
+    Ok(corpus)
 }
 
 fn unique_names(corpora: &mut [Corpus]) {
@@ -278,7 +256,7 @@ pub fn fit(paths: &[PathBuf], output: &Path) -> Status {
         if corpus.items.is_empty() {
             return Ok(());
         }
-        let (fitted, fitted_from) = fit_items(corpus.items.iter());
+        let (fitted, fitted_from) = tad_eval::generator::fit(corpus.items.iter());
         if let Err(e) = tad_frontend::store::write_atomic(output, fitted.to_json().as_bytes()) {
             *status = Status::Usage;
             errln!("error: cannot write {}: {e}", output.display())?;
@@ -320,37 +298,6 @@ struct GenSummary<'a> {
 
 /// `tadslc gen --generator fitted:MODEL`: item `i` is drawn with seed `seed + i`, again
 /// until it checks without errors (at most `attempts` draws).
-/// Draws per scenario before the fitted generator gives up on it (`gen --attempts`).
-pub const ATTEMPTS: usize = 50;
-
-/// The generator fitted to `items`, and how many of them it was fitted on.
-pub fn fit_items<'a>(items: impl Iterator<Item = &'a Item>) -> (tad_fit::Fitted, usize) {
-    let examples: Vec<tad_fit::Example> =
-        items.filter_map(|i| tad_fit::Example::of(&i.tad, &tad_syntax::analyze(&i.tad).0)).collect();
-    (tad_fit::Fitted::fit(&examples), examples.len())
-}
-
-/// Scenario `name` drawn from `fitted` with `seed` and checked, drawn again while it has
-/// errors (at most `attempts` draws): the text and its class, and the number of draws.
-pub fn draw_fitted(
-    db: &mut Database,
-    fitted: &tad_fit::Fitted,
-    name: &str,
-    seed: u64,
-    attempts: usize,
-) -> (Option<(String, Class)>, usize) {
-    let mut rng = tad_ir::SplitMix64::new(seed);
-    for draw in 1..=attempts.max(1) {
-        let text = fitted.sample(name, &mut rng);
-        let file = db.set_source(PathBuf::from(format!("{name}.tad")), text.clone(), Language::Tad, &RealFs);
-        let class = tad_db::check(db, file).class;
-        if let Some(class) = class.filter(|_| counts(class)) {
-            return (Some((text, class)), draw);
-        }
-    }
-    (None, attempts.max(1))
-}
-
 pub fn generate_fitted(g: &FittedGen) -> Status {
     crate::output::run(|status| {
         let fitted = match std::fs::read_to_string(g.model)
@@ -381,7 +328,7 @@ pub fn generate_fitted(g: &FittedGen) -> Status {
         for i in 0..g.n {
             let seed = g.seed.wrapping_add(i as u64);
             let name = format!("{stem}_fitted_{:03}", i + 1);
-            let (accepted, draws) = draw_fitted(&mut db, &fitted, &name, seed, g.attempts);
+            let (accepted, draws) = tad_eval::generator::draw_fitted(&mut db, &fitted, &name, seed, g.attempts);
             summary.draws += draws;
             summary.rejected += draws - usize::from(accepted.is_some());
             let Some((text, class)) = accepted else {

@@ -15,7 +15,7 @@ pub mod lsp;
 pub mod runtime;
 
 use crate::output::Closed;
-use crate::{Status, corpus, errln, outln};
+use crate::{Status, errln, outln};
 use std::hint::black_box;
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -66,7 +66,7 @@ pub fn run(n: usize, seed: u64, examples: Option<&Path>, runs: usize) -> Status 
 }
 
 fn run_in(n: usize, seed: u64, examples: Option<&Path>, runs: usize, status: &mut Status) -> Result<(), Closed> {
-    let corpus = corpus::generate(n, seed);
+    let corpus = tad_eval::baseline::generate(n, seed);
     let tad: Vec<&str> = corpus.iter().map(|g| g.tad.as_str()).collect();
     let json: Vec<&str> = corpus.iter().map(|g| g.json.as_str()).collect();
     let tad_bytes: usize = tad.iter().map(|t| t.len()).sum();

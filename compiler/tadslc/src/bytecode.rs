@@ -104,8 +104,7 @@ pub fn compile(
         errln!("{}: not {verb}", input.name)?;
         return Ok(None);
     };
-    let layout = tad_layout::lay_out(scenario);
-    Ok(Some(tad_bytecode::lower(scenario, &layout, &input.name)))
+    Ok(Some(tad_eval::pipeline::program(scenario, &input.name)))
 }
 
 /// `disasm FILE.tadc`: the listing on standard output.

@@ -58,7 +58,7 @@ pub fn collect(paths: &[PathBuf], search: Search) -> (Vec<PathBuf>, Vec<String>)
             files.push(path.clone());
         } else if path.is_dir() {
             let mut found = Vec::new();
-            walk(path, search, &mut found, &mut errors);
+            walk(path, &|p| search.wants(p), &mut found, &mut errors);
             if found.is_empty() {
                 errors.push(format!("no {} in `{}`", search.describe(), path.display()));
             }
@@ -73,7 +73,7 @@ pub fn collect(paths: &[PathBuf], search: Search) -> (Vec<PathBuf>, Vec<String>)
     (files, errors)
 }
 
-fn walk(dir: &Path, search: Search, found: &mut Vec<PathBuf>, errors: &mut Vec<String>) {
+fn walk(dir: &Path, wants: &dyn Fn(&Path) -> bool, found: &mut Vec<PathBuf>, errors: &mut Vec<String>) {
     let entries = match std::fs::read_dir(dir) {
         Ok(entries) => entries,
         Err(e) => {
@@ -89,8 +89,8 @@ fn walk(dir: &Path, search: Search, found: &mut Vec<PathBuf>, errors: &mut Vec<S
         let name = entry.file_name();
         let hidden = name.to_string_lossy().starts_with('.');
         if kind.is_dir() && !hidden && name != "target" && name != "node_modules" {
-            walk(&path, search, found, errors);
-        } else if (kind.is_file() || kind.is_symlink()) && search.wants(&path) && path.is_file() {
+            walk(&path, wants, found, errors);
+        } else if (kind.is_file() || kind.is_symlink()) && wants(&path) && path.is_file() {
             found.push(path);
         }
     }
@@ -136,4 +136,13 @@ pub fn load(paths: &[PathBuf], search: Search, status: &mut crate::Status) -> Re
         }
     }
     Ok(inputs)
+}
+
+/// Every file under `dir` whose extension is `ext`, sorted (hidden directories, `target`
+/// and `node_modules` skipped); an unreadable directory gives none.
+pub fn with_extension(dir: &Path, ext: &str) -> Vec<PathBuf> {
+    let (mut found, mut errors) = (Vec::new(), Vec::new());
+    walk(dir, &|p| p.extension().is_some_and(|e| e == ext), &mut found, &mut errors);
+    found.sort();
+    found
 }

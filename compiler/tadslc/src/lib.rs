@@ -1,15 +1,13 @@
 //! The `tadslc` library: the command line's subcommands, shared with its tests.
 //!
-//! Exit codes: 0 success, 1 the input has errors (or warnings with `--deny-warnings`, or
-//! unformatted files with `fmt --check`), 2 usage or I/O failure; `translate` adds 3
-//! (incomplete), 4 (non-scenario) and 5 (the model's server could not be used).
+//! Exit statuses are [`Status`]; [`EXIT_STATUSES`] says them in one sentence, the same in
+//! `--help`, README.md and spec/output.md (a test holds them together).
 
 pub mod align;
 pub mod bench;
 pub mod build;
 pub mod bytecode;
 pub mod check;
-pub mod corpus;
 pub mod eval;
 pub mod explain;
 pub mod files;
@@ -21,7 +19,6 @@ pub mod manual;
 pub mod output;
 pub mod run;
 pub mod search;
-pub mod shard;
 pub mod train_ego;
 
 /// Output format of `check`.
@@ -31,6 +28,17 @@ pub enum Format {
     Json,
     Sarif,
 }
+
+/// The exit statuses in one sentence (a macro, so `--help` can `concat!` it).
+#[macro_export]
+macro_rules! exit_statuses {
+    () => {
+        "Exit status: 0 success, 1 the input has errors, 2 usage or I/O failure; 3 incomplete and 4 non-scenario (`translate`); 5 the model's server could not be used (`translate`, `gen`, `synth`). The table is in spec/output.md."
+    };
+}
+
+/// [`exit_statuses!`] as a constant.
+pub const EXIT_STATUSES: &str = exit_statuses!();
 
 /// Exit statuses, in increasing precedence.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]

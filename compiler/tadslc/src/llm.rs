@@ -203,7 +203,7 @@ fn descriptions(paths: &[PathBuf]) -> Result<Vec<PathBuf>, String> {
     let mut out = Vec::new();
     for path in paths {
         if path.is_dir() {
-            let found = tad_test_support::files(path, "txt");
+            let found = crate::files::with_extension(path, "txt");
             if found.is_empty() {
                 return Err(format!("{} holds no .txt descriptions", path.display()));
             }
@@ -367,7 +367,7 @@ pub fn translate(t: &TranslateArgs, args: &LlmArgs) -> Status {
         let mut manifest = store::Jsonl::append(&dir.join("translate.jsonl"))
             .map_err(|e| format!("cannot write the manifest: {e}"))?;
         let mut summary = Summary::default();
-        let bar = progress(files.len(), "descriptions");
+        let bar = crate::output::progress(files.len(), "descriptions");
         let mut unreachable = 0;
         for path in &files {
             let text = match read_description(path) {
@@ -412,21 +412,6 @@ pub fn translate(t: &TranslateArgs, args: &LlmArgs) -> Status {
     })
 }
 
-fn progress(total: usize, what: &str) -> indicatif::ProgressBar {
-    use std::io::IsTerminal;
-    if !std::io::stderr().is_terminal() {
-        return indicatif::ProgressBar::hidden();
-    }
-    let bar = indicatif::ProgressBar::new(total as u64);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(&format!(
-            "{{bar:30}} {{pos}}/{{len}} {what} {{msg}} [{{elapsed}}, eta {{eta}}]"
-        ))
-        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-    );
-    bar
-}
-
 fn write_summary(dir: Option<&Path>, summary: &Summary, extra: serde_json::Value) -> Result<(), String> {
     let _ = errln!("{}", summary.render());
     if let Some(dir) = dir {
@@ -448,8 +433,83 @@ pub struct GenArgs<'a> {
     pub baseline: bool,
     /// The short prompt of a fine-tuned model (`generate-tuned.v1`).
     pub tuned: bool,
+    /// The region's examples come from these files or directories; when there are none,
+    /// from the embedded examples whose path starts with `embedded`.
     pub corpus: &'a [PathBuf],
+    pub embedded: &'a str,
     pub jobs: usize,
+}
+
+/// `tadslc gen`'s arguments.
+#[derive(clap::Args)]
+pub struct GenCommand {
+    /// The region (for `llm`; a fitted model knows its own)
+    #[arg(long, value_name = "REGION")]
+    pub region: Option<String>,
+    /// `llm`, or `fitted:MODEL` (a file written by `tadslc fit`)
+    #[arg(long, value_name = "GENERATOR", default_value = "llm")]
+    pub generator: String,
+    /// How many scenarios
+    #[arg(short = 'n', long = "count", value_name = "N", default_value_t = 40)]
+    pub count: usize,
+    /// Write the scenarios, a manifest and a summary here (default: print them)
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// The paper's unaligned baseline: the region's name only, no examples, the general
+    /// vocabulary
+    #[arg(long, conflicts_with = "tuned")]
+    pub baseline: bool,
+    /// Ask with the short prompt of `tadslc sft-export` (for a fine-tuned model)
+    #[arg(long)]
+    pub tuned: bool,
+    /// Scenarios of the region to show as examples (default: the repository's
+    /// `examples/regions/`, embedded in tadslc)
+    #[arg(long, value_name = "PATH")]
+    pub corpus: Vec<PathBuf>,
+    /// Requests under way at once
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub jobs: usize,
+    /// With a fitted generator: draws per scenario before giving up on it
+    #[arg(long, value_name = "N", default_value_t = tad_eval::ATTEMPTS)]
+    pub attempts: usize,
+    #[command(flatten)]
+    pub llm: LlmArgs,
+}
+
+/// `tadslc gen`: the fitted generator (`--generator fitted:MODEL`) or a language model.
+pub fn gen_command(cmd: &GenCommand) -> Status {
+    if let Some(model) = cmd.generator.strip_prefix("fitted:") {
+        return crate::align::generate_fitted(&crate::align::FittedGen {
+            model: Path::new(model),
+            n: cmd.count,
+            seed: cmd.llm.seed,
+            out: cmd.out.as_deref(),
+            attempts: cmd.attempts,
+        });
+    }
+    let refuse = |message: std::fmt::Arguments| {
+        let _ = errln!("error: {message}");
+        Status::Usage
+    };
+    match &cmd.region {
+        _ if cmd.generator != "llm" => {
+            refuse(format_args!("unknown generator `{}` (expected `llm` or `fitted:MODEL`)", cmd.generator))
+        }
+        None => refuse(format_args!("`--generator llm` needs `--region REGION`")),
+        Some(region) => generate(
+            &GenArgs {
+                region,
+                n: cmd.count,
+                out: cmd.out.as_deref(),
+                baseline: cmd.baseline,
+                tuned: cmd.tuned,
+                corpus: &cmd.corpus,
+                embedded: "examples/regions/",
+                jobs: cmd.jobs,
+            },
+            &cmd.llm,
+        ),
+    }
 }
 
 /// `tadslc gen --region R -n N`.
@@ -475,7 +535,7 @@ pub fn generate(g: &GenArgs, args: &LlmArgs) -> Status {
             seed: Some(args.seed),
             on_text: None,
         };
-        let examples = region_examples(g.corpus, g.region);
+        let examples = region_examples(g.corpus, g.embedded, g.region);
         let spec = tad_frontend::generate::Spec {
             region: g.region,
             n: g.n,
@@ -488,7 +548,7 @@ pub fn generate(g: &GenArgs, args: &LlmArgs) -> Status {
             jobs: g.jobs,
             model: model_label(client.chat()),
         };
-        let bar = progress(g.n, "scenarios");
+        let bar = crate::output::progress(g.n, "scenarios");
         let mut summary = Summary::default();
         let mut transcript = match g.out {
             Some(dir) => Some(store::Jsonl::append(&dir.join("gen.transcript.jsonl")).map_err(|e| e.to_string())?),
@@ -533,28 +593,24 @@ pub fn generate(g: &GenArgs, args: &LlmArgs) -> Status {
     })
 }
 
-/// The programs of `corpus` (files or directories) that name `region`, for the prompt.
-fn region_examples(corpus: &[PathBuf], region: &str) -> Vec<String> {
-    let default = [tad_test_support::repo().join("examples/regions")];
-    let paths: Vec<PathBuf> = if corpus.is_empty() { default.to_vec() } else { corpus.to_vec() };
-    let mut out = Vec::new();
-    for path in paths {
-        let files = if path.is_dir() { tad_test_support::files(&path, "tad") } else { vec![path.clone()] };
-        for file in files {
-            let Ok(text) = std::fs::read_to_string(&file) else { continue };
-            let (module, _) = tad_syntax::analyze(&text);
-            let named = module
-                .scenario
-                .as_ref()
-                .and_then(|s| s.attr("source", "region"))
-                .and_then(|a| a.symbol())
-                .is_some_and(|s| s.name == region);
-            if named {
-                out.push(tad_frontend::with_provenance(&text, &tad_frontend::Provenance::default()));
-            }
+/// The scenarios of `corpus` (files or directories; the embedded examples under `embedded`
+/// when empty) that name `region` and count, for the prompt.
+fn region_examples(corpus: &[PathBuf], embedded: &str, region: &str) -> Vec<String> {
+    let corpus = if corpus.is_empty() {
+        tad_eval::examples::corpus("examples", embedded)
+    } else {
+        let mut status = Status::Ok;
+        match crate::align::read(corpus, &mut status) {
+            Ok(corpus) => corpus,
+            Err(_) => return Vec::new(),
         }
-    }
-    out
+    };
+    corpus
+        .items
+        .iter()
+        .filter(|item| item.region.as_deref() == Some(region))
+        .map(|item| tad_frontend::with_provenance(&item.tad, &tad_frontend::Provenance::default()))
+        .collect()
 }
 
 pub struct SynthArgs<'a> {
@@ -563,7 +619,7 @@ pub struct SynthArgs<'a> {
     pub region: &'a str,
     pub out: &'a Path,
     pub every: f64,
-    pub shard: (usize, usize),
+    pub shard: tad_base::Shard,
     pub jobs: usize,
     pub max_refinements: u32,
 }
@@ -614,7 +670,7 @@ pub fn synth(s: &SynthArgs, args: &LlmArgs) -> Status {
                 }
             });
         }
-        let bar = progress(0, "frames");
+        let bar = crate::output::progress(0, "frames");
         let mut summary = Summary::default();
         let mut failed = 0usize;
         let report = rt
@@ -650,7 +706,7 @@ pub fn synth(s: &SynthArgs, args: &LlmArgs) -> Status {
         write_summary(
             Some(s.out),
             &summary,
-            serde_json::json!({ "region": s.region, "model": model_label(client.chat()), "shard": format!("{}/{}", s.shard.0, s.shard.1) }),
+            serde_json::json!({ "region": s.region, "model": model_label(client.chat()), "shard": s.shard.to_string() }),
         )?;
         if report.interrupted {
             let _ = errln!("interrupted: run the same command again to continue");
@@ -662,17 +718,6 @@ pub fn synth(s: &SynthArgs, args: &LlmArgs) -> Status {
         let _ = errln!("error: {e}");
         Status::Usage
     })
-}
-
-/// `i/n` for `--shard`.
-pub fn parse_shard(text: &str) -> Result<(usize, usize), String> {
-    let (i, n) = text.split_once('/').ok_or("a shard is written i/n, e.g. 0/4")?;
-    let (i, n): (usize, usize) =
-        (i.trim().parse().map_err(|_| "i is not a number")?, n.trim().parse().map_err(|_| "n is not a number")?);
-    if n == 0 || i >= n {
-        return Err(format!("shard {i}/{n}: i must be below n"));
-    }
-    Ok((i, n))
 }
 
 /// `tadslc grammar`.

@@ -4,10 +4,9 @@
 //! the terminal, exit codes. Each subcommand lives in its own module and returns an
 //! [`ExitCode`]-like status; `main` only parses arguments and dispatches.
 //!
-//! Exit codes: 0 success, 1 the input has errors (or warnings with `--deny-warnings`, or
-//! unformatted files with `fmt --check`), 2 usage or I/O failure. A closed standard
-//! output or error (a broken pipe) stops the output quietly and leaves the status as the
-//! run had it (`spec/output.md`).
+//! Exit statuses: `tadslc::EXIT_STATUSES`. A closed standard output or error (a broken
+//! pipe) stops the output quietly and leaves the status as the run had it
+//! (`spec/output.md`).
 
 use clap::{CommandFactory, Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
@@ -19,10 +18,11 @@ use tadslc::{Format, bench, check, explain, fmt};
     name = "tadslc",
     version,
     about = "The TADSL compiler: check, format, convert, build and explain traffic scenarios",
-    after_help = "Run `tadslc explain CODE` for what a diagnostic code means and how to fix it \
-                  (`tadslc explain` lists them all).\n\
-                  Exit status: 0 no errors, 1 errors, 2 usage or I/O failure; the output formats \
-                  and statuses are specified in spec/output.md."
+    after_help = concat!(
+        "Run `tadslc explain CODE` for what a diagnostic code means and how to fix it \
+         (`tadslc explain` lists them all).\n",
+        tadslc::exit_statuses!()
+    )
 )]
 struct Cli {
     /// When to colour terminal output (default: on a terminal, unless NO_COLOR is set)
@@ -120,40 +120,7 @@ enum Command {
     ///
     /// Scenario files are compiled in memory; `.tadc` files are loaded. Each file, ego and
     /// seed is one episode, its parameters sampled from the seed.
-    Run {
-        /// Scenario files or directories (searched recursively for *.tad and *.yaml), or
-        /// `.tadc` bytecode files
-        #[arg(required = true)]
-        paths: Vec<PathBuf>,
-        /// The ego policies, comma-separated or repeated: `idm`, `naive`, `learned:PATH`
-        /// (a SafeBench SAC actor in safetensors)
-        #[arg(long, value_delimiter = ',', default_values_t = ["idm".to_string(), "naive".to_string()])]
-        ego: Vec<String>,
-        /// Seeds `A..B` (B excluded, as in Rust), `A..=B` (B included) or one seed `A`
-        #[arg(long, default_value = "0..3", value_parser = tadslc::run::parse_seeds)]
-        seeds: std::ops::Range<u64>,
-        /// Output format: a table for people, or JSON lines (one object per episode, then
-        /// one aggregate object per ego)
-        #[arg(long, value_enum, default_value_t = tadslc::run::RunFormat::Table)]
-        format: tadslc::run::RunFormat,
-        /// Write every actor's pose at every step as JSON lines
-        #[arg(long, value_name = "FILE")]
-        trace: Option<PathBuf>,
-        /// Draw the first episode: `.svg` (a figure) or `.gif` (an animation)
-        #[arg(long, value_name = "FILE")]
-        render: Option<PathBuf>,
-        /// Score as SafeBench's scorer does, quirks included (TS 0 when nothing completes,
-        /// yaw not unwrapped, off-road never ends an episode)
-        #[arg(long)]
-        compat: bool,
-        /// Run every N-th input from I (a job array's index I of N jobs, from 0)
-        #[arg(long, value_name = "I/N", default_value = "0/1", value_parser = tadslc::shard::parse)]
-        shard: tadslc::shard::Shard,
-        /// Write the scored episodes to DIR/results.json (DIR/results.I-of-N.json with
-        /// --shard), for `tadslc merge`
-        #[arg(long, value_name = "DIR")]
-        out: Option<PathBuf>,
-    },
+    Run(tadslc::run::RunArgs),
     /// Search each scenario's parameters for the scenes that challenge an ego most
     /// (ChatScene's adversarial search) and write them as TAD with the parameters fixed
     ///
@@ -161,34 +128,7 @@ enum Command {
     /// range is re-fitted to mean ± std of the colliding scenes so far; the 2 kept are the
     /// colliding ones with the lowest OS, then the lowest-OS others. Also writes
     /// `search.json` (ranges by round, collision rates, the chosen scenes).
-    Search {
-        /// Scenario files or directories (searched recursively), or `.tadc` files
-        #[arg(required = true)]
-        paths: Vec<PathBuf>,
-        /// The ego the scenes are searched against: `idm`, `naive`, `learned:PATH`
-        #[arg(long, default_value = "idm")]
-        ego: String,
-        /// The directory the chosen scenes and `search.json` are written to
-        #[arg(short, long, value_name = "DIR")]
-        out: PathBuf,
-        /// Scenes sampled per scenario
-        #[arg(long, default_value_t = 50)]
-        samples: usize,
-        /// Ranges are re-fitted after every this many scenes
-        #[arg(long, default_value_t = 10)]
-        round: usize,
-        /// Scenes kept per scenario
-        #[arg(long, default_value_t = 2)]
-        keep: usize,
-        #[arg(long, default_value_t = 0)]
-        seed: u64,
-        /// Search every N-th input from I (a job array's index I of N jobs, from 0)
-        #[arg(long, value_name = "I/N", default_value = "0/1", value_parser = tadslc::shard::parse)]
-        shard: tadslc::shard::Shard,
-        /// Score as SafeBench's scorer does, quirks included
-        #[arg(long)]
-        compat: bool,
-    },
+    Search(tadslc::search::SearchArgs),
     /// The paper's results table: generators × egos × SafeBench's ten metrics and OS,
     /// per region
     ///
@@ -196,63 +136,7 @@ enum Command {
     /// generator: scenarios generated (`fitted` on the region's scenarios, `baseline` the
     /// region-agnostic generator) or taken from a directory, checked, searched against the
     /// search ego (ChatScene's search), and the kept scenes run by every ego.
-    Eval {
-        /// The corpus the regions and the fitted generators come from
-        #[arg(default_value = "examples")]
-        corpus: Vec<PathBuf>,
-        /// Regions, comma-separated or repeated
-        #[arg(long = "region", value_delimiter = ',')]
-        regions: Vec<String>,
-        /// Generators: `fitted` (fitted on the region's scenarios), `baseline` (region-agnostic),
-        /// `llm`, `llm-baseline`, `llm-tuned` (a language model through `tadslc gen`'s loop:
-        /// the aligned prompt, the paper's unaligned region prompt, the fine-tuned model's
-        /// prompt with `--adapter`), or a directory of scenarios
-        #[arg(long, value_delimiter = ',', default_values_t = ["fitted".to_string(), "baseline".to_string()])]
-        generators: Vec<String>,
-        /// The egos evaluated: `idm`, `naive`, `learned:PATH`
-        #[arg(long, value_delimiter = ',', default_values_t = ["idm".to_string(), "naive".to_string()])]
-        egos: Vec<String>,
-        /// The ego the scenes are searched against (ChatScene's surrogate)
-        #[arg(long, default_value = "idm")]
-        search_ego: String,
-        /// Scenarios per region and generator
-        #[arg(short, default_value_t = 10)]
-        n: usize,
-        /// Scenes sampled per scenario by the search
-        #[arg(long, default_value_t = 50)]
-        samples: usize,
-        /// Scenes kept per scenario
-        #[arg(long, default_value_t = 2)]
-        keep: usize,
-        /// Requests in flight to the model's server, for the `llm` generators
-        #[arg(long, default_value_t = 1)]
-        jobs: usize,
-        #[arg(long, value_enum, default_value_t = tadslc::eval::EvalFormat::Markdown)]
-        format: tadslc::eval::EvalFormat,
-        /// Write the scored episodes to DIR/results.json (DIR/results.I-of-N.json with --shard)
-        #[arg(long, value_name = "DIR")]
-        out: Option<PathBuf>,
-        /// Draw the OS of each generator and ego as an SVG bar chart
-        #[arg(long, value_name = "FILE")]
-        plot: Option<PathBuf>,
-        /// Evaluate every N-th scenario from I (a job array's index I of N jobs, from 0)
-        #[arg(long, value_name = "I/N", default_value = "0/1", value_parser = tadslc::shard::parse)]
-        shard: tadslc::shard::Shard,
-        /// Also the "after fine-tuning" table: a learned ego trained with SAC for this many
-        /// episodes on 3/5 of each behaviour's kept scenes, every ego on the other 2/5
-        #[arg(long, value_name = "EPISODES", default_value_t = 0)]
-        finetune: usize,
-        /// Learning steps per fine-tuning episode (ChatScene: 1)
-        #[arg(long, value_name = "N", default_value_t = 1)]
-        finetune_updates: usize,
-        /// Where fine-tuning starts: a `train-ego` checkpoint directory (actor, critics, replay),
-        /// or an actor alone (a safetensors file, as `learned:PATH` reads)
-        #[arg(long, value_name = "FILE")]
-        finetune_from: Option<PathBuf>,
-        /// The model for the `llm` generators (`--seed` seeds every generator and the search)
-        #[command(flatten)]
-        llm: tadslc::llm::LlmArgs,
-    },
+    Eval(tadslc::eval::EvalArgs),
     /// Combine the results files of `eval --shard` (or `run --shard --out`) into one table
     Merge {
         /// The results files
@@ -424,8 +308,8 @@ enum Command {
         #[arg(long, value_name = "S", default_value_t = 15.0)]
         every: f64,
         /// Do only the frames of shard i of n (`0/4`)
-        #[arg(long, value_name = "I/N", default_value = "0/1", value_parser = tadslc::llm::parse_shard)]
-        shard: (usize, usize),
+        #[arg(long, value_name = "I/N", default_value = "0/1")]
+        shard: tad_base::Shard,
         /// Frames under way at once
         #[arg(long, value_name = "N", default_value_t = 1)]
         jobs: usize,
@@ -442,38 +326,7 @@ enum Command {
     /// no GPU; each scenario drawn again until it checks without errors); `--generator llm`
     /// (the default) asks the language model, with the region's examples (aligned), its
     /// name only (`--baseline`), or the short prompt a fine-tuned model learnt (`--tuned`).
-    Gen {
-        /// The region (for `llm`; a fitted model knows its own)
-        #[arg(long, value_name = "REGION")]
-        region: Option<String>,
-        /// `llm`, or `fitted:MODEL` (a file written by `tadslc fit`)
-        #[arg(long, value_name = "GENERATOR", default_value = "llm")]
-        generator: String,
-        /// How many scenarios
-        #[arg(short = 'n', long = "count", value_name = "N", default_value_t = 40)]
-        count: usize,
-        /// Write the scenarios, a manifest and a summary here (default: print them)
-        #[arg(long, value_name = "DIR")]
-        out: Option<PathBuf>,
-        /// The paper's unaligned baseline: the region's name only, no examples, the general
-        /// vocabulary
-        #[arg(long, conflicts_with = "tuned")]
-        baseline: bool,
-        /// Ask with the short prompt of `tadslc sft-export` (for a fine-tuned model)
-        #[arg(long)]
-        tuned: bool,
-        /// Scenarios of the region to show as examples (default: examples/regions)
-        #[arg(long, value_name = "PATH")]
-        corpus: Vec<PathBuf>,
-        /// Requests under way at once
-        #[arg(long, value_name = "N", default_value_t = 1)]
-        jobs: usize,
-        /// With a fitted generator: draws per scenario before giving up on it
-        #[arg(long, value_name = "N", default_value_t = tadslc::align::ATTEMPTS)]
-        attempts: usize,
-        #[command(flatten)]
-        llm: tadslc::llm::LlmArgs,
-    },
+    Gen(tadslc::llm::GenCommand),
     /// The statistics of corpora: the corpus table and a histogram per attribute
     ///
     /// Each path is one corpus (a directory of scenarios, e.g. one per region); only
@@ -719,55 +572,9 @@ fn main() -> ExitCode {
             tadslc::bytecode::build(&paths, output.as_deref(), map_dir.is_some() || map.is_some(), color)
         }
         Command::Disasm { path } => tadslc::bytecode::disasm(&path),
-        Command::Run { paths, ego, seeds, format, trace, render, compat, shard, out } => tadslc::run::run(
-            &tadslc::run::RunArgs { paths, egos: ego, seeds, format, trace, render, compat, shard, out },
-            color,
-        ),
-        Command::Search { paths, ego, out, samples, round, keep, seed, shard, compat } => tadslc::search::run(
-            &tadslc::search::SearchArgs { paths, ego, out, samples, round, keep, seed, shard, compat },
-            color,
-        ),
-        Command::Eval {
-            corpus,
-            regions,
-            generators,
-            egos,
-            search_ego,
-            n,
-            samples,
-            keep,
-            jobs,
-            format,
-            out,
-            plot,
-            shard,
-            finetune,
-            finetune_updates,
-            finetune_from,
-            llm,
-        } => tadslc::eval::eval(
-            &tadslc::eval::EvalArgs {
-                corpus,
-                regions,
-                generators,
-                egos,
-                search_ego,
-                n,
-                samples,
-                keep,
-                seed: llm.seed,
-                format,
-                out,
-                plot,
-                shard,
-                jobs,
-                finetune,
-                finetune_updates,
-                finetune_from,
-                llm,
-            },
-            color,
-        ),
+        Command::Run(args) => tadslc::run::run(&args, color),
+        Command::Search(args) => tadslc::search::run(&args, color),
+        Command::Eval(args) => tadslc::eval::eval(&args, color),
         Command::Merge { files, format, plot } => tadslc::eval::merge(&files, format, plot.as_deref()),
         Command::Import { path, output } => tadslc::interchange::run_import(&path, output.as_deref(), color),
         Command::Export { format: ExportFormat::Yaml, yaml: _, path, output } => {
@@ -777,7 +584,7 @@ fn main() -> ExitCode {
         Command::Lsp { stdio: _ } => match tad_lsp::run_stdio() {
             Ok(()) => tadslc::Status::Ok,
             Err(error) => {
-                eprintln!("error: the language server could not start: {error}");
+                let _ = tadslc::errln!("error: the language server could not start: {error}");
                 tadslc::Status::Usage
             }
         },
@@ -825,37 +632,8 @@ fn main() -> ExitCode {
             },
             &llm,
         ),
-        Command::Gen { region, generator, count, out, baseline, tuned, corpus, jobs, attempts, llm } => {
-            if let Some(model) = generator.strip_prefix("fitted:") {
-                tadslc::align::generate_fitted(&tadslc::align::FittedGen {
-                    model: std::path::Path::new(model),
-                    n: count,
-                    seed: llm.seed,
-                    out: out.as_deref(),
-                    attempts,
-                })
-            } else if generator != "llm" {
-                eprintln!("error: unknown generator `{generator}` (expected `llm` or `fitted:MODEL`)");
-                tadslc::Status::Usage
-            } else if let Some(region) = region {
-                tadslc::llm::generate(
-                    &tadslc::llm::GenArgs {
-                        region: &region,
-                        n: count,
-                        out: out.as_deref(),
-                        baseline,
-                        tuned,
-                        corpus: &corpus,
-                        jobs,
-                    },
-                    &llm,
-                )
-            } else {
-                eprintln!("error: `--generator llm` needs `--region REGION`");
-                tadslc::Status::Usage
-            }
-        }
-        Command::Finetune(args) => return std::process::ExitCode::from(tadslc::finetune::finetune(&args) as u8),
+        Command::Gen(args) => tadslc::llm::gen_command(&args),
+        Command::Finetune(args) => tadslc::finetune::finetune(&args),
         Command::TrainEgo(args) => tadslc::train_ego::train_ego(&args, color),
         Command::Stats { corpora, format, plot } => {
             tadslc::align::stats(&tadslc::align::StatsArgs { corpora: &corpora, format, plot: plot.as_deref() })

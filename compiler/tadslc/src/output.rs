@@ -91,3 +91,18 @@ pub fn run(body: impl FnOnce(&mut Status) -> Result<(), Closed>) -> Status {
         Err(closed) => closed.merge(status),
     }
 }
+
+/// The progress bar of every long command, on standard error, shown at a terminal only:
+/// `total` units named `unit` (`episodes`, `steps`); a message follows the count.
+pub fn progress(total: usize, unit: &str) -> indicatif::ProgressBar {
+    use std::io::IsTerminal;
+    if !std::io::stderr().is_terminal() {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new(total as u64);
+    let template = format!("{{bar:30}} {{pos}}/{{len}} {unit} {{msg}} [{{elapsed}}, eta {{eta}}]");
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(&template).unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar
+}

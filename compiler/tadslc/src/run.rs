@@ -26,15 +26,40 @@ pub enum RunFormat {
     Json,
 }
 
+/// `tadslc run`'s arguments.
+#[derive(clap::Args)]
 pub struct RunArgs {
+    /// Scenario files or directories (searched recursively for *.tad and *.yaml), or
+    /// `.tadc` bytecode files
+    #[arg(required = true)]
     pub paths: Vec<PathBuf>,
+    /// The ego policies, comma-separated or repeated: `idm`, `naive`, `learned:PATH`
+    /// (a SafeBench SAC actor in safetensors)
+    #[arg(long = "ego", value_delimiter = ',', default_values_t = ["idm".to_string(), "naive".to_string()])]
     pub egos: Vec<String>,
-    pub seeds: Range<u64>,
-    pub format: RunFormat,
+    /// Seeds `A..B` (B excluded, as in Rust), `A..=B` (B included) or one seed `A`
+    #[arg(long, default_value = "0..3", value_parser = crate::run::parse_seeds)]
+    pub seeds: std::ops::Range<u64>,
+    /// Output format: a table for people, or JSON lines (one object per episode, then
+    /// one aggregate object per ego)
+    #[arg(long, value_enum, default_value_t = crate::run::RunFormat::Table)]
+    pub format: crate::run::RunFormat,
+    /// Write every actor's pose at every step as JSON lines
+    #[arg(long, value_name = "FILE")]
     pub trace: Option<PathBuf>,
+    /// Draw the first episode: `.svg` (a figure) or `.gif` (an animation)
+    #[arg(long, value_name = "FILE")]
     pub render: Option<PathBuf>,
+    /// Score as SafeBench's scorer does, quirks included (TS 0 when nothing completes,
+    /// yaw not unwrapped, off-road never ends an episode)
+    #[arg(long)]
     pub compat: bool,
-    pub shard: crate::shard::Shard,
+    /// Run every N-th input from I (a job array's index I of N jobs, from 0)
+    #[arg(long, value_name = "I/N", default_value = "0/1")]
+    pub shard: tad_base::Shard,
+    /// Write the scored episodes to DIR/results.json (DIR/results.I-of-N.json with
+    /// --shard), for `tadslc merge`
+    #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
 }
 
@@ -57,48 +82,14 @@ pub fn parse_seeds(text: &str) -> Result<Range<u64>, String> {
     Ok(range)
 }
 
-/// An ego policy by its command-line name, made afresh for every episode (a learned
-/// actor is read once and copied).
-pub enum Ego {
-    Idm,
-    Naive,
-    Learned(tad_policy::Learned),
-}
-
-impl Ego {
-    pub fn parse(spec: &str) -> Result<Ego, tad_policy::PolicyError> {
-        match spec.split_once(':') {
-            Some(("learned", path)) if !path.is_empty() => Ok(Ego::Learned(tad_policy::Learned::load(path)?)),
-            _ => {
-                let policy = tad_policy::parse_policy(spec)?;
-                Ok(if policy.name() == "idm" { Ego::Idm } else { Ego::Naive })
-            }
-        }
-    }
-
-    pub fn copy(&self) -> Ego {
-        match self {
-            Ego::Idm => Ego::Idm,
-            Ego::Naive => Ego::Naive,
-            Ego::Learned(actor) => Ego::Learned(actor.clone()),
-        }
-    }
-
-    pub fn make(&self) -> Box<dyn tad_policy::EgoPolicy> {
-        match self {
-            Ego::Idm => Box::new(tad_policy::Idm::default()),
-            Ego::Naive => Box::new(tad_policy::Naive::default()),
-            Ego::Learned(actor) => Box::new(actor.clone()),
-        }
-    }
-}
-
 /// One scenario ready to run, named for people.
 pub struct Loaded {
     pub name: String,
     pub scene: Scene,
     /// The source it was compiled from (`None` for a `.tadc` file).
     pub source: Option<files::Input>,
+    /// Its behaviour, the key of the fine-tuning split (`None` for a `.tadc` file).
+    pub key: Option<String>,
 }
 
 /// Every input as a scene: sources compiled, `.tadc` files loaded.
@@ -113,8 +104,12 @@ pub fn load(paths: &[PathBuf], color: bool, status: &mut Status) -> Result<Vec<L
                 *status = (*status).max(Status::Failed);
                 continue;
             };
+            let file = crate::check::register(&mut db, &input);
+            let key = tad_eval::corpus::behaviour_of(&db, file);
             match Scene::new(&program) {
-                Ok(scene) => loaded.push(Loaded { name: input.name.clone(), scene, source: Some(input.clone()) }),
+                Ok(scene) => {
+                    loaded.push(Loaded { name: input.name.clone(), scene, source: Some(input.clone()), key: Some(key) })
+                }
                 Err(e) => {
                     *status = (*status).max(Status::Failed);
                     errln!("{}: not run: {e}", input.name)?;
@@ -124,14 +119,16 @@ pub fn load(paths: &[PathBuf], color: bool, status: &mut Status) -> Result<Vec<L
     }
     for path in bytecode {
         let name = path.display().to_string();
+        // a file that cannot be read is an I/O failure (2); one that does not load is
+        // input with errors (1), as under `disasm`
         let program = match std::fs::read(&path) {
-            Ok(bytes) => tad_bytecode::decode(&bytes).map_err(|e| e.to_string()),
-            Err(e) => Err(format!("cannot read it: {e}")),
+            Ok(bytes) => tad_bytecode::decode(&bytes).map_err(|e| (Status::Failed, e.to_string())),
+            Err(e) => Err((Status::Usage, format!("cannot read it: {e}"))),
         };
-        match program.and_then(|p| Scene::new(&p).map_err(|e| e.to_string())) {
-            Ok(scene) => loaded.push(Loaded { name, scene, source: None }),
-            Err(e) => {
-                *status = (*status).max(Status::Usage);
+        match program.and_then(|p| Scene::new(&p).map_err(|e| (Status::Failed, e.to_string()))) {
+            Ok(scene) => loaded.push(Loaded { name, scene, source: None, key: None }),
+            Err((failed, e)) => {
+                *status = (*status).max(failed);
                 errln!("error: {name}: {e}")?;
             }
         }
@@ -142,7 +139,7 @@ pub fn load(paths: &[PathBuf], color: bool, status: &mut Status) -> Result<Vec<L
 /// The inputs of one shard: every N-th loaded scenario from I.
 pub fn load_shard(
     paths: &[PathBuf],
-    shard: crate::shard::Shard,
+    shard: tad_base::Shard,
     color: bool,
     status: &mut Status,
 ) -> Result<Vec<Loaded>, Closed> {
@@ -181,7 +178,7 @@ fn run_in(args: &RunArgs, color: bool, status: &mut Status) -> Result<(), Closed
     let keep_frames = args.trace.is_some() || args.render.is_some();
     let opts = Options { mode, keep_frames, ..Options::default() };
     let total = scenes.len() * policies.len() * (args.seeds.end - args.seeds.start) as usize;
-    let progress = Progress::new(total, "episodes");
+    let progress = crate::output::progress(total, "episodes");
     let mut trace = match &args.trace {
         Some(path) => match std::fs::File::create(path) {
             Ok(f) => Some(std::io::BufWriter::new(f)),
@@ -213,11 +210,11 @@ fn run_in(args: &RunArgs, color: bool, status: &mut Status) -> Result<(), Closed
                     episode.frames = Vec::new();
                 }
                 done.push(Done { file: f, ego: e, episode, score });
-                progress.tick();
+                progress.inc(1);
             }
         }
     }
-    progress.finish();
+    progress.finish_and_clear();
     if let Some(w) = trace.as_mut()
         && let Err(e) = w.flush()
     {
@@ -275,7 +272,7 @@ fn run_in(args: &RunArgs, color: bool, status: &mut Status) -> Result<(), Closed
 /// The episodes as a results file of `eval`'s form (one region `all`, one generator
 /// `files`), for `tadslc merge`.
 fn write_results(dir: &Path, args: &RunArgs, scenes: &[Loaded], done: &[Done]) -> std::io::Result<()> {
-    use crate::eval::{Results, Row, Setup};
+    use tad_eval::{Results, Row, Setup};
     let rows: Vec<Row> = done
         .iter()
         .map(|d| Row {
@@ -288,9 +285,8 @@ fn write_results(dir: &Path, args: &RunArgs, scenes: &[Loaded], done: &[Done]) -
             score: d.score.clone(),
         })
         .collect();
-    let results = Results {
-        format: crate::eval::FORMAT.into(),
-        setup: Setup {
+    let results = Results::new(
+        Setup {
             regions: vec!["all".into()],
             generators: vec!["files".into()],
             egos: args.egos.clone(),
@@ -300,12 +296,11 @@ fn write_results(dir: &Path, args: &RunArgs, scenes: &[Loaded], done: &[Done]) -
             keep: 0,
             seed: args.seeds.start,
         },
-        shard: args.shard,
-        scenarios: [("all/files".to_string(), scenes.len())].into_iter().collect(),
+        args.shard,
+        [("all/files".to_string(), scenes.len())].into_iter().collect(),
         rows,
-    };
-    std::fs::create_dir_all(dir)?;
-    std::fs::write(dir.join(args.shard.file_name("results", "json")), serde_json::to_string(&results)? + "\n")
+    );
+    results.write(dir).map(|_| ())
 }
 
 fn episode_json(file: &str, ego: &str, e: &Episode, score: &tad_metrics::EpisodeScore) -> serde_json::Value {
@@ -462,37 +457,6 @@ fn print_table(scenes: &[Loaded], egos: &[String], done: &[Done], mode: Mode) ->
     }
     outln!()?;
     outln!("values normalised as in TrafficAlign's tables (value / max; OS 1 is perfect); {} scoring", mode.as_str())
-}
-
-/// A progress bar on standard error for long batches at a terminal.
-pub struct Progress(Option<indicatif::ProgressBar>);
-
-impl Progress {
-    /// `total` units, named `unit` (`episodes`).
-    pub fn new(total: usize, unit: &str) -> Progress {
-        use std::io::IsTerminal;
-        let show = total >= 20 && std::io::stderr().is_terminal();
-        Progress(show.then(|| {
-            let bar = indicatif::ProgressBar::new(total as u64);
-            let template = format!("{{bar:40}} {{pos}}/{{len}} {unit} {{eta}}");
-            if let Ok(style) = indicatif::ProgressStyle::with_template(&template) {
-                bar.set_style(style);
-            }
-            bar
-        }))
-    }
-
-    pub fn tick(&self) {
-        if let Some(bar) = &self.0 {
-            bar.inc(1);
-        }
-    }
-
-    pub fn finish(&self) {
-        if let Some(bar) = &self.0 {
-            bar.finish_and_clear();
-        }
-    }
 }
 
 #[cfg(test)]

@@ -16,19 +16,38 @@ use tad_policy::EgoPolicy;
 use tad_search::{Config, Outcome};
 
 use crate::output::Closed;
-use crate::run::{Ego, Loaded};
-use crate::shard::Shard;
+use crate::run::Loaded;
 use crate::{Status, errln, outln};
+use tad_policy::EgoSpec;
 
+/// `tadslc search`'s arguments.
+#[derive(clap::Args)]
 pub struct SearchArgs {
+    /// Scenario files or directories (searched recursively), or `.tadc` files
+    #[arg(required = true)]
     pub paths: Vec<PathBuf>,
+    /// The ego the scenes are searched against: `idm`, `naive`, `learned:PATH`
+    #[arg(long, default_value = "idm")]
     pub ego: String,
+    /// The directory the chosen scenes and `search.json` are written to
+    #[arg(short, long, value_name = "DIR")]
     pub out: PathBuf,
+    /// Scenes sampled per scenario
+    #[arg(long, default_value_t = tad_search::Config::default().samples)]
     pub samples: usize,
+    /// Ranges are re-fitted after every this many scenes
+    #[arg(long, default_value_t = tad_search::Config::default().round)]
     pub round: usize,
+    /// Scenes kept per scenario
+    #[arg(long, default_value_t = tad_search::Config::default().keep)]
     pub keep: usize,
+    #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    pub shard: Shard,
+    /// Search every N-th input from I (a job array's index I of N jobs, from 0)
+    #[arg(long, value_name = "I/N", default_value = "0/1")]
+    pub shard: tad_base::Shard,
+    /// Score as SafeBench's scorer does, quirks included
+    #[arg(long)]
     pub compat: bool,
 }
 
@@ -50,7 +69,7 @@ pub struct Written {
 }
 
 fn search_in(args: &SearchArgs, color: bool, status: &mut Status) -> Result<(), Closed> {
-    let ego = match Ego::parse(&args.ego) {
+    let ego = match EgoSpec::parse(&args.ego) {
         Ok(ego) => ego,
         Err(e) => {
             *status = Status::Usage;
@@ -70,17 +89,17 @@ fn search_in(args: &SearchArgs, color: bool, status: &mut Status) -> Result<(), 
     let config = Config { samples: args.samples, round: args.round, keep: args.keep, seed: args.seed, mode };
     let total: usize =
         scenes.iter().map(|s| if s.scene.program.params.is_empty() { 1 } else { args.samples.max(1) }).sum();
-    let progress = crate::run::Progress::new(total, "episodes");
+    let progress = crate::output::progress(total, "episodes");
     let done = AtomicUsize::new(0);
     let tick = || {
         done.fetch_add(1, Ordering::Relaxed);
-        progress.tick();
+        progress.inc(1);
     };
     let make = || ego.make();
     let started = std::time::Instant::now();
     let outcomes: Vec<Outcome> =
         scenes.par_iter().map(|l| tad_search::search(&l.scene, &make, &config, &tick)).collect();
-    progress.finish();
+    progress.finish_and_clear();
     let seconds = started.elapsed().as_secs_f64();
 
     let mut taken = HashSet::new();
@@ -178,7 +197,7 @@ fn write_scene(
     outcome: &Outcome,
     i: usize,
     k: usize,
-    ego: &Ego,
+    ego: &EgoSpec,
     mode: Mode,
     taken: &mut HashSet<String>,
     color: bool,

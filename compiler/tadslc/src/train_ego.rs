@@ -1,14 +1,19 @@
-//! `tadslc train-ego`: SAC training of a learned ego (`tad-train`) on scenario files, with
-//! checkpoints, resume, progress with returns, and the paper's held-out split.
+//! `tadslc train-ego` and the fine-tuning stage of `tadslc eval`: SAC training of a learned
+//! ego through `tad-eval`'s one driver (`tad_eval::train`), with checkpoints, resume,
+//! progress with returns, and the paper's held-out split.
 //!
 //! Episode `n` runs scenario `task(n)` of the training list with parameters sampled from
 //! the task's seed, so the whole run is a function of the seed and the inputs. The split
-//! keys each scenario by its behaviour (`behaviour_key`).
+//! keys each scenario by its behaviour (`tad_eval::corpus::behaviour`).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use tad_train::{Config, Trainer};
+use tad_eval::train::{Start, TrainScene};
+use tad_eval::{Kept, Plan, Results, Setup};
+use tad_policy::EgoSpec;
+use tad_train::{Config, TrainError, Trainer};
 
+use crate::eval::{EvalArgs, EvalFormat};
 use crate::output::Closed;
 use crate::run::Loaded;
 use crate::{Status, errln, outln, plural};
@@ -23,22 +28,22 @@ pub struct TrainEgoArgs {
     #[arg(short, long, value_name = "FILE")]
     pub out: PathBuf,
     /// Training episodes in all (ChatScene: 600)
-    #[arg(long, value_name = "N", default_value_t = 600)]
+    #[arg(long, value_name = "N", default_value_t = Config::default().episodes)]
     pub episodes: usize,
     /// Learning steps after each episode (ChatScene: 1)
-    #[arg(long, value_name = "N", default_value_t = 1)]
+    #[arg(long, value_name = "N", default_value_t = Config::default().updates_per_episode)]
     pub updates_per_episode: usize,
     /// Hidden widths of the actor and the critics
     #[arg(long, value_delimiter = ',', default_value = "256,256")]
     pub hidden: Vec<usize>,
     /// Learning rate of the actor and the critics
-    #[arg(long, default_value_t = 1e-4)]
+    #[arg(long, default_value_t = Config::default().actor_lr)]
     pub lr: f64,
     /// Transitions per learning step
-    #[arg(long, value_name = "N", default_value_t = 512)]
+    #[arg(long, value_name = "N", default_value_t = Config::default().batch)]
     pub batch: usize,
     /// No learning before the replay holds this many transitions
-    #[arg(long, value_name = "N", default_value_t = 1000)]
+    #[arg(long, value_name = "N", default_value_t = Config::default().start_training)]
     pub start_training: usize,
     /// Start the actor from a trained one (a safetensors actor, as `learned:PATH` reads)
     #[arg(long, value_name = "FILE")]
@@ -55,7 +60,7 @@ pub struct TrainEgoArgs {
     /// Continue from the checkpoint
     #[arg(long)]
     pub resume: bool,
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = Config::default().seed)]
     pub seed: u64,
 }
 
@@ -75,30 +80,9 @@ impl TrainEgoArgs {
     }
 }
 
-/// A scenario's behaviour for the split: its first actor group's behaviour (the adversary
-/// of ChatScene's scenarios), else its ego's, else `none`.
-pub fn behaviour_key(loaded: &Loaded) -> String {
-    loaded.source.as_ref().map_or_else(|| "none".into(), |input| behaviour_of(&input.text))
-}
-
-/// [`behaviour_key`] of a scenario's text.
-pub fn behaviour_of(text: &str) -> String {
-    let module = tad_syntax::analyze(text).0;
-    let Some(scenario) = module.scenario else { return "none".into() };
-    let name = |attr: Option<&tad_syntax::model::Attr>| attr.and_then(|a| a.symbol()).map(|s| s.name.clone());
-    scenario
-        .actors
-        .first()
-        .and_then(|g| name(g.attr("behavior")))
-        .or_else(|| name(scenario.attr("ego", "behavior")))
-        .unwrap_or_else(|| "none".into())
-}
-
-/// `OUT.split.json` beside `out`.
-fn sibling(out: &Path, suffix: &str) -> PathBuf {
-    let mut name = out.file_name().map(|n| n.to_os_string()).unwrap_or_else(|| "ego".into());
-    name.push(suffix);
-    out.with_file_name(name)
+/// A scenario's behaviour for the split (`none` for a `.tadc` file, which has no source).
+fn behaviour_key(loaded: &Loaded) -> String {
+    loaded.key.clone().unwrap_or_else(|| "none".into())
 }
 
 pub fn train_ego(args: &TrainEgoArgs, color: bool) -> Status {
@@ -112,6 +96,7 @@ fn train_in(args: &TrainEgoArgs, color: bool, status: &mut Status) -> Result<(),
         return errln!("error: {e}");
     }
     let scenes = crate::run::load(&args.paths, color, status)?;
+    let scenes: &[Loaded] = &scenes;
     if scenes.is_empty() {
         *status = (*status).max(Status::Usage);
         return errln!("error: no scenario to train on");
@@ -131,7 +116,7 @@ fn train_in(args: &TrainEgoArgs, color: bool, status: &mut Status) -> Result<(),
     if args.split {
         let names = |list: &[usize]| list.iter().map(|&i| scenes[i].name.clone()).collect::<Vec<_>>();
         let value = serde_json::json!({ "seed": args.seed, "train": names(&train), "test": names(&test) });
-        let path = sibling(&args.out, ".split.json");
+        let path = tad_train::beside(&args.out, ".split.json");
         if let Err(e) = std::fs::write(&path, serde_json::to_string_pretty(&value).unwrap_or_default() + "\n") {
             *status = Status::Usage;
             return errln!("error: cannot write `{}`: {e}", path.display());
@@ -158,15 +143,9 @@ fn train_in(args: &TrainEgoArgs, color: bool, status: &mut Status) -> Result<(),
             }
         }
     } else {
-        let made = Trainer::new(config.clone()).and_then(|mut t| {
-            if let Some(init) = &args.init {
-                let learned = tad_policy::Learned::load(init)?;
-                t.init_actor(&learned)?;
-            }
-            Ok(t)
-        });
-        match made {
-            Ok(t) => t,
+        let start = args.init.as_deref().map_or(Start::Scratch, Start::Actor);
+        match start.trainer(config.clone()) {
+            Ok((t, _)) => t,
             Err(e) => {
                 *status = Status::Usage;
                 return errln!("error: {e}");
@@ -175,25 +154,16 @@ fn train_in(args: &TrainEgoArgs, color: bool, status: &mut Status) -> Result<(),
     };
     let total = args.episodes;
     let start = trainer.episodes() as usize;
-    let progress = crate::run::Progress::new(total.saturating_sub(start), "episodes");
+    let progress = crate::output::progress(total.saturating_sub(start), "episodes");
     let window = 25;
     let (mut returns, mut collisions) = (Vec::new(), Vec::new());
     let started = std::time::Instant::now();
-    while (trainer.episodes() as usize) < total {
-        let task = trainer.task(train.len());
-        let loaded = &scenes[train[task.scenario]];
-        let params = tad_runtime::sample::sample(&loaded.scene.program.params, Some(task.seed));
-        let stats = match trainer.step(&loaded.scene, params, task.seed) {
-            Ok(stats) => stats,
-            Err(e) => {
-                *status = Status::Failed;
-                let _ = trainer.save_checkpoint(&checkpoint);
-                return errln!("error: training stopped at episode {}: {e}", trainer.episodes());
-            }
-        };
+    let train_scenes: Vec<TrainScene> =
+        train.iter().map(|&i| TrainScene { scene: &scenes[i].scene, fixed: None }).collect();
+    let trained = tad_eval::train::train(&mut trainer, total, &train_scenes, |trainer, stats| -> Result<(), Stop> {
         returns.push(stats.episode_return);
         collisions.push(stats.collision);
-        progress.tick();
+        progress.inc(1);
         let n = trainer.episodes() as usize;
         if n.is_multiple_of(window) || n == total {
             let k = returns.len().min(window);
@@ -203,18 +173,28 @@ fn train_in(args: &TrainEgoArgs, color: bool, status: &mut Status) -> Result<(),
                 "episode {n}/{total}: return {mean:.1} (mean of the last {k}), collisions {hits}/{k}, replay {}, updates {}",
                 trainer.replay_len(),
                 trainer.updates()
-            )?;
+            )
+            .map_err(Stop::Closed)?;
         }
-        if args.every > 0
-            && n.is_multiple_of(args.every)
-            && n < total
-            && let Err(e) = trainer.save_checkpoint(&checkpoint)
-        {
+        if args.every > 0 && n.is_multiple_of(args.every) && n < total {
+            trainer.save_checkpoint(&checkpoint).map_err(Stop::Checkpoint)?;
+        }
+        Ok(())
+    });
+    progress.finish_and_clear();
+    match trained {
+        Ok(()) => {}
+        Err(Stop::Closed(closed)) => return Err(closed),
+        Err(Stop::Checkpoint(e)) => {
             *status = Status::Usage;
             return errln!("error: {e}");
         }
+        Err(Stop::Train(e)) => {
+            *status = Status::Failed;
+            let _ = trainer.save_checkpoint(&checkpoint);
+            return errln!("error: training stopped at episode {}: {e}", trainer.episodes());
+        }
     }
-    progress.finish();
     if let Err(e) = trainer.save_checkpoint(&checkpoint).and_then(|_| trainer.save_actor(&args.out)) {
         *status = Status::Usage;
         return errln!("error: {e}");
@@ -245,4 +225,113 @@ fn train_in(args: &TrainEgoArgs, color: bool, status: &mut Status) -> Result<(),
         args.out.display(),
         checkpoint.display()
     )
+}
+
+/// Why a training loop stopped early.
+enum Stop {
+    Closed(Closed),
+    Checkpoint(TrainError),
+    Train(TrainError),
+}
+
+impl From<TrainError> for Stop {
+    fn from(e: TrainError) -> Stop {
+        Stop::Train(e)
+    }
+}
+
+/// The "after fine-tuning" table of `eval --finetune`: a learned ego trained with SAC on
+/// 3/5 of each behaviour's kept scenes (from `--finetune-from`, else from scratch), then
+/// it, the ego it started from and the `--egos` on the held-out 2/5.
+pub fn finetune(args: &EvalArgs, plan: &Plan, kept: &[Kept], status: &mut Status) -> Result<(), Closed> {
+    let keys: Vec<String> = kept.iter().map(|k| k.unit.key.clone()).collect();
+    let (train, test) = tad_train::split(&keys, args.llm.seed);
+    if train.is_empty() || test.is_empty() {
+        *status = (*status).max(Status::Failed);
+        return errln!("warning: no fine-tuning: {} kept scenes are too few to hold some out", kept.len());
+    }
+    let config = Config {
+        episodes: args.finetune,
+        updates_per_episode: args.finetune_updates,
+        seed: args.llm.seed,
+        ..Config::default()
+    };
+    let start = args.finetune_from.as_deref().map_or(Start::Scratch, Start::from_path);
+    let (mut trainer, before) = match start.trainer(config) {
+        Ok(made) => made,
+        Err(e) => {
+            *status = Status::Usage;
+            return errln!("error: --finetune-from: {e}");
+        }
+    };
+    let first = trainer.episodes() as usize;
+    errln!(
+        "fine-tuning a learned ego on {} ({} held out), {}",
+        plural(train.len(), "scene"),
+        test.len(),
+        plural(args.finetune, "episode")
+    )?;
+    let progress = crate::output::progress(args.finetune, "episodes");
+    let scenes: Vec<TrainScene> = train
+        .iter()
+        .map(|&i| TrainScene { scene: &kept[i].unit.scene, fixed: Some((kept[i].params.clone(), kept[i].seed)) })
+        .collect();
+    let trained =
+        tad_eval::train::train(&mut trainer, first + args.finetune, &scenes, |_, _| -> Result<(), TrainError> {
+            progress.inc(1);
+            Ok(())
+        });
+    progress.finish_and_clear();
+    if let Err(e) = trained {
+        *status = Status::Failed;
+        return errln!("error: fine-tuning stopped: {e}");
+    }
+    let after = match trainer.actor() {
+        Ok(a) => a,
+        Err(e) => {
+            *status = Status::Failed;
+            return errln!("error: {e}");
+        }
+    };
+    if let Some(dir) = &args.out {
+        let path = dir.join("finetuned.safetensors");
+        if let Err(e) = after.save(&path) {
+            *status = Status::Usage;
+            return errln!("error: {e}");
+        }
+        errln!("the fine-tuned ego in {}", path.display())?;
+    }
+    // the held-out scenes, every ego
+    let mut drivers: Vec<(String, EgoSpec)> = Vec::new();
+    if let Some(actor) = before {
+        drivers.push(("learned (before)".into(), EgoSpec::Learned(actor)));
+    }
+    drivers.push(("learned (fine-tuned)".into(), EgoSpec::Learned(after)));
+    drivers.extend(plan.setup.egos.iter().cloned().zip(plan.egos.iter().cloned()));
+    let rows = tad_eval::harness::held_out(kept, &test, &drivers);
+    let setup = Setup {
+        regions: vec!["held-out".into()],
+        generators: vec!["searched".into()],
+        egos: drivers.iter().map(|(n, _)| n.clone()).collect(),
+        ..plan.setup.clone()
+    };
+    let scenarios = [("held-out/searched".to_string(), test.len())].into_iter().collect();
+    if args.format == EvalFormat::Markdown {
+        outln!()?;
+        outln!(
+            "After fine-tuning: the learned ego trained on {} kept scenes (3/5 of each behaviour's), all egos on the {} held out:",
+            train.len(),
+            test.len()
+        )?;
+        outln!()?;
+    }
+    let was = tad_eval::harness::collision_rate(&rows, "learned (before)");
+    let now = tad_eval::harness::collision_rate(&rows, "learned (fine-tuned)");
+    let results = Results::new(setup, tad_base::Shard::ALL, scenarios, rows);
+    crate::eval::print(&[results], args.format, None, status)?;
+    if drivers.iter().any(|(n, _)| n == "learned (before)") {
+        let change = if was > 0.0 { format!("{:+.0} %", 100.0 * (now - was) / was) } else { "–".into() };
+        errln!("held-out collision rate of the learned ego: {was:.3} before, {now:.3} after fine-tuning ({change})")?;
+    }
+    Ok(())
 }

@@ -110,7 +110,7 @@ fn generated_scenarios_build_to_programs_that_load() {
     let dir = scratch("bytecode-corpus");
     let inputs = dir.join("in");
     std::fs::create_dir_all(&inputs).unwrap();
-    for (i, g) in tadslc::corpus::generate(300, 11).into_iter().enumerate() {
+    for (i, g) in tad_eval::baseline::generate(300, 11).into_iter().enumerate() {
         std::fs::write(inputs.join(format!("g{i:03}.tad")), g.tad).unwrap();
     }
     let out = dir.join("out");

@@ -110,9 +110,39 @@ fn eval_prints_the_table_in_every_format_deterministically() {
 }
 
 #[test]
+fn a_killed_run_resumes_from_its_journal_and_ends_as_an_unbroken_one() {
+    let dir = scratch("eval-resume");
+    let args = ["eval", "examples", "--region", "los_angeles", "-n", "3", "--samples", "10", "--format", "csv"];
+    let whole = tadslc(&[&args[..], &["--out", path(&dir)]].concat(), "");
+    assert_eq!(code(&whole), 0, "{}", stderr(&whole));
+    assert!(!stderr(&whole).contains("resumed"), "{}", stderr(&whole));
+    let results = std::fs::read(dir.join("results.json")).unwrap();
+    // the kill: the results file never written, two units in the journal, a third cut short
+    let journal = dir.join("results.jsonl");
+    let text = std::fs::read_to_string(&journal).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    let units = lines.len() - 1;
+    assert!(units >= 4, "a head, then a line per scenario run: {text}");
+    std::fs::write(&journal, format!("{}\n{}\n{}\n{}", lines[0], lines[1], lines[2], &lines[3][..20])).unwrap();
+    std::fs::remove_file(dir.join("results.json")).unwrap();
+    let again = tadslc(&[&args[..], &["--out", path(&dir)]].concat(), "");
+    assert_eq!(code(&again), 0, "{}", stderr(&again));
+    assert!(stderr(&again).contains(&format!("resumed 2 of {units} scenarios from")), "{}", stderr(&again));
+    assert_eq!(stdout(&again), stdout(&whole), "the resumed run's table is the unbroken run's");
+    assert_eq!(std::fs::read(dir.join("results.json")).unwrap(), results, "and so is its results file");
+    assert_eq!(std::fs::read_to_string(&journal).unwrap().lines().count(), 1 + units, "the cut line was replaced");
+    // another command's journal is not resumed from
+    let other =
+        tadslc(&["eval", "examples", "--region", "los_angeles", "-n", "2", "--samples", "10", "--out", path(&dir)], "");
+    assert_eq!(code(&other), 0, "{}", stderr(&other));
+    assert!(!stderr(&other).contains("resumed"), "{}", stderr(&other));
+}
+
+#[test]
 fn shards_merge_into_the_table_of_one_run() {
     let dir = scratch("eval-shards");
-    let args = ["eval", "examples", "--region", "los_angeles", "-n", "3", "--samples", "10", "--format", "csv"];
+    // JSON carries every bit of the aggregates: the shards' sums must be the whole run's
+    let args = ["eval", "examples", "--region", "los_angeles", "-n", "3", "--samples", "10", "--format", "json"];
     let whole = tadslc(&[&args[..], &["--out", path(&dir.join("whole"))]].concat(), "");
     assert_eq!(code(&whole), 0, "{}", stderr(&whole));
     let mut files = Vec::new();
@@ -123,9 +153,12 @@ fn shards_merge_into_the_table_of_one_run() {
         files.push(dir.join(format!("results.{i}-of-3.json")));
     }
     let names: Vec<&str> = files.iter().map(|f| path(f)).collect();
-    let merged = tadslc(&[&["merge"][..], &names, &["--format", "csv"]].concat(), "");
+    let merged = tadslc(&[&["merge"][..], &names, &["--format", "json"]].concat(), "");
     assert_eq!(code(&merged), 0, "{}", stderr(&merged));
     assert_eq!(stdout(&merged), stdout(&whole), "the shards' table is the whole run's");
+    let reversed: Vec<&str> = names.iter().rev().copied().collect();
+    let backwards = tadslc(&[&["merge"][..], &reversed, &["--format", "json"]].concat(), "");
+    assert_eq!(stdout(&backwards), stdout(&whole), "in any order of the files");
     // a missing shard is a warning and status 1; a repeated one, or another command's, an error
     let part = tadslc(&["merge", names[0], names[1]], "");
     assert_eq!(code(&part), 1);
@@ -314,4 +347,28 @@ fn eval_adds_the_after_fine_tuning_table_when_asked() {
     let sharded = tadslc(&["eval", "examples", "--finetune", "5", "--shard", "0/2"], "");
     assert_eq!(code(&sharded), 2);
     assert!(stderr(&sharded).contains("without --shard"), "{}", stderr(&sharded));
+}
+
+#[test]
+fn eval_and_gen_work_from_any_directory_on_their_embedded_defaults() {
+    // run from a directory with no examples/ in it, as an installed tadslc is
+    let elsewhere = scratch("eval-elsewhere");
+    let run = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_tadslc"))
+            .args(args)
+            .current_dir(&elsewhere)
+            .output()
+            .expect("tadslc runs")
+    };
+    let small = ["--region", "los_angeles", "-n", "2", "--samples", "5", "--format", "csv"];
+    let there = run(&[&["eval"][..], &small].concat());
+    assert_eq!(code(&there), 0, "{}", stderr(&there));
+    let here = tadslc(&[&["eval", "examples"][..], &small].concat(), "");
+    assert_eq!(stdout(&there), stdout(&here), "the embedded examples are the repository's");
+    let model = elsewhere.join("la.model");
+    let fit = tadslc(&["fit", "examples", "-o", path(&model)], "");
+    assert_eq!(code(&fit), 0, "{}", stderr(&fit));
+    let generated = run(&["gen", "--generator", &format!("fitted:{}", path(&model)), "-n", "2"]);
+    assert_eq!(code(&generated), 0, "{}", stderr(&generated));
+    assert!(stdout(&generated).contains("scenario "), "{}", stdout(&generated));
 }

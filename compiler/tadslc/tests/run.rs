@@ -115,7 +115,9 @@ fn bad_input_is_refused_clearly() {
         &["run", &bad.to_string_lossy(), "examples/safety/right_turn.tad", "--seeds", "0", "--format", "json"],
         "",
     );
-    assert_eq!(code(&run), 2, "a corrupt file is an error, the rest still runs");
+    assert_eq!(code(&run), 1, "a corrupt file is an input with errors, the rest still runs");
+    let disasm = tadslc(&["disasm", &bad.to_string_lossy()], "");
+    assert_eq!(code(&disasm), code(&run), "the same input has the same status in every command");
     assert!(stderr(&run).contains("bad.tadc"), "{}", stderr(&run));
     assert_eq!(json_lines(&run).len(), 4, "right_turn with idm and naive, then an aggregate per ego");
     let run = tadslc(&["run", "examples/safety/right_turn.tad", "--ego", "robot"], "");

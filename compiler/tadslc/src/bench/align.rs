@@ -1,11 +1,11 @@
 //! `tadslc bench --align`: the recovery experiment.
 //!
-//! For each labelled synthetic region ([`crate::corpus::SYNTHETIC`]) a training sample and
+//! For each labelled synthetic region ([`tad_eval::synthetic::SYNTHETIC`]) a training sample and
 //! a held-out sample are drawn with different seeds; the fitted generator is fitted to the
 //! training sample and generates as many scenarios. Each generator's output is compared
 //! with the held-out sample: the fitted generator of the region itself, the fitted
 //! generators of the other regions, and the unaligned baseline (the region-agnostic
-//! generator of [`crate::corpus::generate`], which knows the language but not the region).
+//! generator of [`tad_eval::baseline`], which knows the language but not the region).
 //! Extra corpora (a language model's, a fine-tuned model's) are compared the same way
 //! when given as `--corpus LABEL=REGION:DIR`. Every corpus is written under `--out`, so
 //! `tadslc compare` can look again.
@@ -15,9 +15,9 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use crate::align::{self, Embedding, FittedGen};
-use crate::corpus::{self, SYNTHETIC};
 use crate::output::Closed;
 use crate::{Status, errln, outln};
+use tad_eval::synthetic::{self, SYNTHETIC};
 
 pub struct AlignArgs {
     pub n: usize,
@@ -34,7 +34,7 @@ pub struct AlignArgs {
 pub fn parse_extra(s: &str) -> Result<(String, String, PathBuf), String> {
     let (label, rest) = s.split_once('=').ok_or("expected LABEL=REGION:DIR")?;
     let (region, dir) = rest.split_once(':').ok_or("expected LABEL=REGION:DIR")?;
-    if corpus::synthetic(region).is_none() {
+    if synthetic::synthetic(region).is_none() {
         let labels: Vec<&str> = SYNTHETIC.iter().map(|r| r.label).collect();
         return Err(format!("no synthetic region `{region}` (there are {})", labels.join(", ")));
     }
@@ -131,22 +131,10 @@ pub fn experiment(args: &AlignArgs, status: &mut Status) -> Result<Result<Vec<Ro
     Ok(Ok(rows))
 }
 
-/// `n` scenarios of the region-agnostic generator that check without errors.
+/// `n` scenarios of the baseline generator that count.
 fn unaligned(n: usize, seed: u64) -> Vec<String> {
     let mut db = tad_db::Database::new(tad_check::Options::default());
-    let mut out = Vec::new();
-    let mut round = 0;
-    while out.len() < n && round < 50 {
-        for g in corpus::generate(n, seed.wrapping_add(round)) {
-            let file =
-                db.set_source(PathBuf::from("unaligned.tad"), g.tad.clone(), tad_db::Language::Tad, &tad_db::NoFs);
-            if align::counts(tad_db::check(&db, file).class) && out.len() < n {
-                out.push(g.tad);
-            }
-        }
-        round += 1;
-    }
-    out
+    tad_eval::baseline::sample(&mut db, n, seed, |i| format!("unaligned_{i}")).into_iter().map(|(_, t)| t).collect()
 }
 
 fn load(dir: &Path, status: &mut Status) -> Result<Vec<tad_stats::Features>, Closed> {

@@ -69,7 +69,7 @@ pub fn run(args: &LlmArgs) -> Status {
 }
 
 fn requests(args: &LlmArgs) -> Result<(Vec<Request>, String, String), String> {
-    let mut files = tad_test_support::files(&args.descriptions, "txt");
+    let mut files = crate::files::with_extension(&args.descriptions, "txt");
     files.sort();
     if files.is_empty() {
         return Err(format!(

@@ -96,7 +96,7 @@ impl Server {
                 continue;
             }
             if std::env::var_os("TADSL_BENCH_DEBUG").is_some() {
-                eprintln!("{}", message.to_string().chars().take(200).collect::<String>());
+                let _ = crate::errln!("{}", message.to_string().chars().take(200).collect::<String>());
             }
             if pred(&message) {
                 return Ok(message);
@@ -201,12 +201,12 @@ fn measure(samples: usize, runs: usize) -> std::io::Result<Result<(), Closed>> {
     }
 
     // memory after every example is open and checked
-    let examples = tad_test_support::examples();
+    let examples: Vec<&(&str, &str)> =
+        tad_eval::examples::EXAMPLES.iter().filter(|(p, _)| p.ends_with(".tad")).collect();
     let mut bytes = 0;
-    for (i, example) in examples.iter().enumerate() {
-        let source = std::fs::read_to_string(example)?;
+    for (i, (path, source)) in examples.iter().enumerate() {
         bytes += source.len();
-        let uri = format!("file://{}", example.canonicalize()?.display());
+        let uri = format!("file:///tadsl-examples/{path}");
         let document = json!({"uri": uri, "languageId": "tad", "version": 1, "text": source});
         server.notify("textDocument/didOpen", json!({"textDocument": document}))?;
         if i + 1 == examples.len() {

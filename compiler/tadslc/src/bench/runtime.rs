@@ -321,17 +321,16 @@ fn print_table(
 
 /// ChatScene's search: the safety examples round robin, seeds 0.. each.
 fn search(args: &RuntimeArgs, policy: &mut dyn tad_policy::EgoPolicy, status: &mut Status) -> Result<(), Closed> {
-    let dir = tad_test_support::repo().join("examples/safety");
     let mut db = Database::new(tad_check::Options::default());
     let mut scenes = Vec::new();
-    for path in tad_test_support::files(&dir, "tad") {
-        let input = match crate::files::read(&path) {
-            Ok(input) => input,
-            Err(e) => {
-                *status = Status::Usage;
-                errln!("error: {e}")?;
-                continue;
-            }
+    let safety =
+        tad_eval::examples::EXAMPLES.iter().filter(|(p, _)| p.starts_with("examples/safety/") && p.ends_with(".tad"));
+    for (path, text) in safety {
+        let input = crate::files::Input {
+            name: path.to_string(),
+            path: Some(path.into()),
+            text: text.to_string(),
+            invalid_utf8: None,
         };
         let Some(program) = crate::bytecode::compile(&mut db, &input, "searched", false)? else {
             *status = Status::Failed;
@@ -350,7 +349,7 @@ fn search(args: &RuntimeArgs, policy: &mut dyn tad_policy::EgoPolicy, status: &m
     }
     if scenes.is_empty() {
         *status = (*status).max(Status::Usage);
-        return errln!("error: no safety example to search in `{}`", dir.display());
+        return errln!("error: no safety example to search (examples/safety/ is embedded)");
     }
     let mut steps = 0u64;
     let mut stops: Vec<(&'static str, usize)> = Vec::new();

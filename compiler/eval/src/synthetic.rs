@@ -1,108 +1,9 @@
-//! A seeded generator of valid scenarios, for benchmarks and robustness tests.
-//!
-//! The same seed gives the same corpus on every machine (SplitMix64, no platform
-//! randomness). Each scenario also comes as an equivalent JSON document, so a benchmark
-//! can compare our front end with a production JSON parser on the same content.
+//! Labelled synthetic regions: known distributions of every choice, so a generator fitted
+//! to a sample of one can be checked for recovering it (the recovery experiment, `tadslc
+//! bench --align`). Weights are relative; nothing here is real data, and every scenario
+//! says so.
 
-/// The seeded generator the IR samples parameters with (SplitMix64), with its helpers.
-pub use tad_ir::{Rng as _, SplitMix64 as Rng};
-
-const WEATHER: &[&str] = &["clear", "cloudy", "foggy", "rainy", "snowy", "wet"];
-const TIME: &[&str] = &["daytime", "nighttime", "dawn", "dusk"];
-const ROAD: &[&str] = &["straight_road", "curved_road", "intersection", "t_intersection", "roundabout"];
-const CONTEXT: &[&str] = &["urban", "residential", "highway", "country_road", "dirt_road", "hill_road"];
-const SIGNS: &[&str] = &["stop_sign", "speed_limit_sign", "yield_sign", "yield_to_pedestrian_sign", "school_zone"];
-const LIGHT: &[&str] = &["green", "red", "yellow", "broken", "none"];
-const TRAFFIC: &[&str] = &["free_flow", "light", "moderate", "heavy", "jam"];
-const ROADSIDE: &[&str] = &["sidewalk", "buildings", "trees", "shops", "parked_cars", "fields", "forest", "houses"];
-const TYPES: &[&str] = &["sedan", "suv", "car", "truck", "bus", "van", "taxi", "motorcycle", "bicycle", "pedestrian"];
-const BEHAVIORS: &[&str] =
-    &["move_forward", "stopped", "parked", "turn_left", "turn_right", "change_lane_left", "yield"];
-const RELATIONS: &[&str] =
-    &["front", "behind", "left", "right", "left_front", "right_front", "left_behind", "right_behind"];
-const REGIONS: &[&str] = &["los_angeles", "new_york_city", "yellowstone", "yosemite", "switzerland"];
-
-/// One generated scenario in TAD and in JSON.
-pub struct Generated {
-    pub tad: String,
-    pub json: String,
-}
-
-pub fn scenario(rng: &mut Rng, index: usize) -> Generated {
-    use std::fmt::Write;
-    let lanes = 1 + rng.below(4) as i64;
-    let two_way = rng.chance(70);
-    let weather = rng.pick(WEATHER);
-    let time = rng.pick(TIME);
-    let road = rng.pick(ROAD);
-    let context = rng.pick(CONTEXT);
-    let light = rng.pick(LIGHT);
-    let traffic = rng.pick(TRAFFIC);
-    let signs: Vec<&str> =
-        (0..rng.below(3)).map(|_| *rng.pick(SIGNS)).collect::<std::collections::BTreeSet<_>>().into_iter().collect();
-    let roadside: Vec<&str> = (0..1 + rng.below(3))
-        .map(|_| *rng.pick(ROADSIDE))
-        .collect::<std::collections::BTreeSet<_>>()
-        .into_iter()
-        .collect();
-    let region = rng.pick(REGIONS);
-    let ego_speed = rng.below(80);
-    let ego_lane = 1 + rng.below(lanes as usize) as i64;
-    let direction = if two_way { "two_way" } else { "one_way" };
-
-    let mut tad = String::new();
-    let mut json = String::new();
-    let _ = write!(
-        tad,
-        "// generated scenario {index}\nscenario generated_{index} {{\n  source {{\n    video: \"video_{index}.mp4\"\n    time: {} s\n    region: {region}\n  }}\n  \
-         environment {{\n    weather: {weather}\n    time: {time}\n  }}\n  road {{\n    type: {road}\n    context: {context}\n    lanes: {lanes}\n    \
-         direction: {direction}\n    signs: [{}]\n    light: {light}\n    traffic: {traffic}\n    roadside: [{}]\n  }}\n  \
-         ego {{\n    behavior: move_forward\n    speed: {ego_speed} km/h\n    lane: {ego_lane}\n  }}\n",
-        15 * index,
-        signs.join(", "),
-        roadside.join(", "),
-    );
-    let quoted = |items: &[&str]| items.iter().map(|s| format!("\"{s}\"")).collect::<Vec<_>>().join(",");
-    let _ = write!(
-        json,
-        "{{\"name\":\"generated_{index}\",\"source\":{{\"video\":\"video_{index}.mp4\",\"time\":{{\"value\":{},\"unit\":\"s\"}},\"region\":\"{region}\"}},\
-         \"environment\":{{\"weather\":\"{weather}\",\"time\":\"{time}\"}},\"road\":{{\"type\":\"{road}\",\"context\":\"{context}\",\"lanes\":{lanes},\
-         \"direction\":\"{direction}\",\"signs\":[{}],\"light\":\"{light}\",\"traffic\":\"{traffic}\",\"roadside\":[{}]}},\
-         \"ego\":{{\"behavior\":\"move_forward\",\"speed\":{{\"value\":{ego_speed},\"unit\":\"km/h\"}},\"lane\":{ego_lane}}},\"actors\":[",
-        15 * index,
-        quoted(&signs),
-        quoted(&roadside),
-    );
-    let groups = rng.below(8);
-    for g in 0..groups {
-        let count = 1 + rng.below(10);
-        let kind = rng.pick(TYPES);
-        let behavior = rng.pick(BEHAVIORS);
-        let speed = if *behavior == "parked" { 0 } else { rng.below(60) };
-        let relation = rng.pick(RELATIONS);
-        let max = lanes as usize;
-        let lane = if two_way && rng.chance(30) { -(1 + rng.below(max) as i64) } else { 1 + rng.below(max) as i64 };
-        let _ = write!(
-            tad,
-            "  actor group_{g}: {count} {kind} {{\n    behavior: {behavior}\n    speed: {speed} km/h\n    position: {relation} of ego\n    lane: {lane}\n  }}\n"
-        );
-        let _ = write!(
-            json,
-            "{}{{\"name\":\"group_{g}\",\"count\":{count},\"type\":\"{kind}\",\"behavior\":\"{behavior}\",\"speed\":{{\"value\":{speed},\"unit\":\"km/h\"}},\
-             \"position\":{{\"relation\":\"{relation}\",\"reference\":\"ego\"}},\"lane\":{lane}}}",
-            if g == 0 { "" } else { "," }
-        );
-    }
-    tad.push_str("}\n");
-    json.push_str("]}");
-    Generated { tad, json }
-}
-
-/// `n` scenarios from `seed`.
-pub fn generate(n: usize, seed: u64) -> Vec<Generated> {
-    let mut rng = Rng::new(seed);
-    (0..n).map(|i| scenario(&mut rng, i)).collect()
-}
+use tad_base::{Rng, SplitMix64};
 
 /// A labelled synthetic region: known distributions of every choice, so a generator fitted
 /// to a sample of it can be checked for recovering it (`tadslc bench --align`). Weights are
@@ -234,7 +135,7 @@ pub fn synthetic(label: &str) -> Option<&'static SyntheticRegion> {
     SYNTHETIC.iter().find(|r| r.label == label)
 }
 
-fn weighted<'a, T>(rng: &mut Rng, items: &'a [(T, u32)]) -> &'a T {
+fn weighted<'a, T>(rng: &mut SplitMix64, items: &'a [(T, u32)]) -> &'a T {
     let total: u32 = items.iter().map(|(_, w)| w).sum();
     let mut u = rng.below(total.max(1) as usize) as u32;
     for (item, w) in items {
@@ -247,18 +148,18 @@ fn weighted<'a, T>(rng: &mut Rng, items: &'a [(T, u32)]) -> &'a T {
 }
 
 /// Each name with its weight as a percentage chance, independently.
-fn subset(rng: &mut Rng, items: &[(&'static str, u32)]) -> Vec<&'static str> {
+fn subset(rng: &mut SplitMix64, items: &[(&'static str, u32)]) -> Vec<&'static str> {
     items.iter().filter(|(_, w)| rng.chance(*w as usize)).map(|(n, _)| *n).collect()
 }
 
 impl SyntheticRegion {
     /// Scenario `index` of this region, drawn from `rng`.
-    pub fn scenario(&self, rng: &mut Rng, index: usize) -> String {
+    pub fn scenario(&self, rng: &mut SplitMix64, index: usize) -> String {
         let lanes = *weighted(rng, self.lanes);
         let one_way = rng.chance(self.one_way as usize);
         let road = weighted(rng, self.road);
         let ego_lane = 1 + rng.below(lanes as usize) as i64;
-        let between = |rng: &mut Rng, (lo, hi): (u32, u32)| lo + rng.below((hi - lo + 1) as usize) as u32;
+        let between = |rng: &mut SplitMix64, (lo, hi): (u32, u32)| lo + rng.below((hi - lo + 1) as usize) as u32;
         let mut out = format!("// synthetic: drawn from the labelled distribution `{}` (not real data)\n", self.label);
         if let Some(module) = self.uses {
             out.push_str(&format!("use {module}\n\n"));
@@ -307,7 +208,7 @@ impl SyntheticRegion {
 
     /// `n` scenarios from `seed`.
     pub fn sample(&self, n: usize, seed: u64) -> Vec<String> {
-        let mut rng = Rng::new(seed);
+        let mut rng = SplitMix64::new(seed);
         (0..n).map(|i| self.scenario(&mut rng, i)).collect()
     }
 }
@@ -315,15 +216,6 @@ impl SyntheticRegion {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn the_same_seed_gives_the_same_corpus() {
-        let a: Vec<String> = generate(20, 7).into_iter().map(|g| g.tad).collect();
-        let b: Vec<String> = generate(20, 7).into_iter().map(|g| g.tad).collect();
-        let c: Vec<String> = generate(20, 8).into_iter().map(|g| g.tad).collect();
-        assert_eq!(a, b);
-        assert_ne!(a, c);
-    }
 
     #[test]
     fn synthetic_regions_are_valid_scenarios() {
@@ -338,19 +230,6 @@ mod tests {
                 assert!(errors.is_empty(), "{errors:?}\n{text}");
                 assert_eq!(tad_syntax::format::format(&text).as_deref(), Ok(text.as_str()));
             }
-        }
-    }
-
-    #[test]
-    fn generated_scenarios_are_clean_formatted_and_valid_json() {
-        for g in generate(200, 3) {
-            let (module, diagnostics) = tad_syntax::analyze(&g.tad);
-            assert!(diagnostics.is_empty(), "{diagnostics:?}\n{}", g.tad);
-            assert!(module.scenario.is_some());
-            assert_eq!(tad_syntax::format::format(&g.tad).as_deref(), Ok(g.tad.as_str()));
-            let value: serde_json::Value = serde_json::from_str(&g.json).expect("valid JSON");
-            let groups = module.scenario.map(|s| s.actors.len()).unwrap_or(0);
-            assert_eq!(value["actors"].as_array().map(Vec::len), Some(groups));
         }
     }
 }
