@@ -25,7 +25,8 @@ use candle_core::{Device, Tensor, Var};
 use serde::{Deserialize, Serialize};
 
 pub use data::{Example, Message, read_jsonl};
-pub use model::{LoraSet, Rng, Rope, Weights};
+pub use model::{LoraSet, Rng, Rope, Weights, uniform};
+use tad_base::Rng as _;
 pub use tad_local::{Adapter, Target};
 
 use model::err;
@@ -55,8 +56,9 @@ pub struct Config {
 impl Default for Config {
     fn default() -> Config {
         Config {
+            // the paper's r = alpha = 16
             rank: 16,
-            alpha: 32.0,
+            alpha: 16.0,
             targets: Target::ALL.to_vec(),
             learning_rate: 2e-4,
             weight_decay: 0.0,
@@ -107,6 +109,27 @@ pub struct Report {
     pub adapter: PathBuf,
 }
 
+/// Why training did not finish, by whose fix it needs.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum FinetuneError {
+    /// The settings, the examples, the model or a checkpoint cannot train: the caller's to fix.
+    Setup(String),
+    /// A file could not be read or written.
+    Io(String),
+    /// Training itself failed (a loss that is not a number, a numerical error).
+    Training(String),
+}
+
+impl std::fmt::Display for FinetuneError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            FinetuneError::Setup(m) | FinetuneError::Io(m) | FinetuneError::Training(m) => f.write_str(m),
+        }
+    }
+}
+
+impl std::error::Error for FinetuneError {}
+
 /// An example as tokens: the loss is on `tokens[answer..]`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Sample {
@@ -148,14 +171,15 @@ pub fn train(
     config: &Config,
     out: &Path,
     progress: &mut dyn FnMut(&Progress),
-) -> Result<Report, String> {
-    let (weights, content) = Weights::load(gguf)?;
-    let tokenizer = tad_local::tokenizer(&content).map_err(|e| format!("the model's tokenizer: {e}"))?;
+) -> Result<Report, FinetuneError> {
+    let (weights, content) = Weights::load(gguf).map_err(FinetuneError::Setup)?;
+    let tokenizer =
+        tad_local::tokenizer(&content).map_err(|e| FinetuneError::Setup(format!("the model's tokenizer: {e}")))?;
     let max_len = config.max_len.min(weights.shape.context);
     let mut samples = Vec::new();
     let mut warnings = Vec::new();
     for (i, example) in examples.iter().enumerate() {
-        let (sample, warning) = tokenize(&tokenizer, example, max_len)?;
+        let (sample, warning) = tokenize(&tokenizer, example, max_len).map_err(FinetuneError::Setup)?;
         if let Some(w) = warning {
             warnings.push(format!("example {}: {w}", i + 1));
         }
@@ -285,155 +309,222 @@ fn save_checkpoint(
     Ok(dir)
 }
 
-/// Trains on samples already tokenized (for models without a tokenizer: tests).
+/// Trains on samples already tokenized (for models without a tokenizer: tests): checks
+/// the settings, starts (or resumes from the checkpoint), runs the epochs, writes the adapter.
 pub fn train_samples(
     weights: &Weights,
     samples: &[Sample],
     config: &Config,
     out: &Path,
     progress: &mut dyn FnMut(&Progress),
-) -> Result<Report, String> {
-    if samples.is_empty() {
-        return Err("no examples to train on".into());
-    }
-    if config.rank == 0 || config.targets.is_empty() || config.epochs == 0 || config.max_len < 2 {
-        return Err("the rank, the targets, the epochs and max_len must not be zero".into());
-    }
-    if !(config.learning_rate.is_finite() && config.learning_rate > 0.0) {
-        return Err("the learning rate must be a positive number".into());
-    }
-    let shape = weights.shape;
-    let accumulate = config.accumulate.max(1);
-    let mut targets = config.targets.clone();
-    targets.sort();
-    targets.dedup();
-    let mut state = State {
-        step: 0,
-        epoch: 0,
-        position: 0,
-        rng: config.seed ^ 0x005E_ED0F_0DE5,
-        losses: Vec::new(),
-        seed: config.seed,
-        rank: config.rank,
-        alpha: config.alpha,
-        targets: targets.iter().map(|t| t.module().to_string()).collect(),
-        examples: samples.len(),
-        accumulate,
-        epochs: config.epochs,
-    };
-    std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
-    let checkpoint = out.join(CHECKPOINT);
-    let mut resumed_at = None;
-    let (lora, mut optimizer);
-    if config.resume && checkpoint.join(STATE_FILE).exists() {
-        let text = std::fs::read_to_string(checkpoint.join(STATE_FILE))
-            .map_err(|e| format!("cannot read the checkpoint: {e}"))?;
-        let saved: State = serde_json::from_str(&text).map_err(|e| format!("the checkpoint's state: {e}"))?;
-        let same = |s: &State| (s.seed, s.rank, s.alpha, s.targets.clone(), s.examples, s.accumulate);
-        if same(&saved) != same(&state) {
-            return Err(format!(
-                "the checkpoint in {} is of another run (seed, rank, alpha, targets, examples or accumulation differ): remove it or train without --resume",
-                checkpoint.display()
-            ));
-        }
-        let adapter = Adapter::load(&checkpoint)?;
-        lora = LoraSet::from_adapter(&adapter, &shape)?;
-        optimizer = AdamW::new(lora.named(), config.learning_rate, config.weight_decay)?;
-        optimizer.load(&checkpoint.join(OPTIMIZER_FILE), saved.step)?;
-        resumed_at = Some(saved.step);
-        state.step = saved.step;
-        state.epoch = saved.epoch;
-        state.position = saved.position;
-        state.rng = saved.rng;
-        state.losses = saved.losses;
-    } else {
-        lora = LoraSet::new(&shape, config.rank, config.alpha, &targets, config.seed)?;
-        optimizer = AdamW::new(lora.named(), config.learning_rate, config.weight_decay)?;
-    }
-
-    let per_epoch = samples.len().div_ceil(accumulate);
-    let steps = per_epoch * config.epochs;
-    let longest = samples.iter().map(|s| s.tokens.len()).max().unwrap_or(1);
-    let rope = Rope::new(&shape, longest)?;
+) -> Result<Report, FinetuneError> {
+    check(samples, config)?;
+    std::fs::create_dir_all(out).map_err(|e| FinetuneError::Io(format!("cannot create {}: {e}", out.display())))?;
+    let mut run = Run::start(weights, samples, config, out)?;
     let start = Instant::now();
-    let (mut tokens, mut answer_tokens, mut steps_run) = (0usize, 0usize, 0usize);
-    while state.epoch < config.epochs {
-        let order = epoch_order(samples.len(), &mut Rng(state.rng));
-        while state.position < order.len() {
-            let batch = &order[state.position..(state.position + accumulate).min(order.len())];
-            let mut grads: Vec<Option<Tensor>> = vec![None; optimizer.vars.len()];
-            let mut loss_sum = 0f32;
-            for &i in batch {
-                let sample = &samples[i];
-                let loss = weights.loss(&sample.tokens, sample.answer, Some(&lora), &rope).map_err(err)?;
-                loss_sum += loss.to_scalar::<f32>().map_err(err)?;
-                let store = loss.backward().map_err(err)?;
-                for (slot, (_, var)) in grads.iter_mut().zip(&optimizer.vars) {
-                    if let Some(g) = store.get(var.as_tensor()) {
-                        let g = (g / batch.len() as f64).map_err(err)?;
-                        *slot = Some(match slot.take() {
-                            Some(sum) => (sum + g).map_err(err)?,
-                            None => g,
-                        });
-                    }
-                }
-                tokens += sample.tokens.len();
-                answer_tokens += sample.tokens.len() - sample.answer;
-            }
-            optimizer.apply(&grads).map_err(err)?;
-            let loss = loss_sum / batch.len() as f32;
-            if !loss.is_finite() {
-                return Err(format!("the loss is {loss} at step {}: try a lower learning rate", state.step + 1));
-            }
-            state.step += 1;
-            steps_run += 1;
-            state.position += batch.len();
-            state.losses.push(loss);
-            let epoch = state.epoch;
-            let epoch_done = state.position >= order.len();
-            if epoch_done {
-                state.epoch += 1;
-                state.position = 0;
-                // the next epoch's order is drawn from where this one's left the generator
-                let mut rng = Rng(state.rng);
-                epoch_order(samples.len(), &mut rng);
-                state.rng = rng.0;
-            }
-            let mut written = None;
-            if config.checkpoint_every > 0 && state.step.is_multiple_of(config.checkpoint_every) && state.step < steps {
-                written = Some(save_checkpoint(out, &lora, &shape, &optimizer, &state)?);
-            }
-            let seconds = start.elapsed().as_secs_f64();
-            progress(&Progress {
-                step: state.step,
-                steps,
-                epoch,
-                loss,
-                tokens_per_s: tokens as f64 / seconds.max(1e-9),
-                checkpoint: written,
-            });
-            if epoch_done {
-                break;
-            }
-        }
-    }
-    let adapter = lora.to_adapter(&shape)?;
-    adapter.save(out)?;
+    run.epochs(weights, samples, config, out, start, progress)?;
+    let Run { lora, optimizer, state, resumed_at, counts, .. } = run;
+    let shape = weights.shape;
+    let adapter = lora.to_adapter(&shape).map_err(FinetuneError::Training)?;
+    adapter.save(out).map_err(FinetuneError::Io)?;
     if config.checkpoint_every > 0 {
-        save_checkpoint(out, &lora, &shape, &optimizer, &state)?;
+        save_checkpoint(out, &lora, &shape, &optimizer, &state).map_err(FinetuneError::Io)?;
     }
     let seconds = start.elapsed().as_secs_f64();
     Ok(Report {
         steps: state.step,
-        steps_run,
+        steps_run: counts.steps_run,
         examples: samples.len(),
-        tokens,
-        answer_tokens,
+        tokens: counts.tokens,
+        answer_tokens: counts.answer_tokens,
         seconds,
-        tokens_per_s: tokens as f64 / seconds.max(1e-9),
+        tokens_per_s: counts.tokens as f64 / seconds.max(1e-9),
         losses: state.losses,
         resumed_at,
         warnings: Vec::new(),
         adapter: out.to_path_buf(),
     })
+}
+
+/// A numerical failure while training.
+fn training(e: impl std::fmt::Display) -> FinetuneError {
+    FinetuneError::Training(e.to_string())
+}
+
+/// Settings and examples that can train.
+fn check(samples: &[Sample], config: &Config) -> Result<(), FinetuneError> {
+    let refuse = |m: &str| Err(FinetuneError::Setup(m.into()));
+    if samples.is_empty() {
+        return refuse("no examples to train on");
+    }
+    if config.rank == 0 || config.targets.is_empty() || config.epochs == 0 || config.max_len < 2 {
+        return refuse("the rank, the targets, the epochs and max_len must not be zero");
+    }
+    if !(config.learning_rate.is_finite() && config.learning_rate > 0.0) {
+        return refuse("the learning rate must be a positive number");
+    }
+    Ok(())
+}
+
+/// Tokens and steps of this run (not of the run it resumed).
+#[derive(Default)]
+struct Counts {
+    tokens: usize,
+    answer_tokens: usize,
+    steps_run: usize,
+}
+
+/// A training run under way: the adapters, their optimizer, the state checkpoints keep.
+struct Run {
+    lora: LoraSet,
+    optimizer: AdamW,
+    state: State,
+    resumed_at: Option<usize>,
+    rope: Rope,
+    accumulate: usize,
+    counts: Counts,
+}
+
+impl Run {
+    /// A fresh run, or the checkpoint's when resuming one of the same settings.
+    fn start(weights: &Weights, samples: &[Sample], config: &Config, out: &Path) -> Result<Run, FinetuneError> {
+        let setup = FinetuneError::Setup;
+        let shape = weights.shape;
+        let accumulate = config.accumulate.max(1);
+        let mut targets = config.targets.clone();
+        targets.sort();
+        targets.dedup();
+        let mut state = State {
+            step: 0,
+            epoch: 0,
+            position: 0,
+            rng: config.seed ^ 0x005E_ED0F_0DE5,
+            losses: Vec::new(),
+            seed: config.seed,
+            rank: config.rank,
+            alpha: config.alpha,
+            targets: targets.iter().map(|t| t.module().to_string()).collect(),
+            examples: samples.len(),
+            accumulate,
+            epochs: config.epochs,
+        };
+        let checkpoint = out.join(CHECKPOINT);
+        let mut resumed_at = None;
+        let (lora, mut optimizer);
+        if config.resume && checkpoint.join(STATE_FILE).exists() {
+            let text = std::fs::read_to_string(checkpoint.join(STATE_FILE))
+                .map_err(|e| FinetuneError::Io(format!("cannot read the checkpoint: {e}")))?;
+            let saved: State =
+                serde_json::from_str(&text).map_err(|e| setup(format!("the checkpoint's state: {e}")))?;
+            let same = |s: &State| (s.seed, s.rank, s.alpha, s.targets.clone(), s.examples, s.accumulate);
+            if same(&saved) != same(&state) {
+                return Err(setup(format!(
+                    "the checkpoint in {} is of another run (seed, rank, alpha, targets, examples or accumulation differ): remove it or train without --resume",
+                    checkpoint.display()
+                )));
+            }
+            let adapter = Adapter::load(&checkpoint).map_err(setup)?;
+            lora = LoraSet::from_adapter(&adapter, &shape).map_err(setup)?;
+            optimizer = AdamW::new(lora.named(), config.learning_rate, config.weight_decay).map_err(setup)?;
+            optimizer.load(&checkpoint.join(OPTIMIZER_FILE), saved.step).map_err(setup)?;
+            resumed_at = Some(saved.step);
+            state.step = saved.step;
+            state.epoch = saved.epoch;
+            state.position = saved.position;
+            state.rng = saved.rng;
+            state.losses = saved.losses;
+        } else {
+            lora = LoraSet::new(&shape, config.rank, config.alpha, &targets, config.seed).map_err(setup)?;
+            optimizer = AdamW::new(lora.named(), config.learning_rate, config.weight_decay).map_err(setup)?;
+        }
+        let longest = samples.iter().map(|s| s.tokens.len()).max().unwrap_or(1);
+        let rope = Rope::new(&shape, longest).map_err(setup)?;
+        Ok(Run { lora, optimizer, state, resumed_at, rope, accumulate, counts: Counts::default() })
+    }
+
+    /// Every remaining epoch, a step per `accumulate` examples, reporting each step.
+    fn epochs(
+        &mut self,
+        weights: &Weights,
+        samples: &[Sample],
+        config: &Config,
+        out: &Path,
+        start: Instant,
+        progress: &mut dyn FnMut(&Progress),
+    ) -> Result<(), FinetuneError> {
+        let state = &mut self.state;
+        let per_epoch = samples.len().div_ceil(self.accumulate);
+        let steps = per_epoch * config.epochs;
+        while state.epoch < config.epochs {
+            let order = epoch_order(samples.len(), &mut Rng(state.rng));
+            while state.position < order.len() {
+                let batch = &order[state.position..(state.position + self.accumulate).min(order.len())];
+                let mut grads: Vec<Option<Tensor>> = vec![None; self.optimizer.vars.len()];
+                let mut loss_sum = 0f32;
+                for &i in batch {
+                    let sample = &samples[i];
+                    let loss =
+                        weights.loss(&sample.tokens, sample.answer, Some(&self.lora), &self.rope).map_err(training)?;
+                    loss_sum += loss.to_scalar::<f32>().map_err(training)?;
+                    let store = loss.backward().map_err(training)?;
+                    for (slot, (_, var)) in grads.iter_mut().zip(&self.optimizer.vars) {
+                        if let Some(g) = store.get(var.as_tensor()) {
+                            let g = (g / batch.len() as f64).map_err(training)?;
+                            *slot = Some(match slot.take() {
+                                Some(sum) => (sum + g).map_err(training)?,
+                                None => g,
+                            });
+                        }
+                    }
+                    self.counts.tokens += sample.tokens.len();
+                    self.counts.answer_tokens += sample.tokens.len() - sample.answer;
+                }
+                self.optimizer.apply(&grads).map_err(training)?;
+                let loss = loss_sum / batch.len() as f32;
+                if !loss.is_finite() {
+                    return Err(training(format!(
+                        "the loss is {loss} at step {}: try a lower learning rate",
+                        state.step + 1
+                    )));
+                }
+                state.step += 1;
+                self.counts.steps_run += 1;
+                state.position += batch.len();
+                state.losses.push(loss);
+                let epoch = state.epoch;
+                let epoch_done = state.position >= order.len();
+                if epoch_done {
+                    state.epoch += 1;
+                    state.position = 0;
+                    // the next epoch's order is drawn from where this one's left the generator
+                    let mut rng = Rng(state.rng);
+                    epoch_order(samples.len(), &mut rng);
+                    state.rng = rng.0;
+                }
+                let mut written = None;
+                if config.checkpoint_every > 0
+                    && state.step.is_multiple_of(config.checkpoint_every)
+                    && state.step < steps
+                {
+                    written = Some(
+                        save_checkpoint(out, &self.lora, &weights.shape, &self.optimizer, state)
+                            .map_err(FinetuneError::Io)?,
+                    );
+                }
+                let seconds = start.elapsed().as_secs_f64();
+                progress(&Progress {
+                    step: state.step,
+                    steps,
+                    epoch,
+                    loss,
+                    tokens_per_s: self.counts.tokens as f64 / seconds.max(1e-9),
+                    checkpoint: written,
+                });
+                if epoch_done {
+                    break;
+                }
+            }
+        }
+        Ok(())
+    }
 }

@@ -21,36 +21,13 @@ pub(crate) fn err(e: impl std::fmt::Display) -> String {
     e.to_string()
 }
 
-/// A seeded generator (SplitMix64): A's initialisation and the shuffling of examples.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Rng(pub u64);
+use tad_base::Rng as _;
+/// The seeded generator of A's initialisation and the shuffling of examples.
+pub use tad_base::SplitMix64 as Rng;
 
-impl Rng {
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in `[0, 1)`.
-    pub fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    /// Uniform in `[-bound, bound)`.
-    pub fn uniform(&mut self, bound: f32) -> f32 {
-        ((self.unit() * 2.0 - 1.0) as f32) * bound
-    }
-
-    /// Fisher–Yates.
-    pub fn shuffle<T>(&mut self, items: &mut [T]) {
-        for i in (1..items.len()).rev() {
-            let j = (self.next_u64() % (i as u64 + 1)) as usize;
-            items.swap(i, j);
-        }
-    }
+/// Uniform in `[-bound, bound)`.
+pub fn uniform(rng: &mut Rng, bound: f32) -> f32 {
+    ((rng.unit() * 2.0 - 1.0) as f32) * bound
 }
 
 struct Block {
@@ -124,7 +101,7 @@ impl Weights {
         let mut rng = Rng(seed);
         let device = Device::Cpu;
         let mut matrix = |rows: usize, cols: usize, bound: f32| {
-            let v: Vec<f32> = (0..rows * cols).map(|_| rng.uniform(bound)).collect();
+            let v: Vec<f32> = (0..rows * cols).map(|_| uniform(&mut rng, bound)).collect();
             Tensor::from_vec(v, (rows, cols), &device).map_err(err)
         };
         let embedding = matrix(vocab, shape.dim, 1.0)?;
@@ -167,7 +144,7 @@ impl LoraSet {
             for &t in targets {
                 let (inputs, outputs) = t.dims(shape);
                 let bound = 1.0 / (inputs as f32).sqrt();
-                let a: Vec<f32> = (0..rank * inputs).map(|_| rng.uniform(bound)).collect();
+                let a: Vec<f32> = (0..rank * inputs).map(|_| uniform(&mut rng, bound)).collect();
                 let lora = Lora { a, b: vec![0.0; outputs * rank], inputs, outputs };
                 pairs.insert((layer, t), lora);
             }

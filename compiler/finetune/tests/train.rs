@@ -7,7 +7,9 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use tad_finetune::{Adapter, Config, Example, LoraSet, Message, Progress, Rng, Sample, Target, Weights};
+use tad_finetune::{
+    Adapter, Config, Example, FinetuneError, LoraSet, Message, Progress, Rng, Sample, Target, Weights, uniform,
+};
 use tad_local::{Lora, Shape};
 
 fn tiny_shape() -> Shape {
@@ -48,8 +50,8 @@ fn random_adapter(shape: &Shape, rank: usize, targets: &[Target], seed: u64, bou
     for layer in 0..shape.layers {
         for &t in targets {
             let (inputs, outputs) = t.dims(shape);
-            let a = (0..rank * inputs).map(|_| rng.uniform(1.0 / (inputs as f32).sqrt())).collect();
-            let b = (0..outputs * rank).map(|_| rng.uniform(bound)).collect();
+            let a = (0..rank * inputs).map(|_| uniform(&mut rng, 1.0 / (inputs as f32).sqrt())).collect();
+            let b = (0..outputs * rank).map(|_| uniform(&mut rng, bound)).collect();
             layers.insert((layer, t), Lora { a, b, inputs, outputs });
         }
     }
@@ -159,13 +161,10 @@ fn a_resumed_run_ends_where_an_uninterrupted_one_does() {
         let diff = lora.b.iter().zip(&other.b).map(|(x, y)| (x - y).abs()).fold(0f32, f32::max);
         assert!(diff < 1e-5, "{key:?} differs by {diff}");
     }
-    // a checkpoint of another run is refused
+    // a checkpoint of another run is refused, as the caller's to fix
     let other = Config { seed: 10, ..resume };
-    assert!(
-        tad_finetune::train_samples(&weights, &samples, &other, &part, &mut |_| {})
-            .unwrap_err()
-            .contains("another run")
-    );
+    let refused = tad_finetune::train_samples(&weights, &samples, &other, &part, &mut |_| {}).unwrap_err();
+    assert!(matches!(&refused, FinetuneError::Setup(m) if m.contains("another run")), "{refused:?}");
 }
 
 #[test]

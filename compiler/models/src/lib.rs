@@ -180,24 +180,30 @@ pub fn model(name: &str) -> Option<&'static Model> {
 /// failing to is a panic); otherwise `None`, with a `SKIPPED` note on standard error. The
 /// one place the test suites' convention lives.
 pub fn for_tests(name: &str) -> Option<PathBuf> {
+    /// A line on the test's standard error (what `cargo test` shows of a failing test).
+    fn test_note(line: std::fmt::Arguments<'_>) {
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), "{line}");
+    }
     static FETCHING: std::sync::Mutex<()> = std::sync::Mutex::new(());
     let model = model(name).unwrap_or_else(|| panic!("no model `{name}` in MODELS"));
     if model.installed().is_none() && std::env::var_os("TAD_REQUIRE_MODEL").is_some() {
         let _one = FETCHING.lock().unwrap_or_else(|e| e.into_inner());
         if model.installed().is_none() {
             let python = std::env::var("TADSL_PYTHON").unwrap_or_else(|_| "python3".into());
-            if let Err(e) = model.fetch(&python, &mut |line| eprintln!("{line}")) {
+            // a test helper: it speaks to the test's own output
+            if let Err(e) = model.fetch(&python, &mut |line| test_note(format_args!("{line}"))) {
                 panic!("{} is required (TAD_REQUIRE_MODEL is set) and could not be fetched: {e}", model.name);
             }
         }
     }
     let installed = model.installed();
     if installed.is_none() {
-        eprintln!(
+        test_note(format_args!(
             "SKIPPED: {} is not installed (tadslc model fetch {})",
             model.name,
             model.aliases.first().unwrap_or(&model.name)
-        );
+        ));
     }
     installed
 }

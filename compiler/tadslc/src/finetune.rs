@@ -3,7 +3,10 @@
 
 use std::path::{Path, PathBuf};
 
-use tad_finetune::{Config, Progress, Target};
+use tad_finetune::{Config, FinetuneError, Progress, Target};
+
+use crate::output::Closed;
+use crate::{Status, errln, outln};
 
 /// Fine-tune the local model with LoRA on chat examples
 #[derive(clap::Args, Debug, Clone)]
@@ -15,31 +18,31 @@ pub struct FinetuneArgs {
     #[arg(short, long, value_name = "DIR")]
     pub out: PathBuf,
     /// LoRA rank
-    #[arg(long, value_name = "R", default_value_t = 16)]
+    #[arg(long, value_name = "R", default_value_t = Config::default().rank)]
     pub rank: usize,
     /// LoRA alpha (the update is scaled by alpha / rank; the paper's r = alpha = 16)
-    #[arg(long, default_value_t = 16.0)]
+    #[arg(long, default_value_t = Config::default().alpha)]
     pub alpha: f32,
     /// Projections to adapt, from q,k,v,o,gate,up,down
     #[arg(long, value_delimiter = ',', default_value = "q,k,v,o,gate,up,down")]
     pub targets: Vec<String>,
     /// AdamW's learning rate
-    #[arg(long, default_value_t = 2e-4)]
+    #[arg(long, default_value_t = Config::default().learning_rate)]
     pub lr: f64,
     /// Passes over the examples
-    #[arg(long, value_name = "N", default_value_t = 2)]
+    #[arg(long, value_name = "N", default_value_t = Config::default().epochs)]
     pub epochs: usize,
     /// Tokens per example (longer answers are cut, with a warning)
-    #[arg(long, value_name = "N", default_value_t = 1024)]
+    #[arg(long, value_name = "N", default_value_t = Config::default().max_len)]
     pub max_len: usize,
     /// Examples per optimizer step (gradients averaged)
-    #[arg(long, value_name = "N", default_value_t = 1)]
+    #[arg(long, value_name = "N", default_value_t = Config::default().accumulate)]
     pub accumulate: usize,
     /// Seed of the initialisation and of the examples' order
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = Config::default().seed)]
     pub seed: u64,
     /// Write a checkpoint every N steps (0: never)
-    #[arg(long, value_name = "N", default_value_t = 0)]
+    #[arg(long, value_name = "N", default_value_t = Config::default().checkpoint_every)]
     pub checkpoint_every: usize,
     /// Continue from the checkpoint in the output directory
     #[arg(long)]
@@ -88,27 +91,18 @@ impl FinetuneArgs {
     }
 }
 
-fn bar(steps: usize) -> indicatif::ProgressBar {
-    use std::io::IsTerminal;
-    if !std::io::stderr().is_terminal() {
-        return indicatif::ProgressBar::hidden();
-    }
-    let bar = indicatif::ProgressBar::new(steps as u64);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} steps {msg} [{elapsed}, eta {eta}]")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-    );
-    bar
+/// Runs `tadslc finetune`: 0 when the adapter is written, 2 for a usage or I/O error (bad
+/// flags, unreadable examples, no model, a checkpoint of another run), 1 when training fails.
+pub fn finetune(args: &FinetuneArgs) -> Status {
+    crate::output::run(|status| finetune_in(args, status))
 }
 
-/// Runs `tadslc finetune`: 0 when the adapter is written, 2 for a usage or I/O error (bad
-/// flags, unreadable examples, no model), 1 when training fails.
-pub fn finetune(args: &FinetuneArgs) -> i32 {
+fn finetune_in(args: &FinetuneArgs, status: &mut Status) -> Result<(), Closed> {
     let config = match args.config() {
         Ok(c) => c,
         Err(e) => {
-            eprintln!("error: {e}");
-            return 2;
+            *status = Status::Usage;
+            return errln!("error: {e}");
         }
     };
     let file = data_file(&args.data);
@@ -117,13 +111,13 @@ pub fn finetune(args: &FinetuneArgs) -> i32 {
         .and_then(|text| tad_finetune::read_jsonl(&text).map_err(|e| format!("{}: {e}", file.display())))
     {
         Ok(x) if x.is_empty() => {
-            eprintln!("error: {} holds no examples", file.display());
-            return 2;
+            *status = Status::Usage;
+            return errln!("error: {} holds no examples", file.display());
         }
         Ok(x) => x,
         Err(e) => {
-            eprintln!("error: {e}");
-            return 2;
+            *status = Status::Usage;
+            return errln!("error: {e}");
         }
     };
     let gguf = match tad_local::model(&args.model) {
@@ -133,8 +127,8 @@ pub fn finetune(args: &FinetuneArgs) -> i32 {
     let gguf = match gguf {
         Ok(p) => p,
         Err(e) => {
-            eprintln!("error: {e}");
-            return 2;
+            *status = Status::Usage;
+            return errln!("error: {e}");
         }
     };
     let mut progress: Option<indicatif::ProgressBar> = None;
@@ -143,11 +137,11 @@ pub fn finetune(args: &FinetuneArgs) -> i32 {
         std::io::stderr().is_terminal()
     };
     let result = tad_finetune::train(&gguf, &examples, &config, &args.out, &mut |p: &Progress| {
-        let bar = progress.get_or_insert_with(|| bar(p.steps));
+        let bar = progress.get_or_insert_with(|| crate::output::progress(p.steps, "steps"));
         bar.set_position(p.step as u64);
         bar.set_message(format!("epoch {} loss {:.4} {:.0} tokens/s", p.epoch + 1, p.loss, p.tokens_per_s));
         if !terminal {
-            eprintln!(
+            let _ = errln!(
                 "step {}/{} epoch {} loss {:.4} {:.1} tokens/s",
                 p.step,
                 p.steps,
@@ -157,35 +151,36 @@ pub fn finetune(args: &FinetuneArgs) -> i32 {
             );
         }
         if let Some(dir) = &p.checkpoint {
-            bar.suspend(|| eprintln!("checkpoint: {}", dir.display()));
+            bar.suspend(|| errln!("checkpoint: {}", dir.display())).ok();
         }
     });
     if let Some(bar) = progress {
         bar.finish_and_clear();
     }
-    match result {
-        Ok(report) => {
-            for w in &report.warnings {
-                eprintln!("warning: {w}");
-            }
-            if let Some(step) = report.resumed_at {
-                eprintln!("resumed after step {step}");
-            }
-            let first = report.losses.first().copied().unwrap_or(f32::NAN);
-            let last = report.losses.last().copied().unwrap_or(f32::NAN);
-            println!(
-                "wrote the adapter to {}: {} examples, {} steps, loss {first:.4} -> {last:.4}, {:.1} tokens/s",
-                report.adapter.display(),
-                report.examples,
-                report.steps,
-                report.tokens_per_s
-            );
-            0
-        }
+    let report = match result {
+        Ok(report) => report,
         Err(e) => {
-            eprintln!("error: {e}");
-            // what could not be read or written is the caller's to fix
-            if e.starts_with("cannot ") || e.contains("another run") || e.contains("no examples") { 2 } else { 1 }
+            // what could not be read or written, or set up, is the caller's to fix
+            *status = match e {
+                FinetuneError::Setup(_) | FinetuneError::Io(_) => Status::Usage,
+                FinetuneError::Training(_) => Status::Failed,
+            };
+            return errln!("error: {e}");
         }
+    };
+    for w in &report.warnings {
+        errln!("warning: {w}")?;
     }
+    if let Some(step) = report.resumed_at {
+        errln!("resumed after step {step}")?;
+    }
+    let first = report.losses.first().copied().unwrap_or(f32::NAN);
+    let last = report.losses.last().copied().unwrap_or(f32::NAN);
+    outln!(
+        "wrote the adapter to {}: {} examples, {} steps, loss {first:.4} -> {last:.4}, {:.1} tokens/s",
+        report.adapter.display(),
+        report.examples,
+        report.steps,
+        report.tokens_per_s
+    )
 }
