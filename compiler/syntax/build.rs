@@ -1,3 +1,5 @@
+//! Generates the parser from `src/grammar.lalrpop` (LALRPOP) into `OUT_DIR`.
+
 fn main() {
     let out = std::env::var("OUT_DIR").expect("cargo sets OUT_DIR");
     lalrpop::Configuration::new()

@@ -1,3 +1,7 @@
+//! Unit tests of the search: ranges move towards collisions, results are seeded and
+//! independent of the thread count, the re-fit is mean ± std clipped to the slot, and `fix`
+//! writes the chosen parameters (and the layout's room as an `offset`) back.
+
 use super::*;
 use tad_policy::parse_policy;
 

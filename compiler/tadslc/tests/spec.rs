@@ -125,3 +125,87 @@ fn vocabulary_spec_lists_every_declaration_kind_and_field() {
         assert_eq!(listed, fields, "spec/vocabulary.md for `{}`", kind.name);
     }
 }
+
+#[test]
+fn exit_statuses_are_said_the_same_everywhere() {
+    let root = tad_test_support::repo();
+    for doc in ["README.md", "spec/output.md"] {
+        let text = std::fs::read_to_string(root.join(doc)).unwrap();
+        assert!(text.contains(tadslc::EXIT_STATUSES), "{doc} does not say `{}`", tadslc::EXIT_STATUSES);
+    }
+    let help = common::tadslc(&["--help"], "");
+    assert!(common::stdout(&help).contains(tadslc::EXIT_STATUSES), "{}", common::stdout(&help));
+    // the spec's table has one row per status, in order
+    let spec = std::fs::read_to_string(root.join("spec/output.md")).unwrap();
+    let table: Vec<u8> = spec
+        .split("## Exit status")
+        .nth(1)
+        .unwrap()
+        .lines()
+        .filter_map(|l| l.strip_prefix("| ")?.split(' ').next()?.parse().ok())
+        .collect();
+    use tadslc::Status;
+    let statuses =
+        [Status::Ok, Status::Failed, Status::Usage, Status::Incomplete, Status::NonScenario, Status::Unreachable];
+    assert_eq!(table, statuses.iter().map(|&s| s as u8).collect::<Vec<_>>());
+}
+
+/// `option`'s default as `tadslc COMMAND --help` shows it (`[default: X]`).
+fn help_default(command: &str, option: &str) -> Option<String> {
+    let help = common::stdout(&common::tadslc(&[command, "--help"], ""));
+    let start = help.find(&format!("{option} ")).or_else(|| help.find(&format!("{option}\n")))?;
+    let rest = &help[start..];
+    let end = [rest[1..].find("\n  -"), rest[1..].find("\n      --")]
+        .into_iter()
+        .flatten()
+        .min()
+        .map_or(rest.len(), |e| e + 1);
+    let block = &rest[..end];
+    let value = block.split("[default: ").nth(1)?.split(']').next()?;
+    Some(value.to_string())
+}
+
+/// Two defaults agree: as numbers when both are numbers, else as text.
+fn same_default(a: &str, b: &str) -> bool {
+    match (a.trim().parse::<f64>(), b.trim().parse::<f64>()) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => a.trim().trim_matches('`') == b.trim().trim_matches('`'),
+    }
+}
+
+#[test]
+fn the_specs_defaults_are_the_commands() {
+    let root = tad_test_support::repo();
+    let mut checked = 0;
+    let mut wrong = Vec::new();
+    // spec/llm.md's `finetune` table: | `--rank R` | 16 | …
+    let llm = std::fs::read_to_string(root.join("spec/llm.md")).unwrap();
+    let table = llm.split("| `-o, --out DIR` |").nth(1).unwrap().split("\n\n").next().unwrap();
+    for row in table.lines().filter(|l| l.starts_with("| `--")) {
+        let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+        let option = cells[1].trim_matches('`').split(' ').next().unwrap();
+        let spec = cells[2].split(' ').next().unwrap();
+        // a default in words (`off`, `the default`) is not a value to compare
+        let value = spec.parse::<f64>().is_ok() || spec.starts_with('`');
+        if let Some(help) = help_default("finetune", option).filter(|_| value) {
+            checked += 1;
+            if !same_default(spec, &help) {
+                wrong.push(format!("finetune {option}: spec/llm.md {spec}, --help {help}"));
+            }
+        }
+    }
+    // spec/eval.md's search options: `--samples N` (50), …
+    let eval = std::fs::read_to_string(root.join("spec/eval.md")).unwrap();
+    let options = eval.split("## 4. `tadslc search").nth(1).unwrap().split("Inputs as").next().unwrap();
+    for part in options.split("`--").skip(1) {
+        let option = format!("--{}", part.split([' ', '`']).next().unwrap());
+        let Some(spec) = part.split_once("` (").map(|(_, rest)| rest.split(')').next().unwrap()) else { continue };
+        checked += 1;
+        match help_default("search", &option) {
+            Some(help) if same_default(spec, &help) => {}
+            help => wrong.push(format!("search {option}: spec/eval.md {spec}, --help {help:?}")),
+        }
+    }
+    assert!(checked >= 9, "only {checked} defaults found in the specs");
+    assert!(wrong.is_empty(), "{wrong:#?}");
+}
