@@ -18,6 +18,7 @@
 pub mod facts;
 pub mod fidelity;
 pub mod geom;
+pub mod idm;
 mod place;
 pub mod predict;
 pub mod road;

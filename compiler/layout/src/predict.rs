@@ -1,16 +1,15 @@
 //! A kinematic roll-out of a layout: the ego keeps its stated speed along its path; every
 //! other actor waits for its start (delay, trigger), then moves along its path at its
 //! speed, vehicles following whatever is ahead on their path with the Intelligent Driver
-//! Model. Adversaries (groups timed to a conflict) do not yield to the ego. It is what the
+//! Model (`crate::idm`, the runtime's). Adversaries (groups timed to a conflict) do not yield to the ego. It is what the
 //! layout promises, checked by `crate::fidelity` without a simulator; the runtime is the
 //! real simulation.
 
 use crate::fidelity::{Trace, TraceObject};
 use crate::geom::{Pose, Vec2};
+use crate::idm::IdmParams;
 use crate::{Body, Layout};
 
-/// IDM: maximum acceleration, comfortable deceleration (m/s²), headway (s), jam gap (m).
-const IDM: (f64, f64, f64, f64) = (2.0, 3.0, 1.0, 2.0);
 const LOOKAHEAD: f64 = 60.0;
 
 /// Roll the layout out for `steps` steps of `dt` seconds; step 0 is the start.
@@ -57,13 +56,7 @@ pub fn roll_out(layout: &Layout, steps: usize, dt: f64) -> Trace {
                 v[k] = a.speed;
             } else {
                 let leader = leader(&agents, &current, k, s[k], adversary[k]);
-                let (a_max, b, headway, jam) = IDM;
-                let free = 1.0 - (v[k] / a.speed.max(0.1)).powi(4);
-                let interaction = leader.map_or(0.0, |(gap, lead_speed)| {
-                    let wanted = jam + v[k] * headway + v[k] * (v[k] - lead_speed) / (2.0 * (a_max * b).sqrt());
-                    (wanted.max(0.0) / gap.max(0.1)).powi(2)
-                });
-                let accel = (a_max * (free - interaction)).max(-9.0);
+                let accel = IdmParams::default().accel(v[k], a.speed, leader);
                 v[k] = (v[k] + accel * dt).max(0.0);
             }
             s[k] += v[k] * dt;

@@ -65,8 +65,7 @@ pub const ACCEL_MIN: f64 = -8.0;
 pub const ACCEL_MAX: f64 = 3.0;
 /// The wheel angle of `steer = ±1`, rad (CARLA's cars: 70°).
 pub const MAX_WHEEL_ANGLE: f64 = 70.0 * std::f64::consts::PI / 180.0;
-/// A speed below this is standing (SafeBench's stop-sign threshold), m/s.
-pub const STANDING: f64 = 0.1;
+pub use tad_layout::idm::STANDING;
 
 /// What the ego's driver sees at a step. Frame: the ego's, `x` forward, `y` left.
 #[derive(Clone, Debug, PartialEq)]

@@ -1,6 +1,6 @@
 //! The motion models: a kinematic bicycle (reference point at the centre, as highway-env's
 //! vehicles), pure-pursuit steering onto a track, and the Intelligent Driver Model for speed
-//! (`tad_policy::IdmParams`, the one IDM of the workspace).
+//! (`tad_layout::idm::IdmParams`, the one IDM of the workspace, which the layout's roll-out follows with too).
 
 use tad_layout::geom::{Path, Pose, Vec2};
 
