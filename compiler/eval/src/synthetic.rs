@@ -135,6 +135,37 @@ pub fn synthetic(label: &str) -> Option<&'static SyntheticRegion> {
     SYNTHETIC.iter().find(|r| r.label == label)
 }
 
+/// The fastest a behaviour's actor is drawn, in whole km/h, from the standard vocabulary
+/// (not a list of names): 0 when its motion stands as the layout judges it (stop, parked,
+/// stand), else its declared `max_speed` (1 for `graze`: grazing animals move, slowly).
+fn max_speed(behavior: &str) -> Option<u32> {
+    use tad_syntax::schema::{ClosedSet, Motion};
+    static LIMITS: std::sync::OnceLock<Vec<(String, u32)>> = std::sync::OnceLock::new();
+    let limits = LIMITS.get_or_init(|| {
+        let mut db = tad_db::Database::new(tad_check::Options::default());
+        let modules: String = tad_db::stdlib::MODULES
+            .iter()
+            .filter(|(name, _)| *name != tad_db::PRELUDE)
+            .map(|(name, _)| format!("use {name}\n"))
+            .collect();
+        let file = db.set_file("<vocabulary>.tad".into(), modules);
+        let vocabulary = &tad_db::vocabulary(&db, file).vocabulary;
+        vocabulary
+            .names("behavior")
+            .into_iter()
+            .filter_map(|name| {
+                let entry = vocabulary.get("behavior", name)?;
+                let motion = entry.symbol("motion").and_then(Motion::parse);
+                if matches!(motion, Some(Motion::Stop | Motion::Parked | Motion::Stand)) {
+                    return Some((name.to_string(), 0));
+                }
+                Some((name.to_string(), (entry.speed("max_speed")? * 3.6).round() as u32))
+            })
+            .collect()
+    });
+    limits.iter().find(|(name, _)| name == behavior).map(|&(_, limit)| limit)
+}
+
 fn weighted<'a, T>(rng: &mut SplitMix64, items: &'a [(T, u32)]) -> &'a T {
     let total: u32 = items.iter().map(|(_, w)| w).sum();
     let mut u = rng.below(total.max(1) as usize) as u32;
@@ -188,8 +219,8 @@ impl SyntheticRegion {
             let (kind, _, most, behaviors, speeds) = self.actors[*weighted(rng, &weights)];
             let count = 1 + rng.below(most);
             let behavior = weighted(rng, behaviors);
-            let speed =
-                if matches!(*behavior, "stopped" | "parked" | "stand" | "graze") { 0 } else { between(rng, speeds) };
+            let drawn = between(rng, speeds);
+            let speed = max_speed(behavior).map_or(drawn, |limit| drawn.min(limit));
             let relation = weighted(rng, self.relations);
             let lane = match *relation {
                 "left" | "left_front" | "left_behind" if ego_lane > 1 => ego_lane - 1,
@@ -216,6 +247,13 @@ impl SyntheticRegion {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn speed_limits_are_the_vocabularys() {
+        assert_eq!((max_speed("stopped"), max_speed("parked"), max_speed("stand")), (Some(0), Some(0), Some(0)));
+        assert_eq!(max_speed("graze"), Some(1), "grazing animals move, slowly, as the layout moves them");
+        assert_eq!(max_speed("cross"), None);
+    }
 
     #[test]
     fn synthetic_regions_are_valid_scenarios() {
