@@ -25,7 +25,22 @@ const RELATIONS: &[&str] =
     &["front", "behind", "left", "right", "left_front", "right_front", "left_behind", "right_behind"];
 const REGIONS: &[&str] = &["los_angeles", "new_york_city", "yellowstone", "yosemite", "switzerland"];
 
-/// One generated scenario in TAD and in JSON.
+/// The generator's choices by declaration kind: which common names it draws from (its
+/// distribution); every name is declared in `stdlib/`, which a test holds.
+pub const CHOICES: &[(&str, &[&str])] = &[
+    ("weather", WEATHER),
+    ("time_of_day", TIME),
+    ("road_type", ROAD),
+    ("road_context", CONTEXT),
+    ("traffic_sign", SIGNS),
+    ("light_state", LIGHT),
+    ("traffic_density", TRAFFIC),
+    ("roadside", ROADSIDE),
+    ("actor_type", TYPES),
+    ("behavior", BEHAVIORS),
+    ("relation", RELATIONS),
+    ("region", REGIONS),
+];
 
 /// One generated scenario in TAD and in JSON.
 pub struct Generated {
@@ -135,6 +150,21 @@ pub fn region_seed(seed: u64, region: &str) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn every_choice_is_a_declared_name_of_its_kind() {
+        let mut db = Database::new(tad_check::Options::default());
+        let file = db.set_file("<vocabulary>.tad".into(), String::new());
+        let vocabulary = &tad_db::vocabulary(&db, file).vocabulary;
+        for (kind, names) in CHOICES {
+            for name in *names {
+                assert!(
+                    vocabulary.get(kind, name).is_some_and(|e| e.name == *name),
+                    "`{name}` is not a {kind} declared in stdlib/ (under that name)"
+                );
+            }
+        }
+    }
 
     #[test]
     fn the_same_seed_gives_the_same_corpus() {
