@@ -17,19 +17,59 @@ use tad_db::Database;
 use tad_diagnostics::render::{FileReport, human};
 use tad_scenic::{EmitOptions, Simulator};
 
-/// Targets `build` knows.
-pub const TARGETS: &[&str] = &["scenic"];
+/// `tadslc build`'s arguments.
+#[derive(clap::Args)]
+pub struct BuildArgs {
+    /// Scenario files or directories (searched recursively for *.tad)
+    #[arg(required = true)]
+    pub paths: Vec<PathBuf>,
+    /// The target language
+    #[arg(long, value_enum, default_value_t = Target::Scenic)]
+    pub target: Target,
+    /// Output directory (default: standard output for a single file; required for
+    /// bytecode)
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// Directory of the CARLA OpenDRIVE maps (`TownNN.xodr`); default: the map
+    /// next to the program
+    #[arg(long)]
+    pub map_dir: Option<PathBuf>,
+    /// The town to use, e.g. `Town10HD` (default: the first map with the road's features)
+    #[arg(long)]
+    pub map: Option<String>,
+    /// Which simulator the behaviors are written for
+    #[arg(long, value_enum, default_value_t = SimulatorArg::Carla)]
+    pub simulator: SimulatorArg,
+}
 
-pub fn run(
-    paths: &[PathBuf],
-    target: &str,
-    out: Option<&Path>,
-    map_dir: Option<&Path>,
-    map: Option<&str>,
-    simulator: &str,
-    color: bool,
-) -> Status {
-    crate::output::run(|status| run_in(paths, target, out, map_dir, map, simulator, color, status))
+/// The targets of `build`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Target {
+    /// Scenic 3 programs (`NAME.scenic`)
+    Scenic,
+    /// Bytecode for the runtime (`NAME.tadc`, `spec/bytecode.md`)
+    Bytecode,
+}
+
+/// `--simulator`: `tad_scenic::Simulator` on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum SimulatorArg {
+    Carla,
+    Newtonian,
+}
+
+impl From<SimulatorArg> for Simulator {
+    fn from(simulator: SimulatorArg) -> Simulator {
+        match simulator {
+            SimulatorArg::Carla => Simulator::Carla,
+            SimulatorArg::Newtonian => Simulator::Newtonian,
+        }
+    }
+}
+
+/// `tadslc build --target scenic`.
+pub fn run(args: &BuildArgs, color: bool) -> Status {
+    crate::output::run(|status| run_in(args, color, status))
 }
 
 /// Where a program written to `out` (a directory, or standard output) will look for its
@@ -39,25 +79,10 @@ struct MissingMap {
     programs: Vec<String>,
 }
 
-#[allow(clippy::too_many_arguments)]
-fn run_in(
-    paths: &[PathBuf],
-    target: &str,
-    out: Option<&Path>,
-    map_dir: Option<&Path>,
-    map: Option<&str>,
-    simulator: &str,
-    color: bool,
-    status: &mut Status,
-) -> Result<(), Closed> {
-    if !target.eq_ignore_ascii_case("scenic") {
-        *status = Status::Usage;
-        return errln!("error: unknown target `{target}` (targets: {})", TARGETS.join(", "));
-    }
-    let Some(simulator) = Simulator::parse(simulator) else {
-        *status = Status::Usage;
-        return errln!("error: unknown simulator `{simulator}` (simulators: carla, newtonian)");
-    };
+fn run_in(args: &BuildArgs, color: bool, status: &mut Status) -> Result<(), Closed> {
+    let (paths, out, map_dir, map) =
+        (&args.paths, args.output.as_deref(), args.map_dir.as_deref(), args.map.as_deref());
+    let simulator = Simulator::from(args.simulator);
     let inputs = files::load(paths, Search::Tad, status)?;
     if out.is_none() && inputs.len() > 1 {
         *status = Status::Usage;
@@ -207,6 +232,17 @@ mod tests {
         dir
     }
 
+    fn build(paths: &[PathBuf], output: Option<&Path>, map_dir: Option<&str>, simulator: SimulatorArg) -> BuildArgs {
+        BuildArgs {
+            paths: paths.to_vec(),
+            target: Target::Scenic,
+            output: output.map(Path::to_path_buf),
+            map_dir: map_dir.map(PathBuf::from),
+            map: None,
+            simulator,
+        }
+    }
+
     fn example(path: &str) -> PathBuf {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join(path)
     }
@@ -216,7 +252,8 @@ mod tests {
         let out = scratch("ok");
         let inputs =
             [example("examples/safety/right_turn.tad"), example("examples/regions/yosemite_deer_on_curve.tad")];
-        let status = run(&inputs, "scenic", Some(&out), Some(Path::new("maps")), None, "newtonian", false);
+        let args = build(&inputs, Some(&out), Some("maps"), SimulatorArg::Newtonian);
+        let status = run(&args, false);
         assert_eq!(status, Status::Ok);
         let text = std::fs::read_to_string(out.join("right_turn.scenic")).unwrap();
         assert!(text.contains("model scenic.simulators.newtonian.driving_model"));
@@ -230,11 +267,12 @@ mod tests {
         let dir = scratch("errors");
         let bad = dir.join("bad.tad");
         std::fs::write(&bad, "scenario bad {\n  environment {\n    weather: sunnyy\n  }\n}\n").unwrap();
-        assert_eq!(run(std::slice::from_ref(&bad), "scenic", Some(&dir), None, None, "carla", false), Status::Failed);
+        assert_eq!(
+            run(&build(std::slice::from_ref(&bad), Some(&dir), None, SimulatorArg::Carla), false),
+            Status::Failed
+        );
         assert!(!dir.join("bad.scenic").exists());
         let good = example("examples/safety/right_turn.tad");
-        assert_eq!(run(std::slice::from_ref(&good), "python", None, None, None, "carla", false), Status::Usage);
-        assert_eq!(run(std::slice::from_ref(&good), "scenic", None, None, None, "lgsvl", false), Status::Usage);
-        assert_eq!(run(&[good.clone(), good], "scenic", None, None, None, "carla", false), Status::Usage);
+        assert_eq!(run(&build(&[good.clone(), good], None, None, SimulatorArg::Carla), false), Status::Usage);
     }
 }

