@@ -9,11 +9,8 @@
 use std::path::PathBuf;
 
 use tad_eval::train::{Start, TrainScene};
-use tad_eval::{Kept, Plan, Results, Setup};
-use tad_policy::EgoSpec;
 use tad_train::{Config, TrainError, Trainer};
 
-use crate::eval::{EvalArgs, EvalFormat};
 use crate::output::Closed;
 use crate::run::Loaded;
 use crate::{Status, errln, outln, plural};
@@ -238,100 +235,4 @@ impl From<TrainError> for Stop {
     fn from(e: TrainError) -> Stop {
         Stop::Train(e)
     }
-}
-
-/// The "after fine-tuning" table of `eval --finetune`: a learned ego trained with SAC on
-/// 3/5 of each behaviour's kept scenes (from `--finetune-from`, else from scratch), then
-/// it, the ego it started from and the `--egos` on the held-out 2/5.
-pub fn finetune(args: &EvalArgs, plan: &Plan, kept: &[Kept], status: &mut Status) -> Result<(), Closed> {
-    let keys: Vec<String> = kept.iter().map(|k| k.unit.key.clone()).collect();
-    let (train, test) = tad_train::split(&keys, args.llm.seed);
-    if train.is_empty() || test.is_empty() {
-        *status = (*status).max(Status::Failed);
-        return errln!("warning: no fine-tuning: {} kept scenes are too few to hold some out", kept.len());
-    }
-    let config = Config {
-        episodes: args.finetune,
-        updates_per_episode: args.finetune_updates,
-        seed: args.llm.seed,
-        ..Config::default()
-    };
-    let start = args.finetune_from.as_deref().map_or(Start::Scratch, Start::from_path);
-    let (mut trainer, before) = match start.trainer(config) {
-        Ok(made) => made,
-        Err(e) => {
-            *status = Status::Usage;
-            return errln!("error: --finetune-from: {e}");
-        }
-    };
-    let first = trainer.episodes() as usize;
-    errln!(
-        "fine-tuning a learned ego on {} ({} held out), {}",
-        plural(train.len(), "scene"),
-        test.len(),
-        plural(args.finetune, "episode")
-    )?;
-    let progress = crate::output::progress(args.finetune, "episodes");
-    let scenes: Vec<TrainScene> = train
-        .iter()
-        .map(|&i| TrainScene { scene: &kept[i].unit.scene, fixed: Some((kept[i].params.clone(), kept[i].seed)) })
-        .collect();
-    let trained =
-        tad_eval::train::train(&mut trainer, first + args.finetune, &scenes, |_, _| -> Result<(), TrainError> {
-            progress.inc(1);
-            Ok(())
-        });
-    progress.finish_and_clear();
-    if let Err(e) = trained {
-        *status = Status::Failed;
-        return errln!("error: fine-tuning stopped: {e}");
-    }
-    let after = match trainer.actor() {
-        Ok(a) => a,
-        Err(e) => {
-            *status = Status::Failed;
-            return errln!("error: {e}");
-        }
-    };
-    if let Some(dir) = &args.out {
-        let path = dir.join("finetuned.safetensors");
-        if let Err(e) = after.save(&path) {
-            *status = Status::Usage;
-            return errln!("error: {e}");
-        }
-        errln!("the fine-tuned ego in {}", path.display())?;
-    }
-    // the held-out scenes, every ego
-    let mut drivers: Vec<(String, EgoSpec)> = Vec::new();
-    if let Some(actor) = before {
-        drivers.push(("learned (before)".into(), EgoSpec::Learned(actor)));
-    }
-    drivers.push(("learned (fine-tuned)".into(), EgoSpec::Learned(after)));
-    drivers.extend(plan.setup.egos.iter().cloned().zip(plan.egos.iter().cloned()));
-    let rows = tad_eval::harness::held_out(kept, &test, &drivers);
-    let setup = Setup {
-        regions: vec!["held-out".into()],
-        generators: vec!["searched".into()],
-        egos: drivers.iter().map(|(n, _)| n.clone()).collect(),
-        ..plan.setup.clone()
-    };
-    let scenarios = [("held-out/searched".to_string(), test.len())].into_iter().collect();
-    if args.format == EvalFormat::Markdown {
-        outln!()?;
-        outln!(
-            "After fine-tuning: the learned ego trained on {} kept scenes (3/5 of each behaviour's), all egos on the {} held out:",
-            train.len(),
-            test.len()
-        )?;
-        outln!()?;
-    }
-    let was = tad_eval::harness::collision_rate(&rows, "learned (before)");
-    let now = tad_eval::harness::collision_rate(&rows, "learned (fine-tuned)");
-    let results = Results::new(setup, tad_base::Shard::ALL, scenarios, rows);
-    crate::eval::print(&[results], args.format, None, status)?;
-    if drivers.iter().any(|(n, _)| n == "learned (before)") {
-        let change = if was > 0.0 { format!("{:+.0} %", 100.0 * (now - was) / was) } else { "–".into() };
-        errln!("held-out collision rate of the learned ego: {was:.3} before, {now:.3} after fine-tuning ({change})")?;
-    }
-    Ok(())
 }
