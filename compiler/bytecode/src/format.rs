@@ -221,10 +221,5 @@ pub fn place_name(place: Place) -> &'static str {
 }
 
 pub fn light_name(light: Light) -> &'static str {
-    match light {
-        Light::Off => "off",
-        Light::Red => "red",
-        Light::Yellow => "yellow",
-        Light::Green => "green",
-    }
+    tad_ir::ClosedSet::as_str(light)
 }

@@ -113,13 +113,8 @@ fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
     (a[0] + abx * t - p[0]).hypot(a[1] + aby * t - p[1])
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Light {
-    Off,
-    Red,
-    Yellow,
-    Green,
-}
+/// What a light shows in a phase: the workspace's one light state (`tad_ir::Signal`).
+pub use tad_ir::Signal as Light;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Phase {

@@ -26,6 +26,8 @@ pub mod road;
 pub use facts::{Body, Chosen, Facts, MAX_GROUP};
 pub use place::lay_out;
 pub use road::{Arm, Road, Shape, Side, Station, Turn};
+/// What a traffic light shows: the schema's closed set, the one light state of the workspace.
+pub use tad_ir::{ClosedSet, Signal};
 
 use geom::{Footprint, Path, Pose};
 use tad_ir::{GroupId, Motion, Span};

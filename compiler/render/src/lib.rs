@@ -76,28 +76,11 @@ pub struct Frame {
     pub lights: Vec<(Arm, Light)>,
 }
 
-/// What a traffic light shows.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Light {
-    Green,
-    Yellow,
-    Red,
-    /// Dark or flashing.
-    Off,
-}
+/// What a traffic light shows (`tad_layout::Signal`, the workspace's one light state).
+pub use tad_layout::Signal as Light;
 
-impl Light {
-    pub const ALL: [Light; 4] = [Light::Green, Light::Yellow, Light::Red, Light::Off];
-
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Light::Green => "green",
-            Light::Yellow => "yellow",
-            Light::Red => "red",
-            Light::Off => "off",
-        }
-    }
-}
+/// The lights in the order the legend lists them.
+pub const LIGHTS: [Light; 4] = [Light::Green, Light::Yellow, Light::Red, Light::Off];
 
 /// Something that happened: a collision, a red light run, a lane invasion…
 #[derive(Clone, Debug, PartialEq)]

@@ -81,7 +81,7 @@ pub fn all() -> Vec<Colour> {
     for k in Kind::ALL {
         all.extend([kind(k).fill, kind(k).dark]);
     }
-    all.extend(crate::Light::ALL.map(light));
+    all.extend(crate::LIGHTS.map(light));
     let mut seen = std::collections::HashSet::new();
     all.retain(|c| seen.insert(*c));
     all

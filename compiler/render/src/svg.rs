@@ -483,7 +483,7 @@ fn legend_entries(scene: &Scene) -> Vec<Entry> {
     if !scene.events.is_empty() {
         entries.push(Entry::Event);
     }
-    for l in Light::ALL {
+    for l in crate::LIGHTS {
         if scene.frames.iter().any(|f| f.lights.iter().any(|(_, x)| *x == l)) {
             entries.push(Entry::Light(l));
         }
@@ -595,7 +595,7 @@ fn draw_legend(s: &mut Svg, entries: &[Entry], x: f64, y: f64, h: f64) {
                     palette::light(*l).hex(),
                     palette::INK.hex()
                 ),
-                format!("light {}", l.as_str()),
+                format!("light {}", tad_layout::ClosedSet::as_str(*l)),
             ),
             Entry::Note(t) => (String::new(), t.clone()),
         };

@@ -346,13 +346,7 @@ fn round(x: f64) -> f64 {
 }
 
 fn render(path: &Path, scene: &Scene, ego: &str, e: &Episode) -> std::io::Result<()> {
-    use tad_render::{ActorInfo, Frame, Kind, Light};
-    let light = |l: tad_bytecode::Light| match l {
-        tad_bytecode::Light::Off => Light::Off,
-        tad_bytecode::Light::Red => Light::Red,
-        tad_bytecode::Light::Yellow => Light::Yellow,
-        tad_bytecode::Light::Green => Light::Green,
-    };
+    use tad_render::{ActorInfo, Frame, Kind};
     let size = scene.ego.size;
     let actors =
         std::iter::once(ActorInfo { label: "ego".into(), kind: Kind::Ego, length: size.length, width: size.width })
@@ -372,7 +366,7 @@ fn render(path: &Path, scene: &Scene, ego: &str, e: &Episode) -> std::io::Result
         .iter()
         .map(|f| Frame {
             poses: f.poses.iter().map(|&(x, y, yaw)| Some([x, y, yaw])).collect(),
-            lights: f.lights.iter().map(|&(arm, l)| (arm, light(l))).collect(),
+            lights: f.lights.clone(),
         })
         .collect();
     let (start, length) = (scene.ego.start, scene.ego.route_length);
