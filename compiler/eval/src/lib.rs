@@ -19,6 +19,7 @@ pub mod generator;
 pub mod harness;
 pub mod journal;
 pub mod pipeline;
+pub mod recovery;
 pub mod results;
 pub mod synthetic;
 pub mod train;
