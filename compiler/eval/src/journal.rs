@@ -116,18 +116,7 @@ impl Journal {
 mod tests {
     use super::*;
 
-    fn setup(seed: u64) -> Setup {
-        Setup {
-            regions: vec!["r".into()],
-            generators: vec!["g".into()],
-            egos: vec!["idm".into()],
-            search_ego: "idm".into(),
-            n: 1,
-            samples: 1,
-            keep: 1,
-            seed,
-        }
-    }
+    use crate::results::test_setup as setup;
 
     fn entry(unit: usize) -> Entry {
         Entry { unit, rows: Vec::new(), kept: vec![KeptScene { trial: 3, params: vec![0.1 + 0.2, 1e-300], seed: 9 }] }

@@ -279,22 +279,27 @@ pub fn plot(all: &[Results]) -> String {
     )
 }
 
+/// A small setup for the crate's tests, told apart by its seed.
+#[cfg(test)]
+pub(crate) fn test_setup(seed: u64) -> Setup {
+    Setup {
+        regions: vec!["r".into()],
+        generators: vec!["g".into()],
+        egos: vec!["idm".into()],
+        search_ego: "idm".into(),
+        n: 1,
+        samples: 1,
+        keep: 1,
+        seed,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn results(shard: Shard, seed: u64) -> Results {
-        let setup = Setup {
-            regions: vec!["r".into()],
-            generators: vec!["g".into()],
-            egos: vec!["idm".into()],
-            search_ego: "idm".into(),
-            n: 1,
-            samples: 1,
-            keep: 1,
-            seed,
-        };
-        Results::new(setup, shard, BTreeMap::new(), Vec::new())
+        Results::new(test_setup(seed), shard, BTreeMap::new(), Vec::new())
     }
 
     #[test]
