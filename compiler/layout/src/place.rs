@@ -1,25 +1,31 @@
-//! The steps from a resolved scenario to a [`Layout`] (`spec/layout.md` §3–§6):
+//! The steps from a resolved scenario to a [`Layout`] (`spec/layout.md` §3–§6). [`lay_out`]
+//! makes a `Planner`, which holds what the steps share, and calls its methods in order:
 //!
-//! 1. facts of the ego and every group (`crate::facts`);
-//! 2. arms: which road of the junction each group is on, from its relation and lane (a side
+//! 1. `facts`: facts of the ego and every group (`crate::facts`), the ego's lane, the road's
+//!    lanes and whether it leads to a junction;
+//! 2. `arms`: which road of the junction each group is on, from its relation and lane (a side
 //!    relation in the reference's own lane is the crossing arm on that side at a junction and
 //!    the adjacent lane elsewhere; an opposite lane ahead is the opposite arm);
-//! 3. the road: shape, lanes, the junction's arms (a three-way junction keeps the arms the
+//! 3. `road`: shape, lanes, the junction's arms (a three-way junction keeps the arms the
 //!    scenario uses), sidewalks and crosswalks;
-//! 4. stations on the ego's road, in placement order, each group beyond its reference with a
-//!    gap that grows with speed, never overlapping what is already there; crossing groups on
-//!    the sidewalk, spread along it; then the ego's approach to the junction (a queue ahead
-//!    ends at the stop line; a moving ego is about three seconds away);
-//! 5. stations on the other arms, from their stop lines;
-//! 6. paths: through the junction by each vehicle's turn, lane changes, overtaking, walking
-//!    across;
-//! 7. timing: every moving group whose path meets the ego's ahead starts where it reaches
+//! 4. `ego_road`: stations on the ego's road, in placement order, each group beyond its
+//!    reference with a gap that grows with speed, never overlapping what is already there;
+//!    crossing groups on the sidewalk, spread along it; then the ego's approach to the
+//!    junction (a queue ahead ends at the stop line; a moving ego is about two seconds away,
+//!    [`APPROACH_TIME`]); then moving traffic past the stop line moves on across the junction;
+//! 5. `other_arms`: stations on the other arms, from their stop lines;
+//! 6. `paths`: every agent's path, through the junction by each vehicle's turn, lane changes,
+//!    overtaking, walking across;
+//! 7. `timing`: every moving group whose path meets the ego's ahead starts where it reaches
 //!    that point when the ego does at its stated speed (crossing walkers wait instead), kept
 //!    on the side of its reference that its relation says.
+//!
+//! `build` makes the agents and runs steps 6 and 7; while a walker cannot reach a junction's
+//! crossing in time, `wait_for_walkers` moves the ego's start back and they run again.
 
 use std::collections::HashMap;
 
-use tad_ir::{GroupId, Lane, Lateral, Longitudinal, Motion, Reference, Scenario, Span};
+use tad_ir::{GroupId, Lane, Lateral, Longitudinal, Motion, Position, Reference, Scenario, Span};
 
 use crate::facts::{self, Body, Chosen, Facts};
 use crate::geom::{Path, Pose, Vec2};
@@ -41,6 +47,24 @@ const WALKER_SPACING: f64 = 0.9;
 enum Target {
     Ego,
     Group(usize),
+}
+
+/// A group's position: what it is relative to, and on which sides.
+#[derive(Clone, Copy, Debug)]
+struct Relation {
+    target: Target,
+    lateral: Lateral,
+    longitudinal: Longitudinal,
+}
+
+/// Where a group goes: its arm, its lane, its place there and which curb it keeps to.
+#[derive(Clone, Copy, Debug)]
+struct Slot {
+    arm: Arm,
+    lane: i64,
+    place: Place,
+    /// At the curb on the road's left (past its leftmost lane) rather than its right.
+    curb_left: bool,
 }
 
 #[derive(Clone, Debug)]
@@ -68,29 +92,671 @@ fn turn_of(motion: Option<Motion>) -> Turn {
     }
 }
 
+/// Whether a group walks across the road.
+fn crosses(f: &Facts) -> bool {
+    f.motion == Some(Motion::Cross) && f.body != Body::Object
+}
+
 /// The layout of a resolved scenario.
 pub fn lay_out(scenario: &Scenario) -> Layout {
-    let mut chosen: Vec<Chosen> = Vec::new();
-    let mut findings: Vec<Finding> = Vec::new();
-    let scenario_span = scenario.name.as_ref().map_or(scenario.span, |n| n.span);
-    let ego_section = scenario.ego.span.unwrap_or(scenario_span);
-    let ego_facts = facts::ego(scenario, ego_section, &mut chosen);
-    let group_facts: Vec<Facts> = scenario.groups().map(|(id, g)| facts::group(scenario, id, g, &mut chosen)).collect();
-    for (id, g) in scenario.groups() {
-        let f = &group_facts[id.index()];
-        if f.wanted > f.count {
-            findings.push(Finding::Capped {
-                group: id,
-                wanted: f.wanted,
-                placed: f.count,
-                span: g.count.span().unwrap_or(g.name_span),
-            });
+    let mut planner = Planner::facts(scenario);
+    planner.arms();
+    let mut road = planner.road();
+    planner.ego_road(&mut road);
+    planner.other_arms(&road);
+    let mut built = planner.build(&road);
+    for _ in 0..3 {
+        if !planner.wait_for_walkers(&mut road, built.late) {
+            break;
+        }
+        built = planner.build(&road);
+    }
+    planner.finish(road, built)
+}
+
+/// What the steps of [`lay_out`] share: the scenario and its facts, and what the steps decide
+/// for each group (indexed by group) as they go.
+struct Planner<'a> {
+    scenario: &'a Scenario,
+    ids: Vec<GroupId>,
+    /// The groups' indices in placement order.
+    order: Vec<usize>,
+    ego_facts: Facts,
+    group_facts: Vec<Facts>,
+    ego_lane: i64,
+    /// The ego's road's lanes in its direction and in the other (none on a one-way road).
+    lanes: u32,
+    opposite: u32,
+    one_way: bool,
+    shape: Shape,
+    /// The ego's road leads to a junction (its shape, a light, a junction's sign, a turn).
+    junction_road: bool,
+    decisions: Vec<Option<Decision>>,
+    stations: Vec<Vec<(Station, f64)>>,
+    slack: Vec<f64>,
+    occupied: Occupied,
+    chosen: Vec<Chosen>,
+    findings: Vec<Finding>,
+}
+
+impl<'a> Planner<'a> {
+    /// Step 1: the facts of the ego, of every group and of the road.
+    fn facts(scenario: &'a Scenario) -> Planner<'a> {
+        let mut chosen: Vec<Chosen> = Vec::new();
+        let mut findings: Vec<Finding> = Vec::new();
+        let scenario_span = scenario.name.as_ref().map_or(scenario.span, |n| n.span);
+        let ego_section = scenario.ego.span.unwrap_or(scenario_span);
+        let ego_facts = facts::ego(scenario, ego_section, &mut chosen);
+        let group_facts: Vec<Facts> =
+            scenario.groups().map(|(id, g)| facts::group(scenario, id, g, &mut chosen)).collect();
+        for (id, g) in scenario.groups() {
+            let f = &group_facts[id.index()];
+            if f.wanted > f.count {
+                findings.push(Finding::Capped {
+                    group: id,
+                    wanted: f.wanted,
+                    placed: f.count,
+                    span: g.count.span().unwrap_or(g.name_span),
+                });
+            }
+        }
+        let written_lanes = scenario.road.lanes.get().filter(|n| *n >= 1).map(|n| n.min(12) as u32);
+        let ego_lane = ego_lane(scenario, written_lanes, ego_section, &mut chosen);
+        let (lanes, opposite, one_way) = road_lanes(scenario, written_lanes, ego_lane);
+        let (shape, junction_road) = road_kind(scenario, &ego_facts);
+        let n = scenario.groups.len();
+        Planner {
+            scenario,
+            ids: scenario.groups().map(|(id, _)| id).collect(),
+            order: scenario.placement_order.iter().map(|id| id.index()).collect(),
+            ego_facts,
+            group_facts,
+            ego_lane,
+            lanes,
+            opposite,
+            one_way,
+            shape,
+            junction_road,
+            decisions: vec![None; n],
+            stations: vec![Vec::new(); n],
+            slack: vec![0.0; n],
+            occupied: HashMap::new(),
+            chosen,
+            findings,
         }
     }
 
-    // --- the ego's lane and the road's lanes
-    let written_lanes = scenario.road.lanes.get().filter(|n| *n >= 1).map(|n| n.min(12) as u32);
-    let ego_lane = match scenario.ego.lane.get() {
+    /// Step 2: each group's arm, lane, place and facing, in placement order.
+    fn arms(&mut self) {
+        for i in self.order.clone() {
+            let decision = self.decide(i);
+            self.decisions[i] = Some(decision);
+        }
+    }
+
+    /// A group's decision: its relation, then its arm and lane, its place and its facing.
+    fn decide(&mut self, i: usize) -> Decision {
+        let scenario = self.scenario;
+        let group = &scenario.groups[i];
+        let f = &self.group_facts[i];
+        let crosser = crosses(f);
+        let relation = match group.position.given() {
+            None => {
+                self.chosen.push(Chosen {
+                    group: Some(self.ids[i]),
+                    field: "position",
+                    value: "`front of ego`".into(),
+                    span: group.position.span().unwrap_or(group.name_span),
+                    rule: "in front of the ego vehicle when the position is not known",
+                });
+                Relation { target: Target::Ego, lateral: Lateral::Same, longitudinal: Longitudinal::Front }
+            }
+            Some(p) => self.relation(i, p),
+        };
+        let written = group.lane.get().map(Lane::index);
+        let mut slot = self.slot(relation, written, f);
+        if written.is_none() {
+            self.chosen.push(Chosen {
+                group: Some(self.ids[i]),
+                field: "lane",
+                value: format!("lane {}", slot.lane),
+                span: group.lane.span().unwrap_or(group.name_span),
+                rule: "from the position's relation and the lane of its reference",
+            });
+        }
+        self.place_by_motion(f, &mut slot);
+        let facing = if crosser {
+            slot.place = Place::Sidewalk;
+            // at a junction arm, from the side its outgoing lanes are on; on the ego's road,
+            // from the side of the lane written
+            let from = if slot.arm != Arm::Ego || slot.lane < 0 { Side::Left } else { Side::Right };
+            Facing::Across { from }
+        } else {
+            Facing::Along
+        };
+        Decision {
+            arm: slot.arm,
+            lane: slot.lane,
+            place: slot.place,
+            facing,
+            target: relation.target,
+            longitudinal: relation.longitudinal,
+            crosser,
+            curb_left: slot.curb_left,
+            distance: group.distance.given().map(|p| (p.min().0.max(0.0), p.max().0.max(0.0))),
+            span: group.position.given().map_or(group.name_span, |p| p.relation.span),
+        }
+    }
+
+    /// What group `i`'s written position says: its reference (a group placed already, else
+    /// the ego) and its relation's sides.
+    fn relation(&self, i: usize, p: &Position) -> Relation {
+        let relation = self.scenario.entries.resolved(&p.relation.value).map(|r| r.attrs);
+        let target = match &p.reference.value {
+            Reference::Group(j) if j.index() != i && self.decisions[j.index()].is_some() => Target::Group(j.index()),
+            _ => Target::Ego,
+        };
+        Relation {
+            target,
+            lateral: relation.and_then(|r| r.lateral).unwrap_or(Lateral::Same),
+            longitudinal: relation.and_then(|r| r.longitudinal).unwrap_or(Longitudinal::Same),
+        }
+    }
+
+    /// A group's arm and lane: on a road to a junction, a moving group beside the ego in its
+    /// lane comes along the crossing arm on that side, and a vehicle oncoming ahead along the
+    /// opposite arm; anything else is on its reference's arm ([`Planner::beside`]).
+    fn slot(&self, relation: Relation, written: Option<i64>, f: &Facts) -> Slot {
+        let (ref_arm, ref_lane) = match relation.target {
+            Target::Ego => (Arm::Ego, self.ego_lane),
+            Target::Group(j) => self.decisions[j].as_ref().map_or((Arm::Ego, self.ego_lane), |d| (d.arm, d.lane)),
+        };
+        let Relation { lateral, longitudinal, .. } = relation;
+        let moving_vehicle = f.body == Body::Vehicle && !f.is_static();
+        let side_arm = match lateral {
+            Lateral::Left => Some(Arm::Left),
+            Lateral::Right => Some(Arm::Right),
+            _ => None,
+        };
+        let in_lane = |arm: Arm, lane: i64| Slot { arm, lane, place: Place::Lane, curb_left: false };
+        if self.junction_road
+            && ref_arm == Arm::Ego
+            && side_arm.is_some()
+            && written.is_none_or(|l| l == ref_lane)
+            && (moving_vehicle || crosses(f))
+            && longitudinal != Longitudinal::Behind
+        {
+            // from the left or the right: the crossing arm on that side
+            in_lane(side_arm.unwrap_or(Arm::Left), written.map_or(1, i64::abs).min(i64::from(self.lanes)))
+        } else if self.junction_road
+            && ref_arm == Arm::Ego
+            && moving_vehicle
+            && longitudinal == Longitudinal::Front
+            && (lateral == Lateral::Opposite || written.is_some_and(|l| l < 0))
+        {
+            // oncoming: the opposite arm, coming into the junction
+            in_lane(Arm::Opposite, written.map_or(1, i64::abs))
+        } else {
+            self.beside(ref_arm, ref_lane, lateral, written)
+        }
+    }
+
+    /// A group's lane on its reference's arm: the one written, else the one beside the
+    /// reference's lane on its relation's side; past the road's last lane, its shoulder.
+    fn beside(&self, arm: Arm, ref_lane: i64, lateral: Lateral, written: Option<i64>) -> Slot {
+        let (lanes, opposite) = (self.lanes, self.opposite);
+        // a lane written for a group on the opposite arm counts on the ego's road
+        let written = if arm == Arm::Opposite { written.map(|l| -l) } else { written };
+        let ref_lane = Lane::new(ref_lane).unwrap_or(Lane::new(1).expect("1 is a lane"));
+        let mut lane = match written {
+            Some(l) if l != ref_lane.index() || lateral == Lateral::Same || lateral == Lateral::Opposite => l,
+            _ => match lateral {
+                Lateral::Left => ref_lane.shift(-1).index(),
+                Lateral::Right => ref_lane.shift(1).index(),
+                Lateral::Opposite => -ref_lane.index(),
+                Lateral::Same => ref_lane.index(),
+            },
+        };
+        let mut place = Place::Lane;
+        let mut curb_left = false;
+        let (incoming, outgoing) = match arm {
+            Arm::Ego => (lanes, opposite),
+            Arm::Opposite => (opposite.max(1), lanes),
+            _ => (lanes, lanes),
+        };
+        if lane > i64::from(incoming) {
+            lane = i64::from(incoming);
+            place = Place::Shoulder;
+        } else if lane < 0 && lane < -i64::from(outgoing) {
+            curb_left = outgoing == 0;
+            lane = if outgoing == 0 { 1 } else { -i64::from(outgoing) };
+            place = Place::Shoulder;
+        }
+        if self.one_way && arm == Arm::Ego && lane < 0 {
+            lane = 1;
+            place = Place::Shoulder;
+            curb_left = true;
+        }
+        Slot { arm, lane, place, curb_left }
+    }
+
+    /// The place its motion gives a group: parked or grazing in an outermost lane, at its
+    /// curb; a walker walking, on the sidewalk.
+    fn place_by_motion(&self, f: &Facts, slot: &mut Slot) {
+        let (lanes, opposite) = (self.lanes, self.opposite);
+        let outermost = |arm: Arm, lane: i64| {
+            let (incoming, outgoing) = if arm == Arm::Ego { (lanes, opposite) } else { (lanes, lanes) };
+            lane == i64::from(incoming) || lane == -i64::from(outgoing) || (outgoing == 0 && lane == 1)
+        };
+        match f.motion {
+            Some(Motion::Parked) if f.body != Body::Object && outermost(slot.arm, slot.lane) => {
+                slot.place = Place::Curb;
+                // lane 1 of a one-way road of several lanes has its curb on the left
+                slot.curb_left |= self.one_way && slot.arm == Arm::Ego && slot.lane == 1 && lanes > 1;
+            }
+            Some(Motion::Walk) if f.body == Body::Walker => slot.place = Place::Sidewalk,
+            Some(Motion::Graze) if outermost(slot.arm, slot.lane) => slot.place = Place::Curb,
+            _ => {}
+        }
+    }
+
+    /// Step 3: the road: its shape and lanes, the junction's arms (a group on an arm the
+    /// junction lacks moves to the ego's road), sidewalks and crosswalks.
+    fn road(&mut self) -> Road {
+        let scenario = self.scenario;
+        let junction = self.junction();
+        for (i, d) in self.decisions.iter_mut().enumerate() {
+            let Some(d) = d else { continue };
+            if junction.as_ref().is_some_and(|j| !j.arms.contains(&d.arm)) {
+                self.findings.push(Finding::NoArm { group: self.ids[i], arm: d.arm, span: d.span });
+                d.arm = Arm::Ego;
+                d.lane = d.lane.abs().min(i64::from(self.lanes)).max(1);
+            }
+        }
+        let walkway = scenario.road.roadside.given().is_some_and(|r| {
+            r.iter().any(|s| s.value.id().and_then(|id| scenario.entries.get(id)).is_some_and(|e| e.attrs.walkway))
+        });
+        let walkers = self.group_facts.iter().any(|f| f.body == Body::Walker);
+        Road {
+            shape: self.shape,
+            lanes: self.lanes,
+            opposite: self.opposite,
+            cross_lanes: self.lanes,
+            lane_width: road::LANE_WIDTH,
+            sidewalks: walkway || walkers,
+            crosswalks: junction.is_some() || self.decisions.iter().flatten().any(|d| d.crosser),
+            signal: scenario.road.light.given().and_then(|l| scenario.entries.resolved(l)).and_then(|e| e.attrs.signal),
+            junction,
+            approach: 0.0,
+        }
+    }
+
+    /// The junction the ego's road leads to, if any: its arms (a three-way one keeps those
+    /// the groups and the ego's exit use), its size, its light and its stop signs.
+    fn junction(&self) -> Option<Junction> {
+        let scenario = self.scenario;
+        let (arms, roundabout) = match self.shape {
+            Shape::Junction { arms, roundabout } => (arms, roundabout),
+            _ if self.junction_road => (4, false),
+            _ => return None,
+        };
+        let mut needed: Vec<Arm> = self.decisions.iter().flatten().map(|d| d.arm).collect();
+        needed.push(turn_of(self.ego_facts.motion).exit(Arm::Ego));
+        let arms_of = if arms == 3 {
+            let missing = [Arm::Opposite, Arm::Left, Arm::Right]
+                .into_iter()
+                .find(|a| !needed.contains(a))
+                .unwrap_or(Arm::Opposite);
+            Arm::ALL.into_iter().filter(|a| *a != missing).collect()
+        } else {
+            Arm::ALL.to_vec()
+        };
+        let widest = self.lanes.max(self.opposite).max(1);
+        let signal = scenario.road.light.given().and_then(|l| scenario.entries.resolved(l)).map(|e| e.attrs);
+        Some(Junction {
+            arms: arms_of,
+            roundabout,
+            half: widest as f64 * road::LANE_WIDTH + 1.0 + 3.5,
+            signalised: signal.is_some_and(|s| s.present),
+            stop_signs: scenario.road.signs.given().is_some_and(|signs| {
+                signs.iter().any(|s| {
+                    scenario.entries.resolved(&s.value).and_then(|e| e.attrs.opendrive_type) == Some(STOP_SIGN)
+                })
+            }),
+        })
+    }
+
+    /// Step 4: stations on the ego's road (where the ego is taken first), then the ego's
+    /// approach to the junction, then what drives on across it.
+    fn ego_road(&mut self, road: &mut Road) {
+        let ego_len = self.ego_facts.length;
+        self.occupied.entry((Arm::Ego, Key::Lane(self.ego_lane))).or_default().push((
+            -ego_len / 2.0,
+            ego_len / 2.0,
+            self.ego_facts.speed,
+        ));
+        self.place_arm(true, road);
+        if road.junction.is_some() {
+            road.approach = self.approach(road);
+            self.move_to_crosswalk(road.approach);
+        }
+        self.across_junction(road);
+    }
+
+    /// Step 5: stations on the other arms, from their stop lines.
+    fn other_arms(&mut self, road: &Road) {
+        self.place_arm(false, road);
+    }
+
+    /// Places the groups on the ego's road (`on_ego`) or those on the other arms, in
+    /// placement order.
+    fn place_arm(&mut self, on_ego: bool, road: &Road) {
+        for &i in &self.order {
+            let Some(d) = self.decisions[i].as_ref() else { continue };
+            if (d.arm == Arm::Ego) != on_ego {
+                continue;
+            }
+            let f = &self.group_facts[i];
+            let reference = self.reference(d);
+            let min_first = self.min_first(road, d, f);
+            let (placed, room) = place_group(road, d, f, reference, min_first, &mut self.occupied);
+            self.stations[i] = placed;
+            self.slack[i] = room;
+        }
+    }
+
+    /// What a group is placed from: its reference group when that is placed on the same
+    /// arm, else the ego on its road, else the arm's stop line.
+    fn reference(&self, d: &Decision) -> Extent {
+        match d.target {
+            Target::Group(j)
+                if self.decisions[j].as_ref().is_some_and(|r| r.arm == d.arm) && !self.stations[j].is_empty() =>
+            {
+                let r = self.decisions[j].as_ref();
+                let across = r.is_some_and(|r| r.crosser);
+                let rf = &self.group_facts[j];
+                let half = if across { rf.width.max(0.5) / 2.0 } else { rf.length / 2.0 };
+                extent_of(&self.stations[j], half, rf.speed, r.map_or(1, |r| r.lane), d.arm)
+            }
+            _ if d.arm == Arm::Ego => {
+                let half = self.ego_facts.length / 2.0;
+                Extent {
+                    lane: self.ego_lane,
+                    stop_line: false,
+                    low: -half,
+                    high: half,
+                    forward: 1.0,
+                    speed: self.ego_facts.speed,
+                }
+            }
+            _ => Extent::stop_line(),
+        }
+    }
+
+    /// The nearest station a group's first actor may take: a crossing ahead of a moving ego,
+    /// on a road without a junction, is where the walkers reach the ego's lane when the ego
+    /// does.
+    fn min_first(&self, road: &Road, d: &Decision, f: &Facts) -> f64 {
+        let ego = &self.ego_facts;
+        if !(d.crosser
+            && d.arm == Arm::Ego
+            && road.junction.is_none()
+            && d.target == Target::Ego
+            && d.distance.is_none()
+            && f.speed > 0.0
+            && !ego.is_static())
+        {
+            return f64::NEG_INFINITY;
+        }
+        let start = road.curb(match d.facing {
+            Facing::Across { from } => from,
+            _ => Side::Right,
+        });
+        let walk = ((start - road.lateral(self.ego_lane)).abs() + 1.0) / f.speed;
+        (ego.speed * walk + ego.length / 2.0).min(MAX_REACH)
+    }
+
+    /// The ego's distance to its stop line: a queue of stopped vehicles ahead ends at it;
+    /// moving traffic ahead drives on through the junction; what stands elsewhere, or turns
+    /// there, stays before it; a moving ego is [`APPROACH_TIME`] away.
+    fn approach(&self, road: &Road) -> f64 {
+        let ego_len = self.ego_facts.length;
+        let ahead: Vec<(f64, bool, bool)> = self
+            .decisions
+            .iter()
+            .enumerate()
+            .filter(|(_, d)| d.as_ref().is_some_and(|d| d.arm == Arm::Ego && !d.crosser))
+            .flat_map(|(i, d)| {
+                let f = &self.group_facts[i];
+                // moving traffic in the opposite lanes comes from the opposite arm; what stands
+                // there is before the junction too
+                let incoming = d.as_ref().is_some_and(|d| d.lane > 0);
+                if !incoming && !f.is_static() {
+                    return Vec::new();
+                }
+                let queued = incoming && f.is_static() && f.motion != Some(Motion::Parked) && f.body == Body::Vehicle;
+                // what turns at the junction is before it too (only straight traffic moves across)
+                let before = f.is_static() || turn_of(f.motion) != Turn::Straight || road.opposite == 0;
+                self.stations[i].iter().map(|(s, _)| (s.along + f.length / 2.0, before, queued)).collect()
+            })
+            .filter(|(front, _, _)| *front > 0.0)
+            .collect();
+        let front = |which: fn(&(f64, bool, bool)) -> bool| {
+            ahead.iter().filter(|a| which(a)).map(|a| a.0).fold(ego_len / 2.0, f64::max)
+        };
+        let queue = ahead.iter().any(|a| a.2);
+        // on a one-way road the road across the junction may not go on: all of it waits
+        let standing = if road.opposite == 0 { front(|_| true) + 1.0 } else { 0.0 };
+        let standing = standing.max(front(|a| a.1) + 1.0);
+        let base = (self.ego_facts.speed * APPROACH_TIME).clamp(6.0, 40.0) + ego_len / 2.0;
+        (if queue { front(|a| a.2) + 1.0 } else { base }).max(standing).max(6.0)
+    }
+
+    /// Crossers on the ego's road near the junction, or placed from the ego, move to its
+    /// crosswalk.
+    fn move_to_crosswalk(&mut self, approach: f64) {
+        for (i, d) in self.decisions.iter().enumerate() {
+            let Some(d) = d.as_ref().filter(|d| d.arm == Arm::Ego && d.crosser) else { continue };
+            let Some(first) = self.stations[i].first().map(|(s, _)| s.along) else { continue };
+            if first > approach - 8.0 || d.target == Target::Ego {
+                let shift = approach + CROSSWALK - first;
+                for (s, _) in &mut self.stations[i] {
+                    s.along += shift;
+                }
+            }
+        }
+    }
+
+    /// Moving traffic ahead past the stop line is already across the junction: all of it
+    /// moves on to the opposite arm by the same distance, so that none is inside the
+    /// junction and their relations hold.
+    fn across_junction(&mut self, road: &Road) {
+        let Some(half) =
+            road.junction.as_ref().filter(|j| j.arms.contains(&Arm::Opposite) && road.opposite > 0).map(|j| j.half)
+        else {
+            return;
+        };
+        let beyond = |i: usize| {
+            let f = &self.group_facts[i];
+            self.decisions[i].as_ref().is_some_and(|d| d.arm == Arm::Ego && d.lane > 0 && !d.crosser)
+                && !f.is_static()
+                && f.body == Body::Vehicle
+                && turn_of(f.motion) == Turn::Straight
+        };
+        let exit = road.approach + 2.0 * half;
+        let mut push: f64 = 0.0;
+        for i in (0..self.stations.len()).filter(|&i| beyond(i)) {
+            let len = self.group_facts[i].length;
+            for (s, _) in self.stations[i].iter().filter(|(s, _)| s.along + len / 2.0 > road.approach - 0.5) {
+                push = push.max(exit + len / 2.0 + 0.5 - s.along);
+            }
+        }
+        for i in (0..self.stations.len()).filter(|&i| beyond(i)) {
+            let f = &self.group_facts[i];
+            let lane = self.decisions[i].as_ref().map_or(1, |d| d.lane);
+            for (s, _) in self.stations[i].iter_mut().filter(|(s, _)| s.along + f.length / 2.0 > road.approach - 0.5) {
+                let along = s.along + push - exit;
+                *s = Station { arm: Arm::Opposite, along };
+                self.occupied.entry((Arm::Opposite, Key::Lane(-lane))).or_default().push((
+                    along - f.length / 2.0,
+                    along + f.length / 2.0,
+                    f.speed,
+                ));
+            }
+        }
+    }
+
+    /// The agents at their stations, then steps 6 and 7: their paths and their timing.
+    fn build(&self, road: &Road) -> Built {
+        let mut ego = self.ego_agent(road);
+        let mut groups: Vec<GroupLayout> =
+            (0..self.scenario.groups.len()).filter_map(|i| self.group_layout(road, i)).collect();
+        Self::paths(road, &mut ego, &mut groups);
+        let (conflicts, late) = self.timing(road, &ego, &mut groups);
+        Built { ego, groups, conflicts, late }
+    }
+
+    /// The ego's agent, at station 0 of its lane.
+    fn ego_agent(&self, road: &Road) -> Agent {
+        let f = &self.ego_facts;
+        let station = Station { arm: Arm::Ego, along: 0.0 };
+        Agent {
+            group: None,
+            index: 0,
+            body: Body::Vehicle,
+            length: f.length,
+            width: f.width,
+            station,
+            lane: self.ego_lane,
+            place: Place::Lane,
+            lateral: road.lateral(self.ego_lane),
+            facing: Facing::Along,
+            motion: f.motion,
+            turn: turn_of(f.motion),
+            speed: if f.is_static() { 0.0 } else { f.speed },
+            moving: !f.is_static(),
+            start: Start::default(),
+            pose: road.lane_pose(station, self.ego_lane),
+            path: Path::default(),
+            path_start: 0.0,
+        }
+    }
+
+    /// Group `i`'s agents, one at each of its stations; `None` when it was not placed.
+    fn group_layout(&self, road: &Road, i: usize) -> Option<GroupLayout> {
+        let group = &self.scenario.groups[i];
+        let f = self.group_facts[i].clone();
+        let d = self.decisions[i].as_ref()?;
+        let delay = group.delay.given().map_or(0.0, |p| p.nominal().0.max(0.0));
+        let trigger = group.trigger.given().map(|p| p.nominal().0.max(0.0));
+        let waits = delay > 0.0 || trigger.is_some();
+        let agents = self.stations[i]
+            .iter()
+            .enumerate()
+            .map(|(k, &(station, lateral))| {
+                let (lane, lateral, pose) = stand(road, d, station, lateral);
+                Agent {
+                    group: Some(self.ids[i]),
+                    index: k,
+                    body: f.body,
+                    length: f.length,
+                    width: f.width,
+                    station,
+                    lane,
+                    place: d.place,
+                    lateral,
+                    facing: d.facing,
+                    motion: f.motion,
+                    turn: turn_of(f.motion),
+                    speed: if f.is_static() { 0.0 } else { f.speed },
+                    moving: !f.is_static() && !waits && f.body == Body::Vehicle,
+                    start: Start { delay, trigger },
+                    pose,
+                    path: Path::default(),
+                    path_start: 0.0,
+                }
+            })
+            .collect();
+        Some(GroupLayout { group: self.ids[i], facts: f, agents, slack: self.slack[i] })
+    }
+
+    /// Step 6: every agent's path and its start on it, overtaking what stands on the ego's
+    /// road.
+    fn paths(road: &Road, ego: &mut Agent, groups: &mut [GroupLayout]) {
+        let obstacles: Vec<(i64, f64, f64)> = groups
+            .iter()
+            .flat_map(|g| &g.agents)
+            .filter(|a| {
+                a.is_static() && a.station.arm == Arm::Ego && a.place != Place::Sidewalk && a.facing == Facing::Along
+            })
+            .map(|a| (a.lane, a.station.along - a.length / 2.0, a.station.along + a.length / 2.0))
+            .collect();
+        path_of(road, ego, &obstacles);
+        for g in groups {
+            for a in &mut g.agents {
+                path_of(road, a, &obstacles);
+            }
+        }
+    }
+
+    /// Step 7: every moving group without a written distance, delay or trigger is timed to
+    /// its conflict with a moving ego ([`time_group`]); returns the conflicts and how late the
+    /// latest crossing walker is, s.
+    fn timing(&self, road: &Road, ego: &Agent, groups: &mut [GroupLayout]) -> (Vec<Conflict>, f64) {
+        let mut conflicts = Vec::new();
+        let mut late: f64 = 0.0;
+        if !(ego.moving && ego.speed > 0.5) {
+            return (conflicts, late);
+        }
+        for (i, g) in groups.iter_mut().enumerate() {
+            let Some(d) = self.decisions[i].as_ref() else { continue };
+            let group = &self.scenario.groups[i];
+            let written_timing = d.distance.is_some() || group.delay.is_given() || group.trigger.is_given();
+            if written_timing || g.facts.is_static() || g.agents.is_empty() {
+                continue;
+            }
+            if let Some((conflict, lateness)) = time_group(road, ego, d, g) {
+                conflicts.push(conflict);
+                late = late.max(lateness);
+            }
+        }
+        (conflicts, late)
+    }
+
+    /// A walker `late` seconds late for its crossing at a junction moves the ego's start back
+    /// (its approach longer, the walkers at its crosswalk with it); whether it did.
+    fn wait_for_walkers(&mut self, road: &mut Road, late: f64) -> bool {
+        if road.junction.is_none() || late <= 0.05 {
+            return false;
+        }
+        let delta = (late * self.ego_facts.speed + 1.0).min(MAX_REACH - road.approach);
+        if delta <= 0.0 {
+            return false;
+        }
+        road.approach += delta;
+        for (i, d) in self.decisions.iter().enumerate() {
+            if d.as_ref().is_some_and(|d| d.arm == Arm::Ego && d.crosser) {
+                for (s, _) in &mut self.stations[i] {
+                    s.along += delta;
+                }
+            }
+        }
+        true
+    }
+
+    /// The layout: the road, the agents and their conflicts, the findings (what was chosen
+    /// last).
+    fn finish(self, road: Road, built: Built) -> Layout {
+        let Built { ego, groups, conflicts, .. } = built;
+        let mut findings = self.findings;
+        findings.extend(self.chosen.into_iter().map(Finding::Chosen));
+        Layout { road, ego, ego_facts: self.ego_facts, groups, conflicts, findings }
+    }
+}
+
+/// The ego's lane: the one written, else the middle one of the road's (a choice).
+fn ego_lane(scenario: &Scenario, written_lanes: Option<u32>, ego_section: Span, chosen: &mut Vec<Chosen>) -> i64 {
+    match scenario.ego.lane.get() {
         Some(l) if l.index() > 0 => l.index().min(12),
         Some(_) => 1,
         None => {
@@ -104,7 +770,12 @@ pub fn lay_out(scenario: &Scenario) -> Layout {
             });
             lane
         }
-    };
+    }
+}
+
+/// The ego's road's lanes in its direction and in the other (as written, else as many as
+/// the lanes used), and whether it is one way (then none in the other).
+fn road_lanes(scenario: &Scenario, written_lanes: Option<u32>, ego_lane: i64) -> (u32, u32, bool) {
     let one_way =
         scenario.road.direction.given().and_then(|d| scenario.entries.resolved(d)).and_then(|e| e.attrs.opposite_lanes)
             == Some(false);
@@ -121,8 +792,12 @@ pub fn lay_out(scenario: &Scenario) -> Layout {
     };
     let lanes = written_lanes.unwrap_or_else(|| used(true).max(1)).max(ego_lane as u32);
     let opposite = if one_way { 0 } else { lanes.max(used(false)) };
+    (lanes, opposite, one_way)
+}
 
-    // --- the road's kind
+/// The road's shape, and whether it leads to a junction: by its shape, or a light that
+/// shows something, a junction's sign or the ego's turn.
+fn road_kind(scenario: &Scenario, ego_facts: &Facts) -> (Shape, bool) {
     let road_type = scenario.road.road_type.given().and_then(|t| scenario.entries.resolved(t)).map(|e| e.attrs);
     let at_junction = scenario.groups.iter().any(|g| {
         g.position.given().is_some_and(|p| match &p.reference.value {
@@ -149,384 +824,29 @@ pub fn lay_out(scenario: &Scenario) -> Layout {
         signs.iter().any(|s| scenario.entries.resolved(&s.value).is_some_and(|e| e.attrs.opendrive_type.is_some()))
     });
     let turning = matches!(ego_facts.motion, Some(Motion::TurnLeft | Motion::TurnRight | Motion::UTurn));
-    let junction_road = matches!(shape, Shape::Junction { .. }) || lit || junction_sign || turning;
+    (shape, matches!(shape, Shape::Junction { .. }) || lit || junction_sign || turning)
+}
 
-    // --- decisions: arm, lane, place, facing, in placement order
-    let ids: Vec<GroupId> = scenario.groups().map(|(id, _)| id).collect();
-    let order: Vec<usize> = scenario.placement_order.iter().map(|id| id.index()).collect();
-    let mut decisions: Vec<Option<Decision>> = vec![None; scenario.groups.len()];
-    for &i in &order {
-        let group = &scenario.groups[i];
-        let id = ids[i];
-        let f = &group_facts[i];
-        let crosser = f.motion == Some(Motion::Cross) && f.body != Body::Object;
-        let (target, lateral, longitudinal) = match group.position.given() {
-            None => {
-                chosen.push(Chosen {
-                    group: Some(id),
-                    field: "position",
-                    value: "`front of ego`".into(),
-                    span: group.position.span().unwrap_or(group.name_span),
-                    rule: "in front of the ego vehicle when the position is not known",
-                });
-                (Target::Ego, Lateral::Same, Longitudinal::Front)
+/// Where a group's actor stands at a station: its lane and lateral offset (moved across the
+/// junction: in an outgoing lane of the opposite arm) and its pose, turned across the road
+/// when it crosses.
+fn stand(road: &Road, d: &Decision, station: Station, lateral: f64) -> (i64, f64, Pose) {
+    let moved = station.arm != d.arm;
+    let lane = if moved { -d.lane } else { d.lane };
+    let lateral = if moved { road.lateral(lane) } else { lateral };
+    let pose = road.pose_at(station, if d.crosser { 1 } else { lane }, lateral);
+    let yaw = match d.facing {
+        Facing::Along => pose.yaw,
+        Facing::Across { from } => {
+            let base = if station.arm == Arm::Ego { road.lane_pose(station, 1).yaw } else { pose.yaw };
+            let base = if station.arm != Arm::Ego && lane < 0 { base + std::f64::consts::PI } else { base };
+            match from {
+                Side::Right => base + std::f64::consts::FRAC_PI_2,
+                Side::Left => base - std::f64::consts::FRAC_PI_2,
             }
-            Some(p) => {
-                let relation = scenario.entries.resolved(&p.relation.value).map(|r| r.attrs);
-                let target = match &p.reference.value {
-                    Reference::Group(j) if j.index() != i && decisions[j.index()].is_some() => Target::Group(j.index()),
-                    _ => Target::Ego,
-                };
-                (
-                    target,
-                    relation.and_then(|r| r.lateral).unwrap_or(Lateral::Same),
-                    relation.and_then(|r| r.longitudinal).unwrap_or(Longitudinal::Same),
-                )
-            }
-        };
-        let (ref_arm, ref_lane) = match target {
-            Target::Ego => (Arm::Ego, ego_lane),
-            Target::Group(j) => decisions[j].as_ref().map_or((Arm::Ego, ego_lane), |d| (d.arm, d.lane)),
-        };
-        let written = group.lane.get().map(Lane::index);
-        let moving_vehicle = f.body == Body::Vehicle && !f.is_static();
-        let side_arm = match lateral {
-            Lateral::Left => Some(Arm::Left),
-            Lateral::Right => Some(Arm::Right),
-            _ => None,
-        };
-        let mut arm = ref_arm;
-        let mut lane;
-        let mut place = Place::Lane;
-        let mut curb_left = false;
-        if junction_road
-            && ref_arm == Arm::Ego
-            && side_arm.is_some()
-            && written.is_none_or(|l| l == ref_lane)
-            && (moving_vehicle || crosser)
-            && longitudinal != Longitudinal::Behind
-        {
-            // from the left or the right: the crossing arm on that side
-            arm = side_arm.unwrap_or(Arm::Left);
-            lane = written.map_or(1, i64::abs).min(i64::from(lanes));
-        } else if junction_road
-            && ref_arm == Arm::Ego
-            && moving_vehicle
-            && longitudinal == Longitudinal::Front
-            && (lateral == Lateral::Opposite || written.is_some_and(|l| l < 0))
-        {
-            // oncoming: the opposite arm, coming into the junction
-            arm = Arm::Opposite;
-            lane = written.map_or(1, i64::abs);
-        } else {
-            // a lane written for a group on the opposite arm counts on the ego's road
-            let written = if arm == Arm::Opposite { written.map(|l| -l) } else { written };
-            let ref_lane = Lane::new(ref_lane).unwrap_or(Lane::new(1).expect("1 is a lane"));
-            lane = match written {
-                Some(l) if l != ref_lane.index() || lateral == Lateral::Same || lateral == Lateral::Opposite => l,
-                _ => match lateral {
-                    Lateral::Left => ref_lane.shift(-1).index(),
-                    Lateral::Right => ref_lane.shift(1).index(),
-                    Lateral::Opposite => -ref_lane.index(),
-                    Lateral::Same => ref_lane.index(),
-                },
-            };
-            let (incoming, outgoing) = match arm {
-                Arm::Ego => (lanes, opposite),
-                Arm::Opposite => (opposite.max(1), lanes),
-                _ => (lanes, lanes),
-            };
-            if lane > i64::from(incoming) {
-                lane = i64::from(incoming);
-                place = Place::Shoulder;
-            } else if lane < 0 && lane < -i64::from(outgoing) {
-                curb_left = outgoing == 0;
-                lane = if outgoing == 0 { 1 } else { -i64::from(outgoing) };
-                place = Place::Shoulder;
-            }
-            if one_way && arm == Arm::Ego && lane < 0 {
-                lane = 1;
-                place = Place::Shoulder;
-                curb_left = true;
-            }
-        }
-        if written.is_none() {
-            chosen.push(Chosen {
-                group: Some(id),
-                field: "lane",
-                value: format!("lane {lane}"),
-                span: group.lane.span().unwrap_or(group.name_span),
-                rule: "from the position's relation and the lane of its reference",
-            });
-        }
-        let outermost = |arm: Arm, lane: i64| {
-            let (incoming, outgoing) = if arm == Arm::Ego { (lanes, opposite) } else { (lanes, lanes) };
-            lane == i64::from(incoming) || lane == -i64::from(outgoing) || (outgoing == 0 && lane == 1)
-        };
-        match f.motion {
-            Some(Motion::Parked) if f.body != Body::Object && outermost(arm, lane) => {
-                place = Place::Curb;
-                // lane 1 of a one-way road of several lanes has its curb on the left
-                curb_left |= one_way && arm == Arm::Ego && lane == 1 && lanes > 1;
-            }
-            Some(Motion::Walk) if f.body == Body::Walker => place = Place::Sidewalk,
-            Some(Motion::Graze) if outermost(arm, lane) => place = Place::Curb,
-            _ => {}
-        }
-        let facing = if crosser {
-            place = Place::Sidewalk;
-            // at a junction arm, from the side its outgoing lanes are on; on the ego's road,
-            // from the side of the lane written
-            let from = if arm != Arm::Ego || lane < 0 { Side::Left } else { Side::Right };
-            Facing::Across { from }
-        } else {
-            Facing::Along
-        };
-        let distance = group.distance.given().map(|p| (p.min().0.max(0.0), p.max().0.max(0.0)));
-        decisions[i] = Some(Decision {
-            arm,
-            lane,
-            place,
-            facing,
-            target,
-            longitudinal,
-            crosser,
-            curb_left,
-            distance,
-            span: group.position.given().map_or(group.name_span, |p| p.relation.span),
-        });
-    }
-
-    // --- the junction's arms
-    let ego_turn = turn_of(ego_facts.motion);
-    let junction_shape = match shape {
-        Shape::Junction { arms, roundabout } => Some((arms, roundabout)),
-        _ if junction_road => Some((4, false)),
-        _ => None,
-    };
-    let junction = match junction_shape {
-        Some((arms, roundabout)) => {
-            let mut needed: Vec<Arm> = decisions.iter().flatten().map(|d| d.arm).collect();
-            needed.push(ego_turn.exit(Arm::Ego));
-            let arms_of = if arms == 3 {
-                let missing = [Arm::Opposite, Arm::Left, Arm::Right]
-                    .into_iter()
-                    .find(|a| !needed.contains(a))
-                    .unwrap_or(Arm::Opposite);
-                Arm::ALL.into_iter().filter(|a| *a != missing).collect()
-            } else {
-                Arm::ALL.to_vec()
-            };
-            let widest = lanes.max(opposite).max(1);
-            let signal = scenario.road.light.given().and_then(|l| scenario.entries.resolved(l)).map(|e| e.attrs);
-            Some(Junction {
-                arms: arms_of,
-                roundabout,
-                half: widest as f64 * road::LANE_WIDTH + 1.0 + 3.5,
-                signalised: signal.is_some_and(|s| s.present),
-                stop_signs: scenario.road.signs.given().is_some_and(|signs| {
-                    signs.iter().any(|s| {
-                        scenario.entries.resolved(&s.value).and_then(|e| e.attrs.opendrive_type) == Some(STOP_SIGN)
-                    })
-                }),
-            })
-        }
-        None => None,
-    };
-    for (i, d) in decisions.iter_mut().enumerate() {
-        let Some(d) = d else { continue };
-        if junction.as_ref().is_some_and(|j| !j.arms.contains(&d.arm)) {
-            findings.push(Finding::NoArm { group: ids[i], arm: d.arm, span: d.span });
-            d.arm = Arm::Ego;
-            d.lane = d.lane.abs().min(i64::from(lanes)).max(1);
-        }
-    }
-    let walkway = scenario.road.roadside.given().is_some_and(|r| {
-        r.iter().any(|s| s.value.id().and_then(|id| scenario.entries.get(id)).is_some_and(|e| e.attrs.walkway))
-    });
-    let walkers = group_facts.iter().any(|f| f.body == Body::Walker);
-    let mut road = Road {
-        shape,
-        lanes,
-        opposite,
-        cross_lanes: lanes,
-        lane_width: road::LANE_WIDTH,
-        sidewalks: walkway || walkers,
-        crosswalks: junction.is_some() || decisions.iter().flatten().any(|d| d.crosser),
-        signal: scenario.road.light.given().and_then(|l| scenario.entries.resolved(l)).and_then(|e| e.attrs.signal),
-        junction,
-        approach: 0.0,
-    };
-
-    // --- stations on the ego's road, then the approach, then the other arms
-    let mut occupied: Occupied = HashMap::new();
-    let ego_len = ego_facts.length;
-    occupied.entry((Arm::Ego, Key::Lane(ego_lane))).or_default().push((-ego_len / 2.0, ego_len / 2.0, ego_facts.speed));
-    let mut stations: Vec<Vec<(Station, f64)>> = vec![Vec::new(); scenario.groups.len()];
-    let mut slack = vec![0.0; scenario.groups.len()];
-    let ego_extent = Extent {
-        lane: ego_lane,
-        stop_line: false,
-        low: -ego_len / 2.0,
-        high: ego_len / 2.0,
-        forward: 1.0,
-        speed: ego_facts.speed,
-    };
-    let place_arm = |on_ego: bool,
-                     road: &Road,
-                     stations: &mut Vec<Vec<(Station, f64)>>,
-                     slack: &mut Vec<f64>,
-                     occupied: &mut Occupied| {
-        for &i in &order {
-            let Some(d) = decisions[i].as_ref() else { continue };
-            if (d.arm == Arm::Ego) != on_ego {
-                continue;
-            }
-            let f = &group_facts[i];
-            let reference = match d.target {
-                Target::Group(j)
-                    if decisions[j].as_ref().is_some_and(|r| r.arm == d.arm) && !stations[j].is_empty() =>
-                {
-                    let r = decisions[j].as_ref();
-                    let across = r.is_some_and(|r| r.crosser);
-                    let rf = &group_facts[j];
-                    let half = if across { rf.width.max(0.5) / 2.0 } else { rf.length / 2.0 };
-                    extent_of(&stations[j], half, rf.speed, r.map_or(1, |r| r.lane), d.arm)
-                }
-                _ if d.arm == Arm::Ego => ego_extent,
-                _ => Extent::stop_line(),
-            };
-            // a crossing ahead of a moving ego, on a road without a junction, is where the
-            // walkers reach the ego's lane when the ego does
-            let mut min_first = f64::NEG_INFINITY;
-            if d.crosser
-                && d.arm == Arm::Ego
-                && road.junction.is_none()
-                && d.target == Target::Ego
-                && d.distance.is_none()
-                && f.speed > 0.0
-                && !ego_facts.is_static()
-            {
-                let start = road.curb(match d.facing {
-                    Facing::Across { from } => from,
-                    _ => Side::Right,
-                });
-                let walk = ((start - road.lateral(ego_lane)).abs() + 1.0) / f.speed;
-                min_first = (ego_facts.speed * walk + ego_len / 2.0).min(MAX_REACH);
-            }
-            let (placed, room) = place_group(road, d, f, reference, min_first, occupied);
-            stations[i] = placed;
-            slack[i] = room;
         }
     };
-    place_arm(true, &road, &mut stations, &mut slack, &mut occupied);
-    if road.junction.is_some() {
-        // a queue ahead waits at the stop line; a moving ego is a few seconds away
-        let ahead: Vec<(f64, bool, bool)> = decisions
-            .iter()
-            .enumerate()
-            .filter(|(_, d)| d.as_ref().is_some_and(|d| d.arm == Arm::Ego && !d.crosser))
-            .flat_map(|(i, d)| {
-                let f = &group_facts[i];
-                // moving traffic in the opposite lanes comes from the opposite arm; what stands
-                // there is before the junction too
-                let incoming = d.as_ref().is_some_and(|d| d.lane > 0);
-                if !incoming && !f.is_static() {
-                    return Vec::new();
-                }
-                let queued = incoming && f.is_static() && f.motion != Some(Motion::Parked) && f.body == Body::Vehicle;
-                // what turns at the junction is before it too (only straight traffic moves across)
-                let before = f.is_static() || turn_of(f.motion) != Turn::Straight || road.opposite == 0;
-                stations[i].iter().map(|(s, _)| (s.along + f.length / 2.0, before, queued)).collect()
-            })
-            .filter(|(front, _, _)| *front > 0.0)
-            .collect();
-        // moving traffic ahead drives on through the junction; what stands waits before it
-        // a queue of stopped vehicles ends at the stop line; what stands elsewhere stays
-        // before it
-        let front = |which: fn(&(f64, bool, bool)) -> bool| {
-            ahead.iter().filter(|a| which(a)).map(|a| a.0).fold(ego_len / 2.0, f64::max)
-        };
-        let queue = ahead.iter().any(|a| a.2);
-        // on a one-way road the road across the junction may not go on: all of it waits
-        let standing = if road.opposite == 0 { front(|_| true) + 1.0 } else { 0.0 };
-        let standing = standing.max(front(|a| a.1) + 1.0);
-        let base = (ego_facts.speed * APPROACH_TIME).clamp(6.0, 40.0) + ego_len / 2.0;
-        road.approach = if queue { front(|a| a.2) + 1.0 } else { base }.max(standing).max(6.0);
-        // crossers on the ego's road near the junction use its crosswalk
-        for (i, d) in decisions.iter().enumerate() {
-            let Some(d) = d.as_ref().filter(|d| d.arm == Arm::Ego && d.crosser) else { continue };
-            let Some(first) = stations[i].first().map(|(s, _)| s.along) else { continue };
-            if first > road.approach - 8.0 || d.target == Target::Ego {
-                let shift = road.approach + CROSSWALK - first;
-                for (s, _) in &mut stations[i] {
-                    s.along += shift;
-                }
-            }
-        }
-    }
-    if let Some(half) =
-        road.junction.as_ref().filter(|j| j.arms.contains(&Arm::Opposite) && road.opposite > 0).map(|j| j.half)
-    {
-        // moving traffic ahead past the stop line is already across the junction: all of it
-        // moves on by the same distance, so that none is inside the junction and their
-        // relations hold
-        let beyond = |i: usize| {
-            let f = &group_facts[i];
-            decisions[i].as_ref().is_some_and(|d| d.arm == Arm::Ego && d.lane > 0 && !d.crosser)
-                && !f.is_static()
-                && f.body == Body::Vehicle
-                && turn_of(f.motion) == Turn::Straight
-        };
-        let exit = road.approach + 2.0 * half;
-        let mut push: f64 = 0.0;
-        for i in (0..stations.len()).filter(|&i| beyond(i)) {
-            let len = group_facts[i].length;
-            for (s, _) in stations[i].iter().filter(|(s, _)| s.along + len / 2.0 > road.approach - 0.5) {
-                push = push.max(exit + len / 2.0 + 0.5 - s.along);
-            }
-        }
-        for i in (0..stations.len()).filter(|&i| beyond(i)) {
-            let f = &group_facts[i];
-            let lane = decisions[i].as_ref().map_or(1, |d| d.lane);
-            for (s, _) in stations[i].iter_mut().filter(|(s, _)| s.along + f.length / 2.0 > road.approach - 0.5) {
-                let along = s.along + push - exit;
-                *s = Station { arm: Arm::Opposite, along };
-                occupied.entry((Arm::Opposite, Key::Lane(-lane))).or_default().push((
-                    along - f.length / 2.0,
-                    along + f.length / 2.0,
-                    f.speed,
-                ));
-            }
-        }
-    }
-    place_arm(false, &road, &mut stations, &mut slack, &mut occupied);
-    // --- agents, paths and timing; a walker that cannot reach a junction's crossing in
-    // time moves the ego's start back
-    let mut built = build(scenario, &road, &decisions, &group_facts, &stations, &slack, &ids, ego_lane, &ego_facts);
-    for _ in 0..3 {
-        if road.junction.is_none() || built.late <= 0.05 {
-            break;
-        }
-        let delta = (built.late * ego_facts.speed + 1.0).min(MAX_REACH - road.approach);
-        if delta <= 0.0 {
-            break;
-        }
-        road.approach += delta;
-        // walkers at the ego's crosswalk stay at it
-        for (i, d) in decisions.iter().enumerate() {
-            if d.as_ref().is_some_and(|d| d.arm == Arm::Ego && d.crosser) {
-                for (s, _) in &mut stations[i] {
-                    s.along += delta;
-                }
-            }
-        }
-        built = build(scenario, &road, &decisions, &group_facts, &stations, &slack, &ids, ego_lane, &ego_facts);
-    }
-    let Built { ego, groups, conflicts, .. } = built;
-
-    findings.extend(chosen.into_iter().map(Finding::Chosen));
-    Layout { road, ego, ego_facts, groups, conflicts, findings }
+    (lane, lateral, Pose { yaw, ..pose })
 }
 
 struct Built {
@@ -535,129 +855,6 @@ struct Built {
     conflicts: Vec<Conflict>,
     /// How late the latest crossing walker is for its conflict, s.
     late: f64,
-}
-
-#[allow(clippy::too_many_arguments)]
-fn build(
-    scenario: &Scenario,
-    road: &Road,
-    decisions: &[Option<Decision>],
-    group_facts: &[Facts],
-    stations: &[Vec<(Station, f64)>],
-    slack: &[f64],
-    ids: &[GroupId],
-    ego_lane: i64,
-    ego_facts: &Facts,
-) -> Built {
-    let ego_len = ego_facts.length;
-    let ego_turn = turn_of(ego_facts.motion);
-    let ego_station = Station { arm: Arm::Ego, along: 0.0 };
-    let mut ego = Agent {
-        group: None,
-        index: 0,
-        body: Body::Vehicle,
-        length: ego_len,
-        width: ego_facts.width,
-        station: ego_station,
-        lane: ego_lane,
-        place: Place::Lane,
-        lateral: road.lateral(ego_lane),
-        facing: Facing::Along,
-        motion: ego_facts.motion,
-        turn: ego_turn,
-        speed: if ego_facts.is_static() { 0.0 } else { ego_facts.speed },
-        moving: !ego_facts.is_static(),
-        start: Start::default(),
-        pose: road.lane_pose(ego_station, ego_lane),
-        path: Path::default(),
-        path_start: 0.0,
-    };
-    let mut groups: Vec<GroupLayout> = Vec::new();
-    for (i, group) in scenario.groups.iter().enumerate() {
-        let f = group_facts[i].clone();
-        let Some(d) = decisions[i].as_ref() else { continue };
-        let delay = group.delay.given().map_or(0.0, |p| p.nominal().0.max(0.0));
-        let trigger = group.trigger.given().map(|p| p.nominal().0.max(0.0));
-        let waits = delay > 0.0 || trigger.is_some();
-        let agents = stations[i]
-            .iter()
-            .enumerate()
-            .map(|(k, &(station, lateral))| {
-                // moved across the junction: an outgoing lane of the opposite arm
-                let moved = station.arm != d.arm;
-                let lane = if moved { -d.lane } else { d.lane };
-                let lateral = if moved { road.lateral(lane) } else { lateral };
-                let yaw_of = |pose: Pose| match d.facing {
-                    Facing::Along => pose.yaw,
-                    Facing::Across { from } => {
-                        let base = if station.arm == Arm::Ego { road.lane_pose(station, 1).yaw } else { pose.yaw };
-                        let base = if station.arm != Arm::Ego && lane < 0 { base + std::f64::consts::PI } else { base };
-                        match from {
-                            Side::Right => base + std::f64::consts::FRAC_PI_2,
-                            Side::Left => base - std::f64::consts::FRAC_PI_2,
-                        }
-                    }
-                };
-                let pose = road.pose_at(station, if d.crosser { 1 } else { lane }, lateral);
-                let pose = Pose { yaw: yaw_of(pose), ..pose };
-                Agent {
-                    group: Some(ids[i]),
-                    index: k,
-                    body: f.body,
-                    length: f.length,
-                    width: f.width,
-                    station,
-                    lane,
-                    place: d.place,
-                    lateral,
-                    facing: d.facing,
-                    motion: f.motion,
-                    turn: turn_of(f.motion),
-                    speed: if f.is_static() { 0.0 } else { f.speed },
-                    moving: !f.is_static() && !waits && f.body == Body::Vehicle,
-                    start: Start { delay, trigger },
-                    pose,
-                    path: Path::default(),
-                    path_start: 0.0,
-                }
-            })
-            .collect();
-        groups.push(GroupLayout { group: ids[i], facts: f, agents, slack: slack[i] });
-    }
-    let obstacles: Vec<(i64, f64, f64)> = groups
-        .iter()
-        .flat_map(|g| &g.agents)
-        .filter(|a| {
-            a.is_static() && a.station.arm == Arm::Ego && a.place != Place::Sidewalk && a.facing == Facing::Along
-        })
-        .map(|a| (a.lane, a.station.along - a.length / 2.0, a.station.along + a.length / 2.0))
-        .collect();
-    paths(road, &mut ego, &obstacles);
-    for g in &mut groups {
-        for a in &mut g.agents {
-            paths(road, a, &obstacles);
-        }
-    }
-
-    // --- timing
-    let mut conflicts = Vec::new();
-    let mut late: f64 = 0.0;
-    if ego.moving && ego.speed > 0.5 {
-        for (i, g) in groups.iter_mut().enumerate() {
-            let Some(d) = decisions[i].as_ref() else { continue };
-            let written_timing =
-                d.distance.is_some() || scenario.groups[i].delay.is_given() || scenario.groups[i].trigger.is_given();
-            if written_timing || g.facts.is_static() || g.agents.is_empty() {
-                continue;
-            }
-            if let Some((conflict, lateness)) = time_group(road, &ego, d, g) {
-                conflicts.push(conflict);
-                late = late.max(lateness);
-            }
-        }
-    }
-
-    Built { ego, groups, conflicts, late }
 }
 
 /// What is taken along each arm and lane: (from, to, speed of what is there).
@@ -731,44 +928,87 @@ fn place_group(
     min_first: f64,
     occupied: &mut Occupied,
 ) -> (Vec<(Station, f64)>, f64) {
-    let forward = reference.forward;
-    // the way the group extends from its reference, in stations
-    let step = match d.longitudinal {
-        _ if reference.stop_line => 1.0,
-        Longitudinal::Behind => -forward,
-        _ => forward,
-    };
-    let across = matches!(d.facing, Facing::Across { .. });
-    let extent = if across { f.width.max(0.5) } else { f.length };
-    let spacing = if across { WALKER_SPACING.max(f.width + 0.3) } else { f.length + gap(f, f.speed) };
-    let lead = match d.distance {
-        Some((_, high)) => high,
-        None if (reference.speed <= 0.0 || reference.lane != d.lane) && f.is_static() => gap(f, 0.0),
-        None if across => 1.0,
-        None if reference.stop_line && !f.is_static() => 1.0 + 0.5 * f.speed,
-        None if reference.stop_line => 1.0,
-        None => gap(f, reference.speed),
-    };
-    let room = match d.distance {
-        Some((low, high)) => high - low,
-        None => (lead * 0.25).min(5.0),
-    };
-    let lead = if d.distance.is_some() { lead } else { lead + room };
-    let edge = if step > 0.0 { reference.high } else { reference.low };
-    let first = match d.longitudinal {
-        _ if reference.stop_line && across => -CROSSWALK,
-        Longitudinal::Same if !reference.stop_line => (reference.low + reference.high) / 2.0,
-        _ => edge + step * (lead + extent / 2.0),
-    };
-    // on another arm nothing stands inside the junction: what would, goes behind its reference
-    let (first, step) = if d.arm != Arm::Ego && !across && first - extent / 2.0 < 0.5 {
-        (reference.high.max(0.0) + lead + extent / 2.0, 1.0)
+    let placing = Placing::new(road, d, f, reference);
+    if placing.across {
+        let first = placing.clear_strip(min_first, occupied);
+        placing.walkers(first, occupied)
     } else {
-        (first, step)
-    };
-    // walkers across stand in rows of four along the sidewalk, further back row by row
-    let side_lateral = |side: Side, row: usize| {
-        let curb = match (d.arm, side) {
+        placing.along(occupied)
+    }
+}
+
+/// What placing one group's actors shares: the group, its first station, and the way and
+/// spacing its actors follow one another.
+struct Placing<'p> {
+    road: &'p Road,
+    d: &'p Decision,
+    f: &'p Facts,
+    /// Walkers about to cross, side by side along the sidewalk.
+    across: bool,
+    /// The way the group extends from its reference, in stations.
+    step: f64,
+    /// An actor's size along the arm, and the distance from one actor to the next.
+    extent: f64,
+    spacing: f64,
+    /// The first actor's station before anything already there moves it on.
+    first: f64,
+    /// The free room kept between the group and its reference.
+    room: f64,
+    /// What the group occupies along its arm.
+    key: Key,
+}
+
+impl<'p> Placing<'p> {
+    /// The group's first station and spacing, from its reference and its distance (written,
+    /// else a gap that grows with speed, with some room kept).
+    fn new(road: &'p Road, d: &'p Decision, f: &'p Facts, reference: Extent) -> Placing<'p> {
+        let forward = reference.forward;
+        let step = match d.longitudinal {
+            _ if reference.stop_line => 1.0,
+            Longitudinal::Behind => -forward,
+            _ => forward,
+        };
+        let across = matches!(d.facing, Facing::Across { .. });
+        let extent = if across { f.width.max(0.5) } else { f.length };
+        let spacing = if across { WALKER_SPACING.max(f.width + 0.3) } else { f.length + gap(f, f.speed) };
+        let lead = match d.distance {
+            Some((_, high)) => high,
+            None if (reference.speed <= 0.0 || reference.lane != d.lane) && f.is_static() => gap(f, 0.0),
+            None if across => 1.0,
+            None if reference.stop_line && !f.is_static() => 1.0 + 0.5 * f.speed,
+            None if reference.stop_line => 1.0,
+            None => gap(f, reference.speed),
+        };
+        let room = match d.distance {
+            Some((low, high)) => high - low,
+            None => (lead * 0.25).min(5.0),
+        };
+        let lead = if d.distance.is_some() { lead } else { lead + room };
+        let edge = if step > 0.0 { reference.high } else { reference.low };
+        let first = match d.longitudinal {
+            _ if reference.stop_line && across => -CROSSWALK,
+            Longitudinal::Same if !reference.stop_line => (reference.low + reference.high) / 2.0,
+            _ => edge + step * (lead + extent / 2.0),
+        };
+        // on another arm nothing stands inside the junction: what would, goes behind its reference
+        let (first, step) = if d.arm != Arm::Ego && !across && first - extent / 2.0 < 0.5 {
+            (reference.high.max(0.0) + lead + extent / 2.0, 1.0)
+        } else {
+            (first, step)
+        };
+        let key = match (d.facing, d.place) {
+            (Facing::Across { from }, _) => Key::Sidewalk(from),
+            (_, Place::Sidewalk) => Key::Sidewalk(if d.lane > 0 { Side::Right } else { Side::Left }),
+            _ => Key::Lane(d.lane),
+        };
+        Placing { road, d, f, across, step, extent, spacing, first, room, key }
+    }
+
+    /// The lateral offset of a walker across in row `row` on the sidewalk on side `side`:
+    /// rows further back, row by row.
+    fn side_lateral(&self, side: Side, row: usize) -> f64 {
+        let (road, f) = (self.road, self.f);
+        let curb = match (self.d.arm, side) {
             (Arm::Ego, s) => road.curb(s),
             (arm, Side::Right) => -(road.arm_lanes(arm).0 as f64) * road.lane_width,
             (arm, Side::Left) => road.arm_lanes(arm).1 as f64 * road.lane_width,
@@ -777,8 +1017,11 @@ fn place_group(
             + f.length / 2.0
             + row as f64 * (f.length + 0.3);
         if side == Side::Right { curb - out } else { curb + out }
-    };
-    let lane_lateral = |place: Place| {
+    }
+
+    /// The lateral offset of an actor along its lane at `place` there.
+    fn lane_lateral(&self, place: Place) -> f64 {
+        let (road, d, f) = (self.road, self.d, self.f);
         let centre = road.lateral(d.lane);
         match place {
             Place::Lane => centre,
@@ -792,23 +1035,21 @@ fn place_group(
                 let outward = if d.lane > 0 && !d.curb_left { -1.0 } else { 1.0 };
                 centre + outward * shift
             }
-            Place::Sidewalk => side_lateral(if d.lane > 0 { Side::Right } else { Side::Left }, 0),
+            Place::Sidewalk => self.side_lateral(if d.lane > 0 { Side::Right } else { Side::Left }, 0),
         }
-    };
-    let key = match (d.facing, d.place) {
-        (Facing::Across { from }, _) => Key::Sidewalk(from),
-        (_, Place::Sidewalk) => Key::Sidewalk(if d.lane > 0 { Side::Right } else { Side::Left }),
-        _ => Key::Lane(d.lane),
-    };
-    if across {
-        // the strip the walkers cross is clear in every lane of the arm: move it on until it is
-        let columns = f.count.min(4) as f64;
+    }
+
+    /// Walkers about to cross: the first column's station, not before `min_first` and moved
+    /// on until the strip they cross is clear in every lane of the arm, which it then takes.
+    fn clear_strip(&self, min_first: f64, occupied: &mut Occupied) -> f64 {
+        let (d, step, extent, spacing) = (self.d, self.step, self.extent, self.spacing);
+        let columns = self.f.count.min(4) as f64;
         let strip = |first: f64| {
             let ends =
                 [first - step * (extent / 2.0 + 0.3), first + step * ((columns - 1.0) * spacing + extent / 2.0 + 0.3)];
             (ends[0].min(ends[1]), ends[0].max(ends[1]))
         };
-        let mut first_at = if step > 0.0 { first.max(min_first) } else { first };
+        let mut first_at = if step > 0.0 { self.first.max(min_first) } else { self.first };
         for _ in 0..200 {
             let (lo, hi) = strip(first_at);
             let blocking = occupied
@@ -824,64 +1065,83 @@ fn place_group(
             }
         }
         let (lo, hi) = strip(first_at);
-        let (incoming, outgoing) = road.arm_lanes(d.arm);
+        let (incoming, outgoing) = self.road.arm_lanes(d.arm);
         for lane in (-i64::from(outgoing)..=i64::from(incoming)).filter(|l| *l != 0) {
             occupied.entry((d.arm, Key::Lane(lane))).or_default().push((lo, hi, 0.0));
         }
-        return place_walkers(d, f, first_at, step, spacing, occupied, key, side_lateral);
+        first_at
     }
-    let list = occupied.entry((d.arm, key)).or_default();
-    let mut out = Vec::new();
-    let mut centre = first;
-    for k in 0..f.count {
-        let (row, column) = if across { (k / 4, k % 4) } else { (0, k) };
-        let along = if across { first + step * column as f64 * spacing } else { centre };
-        // never on top of what is already there: move on, away from the reference (beside
-        // it, whichever way is nearer)
-        let free = |start: f64, way: f64| {
-            let mut along = start;
-            for _ in 0..200 {
-                // a vehicle keeps its headway to what it shares the lane with, moving or not
-                let keep = |speed: f64| {
-                    if f.body == Body::Vehicle && (speed > 0.0 || f.speed > 0.0) {
-                        2.0 + speed.max(f.speed)
-                    } else {
-                        0.5
-                    }
-                };
-                let (lo, hi) = (along - extent / 2.0, along + extent / 2.0);
-                match list.iter().find(|(a, b, speed)| lo - keep(*speed) + 0.25 < *b && *a < hi + keep(*speed) - 0.25) {
-                    Some(&(a, b, speed)) if !across || row == 0 => {
-                        let keep = keep(speed);
-                        along = if way > 0.0 { b + extent / 2.0 + keep } else { a - extent / 2.0 - keep };
-                    }
-                    _ => break,
+
+    /// Walkers about to cross, from `first`: in rows of four along the sidewalk, row after
+    /// row further back.
+    fn walkers(&self, first: f64, occupied: &mut Occupied) -> (Vec<(Station, f64)>, f64) {
+        let (d, f) = (self.d, self.f);
+        let Facing::Across { from } = d.facing else { return (Vec::new(), 0.0) };
+        let list = occupied.entry((d.arm, self.key)).or_default();
+        let out: Vec<(Station, f64)> = (0..f.count)
+            .map(|k| {
+                let along = first + self.step * (k % 4) as f64 * self.spacing;
+                (Station { arm: d.arm, along }, self.side_lateral(from, k / 4))
+            })
+            .collect();
+        for (s, _) in &out {
+            list.push((s.along - f.width / 2.0, s.along + f.width / 2.0, 0.0));
+        }
+        (out, 0.0)
+    }
+
+    /// Actors along a lane (or its curb or sidewalk), one after another from the first, each
+    /// where it touches nothing already there; with the room kept.
+    fn along(&self, occupied: &mut Occupied) -> (Vec<(Station, f64)>, f64) {
+        let (d, f) = (self.d, self.f);
+        let list = occupied.entry((d.arm, self.key)).or_default();
+        let mut out = Vec::new();
+        let mut centre = self.first;
+        for k in 0..f.count {
+            // never on top of what is already there: move on, away from the reference (beside
+            // it, whichever way is nearer)
+            let mut along = self.free(list, centre, self.step);
+            if d.longitudinal == Longitudinal::Same && k == 0 {
+                let back = self.free(list, self.first, -self.step);
+                if (back - self.first).abs() < (along - self.first).abs() {
+                    along = back;
                 }
             }
-            along
+            list.push((
+                along - self.extent / 2.0,
+                along + self.extent / 2.0,
+                if f.is_static() { 0.0 } else { f.speed },
+            ));
+            out.push((Station { arm: d.arm, along }, self.lane_lateral(d.place)));
+            centre = along + self.step * self.spacing;
+        }
+        (out, if d.longitudinal == Longitudinal::Same { 0.0 } else { self.room })
+    }
+
+    /// The first station from `start`, going `way`, where an actor touches nothing in `list`:
+    /// a vehicle keeps its headway to what it shares the lane with, moving or not.
+    fn free(&self, list: &[(f64, f64, f64)], start: f64, way: f64) -> f64 {
+        let (f, extent) = (self.f, self.extent);
+        let keep = |speed: f64| {
+            if f.body == Body::Vehicle && (speed > 0.0 || f.speed > 0.0) { 2.0 + speed.max(f.speed) } else { 0.5 }
         };
-        let mut along = free(along, step);
-        if d.longitudinal == Longitudinal::Same && k == 0 {
-            let back = free(first, -step);
-            if (back - first).abs() < (along - first).abs() {
-                along = back;
+        let mut along = start;
+        for _ in 0..200 {
+            let (lo, hi) = (along - extent / 2.0, along + extent / 2.0);
+            match list.iter().find(|(a, b, speed)| lo - keep(*speed) + 0.25 < *b && *a < hi + keep(*speed) - 0.25) {
+                Some(&(a, b, speed)) => {
+                    let keep = keep(speed);
+                    along = if way > 0.0 { b + extent / 2.0 + keep } else { a - extent / 2.0 - keep };
+                }
+                None => break,
             }
         }
-        let lateral = match d.facing {
-            Facing::Across { from } => side_lateral(from, row),
-            Facing::Along => lane_lateral(d.place),
-        };
-        if !across || row == 0 {
-            list.push((along - extent / 2.0, along + extent / 2.0, if f.is_static() { 0.0 } else { f.speed }));
-        }
-        out.push((Station { arm: d.arm, along }, lateral));
-        centre = along + step * spacing;
+        along
     }
-    (out, if d.longitudinal == Longitudinal::Same { 0.0 } else { room })
 }
 
 /// The agent's path and its start on it.
-fn paths(road: &Road, a: &mut Agent, obstacles: &[(i64, f64, f64)]) {
+fn path_of(road: &Road, a: &mut Agent, obstacles: &[(i64, f64, f64)]) {
     let heading = Vec2::from_yaw(a.pose.yaw);
     match (a.body, a.facing) {
         (_, Facing::Across { .. }) => {
@@ -1048,30 +1308,4 @@ fn time_group(road: &Road, ego: &Agent, d: &Decision, g: &mut GroupLayout) -> Op
 fn sample_path(path: &Path, from: f64, to: f64) -> Vec<Vec2> {
     let n = ((to - from).max(0.0).ceil() as usize).clamp(1, 4000);
     (0..=n).map(|k| path.pose(from + (to - from) * k as f64 / n as f64).position).collect()
-}
-
-/// Walkers about to cross: in rows of four along the sidewalk, row after row further back.
-#[allow(clippy::too_many_arguments)]
-fn place_walkers(
-    d: &Decision,
-    f: &Facts,
-    first: f64,
-    step: f64,
-    spacing: f64,
-    occupied: &mut Occupied,
-    key: Key,
-    side_lateral: impl Fn(Side, usize) -> f64,
-) -> (Vec<(Station, f64)>, f64) {
-    let Facing::Across { from } = d.facing else { return (Vec::new(), 0.0) };
-    let list = occupied.entry((d.arm, key)).or_default();
-    let out: Vec<(Station, f64)> = (0..f.count)
-        .map(|k| {
-            let along = first + step * (k % 4) as f64 * spacing;
-            (Station { arm: d.arm, along }, side_lateral(from, k / 4))
-        })
-        .collect();
-    for (s, _) in &out {
-        list.push((s.along - f.width / 2.0, s.along + f.width / 2.0, 0.0));
-    }
-    (out, 0.0)
 }

@@ -108,207 +108,249 @@ impl Strip<'_> {
 
 /// The road near `view`: see the module's header.
 pub fn draw(scene: &Scene, view: &Bounds) -> Map {
-    let road = scene.road;
-    let w = if road.lane_width.is_finite() && road.lane_width > 0.0 { road.lane_width } else { 3.5 };
-    let junction = road.junction.as_ref();
-    let roundabout = junction.is_some_and(|j| j.roundabout);
-    let half = junction.map_or(0.0, |j| j.half.max(0.0));
-    let present = |arm: Arm| road.has_arm(arm);
-    // a curb's distance from an arm's centre line on the side towards `toward`
-    let ext = |arm: Arm, toward: Vec2| {
-        let (incoming, outgoing) = road.arm_lanes(arm);
-        let left = (-arm.outward()).left();
-        if left.dot(toward) > 0.0 { outgoing as f64 * w } else { incoming as f64 * w }
-    };
-    let reach = (road.lanes.max(road.opposite).max(road.cross_lanes) as f64) * w + SIDEWALK_WIDTH + NEAR;
-    let window = view.grown(reach);
-
-    let arms: Vec<Arm> =
-        if junction.is_some() { CCW.into_iter().filter(|a| present(*a)).collect() } else { vec![Arm::Ego] };
-    let strips: Vec<Strip> = arms
-        .iter()
-        .filter_map(|&arm| {
-            let (incoming, outgoing) = road.arm_lanes(arm);
-            if incoming + outgoing == 0 {
-                return None;
-            }
-            // the range of s, from the crossing road's far curb (at a junction) outwards
-            let domain = match junction {
-                None => (-RUN, RUN),
-                Some(_) => {
-                    let beyond = CCW
-                        .into_iter()
-                        .filter(|p| present(*p) && p.outward().dot(arm.outward()).abs() < 0.5)
-                        .map(|p| ext(p, -arm.outward()))
-                        .fold(0.0, f64::max);
-                    let far = if arm == Arm::Ego { road.approach + half + RUN } else { half + RUN };
-                    (-beyond.min(half), far)
-                }
-            };
-            let mut strip =
-                Strip { road, arm, lo: -(incoming as f64) * w, hi: outgoing as f64 * w, near: (domain.0, domain.1) };
-            let mut near: Option<(f64, f64)> = None;
-            let mut s = domain.0;
-            while s <= domain.1 {
-                if window.contains(strip.at(s, 0.0)) {
-                    near = Some(near.map_or((s, s), |(a, _)| (a, s)));
-                }
-                s += 1.0;
-            }
-            let (a, b) = near?;
-            strip.near = ((a - 1.0).max(domain.0), (b + 1.0).min(domain.1));
-            Some(strip)
-        })
-        .collect();
-
+    let painter = Painter::new(scene, view);
     let mut items = Vec::new();
-    let area = |items: &mut Vec<Item>, class, points: Option<Vec<Vec2>>, colour| {
-        if let Some(points) = points {
-            items.push(Item::Area { class, points, colour });
-        }
-    };
-    let line = |items: &mut Vec<Item>, class, points: Option<Vec<Vec2>>, colour, width, dash| {
-        if let Some(points) = points {
-            items.push(Item::Line { class, points, colour, width, dash });
-        }
-    };
-    // where an arm's own markings start: the box's edge, or the whole road
-    let outer = if junction.is_some() { half } else { f64::NEG_INFINITY };
-    let centre = road.centre();
-    let ring_outer = half.max(half * RING + palette::RING_LANES * w / 2.0);
+    if painter.road.sidewalks {
+        painter.sidewalks(&mut items);
+    }
+    painter.asphalt(&mut items);
+    painter.markings(&mut items);
+    if painter.road.crosswalks {
+        painter.crosswalks(&mut items);
+    }
+    let signals = painter.stop_lines(&mut items);
+    Map { items, signals }
+}
 
-    // --- sidewalks
-    if road.sidewalks {
-        for st in &strips {
-            area(
-                &mut items,
-                "sidewalk",
-                st.area(outer, f64::INFINITY, st.lo - SIDEWALK_WIDTH, st.lo),
-                palette::SIDEWALK,
-            );
-            area(
-                &mut items,
-                "sidewalk",
-                st.area(outer, f64::INFINITY, st.hi, st.hi + SIDEWALK_WIDTH),
-                palette::SIDEWALK,
-            );
+/// What painting the road's layers shares: the road, its sizes, and its arms' strips near
+/// the view.
+struct Painter<'a> {
+    scene: &'a Scene<'a>,
+    road: &'a Road,
+    /// The lane width, m.
+    w: f64,
+    junction: bool,
+    roundabout: bool,
+    /// Half the junction's box, m (0 without a junction).
+    half: f64,
+    /// Where an arm's own markings start: the box's edge, or the whole road.
+    outer: f64,
+    centre: Vec2,
+    /// The roundabout's ring's outer radius, m.
+    ring_outer: f64,
+    strips: Vec<Strip<'a>>,
+}
+
+impl<'a> Painter<'a> {
+    fn new(scene: &'a Scene<'a>, view: &Bounds) -> Painter<'a> {
+        let road = scene.road;
+        let w = if road.lane_width.is_finite() && road.lane_width > 0.0 { road.lane_width } else { 3.5 };
+        let junction = road.junction.as_ref();
+        let half = junction.map_or(0.0, |j| j.half.max(0.0));
+        let mut painter = Painter {
+            scene,
+            road,
+            w,
+            junction: junction.is_some(),
+            roundabout: junction.is_some_and(|j| j.roundabout),
+            half,
+            outer: if junction.is_some() { half } else { f64::NEG_INFINITY },
+            centre: road.centre(),
+            ring_outer: half.max(half * RING + palette::RING_LANES * w / 2.0),
+            strips: Vec::new(),
+        };
+        painter.strips = painter.strips(view);
+        painter
+    }
+
+    /// A curb's distance from an arm's centre line on the side towards `toward`.
+    fn ext(&self, arm: Arm, toward: Vec2) -> f64 {
+        let (incoming, outgoing) = self.road.arm_lanes(arm);
+        let left = (-arm.outward()).left();
+        if left.dot(toward) > 0.0 { outgoing as f64 * self.w } else { incoming as f64 * self.w }
+    }
+
+    /// The strips of the arms that have lanes and come near the view.
+    fn strips(&self, view: &Bounds) -> Vec<Strip<'a>> {
+        let road = self.road;
+        let reach = (road.lanes.max(road.opposite).max(road.cross_lanes) as f64) * self.w + SIDEWALK_WIDTH + NEAR;
+        let window = view.grown(reach);
+        let arms: Vec<Arm> =
+            if self.junction { CCW.into_iter().filter(|a| road.has_arm(*a)).collect() } else { vec![Arm::Ego] };
+        arms.iter().filter_map(|&arm| self.strip(arm, &window)).collect()
+    }
+
+    /// An arm's strip, if it has lanes and comes into `window`.
+    fn strip(&self, arm: Arm, window: &Bounds) -> Option<Strip<'a>> {
+        let road = self.road;
+        let (incoming, outgoing) = road.arm_lanes(arm);
+        if incoming + outgoing == 0 {
+            return None;
         }
-        if junction.is_some() && roundabout {
+        // the range of s, from the crossing road's far curb (at a junction) outwards
+        let domain = if self.junction {
+            let beyond = CCW
+                .into_iter()
+                .filter(|p| road.has_arm(*p) && p.outward().dot(arm.outward()).abs() < 0.5)
+                .map(|p| self.ext(p, -arm.outward()))
+                .fold(0.0, f64::max);
+            let far = if arm == Arm::Ego { road.approach + self.half + RUN } else { self.half + RUN };
+            (-beyond.min(self.half), far)
+        } else {
+            (-RUN, RUN)
+        };
+        let mut strip = Strip {
+            road,
+            arm,
+            lo: -(incoming as f64) * self.w,
+            hi: outgoing as f64 * self.w,
+            near: (domain.0, domain.1),
+        };
+        let mut near: Option<(f64, f64)> = None;
+        let mut s = domain.0;
+        while s <= domain.1 {
+            if window.contains(strip.at(s, 0.0)) {
+                near = Some(near.map_or((s, s), |(a, _)| (a, s)));
+            }
+            s += 1.0;
+        }
+        let (a, b) = near?;
+        strip.near = ((a - 1.0).max(domain.0), (b + 1.0).min(domain.1));
+        Some(strip)
+    }
+
+    /// Sidewalks along each arm, then round the roundabout or the junction's corners.
+    fn sidewalks(&self, items: &mut Vec<Item>) {
+        for st in &self.strips {
+            let right = st.area(self.outer, f64::INFINITY, st.lo - SIDEWALK_WIDTH, st.lo);
+            area(items, "sidewalk", right, palette::SIDEWALK);
+            let left = st.area(self.outer, f64::INFINITY, st.hi, st.hi + SIDEWALK_WIDTH);
+            area(items, "sidewalk", left, palette::SIDEWALK);
+        }
+        if self.junction && self.roundabout {
             items.push(Item::Disc {
                 class: "sidewalk",
-                centre,
-                radius: ring_outer + SIDEWALK_WIDTH,
+                centre: self.centre,
+                radius: self.ring_outer + SIDEWALK_WIDTH,
                 colour: palette::SIDEWALK,
             });
-        } else if junction.is_some() {
-            for (i, &a) in CCW.iter().enumerate() {
-                let b = CCW[(i + 1) % 4];
-                let (ua, ub) = (a.outward(), b.outward());
-                if present(a) && present(b) {
-                    // a band round the corner, joining the two arms' sidewalks
-                    let (rx, ry) = (half - ext(b, ua), half - ext(a, ub));
-                    if rx > 0.0 && ry > 0.0 {
-                        let k = centre + (ua + ub) * half;
-                        let mut points = quarter(k, ua, ub, rx, ry);
-                        let inner = quarter(k, ua, ub, (rx - SIDEWALK_WIDTH).max(0.0), (ry - SIDEWALK_WIDTH).max(0.0));
-                        points.extend(inner.into_iter().rev());
-                        items.push(Item::Area { class: "sidewalk", points, colour: palette::SIDEWALK });
-                    }
-                }
-            }
-            // where an arm is missing, the crossing road's sidewalk runs past it
-            for m in CCW.into_iter().filter(|m| !present(*m)) {
-                if let Some((e, along)) = past_missing(road, m, &ext) {
-                    let (um, up) = (m.outward(), along);
-                    let points = vec![
-                        centre + um * e + up * half,
-                        centre + um * (e + SIDEWALK_WIDTH) + up * half,
-                        centre + um * (e + SIDEWALK_WIDTH) - up * half,
-                        centre + um * e - up * half,
-                    ];
+        } else if self.junction {
+            self.corner_sidewalks(items);
+        }
+    }
+
+    /// A band round each corner of the junction, joining two arms' sidewalks; where an arm
+    /// is missing, the crossing road's sidewalk runs past it.
+    fn corner_sidewalks(&self, items: &mut Vec<Item>) {
+        let (centre, half) = (self.centre, self.half);
+        for (i, &a) in CCW.iter().enumerate() {
+            let b = CCW[(i + 1) % 4];
+            let (ua, ub) = (a.outward(), b.outward());
+            if self.road.has_arm(a) && self.road.has_arm(b) {
+                let (rx, ry) = (half - self.ext(b, ua), half - self.ext(a, ub));
+                if rx > 0.0 && ry > 0.0 {
+                    let k = centre + (ua + ub) * half;
+                    let mut points = quarter(k, ua, ub, rx, ry);
+                    let inner = quarter(k, ua, ub, (rx - SIDEWALK_WIDTH).max(0.0), (ry - SIDEWALK_WIDTH).max(0.0));
+                    points.extend(inner.into_iter().rev());
                     items.push(Item::Area { class: "sidewalk", points, colour: palette::SIDEWALK });
                 }
             }
         }
-    }
-
-    // --- asphalt
-    for st in &strips {
-        area(&mut items, "surface", st.area(f64::NEG_INFINITY, f64::INFINITY, st.lo, st.hi), palette::ASPHALT);
-    }
-    if junction.is_some() && roundabout {
-        items.push(Item::Disc { class: "surface", centre, radius: ring_outer, colour: palette::ASPHALT });
-        let island = (half * RING - palette::RING_LANES * w / 2.0).max(1.0);
-        items.push(Item::Disc { class: "island", centre, radius: island, colour: palette::ISLAND });
-        let mut ring: Vec<Vec2> = (0..=72)
-            .map(|k| centre + Vec2::from_yaw(k as f64 * std::f64::consts::TAU / 72.0) * (island + 0.3))
-            .collect();
-        ring.dedup();
-        line(&mut items, "edge-line", Some(ring), palette::MARKING, palette::LINE, None);
-    } else if junction.is_some() {
-        for (i, &a) in CCW.iter().enumerate() {
-            let b = CCW[(i + 1) % 4];
-            let (ua, ub) = (a.outward(), b.outward());
-            let (ea, eb) = (ext(a, ub), ext(b, ua));
-            let (rx, ry) = (half - eb, half - ea);
-            if present(a) && present(b) && rx > 0.0 && ry > 0.0 {
-                // the rounded corner: from the inner corner, round the quarter ellipse
-                let k = centre + (ua + ub) * half;
-                let mut points = vec![centre + ua * eb + ub * ea];
-                points.extend(quarter(k, ua, ub, rx, ry));
-                items.push(Item::Area { class: "surface", points, colour: palette::ASPHALT });
+        for m in CCW.into_iter().filter(|m| !self.road.has_arm(*m)) {
+            if let Some((e, along)) = past_missing(self.road, m, &|arm, toward| self.ext(arm, toward)) {
+                let (um, up) = (m.outward(), along);
+                let points = vec![
+                    centre + um * e + up * half,
+                    centre + um * (e + SIDEWALK_WIDTH) + up * half,
+                    centre + um * (e + SIDEWALK_WIDTH) - up * half,
+                    centre + um * e - up * half,
+                ];
+                items.push(Item::Area { class: "sidewalk", points, colour: palette::SIDEWALK });
             }
         }
     }
 
-    // --- markings along each arm
-    for st in &strips {
-        let (incoming, outgoing) = road.arm_lanes(st.arm);
-        let from = outer;
-        let to = f64::INFINITY;
-        let period = palette::DASH.0 + palette::DASH.1;
-        let dividers = (1..incoming).map(|k| -(k as f64) * w).chain((1..outgoing).map(|k| k as f64 * w));
-        for lateral in dividers {
-            line(
-                &mut items,
-                "lane-line",
-                st.dashed(from, to, lateral, period),
-                palette::MARKING,
-                palette::LINE,
-                Some(palette::DASH),
-            );
+    /// Asphalt over the sidewalks: each arm, then the roundabout's ring (with its island) or
+    /// the junction's rounded corners.
+    fn asphalt(&self, items: &mut Vec<Item>) {
+        let (centre, half, w) = (self.centre, self.half, self.w);
+        for st in &self.strips {
+            area(items, "surface", st.area(f64::NEG_INFINITY, f64::INFINITY, st.lo, st.hi), palette::ASPHALT);
         }
-        if incoming > 0 && outgoing > 0 {
-            let off = (palette::CENTRE_GAP + palette::LINE) / 2.0;
-            for lateral in [-off, off] {
-                line(&mut items, "centre-line", st.line(from, to, lateral), palette::CENTRE_LINE, palette::LINE, None);
-            }
-        }
-        for lateral in [st.lo + palette::EDGE_INSET, st.hi - palette::EDGE_INSET] {
-            line(&mut items, "edge-line", st.line(from, to, lateral), palette::MARKING, palette::LINE, None);
-        }
-    }
-    if junction.is_some() && !roundabout {
-        // the crossing road's edge line runs on past a missing arm
-        for m in CCW.into_iter().filter(|m| !present(*m)) {
-            if let Some((e, along)) = past_missing(road, m, &ext) {
-                let at = |t: f64| centre + m.outward() * (e - palette::EDGE_INSET) + along * t;
-                line(&mut items, "edge-line", Some(vec![at(-half), at(half)]), palette::MARKING, palette::LINE, None);
+        if self.junction && self.roundabout {
+            items.push(Item::Disc { class: "surface", centre, radius: self.ring_outer, colour: palette::ASPHALT });
+            let island = (half * RING - palette::RING_LANES * w / 2.0).max(1.0);
+            items.push(Item::Disc { class: "island", centre, radius: island, colour: palette::ISLAND });
+            let mut ring: Vec<Vec2> = (0..=72)
+                .map(|k| centre + Vec2::from_yaw(k as f64 * std::f64::consts::TAU / 72.0) * (island + 0.3))
+                .collect();
+            ring.dedup();
+            line(items, "edge-line", Some(ring), palette::MARKING, palette::LINE, None);
+        } else if self.junction {
+            for (i, &a) in CCW.iter().enumerate() {
+                let b = CCW[(i + 1) % 4];
+                let (ua, ub) = (a.outward(), b.outward());
+                let (ea, eb) = (self.ext(a, ub), self.ext(b, ua));
+                let (rx, ry) = (half - eb, half - ea);
+                if self.road.has_arm(a) && self.road.has_arm(b) && rx > 0.0 && ry > 0.0 {
+                    // the rounded corner: from the inner corner, round the quarter ellipse
+                    let k = centre + (ua + ub) * half;
+                    let mut points = vec![centre + ua * eb + ub * ea];
+                    points.extend(quarter(k, ua, ub, rx, ry));
+                    items.push(Item::Area { class: "surface", points, colour: palette::ASPHALT });
+                }
             }
         }
     }
 
-    // --- crosswalks, stop lines, signals
-    if road.crosswalks {
+    /// Markings along each arm: lane lines, the centre line, edge lines; at a junction, the
+    /// crossing road's edge line runs on past a missing arm.
+    fn markings(&self, items: &mut Vec<Item>) {
+        let w = self.w;
+        for st in &self.strips {
+            let (incoming, outgoing) = self.road.arm_lanes(st.arm);
+            let from = self.outer;
+            let to = f64::INFINITY;
+            let period = palette::DASH.0 + palette::DASH.1;
+            let dividers = (1..incoming).map(|k| -(k as f64) * w).chain((1..outgoing).map(|k| k as f64 * w));
+            for lateral in dividers {
+                let points = st.dashed(from, to, lateral, period);
+                line(items, "lane-line", points, palette::MARKING, palette::LINE, Some(palette::DASH));
+            }
+            if incoming > 0 && outgoing > 0 {
+                let off = (palette::CENTRE_GAP + palette::LINE) / 2.0;
+                for lateral in [-off, off] {
+                    line(items, "centre-line", st.line(from, to, lateral), palette::CENTRE_LINE, palette::LINE, None);
+                }
+            }
+            for lateral in [st.lo + palette::EDGE_INSET, st.hi - palette::EDGE_INSET] {
+                line(items, "edge-line", st.line(from, to, lateral), palette::MARKING, palette::LINE, None);
+            }
+        }
+        if self.junction && !self.roundabout {
+            for m in CCW.into_iter().filter(|m| !self.road.has_arm(*m)) {
+                if let Some((e, along)) = past_missing(self.road, m, &|arm, toward| self.ext(arm, toward)) {
+                    let at = |t: f64| self.centre + m.outward() * (e - palette::EDGE_INSET) + along * t;
+                    let points = Some(vec![at(-self.half), at(self.half)]);
+                    line(items, "edge-line", points, palette::MARKING, palette::LINE, None);
+                }
+            }
+        }
+    }
+
+    /// Crosswalks: inside each junction arm's stop line (outside a roundabout's yield line),
+    /// or where walkers cross a road without a junction; stripes across the whole arm.
+    fn crosswalks(&self, items: &mut Vec<Item>) {
         let depth = palette::CROSSWALK_DEPTH;
-        let places: Vec<(&Strip, f64)> = match junction {
-            Some(_) => {
-                let s = if roundabout { half + palette::STOP_LINE + CROSSWALK } else { half - CROSSWALK };
-                strips.iter().map(|st| (st, s)).collect()
-            }
-            None => {
-                strips.first().map(|st| crossings(scene, st).into_iter().map(|s| (st, s)).collect()).unwrap_or_default()
-            }
+        let places: Vec<(&Strip, f64)> = if self.junction {
+            let s = if self.roundabout { self.half + palette::STOP_LINE + CROSSWALK } else { self.half - CROSSWALK };
+            self.strips.iter().map(|st| (st, s)).collect()
+        } else {
+            self.strips
+                .first()
+                .map(|st| crossings(self.scene, st).into_iter().map(|s| (st, s)).collect())
+                .unwrap_or_default()
         };
         for (st, s) in places {
             let width = st.hi - st.lo;
@@ -331,24 +373,51 @@ pub fn draw(scene: &Scene, view: &Bounds) -> Map {
             }
         }
     }
-    let mut signals = Vec::new();
-    if junction.is_some() {
-        for st in &strips {
-            let (incoming, outgoing) = road.arm_lanes(st.arm);
+
+    /// At a junction, each arm's stop line (a roundabout's yield line) across its incoming
+    /// lanes; returns where each arm's signal stands.
+    fn stop_lines(&self, items: &mut Vec<Item>) -> Vec<(Arm, Vec2)> {
+        let mut signals = Vec::new();
+        if !self.junction {
+            return signals;
+        }
+        for st in &self.strips {
+            let (incoming, outgoing) = self.road.arm_lanes(st.arm);
             if incoming == 0 {
                 continue;
             }
-            let s = half + palette::STOP_LINE / 2.0;
+            let s = self.half + palette::STOP_LINE / 2.0;
             let end = if outgoing > 0 { -(palette::CENTRE_GAP / 2.0 + palette::LINE) } else { st.hi };
-            let (class, dash) = if roundabout { ("yield-line", Some((0.6, 0.4))) } else { ("stop-line", None) };
+            let (class, dash) = if self.roundabout { ("yield-line", Some((0.6, 0.4))) } else { ("stop-line", None) };
             if st.near.0 <= s && s <= st.near.1 {
                 let points = vec![st.at(s, st.lo), st.at(s, end)];
                 items.push(Item::Line { class, points, colour: palette::MARKING, width: palette::STOP_LINE, dash });
             }
-            signals.push((st.arm, st.at(half + palette::STOP_LINE, st.lo - palette::SIGNAL_OFFSET)));
+            signals.push((st.arm, st.at(self.half + palette::STOP_LINE, st.lo - palette::SIGNAL_OFFSET)));
         }
+        signals
     }
-    Map { items, signals }
+}
+
+/// An area, when there is one.
+fn area(items: &mut Vec<Item>, class: &'static str, points: Option<Vec<Vec2>>, colour: Colour) {
+    if let Some(points) = points {
+        items.push(Item::Area { class, points, colour });
+    }
+}
+
+/// A line, when there is one.
+fn line(
+    items: &mut Vec<Item>,
+    class: &'static str,
+    points: Option<Vec<Vec2>>,
+    colour: Colour,
+    width: f64,
+    dash: Option<(f64, f64)>,
+) {
+    if let Some(points) = points {
+        items.push(Item::Line { class, points, colour, width, dash });
+    }
 }
 
 /// Where an arm is missing: the crossing road's curb on its side (m from the centre), and

@@ -7,7 +7,7 @@
 //! bicycle with pure pursuit and IDM, walkers along their track); rapier reports the ego's new
 //! contacts; the criteria read the new state; the record is stored; the stop rules run.
 
-use crate::detect::Detectors;
+use crate::detect::{Detectors, Reading};
 use crate::models::{self, Kinematics, WHEELBASE, pursue};
 use crate::physics::{Physics, Shape};
 use crate::scene::Scene;
@@ -157,156 +157,322 @@ impl Seen {
 
 /// Run one episode of `scene` with parameters `params` (see [`crate::sample`]).
 pub fn run(scene: &Scene, seed: Option<u64>, params: Vec<f64>, policy: &mut dyn EgoPolicy, opts: &Options) -> Episode {
-    let world = &scene.world;
-    let dt = scene.limits.dt;
-    let route = &scene.ego.route;
-    let ego_size = scene.ego.size;
-    let desired = scene.ego.speed.eval(&params).max(0.0);
-    let start = scene.ego_pose();
-    let mut ego = Kinematics { position: start.position, yaw: start.yaw, speed: desired };
-    let (mut ego_s, _) = route.locate(start.position, scene.ego.start, 10.0);
-    let ego_stop = world
-        .stop_line(Arm::Ego, scene.ego.lane)
-        .map(|p| route.locate(p, ego_s, 400.0))
-        .and_then(|(s, d)| (d.abs() < world.road.lane_width).then_some(s));
-    let mut detectors = Detectors::new(scene.ego.start, scene.ego.route_length, ego_stop);
-    let mut actors: Vec<Actor> = scene.actors.iter().map(|a| spawn(scene, a, &params)).collect();
-    let mut shapes = vec![Shape { length: ego_size.length, width: ego_size.width, height: ego_size.height }];
-    shapes.extend(scene.actors.iter().map(|a| Shape {
-        length: a.size.length,
-        width: a.size.width,
-        height: a.size.height,
-    }));
-    let mut physics = Physics::new(&shapes);
-    let mut poses: Vec<(f64, f64, f64)> = Vec::with_capacity(shapes.len());
-    let mut hits = Vec::new();
-    policy.reset();
-    let mut preview = Preview::default();
-
-    let mut records = Vec::with_capacity(scene.limits.max_steps as usize);
-    let mut events = Vec::new();
-    let mut frames = Vec::new();
-    let frame = |ego: &Kinematics, actors: &[Actor], t: f64| Frame {
-        poses: std::iter::once((ego.position.x, ego.position.y, ego.yaw))
-            .chain(actors.iter().map(|a| (a.kin.position.x, a.kin.position.y, a.kin.yaw)))
-            .collect(),
-        speeds: std::iter::once(ego.speed).chain(actors.iter().map(|a| a.kin.speed)).collect(),
-        lights: world.lights(t),
-    };
-    if opts.keep_frames {
-        frames.push(frame(&ego, &actors, 0.0));
-    }
-    // physics sees the start, so a spawn already touching the ego counts at step 1
-    poses.clear();
-    poses.push((ego.position.x, ego.position.y, ego.yaw));
-    poses.extend(actors.iter().map(|a| (a.kin.position.x, a.kin.position.y, a.kin.yaw)));
-    physics.step(&poses, &mut hits);
-    let mut pending_hits: Vec<usize> = hits.clone();
-
-    let mut driven = 0.0;
-    let mut collided = false;
-    let mut off_road_for = 0.0;
-    let mut velocity = Vec2::from_yaw(ego.yaw) * ego.speed;
+    let mut runner = Runner::start(scene, params, policy, opts);
     let mut stop_reason = StopReason::MaxSteps;
-    let mut step = 0u32;
-    let mut before: Vec<Seen> = Vec::with_capacity(actors.len());
-    let route_bend = models::bend(route);
-    while step < scene.limits.max_steps {
-        step += 1;
-        let t = f64::from(step) * dt;
-        before.clear();
-        before.extend(actors.iter().map(|a| Seen::new(&a.kin, a.length, a.width)));
-
-        // scripts, on the previous state
-        for (setup, actor) in scene.actors.iter().zip(actors.iter_mut()) {
-            run_script(scene, &setup.script, actor, &params, t, ego.position);
+    while runner.step < scene.limits.max_steps {
+        if let Some(reason) = runner.advance(policy) {
+            stop_reason = reason;
+            break;
         }
+    }
+    runner.finish(seed, stop_reason)
+}
 
-        // the ego's policy (its arc on the route is the last criteria's: it has not moved)
-        let view =
-            ego_view(scene, &ego, ego_s, route_bend, desired, &actors, &before, t, ego_stop, &detectors, &mut preview);
+/// An episode under way: what its steps share.
+struct Runner<'a> {
+    scene: &'a Scene,
+    opts: &'a Options,
+    params: Vec<f64>,
+    /// The ego's desired speed, m/s.
+    desired: f64,
+    /// The ego's route's [`models::bend`].
+    route_bend: f64,
+    ego: Kinematics,
+    /// The ego's arc on its route, and its stop line's.
+    ego_s: f64,
+    ego_stop: Option<f64>,
+    detectors: Detectors,
+    actors: Vec<Actor>,
+    /// The actors as they were at the end of the previous step.
+    before: Vec<Seen>,
+    physics: Physics,
+    /// Everyone's pose for physics, and the ego's new contacts it reports.
+    poses: Vec<(f64, f64, f64)>,
+    hits: Vec<usize>,
+    /// Contacts at the start, counted at step 1.
+    pending_hits: Vec<usize>,
+    preview: Preview,
+    step: u32,
+    /// The ego's distance driven, m; its velocity at the end of the last step.
+    driven: f64,
+    velocity: Vec2,
+    collided: bool,
+    /// How long the ego has been off the road, s.
+    off_road_for: f64,
+    records: Vec<StepRecord>,
+    events: Vec<Event>,
+    frames: Vec<Frame>,
+}
+
+impl<'a> Runner<'a> {
+    /// The ego and every actor at their start, physics seeing them there.
+    fn start(scene: &'a Scene, params: Vec<f64>, policy: &mut dyn EgoPolicy, opts: &'a Options) -> Runner<'a> {
+        let route = &scene.ego.route;
+        let ego_size = scene.ego.size;
+        let desired = scene.ego.speed.eval(&params).max(0.0);
+        let start = scene.ego_pose();
+        let ego = Kinematics { position: start.position, yaw: start.yaw, speed: desired };
+        let (ego_s, _) = route.locate(start.position, scene.ego.start, 10.0);
+        let ego_stop = scene
+            .world
+            .stop_line(Arm::Ego, scene.ego.lane)
+            .map(|p| route.locate(p, ego_s, 400.0))
+            .and_then(|(s, d)| (d.abs() < scene.world.road.lane_width).then_some(s));
+        let detectors = Detectors::new(scene.ego.start, scene.ego.route_length, ego_stop);
+        let actors: Vec<Actor> = scene.actors.iter().map(|a| spawn(scene, a, &params)).collect();
+        let mut shapes = vec![Shape { length: ego_size.length, width: ego_size.width, height: ego_size.height }];
+        shapes.extend(scene.actors.iter().map(|a| Shape {
+            length: a.size.length,
+            width: a.size.width,
+            height: a.size.height,
+        }));
+        let physics = Physics::new(&shapes);
+        policy.reset();
+        let mut runner = Runner {
+            scene,
+            opts,
+            desired,
+            route_bend: models::bend(route),
+            ego,
+            ego_s,
+            ego_stop,
+            detectors,
+            before: Vec::with_capacity(actors.len()),
+            actors,
+            physics,
+            poses: Vec::with_capacity(shapes.len()),
+            hits: Vec::new(),
+            pending_hits: Vec::new(),
+            preview: Preview::default(),
+            step: 0,
+            driven: 0.0,
+            velocity: Vec2::from_yaw(ego.yaw) * ego.speed,
+            collided: false,
+            off_road_for: 0.0,
+            records: Vec::with_capacity(scene.limits.max_steps as usize),
+            events: Vec::new(),
+            frames: Vec::new(),
+            params,
+        };
+        if opts.keep_frames {
+            let frame = runner.frame(0.0);
+            runner.frames.push(frame);
+        }
+        // physics sees the start, so a spawn already touching the ego counts at step 1
+        runner.touch();
+        runner.pending_hits = runner.hits.clone();
+        runner
+    }
+
+    /// One step, as the module's header lists them; the reason the episode stops after it,
+    /// if it does.
+    fn advance(&mut self, policy: &mut dyn EgoPolicy) -> Option<StopReason> {
+        self.step += 1;
+        let t = f64::from(self.step) * self.scene.limits.dt;
+        self.before.clear();
+        self.before.extend(self.actors.iter().map(|a| Seen::new(&a.kin, a.length, a.width)));
+        self.scripts(t);
+        self.drive_ego(policy, t);
+        self.move_others(t);
+        self.contacts();
+        let reading = self.criteria(t);
+        self.record(t, &reading);
+        self.stop_rule(t, &reading)
+    }
+
+    /// Scripts advance, on the previous state.
+    fn scripts(&mut self, t: f64) {
+        for (setup, actor) in self.scene.actors.iter().zip(self.actors.iter_mut()) {
+            run_script(self.scene, &setup.script, actor, &self.params, t, self.ego.position);
+        }
+    }
+
+    /// The ego's policy acts on what it sees (its arc on the route is the last criteria's:
+    /// it has not moved), and the ego moves.
+    fn drive_ego(&mut self, policy: &mut dyn EgoPolicy, t: f64) {
+        let view = self.ego_view(t);
         let action: Action = policy.act(&view);
         let accel = if action.accel.is_finite() { action.accel.clamp(ACCEL_MIN, ACCEL_MAX) } else { 0.0 };
         let steer = if action.steer.is_finite() { action.steer.clamp(-1.0, 1.0) } else { 0.0 };
-        let old = ego.position;
-        ego.bicycle(WHEELBASE * ego_size.length, -steer * MAX_WHEEL_ANGLE, accel, dt);
-        driven += old.distance(ego.position);
+        let old = self.ego.position;
+        let scene = self.scene;
+        self.ego.bicycle(WHEELBASE * scene.ego.size.length, -steer * MAX_WHEEL_ANGLE, accel, scene.limits.dt);
+        self.driven += old.distance(self.ego.position);
+    }
 
-        // everyone else
-        let ego_seen = Seen::new(&ego, ego_size.length, ego_size.width);
-        for k in 0..actors.len() {
-            move_actor(scene, &mut actors, k, &before, ego_seen, t, dt);
+    /// Everyone else moves.
+    fn move_others(&mut self, t: f64) {
+        let scene = self.scene;
+        let ego_seen = Seen::new(&self.ego, scene.ego.size.length, scene.ego.size.width);
+        for k in 0..self.actors.len() {
+            move_actor(scene, &mut self.actors, k, &self.before, ego_seen, t, scene.limits.dt);
         }
+    }
 
-        // contacts
-        poses.clear();
-        poses.push((ego.position.x, ego.position.y, ego.yaw));
-        poses.extend(actors.iter().map(|a| (a.kin.position.x, a.kin.position.y, a.kin.yaw)));
-        physics.step(&poses, &mut hits);
-        hits.append(&mut pending_hits);
-        if let Some(&other) = hits.first().filter(|_| !collided) {
-            collided = true;
-            events.push(Event { step, kind: EventKind::Collision, position: ego.position, other: Some(other - 1) });
+    /// Physics sees everyone where they are now; its new contacts of the ego go in `hits`.
+    fn touch(&mut self) {
+        self.poses.clear();
+        self.poses.push((self.ego.position.x, self.ego.position.y, self.ego.yaw));
+        self.poses.extend(self.actors.iter().map(|a| (a.kin.position.x, a.kin.position.y, a.kin.yaw)));
+        self.physics.step(&self.poses, &mut self.hits);
+    }
+
+    /// The ego's contacts: its first collision is an event.
+    fn contacts(&mut self) {
+        self.touch();
+        self.hits.append(&mut self.pending_hits);
+        if let Some(&other) = self.hits.first().filter(|_| !self.collided) {
+            self.collided = true;
+            self.events.push(Event {
+                step: self.step,
+                kind: EventKind::Collision,
+                position: self.ego.position,
+                other: Some(other - 1),
+            });
         }
+    }
 
-        // criteria
-        let (s_now, off_route) = route.locate(ego.position, ego_s, 10.0);
-        ego_s = s_now;
-        let fp = Footprint { pose: ego.pose(), length: ego_size.length, width: ego_size.width };
-        let reading = detectors.read(world, route, fp, ego_s, off_route, ego.speed, t);
+    /// The criteria read the new state; what they notice is an event.
+    fn criteria(&mut self, t: f64) -> Reading {
+        let scene = self.scene;
+        let route = &scene.ego.route;
+        let (s_now, off_route) = route.locate(self.ego.position, self.ego_s, 10.0);
+        self.ego_s = s_now;
+        let fp = Footprint { pose: self.ego.pose(), length: scene.ego.size.length, width: scene.ego.size.width };
+        let reading = self.detectors.read(&scene.world, route, fp, self.ego_s, off_route, self.ego.speed, t);
         for (happened, kind) in [
             (reading.lane_invasion, EventKind::LaneInvasion),
             (reading.red_light, EventKind::RedLight),
             (reading.stop_sign, EventKind::StopSign),
-            (reading.off_road && off_road_for == 0.0, EventKind::OffRoad),
+            (reading.off_road && self.off_road_for == 0.0, EventKind::OffRoad),
         ] {
             if happened {
-                events.push(Event { step, kind, position: ego.position, other: None });
+                self.events.push(Event { step: self.step, kind, position: self.ego.position, other: None });
             }
         }
-        off_road_for = if reading.off_road { off_road_for + dt } else { 0.0 };
+        self.off_road_for = if reading.off_road { self.off_road_for + self.scene.limits.dt } else { 0.0 };
+        reading
+    }
+
+    /// The step's record is stored (and its frame, when asked for).
+    fn record(&mut self, t: f64, reading: &Reading) {
+        let ego = &self.ego;
         let new_velocity = Vec2::from_yaw(ego.yaw) * ego.speed;
-        let acceleration = (new_velocity - velocity) * (1.0 / dt);
-        velocity = new_velocity;
-        records.push(StepRecord {
+        let acceleration = (new_velocity - self.velocity) * (1.0 / self.scene.limits.dt);
+        self.velocity = new_velocity;
+        self.records.push(StepRecord {
             time: t,
             velocity: ego.speed,
             acceleration: [acceleration.x, acceleration.y, 0.0],
             position: [ego.position.x, ego.position.y, 0.0],
             // CARLA's yaw turns clockwise, in degrees within [-180, 180]
             yaw_deg: (-ego.yaw).to_degrees().clamp(-180.0, 180.0),
-            driven_distance: driven,
-            lane_invasion: detectors.lane_invasions,
+            driven_distance: self.driven,
+            lane_invasion: self.detectors.lane_invasions,
             off_road: reading.off_road,
-            collision: collided,
-            run_red_light: detectors.red_lights,
-            run_stop: detectors.stop_signs,
+            collision: self.collided,
+            run_red_light: self.detectors.red_lights,
+            run_stop: self.detectors.stop_signs,
             distance_to_route: reading.distance_to_route,
             route_complete: reading.route_complete,
         });
-        if opts.keep_frames {
-            frames.push(frame(&ego, &actors, t));
+        if self.opts.keep_frames {
+            let frame = self.frame(t);
+            self.frames.push(frame);
         }
+    }
 
-        let stop = if collided {
+    /// The stop rules: why the episode ends after this step, if it does.
+    fn stop_rule(&self, t: f64, reading: &Reading) -> Option<StopReason> {
+        let (opts, limits) = (self.opts, &self.scene.limits);
+        if self.collided {
             Some(StopReason::Collision)
         } else if reading.route_complete >= 100.0 {
             Some(StopReason::RouteComplete)
-        } else if opts.mode.off_road_terminates() && off_road_for >= opts.off_road_limit - 1e-9 {
+        } else if opts.mode.off_road_terminates() && self.off_road_for >= opts.off_road_limit - 1e-9 {
             Some(StopReason::OffRoad)
-        } else if driven >= scene.limits.max_distance {
+        } else if self.driven >= limits.max_distance {
             Some(StopReason::MaxDistance)
-        } else if t >= scene.limits.timeout - 1e-9 {
+        } else if t >= limits.timeout - 1e-9 {
             Some(StopReason::Timeout)
         } else {
             None
-        };
-        if let Some(reason) = stop {
-            stop_reason = reason;
-            break;
         }
     }
-    Episode { seed, params, steps: step, stop_reason, records, events, frames }
+
+    /// Every actor's pose and speed (the ego first) and the lights, at time `t`.
+    fn frame(&self, t: f64) -> Frame {
+        let ego = &self.ego;
+        Frame {
+            poses: std::iter::once((ego.position.x, ego.position.y, ego.yaw))
+                .chain(self.actors.iter().map(|a| (a.kin.position.x, a.kin.position.y, a.kin.yaw)))
+                .collect(),
+            speeds: std::iter::once(ego.speed).chain(self.actors.iter().map(|a| a.kin.speed)).collect(),
+            lights: self.scene.world.lights(t),
+        }
+    }
+
+    /// What the ego's driver sees: SafeBench's observation and the full state.
+    fn ego_view(&mut self, t: f64) -> EgoView {
+        let scene = self.scene;
+        let (ego, s, actors, before) = (&self.ego, self.ego_s, &self.actors, &self.before);
+        let route = &scene.ego.route;
+        let size = scene.ego.size;
+        let heading = Vec2::from_yaw(ego.yaw);
+        let i = self.preview.step(&scene.preview, [ego.position.x, ego.position.y]).unwrap_or(0);
+        let point = scene.preview.get(i).copied().unwrap_or([ego.position.x, ego.position.y]);
+        let [lateral_dis, minus_delta_yaw, _] = tad_policy::observation(
+            [ego.position.x, ego.position.y],
+            ego.yaw,
+            point,
+            scene.preview_yaw.get(i).copied().unwrap_or(ego.yaw),
+            ego.speed,
+        );
+        let ego_lane = scene.world.spot(ego.position);
+        let front = before.iter().zip(actors).any(|(o, a)| {
+            let p = o.position;
+            a.body == Body::Vehicle
+                && p.distance(ego.position) <= 15.0
+                && (p - ego.position).dot(heading) > 0.0
+                && o.heading.dot(heading) > 0.0
+                && matches!(ego_lane, Spot::Lane(..))
+                && scene.world.spot(p) == ego_lane
+        });
+        let lookahead = models::lookahead(ego.speed);
+        let target = Pose { position: ego.position, yaw: ego.yaw }.local(route.pose(s + lookahead).position);
+        let leader =
+            ahead_on(route, ego.position, ego.yaw, s, size.length, size.width, ego.speed, true, before.iter().copied());
+        let stop = self.ego_stop.and_then(|line| {
+            let gap = line - (s + size.length / 2.0);
+            (gap > -0.5 && must_stop(scene, Arm::Ego, gap, ego.speed, t, self.detectors.stopped_at_sign()))
+                .then_some(gap.max(0.0))
+        });
+        EgoView {
+            obs: [lateral_dis, minus_delta_yaw, ego.speed, if front { 1.0 } else { 0.0 }],
+            speed: ego.speed,
+            desired_speed: self.desired,
+            target: [target.x, target.y],
+            lookahead,
+            wheelbase: WHEELBASE * size.length,
+            leader,
+            stop,
+            curve_speed: models::curve_speed_knowing(route, self.route_bend, s, ego.speed),
+            dt: scene.limits.dt,
+        }
+    }
+
+    /// The episode as run.
+    fn finish(self, seed: Option<u64>, stop_reason: StopReason) -> Episode {
+        Episode {
+            seed,
+            params: self.params,
+            steps: self.step,
+            stop_reason,
+            records: self.records,
+            events: self.events,
+            frames: self.frames,
+        }
+    }
 }
 
 fn spawn(scene: &Scene, a: &crate::scene::ActorSetup, params: &[f64]) -> Actor {
@@ -704,65 +870,5 @@ fn mobil(scene: &Scene, actors: &mut [Actor], k: usize, before: &[Seen], ego: Se
     }
     if let Some((dir, _)) = choice {
         change_lane(scene, &mut actors[k], dir);
-    }
-}
-
-/// What the ego's driver sees: SafeBench's observation and the full state.
-#[allow(clippy::too_many_arguments)]
-fn ego_view(
-    scene: &Scene,
-    ego: &Kinematics,
-    s: f64,
-    route_bend: f64,
-    desired: f64,
-    actors: &[Actor],
-    before: &[Seen],
-    t: f64,
-    stop_line: Option<f64>,
-    detectors: &Detectors,
-    preview: &mut Preview,
-) -> EgoView {
-    let route = &scene.ego.route;
-    let size = scene.ego.size;
-    let heading = Vec2::from_yaw(ego.yaw);
-    let i = preview.step(&scene.preview, [ego.position.x, ego.position.y]).unwrap_or(0);
-    let point = scene.preview.get(i).copied().unwrap_or([ego.position.x, ego.position.y]);
-    let [lateral_dis, minus_delta_yaw, _] = tad_policy::observation(
-        [ego.position.x, ego.position.y],
-        ego.yaw,
-        point,
-        scene.preview_yaw.get(i).copied().unwrap_or(ego.yaw),
-        ego.speed,
-    );
-    let ego_lane = scene.world.spot(ego.position);
-    let front = before.iter().zip(actors).any(|(o, a)| {
-        let p = o.position;
-        a.body == Body::Vehicle
-            && p.distance(ego.position) <= 15.0
-            && (p - ego.position).dot(heading) > 0.0
-            && o.heading.dot(heading) > 0.0
-            && matches!(ego_lane, Spot::Lane(..))
-            && scene.world.spot(p) == ego_lane
-    });
-    let lookahead = models::lookahead(ego.speed);
-    let target = Pose { position: ego.position, yaw: ego.yaw }.local(route.pose(s + lookahead).position);
-    let leader =
-        ahead_on(route, ego.position, ego.yaw, s, size.length, size.width, ego.speed, true, before.iter().copied());
-    let stop = stop_line.and_then(|line| {
-        let gap = line - (s + size.length / 2.0);
-        (gap > -0.5 && must_stop(scene, Arm::Ego, gap, ego.speed, t, detectors.stopped_at_sign()))
-            .then_some(gap.max(0.0))
-    });
-    EgoView {
-        obs: [lateral_dis, minus_delta_yaw, ego.speed, if front { 1.0 } else { 0.0 }],
-        speed: ego.speed,
-        desired_speed: desired,
-        target: [target.x, target.y],
-        lookahead,
-        wheelbase: WHEELBASE * size.length,
-        leader,
-        stop,
-        curve_speed: models::curve_speed_knowing(route, route_bend, s, ego.speed),
-        dt: scene.limits.dt,
     }
 }

@@ -150,6 +150,8 @@ fn lane_needs(groups: &[Resolved], ego_lane: i64, needs: &mut Needs) {
     needs.index = ego_lane as u32;
 }
 
+/// The map and what of the road it keeps (see the module's header); the ego and the groups
+/// on its road move to lanes the map has when none has all they use.
 pub fn choose(
     scenario: &Scenario,
     road: &RoadRequest,
@@ -164,31 +166,9 @@ pub fn choose(
     let preference: Vec<&str> = road.preference.iter().map(String::as_str).collect();
     let mut needs = Needs::default();
     lane_needs(groups, ego.lane, &mut needs);
-    let base = needs.clone();
     let first: Vec<usize> = laid.groups.iter().map(|g| g.agents.len().min(1)).collect();
     layout::windows(laid, &mut needs, junction, Some(&first));
-    let (map, map_known) = match requested {
-        Some(m) => match maps::known(m) {
-            Some(k) => (k.to_string(), true),
-            None => {
-                report.warn(
-                    Code::W0705,
-                    format!("map `{m}` is not one the backend knows"),
-                    road.span,
-                    "its features are not checked",
-                    Payload::Unknown {
-                        namespace: "map".into(),
-                        name: m.to_string(),
-                        candidates: maps::KNOWN.iter().map(|k| k.to_string()).collect(),
-                        module: None,
-                    },
-                )
-                .note(format!("the known maps are {}; Scenic reports at compile time if this one lacks what the scenario needs", maps::KNOWN.join(", ")));
-                (m.to_string(), false)
-            }
-        },
-        None => (String::new(), true),
-    };
+    let (map, map_known) = requested_map(requested, road.span, report);
     let candidates: Vec<&str> = if !map_known {
         vec![]
     } else if requested.is_some() {
@@ -196,13 +176,7 @@ pub fn choose(
     } else {
         maps::KNOWN.to_vec()
     };
-    let full_windows = |needs: &Needs| {
-        let (mut away, mut before) = (needs.clone(), needs.clone());
-        layout::windows(laid, &mut away, false, None);
-        layout::windows(laid, &mut before, true, None);
-        [away, before]
-    };
-    let mut full = full_windows(&needs);
+    let mut full = full_windows(laid, &needs);
     let mut best = select(&needs, &full, &features, &candidates, &preference);
     if let Some((false, m, _)) = best
         && map_known
@@ -210,117 +184,189 @@ pub fn choose(
         // No map has every lane the scenario uses: move actors into the lanes of the
         // closest layout, and choose again on its map.
         let pool: Vec<&str> = if requested.is_some() { vec![m] } else { candidates.clone() };
-        if let Some((m, same, other)) = maps::closest_layout(&pool, (needs.min_same, needs.min_other)) {
-            let remap = |lane: i64| -> i64 {
-                if lane > 0 {
-                    lane.min(i64::from(same))
-                } else if other > 0 {
-                    lane.max(-i64::from(other))
-                } else {
-                    1
-                }
-            };
-            let mut allowed: Vec<String> = (1..=same).map(|l| format!("lane {l}")).collect();
-            allowed.extend((1..=other).map(|l| format!("lane -{l}")));
-            let mut moved = |lane: i64, span: Span, who: &str| {
-                let to = remap(lane);
-                if to != lane {
-                    report.warn(
-                        Code::W0701,
-                        format!("{m} has no lane {lane} for {who}"),
-                        span,
-                        format!("placed in lane {to}"),
-                        Payload::Incompatible { subject: m.to_string(), value: format!("lane {lane}"), allowed: allowed.clone() },
-                    )
-                    .note(format!("no map has all the lanes the scenario uses; {m} has a road with {} in the ego's direction and {} in the other", plural(same as usize, "lane"), plural(other as usize, "lane")));
-                }
-                to
-            };
-            ego.lane = moved(ego.lane, ego.lane_span, "the ego vehicle");
-            for (g, group) in groups.iter_mut().zip(&scenario.groups).filter(|(g, _)| g.arm == tad_layout::Arm::Ego) {
-                let span = group.lane.span().unwrap_or(group.name_span);
-                g.lane = moved(g.lane, span, &format!("group `{}`", group.name));
-            }
+        if let Some(closest) = maps::closest_layout(&pool, (needs.min_same, needs.min_other)) {
+            move_into_lanes(scenario, closest, &mut ego, groups, report);
             lane_needs(groups, ego.lane, &mut needs);
             layout::windows(laid, &mut needs, junction, Some(&first));
-            full = full_windows(&needs);
-            best = select(&needs, &full, &features, &[m], &preference);
+            full = full_windows(laid, &needs);
+            best = select(&needs, &full, &features, &[closest.0], &preference);
         }
     }
-    let _ = base;
     let (map, kept_flags) = match best {
         Some((base_ok, m, kept)) => {
             if !base_ok {
-                report
-                    .warn(
-                        Code::W0701,
-                        format!("no place on {m} has every lane the scenario uses"),
-                        road.span,
-                        "the Scenic program reports this when compiled",
-                        Payload::Incompatible {
-                            subject: m.to_string(),
-                            value: format!(
-                                "{} in the ego's direction and {} in the other",
-                                plural(needs.min_same as usize, "lane"),
-                                plural(needs.min_other as usize, "lane")
-                            ),
-                            allowed: vec![],
-                        },
-                    )
-                    .note(format!(
-                        "the scenario needs {} in the ego's direction and {} in the other",
-                        plural(needs.min_same as usize, "lane"),
-                        plural(needs.min_other as usize, "lane")
-                    ));
+                lanes_missing(m, &needs, road.span, report);
             }
             (m.to_string(), kept)
         }
         None => (map, vec![true; features.len()]),
     };
-    let mut kept = Vec::new();
-    let mut dropped = Vec::new();
+    let (chosen, kept) = apply_kept(&features, &kept_flags, &needs);
+    let dropped = features
+        .iter()
+        .zip(&kept_flags)
+        .filter(|(_, keep)| !**keep)
+        .map(|((feature, span), _)| {
+            // a shape is tested with every actor in place (see `select`)
+            let description = feature.describe(if let Feature::Shape(_) = feature { &full[0] } else { &chosen });
+            left_out(feature, *span, description, &needs, &map, report)
+        })
+        .collect();
+    let junction = chosen.junction.is_some();
+    Choice { map, map_known, needs: chosen, kept, dropped, ego, junction }
+}
+
+/// The map asked for with `--map`: (its name, whether the backend knows it; W0705 when
+/// not); without one, a map still to choose.
+fn requested_map(requested: Option<&str>, span: Span, report: &mut Report) -> (String, bool) {
+    let Some(m) = requested else { return (String::new(), true) };
+    if let Some(k) = maps::known(m) {
+        return (k.to_string(), true);
+    }
+    report
+        .warn(
+            Code::W0705,
+            format!("map `{m}` is not one the backend knows"),
+            span,
+            "its features are not checked",
+            Payload::Unknown {
+                namespace: "map".into(),
+                name: m.to_string(),
+                candidates: maps::KNOWN.iter().map(|k| k.to_string()).collect(),
+                module: None,
+            },
+        )
+        .note(format!(
+            "the known maps are {}; Scenic reports at compile time if this one lacks what the scenario needs",
+            maps::KNOWN.join(", ")
+        ));
+    (m.to_string(), false)
+}
+
+/// The windows of road every actor of every group needs: away from a junction, and before
+/// one.
+fn full_windows(laid: &tad_layout::Layout, needs: &Needs) -> [Needs; 2] {
+    let (mut away, mut before) = (needs.clone(), needs.clone());
+    layout::windows(laid, &mut away, false, None);
+    layout::windows(laid, &mut before, true, None);
+    [away, before]
+}
+
+/// The ego and the groups on its road move into the lanes of map `m`'s closest layout
+/// (`same` lanes the ego's way, `other` the other way): a W0701 for each that moves.
+fn move_into_lanes(
+    scenario: &Scenario,
+    (m, same, other): (&str, u32, u32),
+    ego: &mut EgoPlan,
+    groups: &mut [Resolved],
+    report: &mut Report,
+) {
+    let remap = |lane: i64| -> i64 {
+        if lane > 0 {
+            lane.min(i64::from(same))
+        } else if other > 0 {
+            lane.max(-i64::from(other))
+        } else {
+            1
+        }
+    };
+    let mut allowed: Vec<String> = (1..=same).map(|l| format!("lane {l}")).collect();
+    allowed.extend((1..=other).map(|l| format!("lane -{l}")));
+    let mut moved = |lane: i64, span: Span, who: &str| {
+        let to = remap(lane);
+        if to != lane {
+            report.warn(
+                Code::W0701,
+                format!("{m} has no lane {lane} for {who}"),
+                span,
+                format!("placed in lane {to}"),
+                Payload::Incompatible { subject: m.to_string(), value: format!("lane {lane}"), allowed: allowed.clone() },
+            )
+            .note(format!("no map has all the lanes the scenario uses; {m} has a road with {} in the ego's direction and {} in the other", plural(same as usize, "lane"), plural(other as usize, "lane")));
+        }
+        to
+    };
+    ego.lane = moved(ego.lane, ego.lane_span, "the ego vehicle");
+    for (g, group) in groups.iter_mut().zip(&scenario.groups).filter(|(g, _)| g.arm == tad_layout::Arm::Ego) {
+        let span = group.lane.span().unwrap_or(group.name_span);
+        g.lane = moved(g.lane, span, &format!("group `{}`", group.name));
+    }
+}
+
+/// W0701: no place on map `m` has every lane the scenario uses.
+fn lanes_missing(m: &str, needs: &Needs, span: Span, report: &mut Report) {
+    report
+        .warn(
+            Code::W0701,
+            format!("no place on {m} has every lane the scenario uses"),
+            span,
+            "the Scenic program reports this when compiled",
+            Payload::Incompatible {
+                subject: m.to_string(),
+                value: format!(
+                    "{} in the ego's direction and {} in the other",
+                    plural(needs.min_same as usize, "lane"),
+                    plural(needs.min_other as usize, "lane")
+                ),
+                allowed: vec![],
+            },
+        )
+        .note(format!(
+            "the scenario needs {} in the ego's direction and {} in the other",
+            plural(needs.min_same as usize, "lane"),
+            plural(needs.min_other as usize, "lane")
+        ));
+}
+
+/// `needs` with the kept features applied, and the descriptions of those.
+fn apply_kept(features: &[(Feature, Span)], kept_flags: &[bool], needs: &Needs) -> (Needs, Vec<String>) {
     let mut chosen = needs.clone();
-    for ((feature, _), keep) in features.iter().zip(&kept_flags) {
+    let mut kept = Vec::new();
+    for ((feature, _), keep) in features.iter().zip(kept_flags) {
         if *keep {
             feature.apply(&mut chosen);
             kept.push(feature.describe(&chosen));
         }
     }
-    for ((feature, span), keep) in features.iter().zip(&kept_flags) {
-        if *keep {
-            continue;
-        }
-        // a shape is tested with every actor in place (see `select`)
-        let description = feature.describe(if let Feature::Shape(_) = feature { &full[0] } else { &chosen });
-        let mut alone = needs.clone();
-        feature.apply(&mut alone);
-        let having: Vec<&str> = maps::KNOWN.iter().copied().filter(|m| alone.feasible(m)).collect();
-        let note = if having.is_empty() {
-            "no map has it together with the lanes the scenario uses".to_string()
-        } else {
-            format!("without the rest of the road, it is on {}", list(&having))
-        };
-        report
-            .warn(
-                Code::W0701,
-                format!("{map} has no place with {description}"),
-                *span,
-                "left out of the road requirements",
-                Payload::Incompatible {
-                    subject: map.clone(),
-                    value: description.clone(),
-                    allowed: having.iter().map(|m| m.to_string()).collect(),
-                },
-            )
-            .note(note)
-            .help(format!(
-                "the map was chosen for what it has; build with --map to choose another ({})",
-                maps::KNOWN.join(", ")
-            ));
-        dropped.push(description);
-    }
-    let junction = chosen.junction.is_some();
-    Choice { map, map_known, needs: chosen, kept, dropped, ego, junction }
+    (chosen, kept)
+}
+
+/// W0701 for a feature the map lacks, with the maps that have it alone; returns its
+/// description.
+fn left_out(
+    feature: &Feature,
+    span: Span,
+    description: String,
+    needs: &Needs,
+    map: &str,
+    report: &mut Report,
+) -> String {
+    let mut alone = needs.clone();
+    feature.apply(&mut alone);
+    let having: Vec<&str> = maps::KNOWN.iter().copied().filter(|m| alone.feasible(m)).collect();
+    let note = if having.is_empty() {
+        "no map has it together with the lanes the scenario uses".to_string()
+    } else {
+        format!("without the rest of the road, it is on {}", list(&having))
+    };
+    report
+        .warn(
+            Code::W0701,
+            format!("{map} has no place with {description}"),
+            span,
+            "left out of the road requirements",
+            Payload::Incompatible {
+                subject: map.to_string(),
+                value: description.clone(),
+                allowed: having.iter().map(|m| m.to_string()).collect(),
+            },
+        )
+        .note(note)
+        .help(format!(
+            "the map was chosen for what it has; build with --map to choose another ({})",
+            maps::KNOWN.join(", ")
+        ));
+    description
 }
 
 /// The best map among `candidates` for `needs` and `features`: whether its base needs hold,

@@ -38,22 +38,51 @@ pub struct RoadRequest {
 /// The road's requests; reports what the maps cannot have.
 pub fn request(scenario: &Scenario, span: Span, report: &mut Report) -> RoadRequest {
     let road = &scenario.road;
-    let entries = &scenario.entries;
-    let lanes: Option<u32> = road.lanes.get().filter(|n| *n >= 1).map(|n| n.min(1000) as u32);
-    let opposite_lanes = road.direction.given().and_then(|d| entries.resolved(d)).and_then(|e| e.attrs.opposite_lanes);
-    let mut features: Vec<(Feature, Span)> = Vec::new();
-    if let Some(n) = lanes {
-        features.push((Feature::Lanes(n), road.lanes.span().unwrap_or(span)));
-    }
-    if let Some(direction_span) = road.direction.given().and(road.direction.span()) {
-        match (opposite_lanes, lanes) {
-            (Some(false), _) => features.push((Feature::Other(0), direction_span)),
-            (Some(true), Some(n)) => features.push((Feature::Other(n), direction_span)),
-            (Some(true), None) => features.push((Feature::OtherAtLeast(1), direction_span)),
-            (None, _) => {}
+    let opposite_lanes =
+        road.direction.given().and_then(|d| scenario.entries.resolved(d)).and_then(|e| e.attrs.opposite_lanes);
+    let mut request = RoadRequest {
+        span,
+        lanes: road.lanes.get().filter(|n| *n >= 1).map(|n| n.min(1000) as u32),
+        one_way: opposite_lanes == Some(false),
+        features: Vec::new(),
+        preference: Vec::new(),
+        light: None,
+        light_span: None,
+        unsignalised: None,
+    };
+    request.lanes_each_way(scenario, opposite_lanes);
+    request.road_type(scenario, report);
+    request.light(scenario, report);
+    request.signs_and_sidewalk(scenario);
+    unmapped_lists(scenario, report);
+    traffic(scenario, report);
+    request.preference = preference(scenario, report);
+    request
+}
+
+impl RoadRequest {
+    /// The lanes written, and the lanes the other way by the direction.
+    fn lanes_each_way(&mut self, scenario: &Scenario, opposite_lanes: Option<bool>) {
+        let road = &scenario.road;
+        if let Some(n) = self.lanes {
+            self.features.push((Feature::Lanes(n), road.lanes.span().unwrap_or(self.span)));
+        }
+        if let Some(direction_span) = road.direction.given().and(road.direction.span()) {
+            match (opposite_lanes, self.lanes) {
+                (Some(false), _) => self.features.push((Feature::Other(0), direction_span)),
+                (Some(true), Some(n)) => self.features.push((Feature::Other(n), direction_span)),
+                (Some(true), None) => self.features.push((Feature::OtherAtLeast(1), direction_span)),
+                (None, _) => {}
+            }
         }
     }
-    if let (Some(written), Some(at)) = (road.road_type.given(), road.road_type.span()) {
+
+    /// The road type's junction (of any kind for a roundabout) or shape; W0700/W0701/W0703
+    /// for what the maps cannot have.
+    fn road_type(&mut self, scenario: &Scenario, report: &mut Report) {
+        let road = &scenario.road;
+        let entries = &scenario.entries;
+        let (Some(written), Some(at)) = (road.road_type.given(), road.road_type.span()) else { return };
         let name = entries.name(written);
         let road_type = entries.resolved(written).map(|e| e.attrs);
         let kind = road_type.and_then(|t| match t.arms {
@@ -72,9 +101,9 @@ pub fn request(scenario: &Scenario, span: Span, report: &mut Report) -> RoadRequ
                         unsupported(named("road_type", name), Some("a junction of any kind".into())),
                     )
                     .note(format!("the maps are {}", maps::KNOWN.join(", ")));
-                features.push((Feature::Junction(None), at));
+                self.features.push((Feature::Junction(None), at));
             }
-            (Some(t), Some(kind)) if t.junction => features.push((Feature::Junction(Some(kind)), at)),
+            (Some(t), Some(kind)) if t.junction => self.features.push((Feature::Junction(Some(kind)), at)),
             (Some(t), None) if t.junction => {
                 report
                     .warn(
@@ -85,11 +114,11 @@ pub fn request(scenario: &Scenario, span: Span, report: &mut Report) -> RoadRequ
                         unsupported(named("road_type", name), Some("a junction of any kind".into())),
                     )
                     .note("it is declared a junction: the ego is placed before a junction of any kind");
-                features.push((Feature::Junction(None), at));
+                self.features.push((Feature::Junction(None), at));
             }
             (Some(t), _) if matches!(t.shape, Some(RoadShape::Straight | RoadShape::Curved)) => {
                 let shape = if t.shape == Some(RoadShape::Straight) { Shape::Straight } else { Shape::Curved };
-                features.push((Feature::Shape(shape), at));
+                self.features.push((Feature::Shape(shape), at));
             }
             _ => {
                 report.warn(
@@ -102,40 +131,65 @@ pub fn request(scenario: &Scenario, span: Span, report: &mut Report) -> RoadRequ
             }
         }
     }
-    let mut light = None;
-    let mut light_span = None;
-    let mut unsignalised = None;
-    if let (Some(written), Some(at)) = (road.light.given(), road.light.span()) {
+
+    /// The light state: a present one asks for traffic lights (and is held when it has a
+    /// signal); one that is not present says a junction ahead has none.
+    fn light(&mut self, scenario: &Scenario, report: &mut Report) {
+        let road = &scenario.road;
+        let entries = &scenario.entries;
+        let (Some(written), Some(at)) = (road.light.given(), road.light.span()) else { return };
         let name = entries.name(written);
         let state = entries.resolved(written).map(|e| e.attrs);
-        if state.is_none_or(|s| s.present) {
-            match state.and_then(|s| s.signal) {
-                Some(signal) => light = Some(Light { signal, name: name.to_string() }),
-                None => {
-                    report
-                        .warn(
-                            Code::W0700,
-                            format!("light state `{name}` has no Scenic mapping"),
-                            at,
-                            "no light is set",
-                            unsupported(named("light_state", name), Some("a junction with traffic lights".into())),
-                        )
-                        .note("CARLA lights are red, yellow, green or off");
+        if !state.is_none_or(|s| s.present) {
+            self.unsignalised = Some(at);
+            return;
+        }
+        match state.and_then(|s| s.signal) {
+            Some(signal) => self.light = Some(Light { signal, name: name.to_string() }),
+            None => {
+                report
+                    .warn(
+                        Code::W0700,
+                        format!("light state `{name}` has no Scenic mapping"),
+                        at,
+                        "no light is set",
+                        unsupported(named("light_state", name), Some("a junction with traffic lights".into())),
+                    )
+                    .note("CARLA lights are red, yellow, green or off");
+            }
+        }
+        self.light_span = Some(at);
+        self.features.push((Feature::Signalised(true), at));
+    }
+
+    /// The junction signs (those with an OpenDRIVE type), and a sidewalk (a roadside that is
+    /// a walkway).
+    fn signs_and_sidewalk(&mut self, scenario: &Scenario) {
+        let road = &scenario.road;
+        if let Some(signs) = road.signs.given() {
+            for sign in signs {
+                if let Some(t) = scenario.entries.resolved(&sign.value).and_then(|e| e.attrs.opendrive_type) {
+                    self.features.push((Feature::Sign(t), sign.span));
                 }
             }
-            light_span = Some(at);
-            features.push((Feature::Signalised(true), at));
-        } else {
-            unsignalised = Some(at);
+        }
+        if let Some(sidewalk) = road.roadside.given().and_then(|r| r.iter().find(|s| walkway(scenario, s.value.id()))) {
+            self.features.push((Feature::Sidewalk, sidewalk.span));
         }
     }
-    if let Some(signs) = road.signs.given() {
-        for sign in signs {
-            if let Some(t) = entries.resolved(&sign.value).and_then(|e| e.attrs.opendrive_type) {
-                features.push((Feature::Sign(t), sign.span));
-            }
-        }
-    }
+}
+
+/// Whether a roadside is a walkway.
+fn walkway(scenario: &Scenario, s: Option<tad_ir::Id<tad_ir::Roadside>>) -> bool {
+    s.and_then(|e| scenario.entries.get(e)).is_some_and(|e| e.attrs.walkway)
+}
+
+/// W0700 for the names of the road's lists that the maps cannot have: signs that are not a
+/// junction's, roadsides that are not walkways, special lanes, hazards, roadworks and
+/// emergency vehicles.
+fn unmapped_lists(scenario: &Scenario, report: &mut Report) {
+    let road = &scenario.road;
+    let entries = &scenario.entries;
     unmapped(
         scenario,
         &road.signs,
@@ -144,16 +198,11 @@ pub fn request(scenario: &Scenario, span: Span, report: &mut Report) -> RoadRequ
         "CARLA's signs are part of the map: only stop and yield signs at junctions can be asked of it",
         report,
     );
-    let walkway =
-        |s: Option<tad_ir::Id<tad_ir::Roadside>>| s.and_then(|e| entries.get(e)).is_some_and(|e| e.attrs.walkway);
-    if let Some(sidewalk) = road.roadside.given().and_then(|r| r.iter().find(|s| walkway(s.value.id()))) {
-        features.push((Feature::Sidewalk, sidewalk.span));
-    }
     unmapped(
         scenario,
         &road.roadside,
         "roadside",
-        walkway,
+        |s| walkway(scenario, s),
         "the maps' scenery is fixed: only sidewalks can be asked of them",
         report,
     );
@@ -189,57 +238,57 @@ pub fn request(scenario: &Scenario, span: Span, report: &mut Report) -> RoadRequ
         "emergency vehicles are not generated; describe them as actor groups (e.g. an ambulance)",
         report,
     );
-    if let (Some(written), Some(at)) = (road.traffic.given(), road.traffic.span()) {
-        let name = entries.name(written);
-        report
-            .warn(
+}
+
+/// W0700 for a traffic density: no background traffic is generated.
+fn traffic(scenario: &Scenario, report: &mut Report) {
+    let road = &scenario.road;
+    let (Some(written), Some(at)) = (road.traffic.given(), road.traffic.span()) else { return };
+    let name = scenario.entries.name(written);
+    report
+        .warn(
+            Code::W0700,
+            format!("traffic density `{name}` has no Scenic mapping"),
+            at,
+            "left out of the Scenic program",
+            unsupported(named("traffic_density", name), None),
+        )
+        .note("no background traffic is generated: only the ego and the actor groups are in the scene");
+}
+
+/// The CARLA towns the road context prefers, best first; W0700 for a context that only
+/// chooses the map, or not even that.
+fn preference(scenario: &Scenario, report: &mut Report) -> Vec<String> {
+    let road = &scenario.road;
+    let entries = &scenario.entries;
+    let (Some(written), Some(at)) = (road.context.given(), road.context.span()) else { return Vec::new() };
+    let name = entries.name(written);
+    let context = entries.resolved(written).map(|e| &e.attrs);
+    match context.filter(|c| !c.carla_towns.is_empty()) {
+        Some(c) => {
+            if let Some(why) = &c.carla_note {
+                report
+                    .warn(
+                        Code::W0700,
+                        format!("road context `{name}` has no Scenic mapping"),
+                        at,
+                        "only the choice of map follows it",
+                        unsupported(named("road_context", name), Some("the choice of map".into())),
+                    )
+                    .note(why.clone());
+            }
+            c.carla_towns.clone()
+        }
+        None => {
+            report.warn(
                 Code::W0700,
-                format!("traffic density `{name}` has no Scenic mapping"),
+                format!("road context `{name}` has no Scenic mapping"),
                 at,
                 "left out of the Scenic program",
-                unsupported(named("traffic_density", name), None),
-            )
-            .note("no background traffic is generated: only the ego and the actor groups are in the scene");
-    }
-    let mut preference = Vec::new();
-    if let (Some(written), Some(at)) = (road.context.given(), road.context.span()) {
-        let name = entries.name(written);
-        let context = entries.resolved(written).map(|e| &e.attrs);
-        match context.filter(|c| !c.carla_towns.is_empty()) {
-            Some(c) => {
-                preference = c.carla_towns.clone();
-                if let Some(why) = &c.carla_note {
-                    report
-                        .warn(
-                            Code::W0700,
-                            format!("road context `{name}` has no Scenic mapping"),
-                            at,
-                            "only the choice of map follows it",
-                            unsupported(named("road_context", name), Some("the choice of map".into())),
-                        )
-                        .note(why.clone());
-                }
-            }
-            None => {
-                report.warn(
-                    Code::W0700,
-                    format!("road context `{name}` has no Scenic mapping"),
-                    at,
-                    "left out of the Scenic program",
-                    unsupported(named("road_context", name), None),
-                );
-            }
+                unsupported(named("road_context", name), None),
+            );
+            Vec::new()
         }
-    }
-    RoadRequest {
-        span,
-        lanes,
-        one_way: opposite_lanes == Some(false),
-        features,
-        preference,
-        light,
-        light_span,
-        unsignalised,
     }
 }
 
