@@ -1,5 +1,5 @@
 //! The Scenic oracle: `shared/scenic/scenic_check.py` run by a Python with Scenic 3.1.1,
-//! on the CARLA maps of `shared/maps/CARLA`.
+//! on the CARLA maps of `shared/maps/CARLA` (found by `tad-scenic-run`, re-exported here).
 //!
 //! Found through `TADSL_SCENIC_PYTHON` (else `.venv-scenic` in the repository, which
 //! `.ci/run` creates), `TADSL_SCENIC_CHECK` and `TADSL_SCENIC_MAPS` (else `../shared`).
@@ -9,19 +9,10 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use crate::{repo, shared};
+use crate::shared;
+pub use tad_scenic_run::{imports_scenic, map_dir, python, shared_maps, turn};
 
-/// A Python that imports `scenic`.
-pub fn python() -> Option<PathBuf> {
-    let candidates =
-        [std::env::var_os("TADSL_SCENIC_PYTHON").map(PathBuf::from), Some(repo().join(".venv-scenic/bin/python"))];
-    candidates.into_iter().flatten().find(|p| imports_scenic(p))
-}
 
-/// Whether `python` is a Python that imports `scenic`.
-pub fn imports_scenic(python: &Path) -> bool {
-    python.is_file() && Command::new(python).args(["-c", "import scenic"]).output().is_ok_and(|o| o.status.success())
-}
 
 /// The oracle script.
 pub fn check_script() -> Option<PathBuf> {
@@ -30,36 +21,7 @@ pub fn check_script() -> Option<PathBuf> {
     candidates.into_iter().flatten().find(|p| p.is_file())
 }
 
-/// The CARLA maps.
-pub fn shared_maps() -> Option<PathBuf> {
-    let candidates = [std::env::var_os("TADSL_SCENIC_MAPS").map(PathBuf::from), shared().map(|s| s.join("maps/CARLA"))];
-    candidates.into_iter().flatten().find(|p| p.join("Town10HD.xodr").is_file())
-}
 
-/// A writable directory (under `base`) of links to the maps, so Scenic's map cache
-/// (`.snet`) lands there and is reused across runs.
-pub fn map_dir(base: &Path) -> Option<PathBuf> {
-    let shared = shared_maps()?;
-    let dir = base.join("scenic-maps");
-    std::fs::create_dir_all(&dir).ok()?;
-    for entry in std::fs::read_dir(&shared).ok()?.flatten() {
-        let path = entry.path();
-        if path.extension().is_some_and(|e| e == "xodr") {
-            let link = dir.join(entry.file_name());
-            if !link.exists() {
-                #[cfg(unix)]
-                let made = std::os::unix::fs::symlink(&path, &link);
-                #[cfg(not(unix))]
-                let made = std::fs::copy(&path, &link).map(|_| ());
-                // another test may have made it meanwhile
-                if made.is_err() && !link.exists() {
-                    return None;
-                }
-            }
-        }
-    }
-    Some(dir)
-}
 
 /// The oracle's python, script and map directory; `None` (after saying so where a user
 /// sees it) when it is not installed, a panic when `TAD_REQUIRE_SCENIC=1`.
@@ -88,12 +50,6 @@ pub fn unavailable(why: &str) {
     let _ = writeln!(std::io::stderr().lock(), "warning: SKIPPED: {why}");
 }
 
-/// This test process's turn to run Scenic: one run at a time, as Scenic processes share
-/// the map cache (`.snet`), which the first compile of a map writes.
-pub fn turn() -> std::sync::MutexGuard<'static, ()> {
-    static SCENIC: std::sync::Mutex<()> = std::sync::Mutex::new(());
-    SCENIC.lock().unwrap_or_else(|e| e.into_inner())
-}
 
 /// Run the oracle on `files` in one process; one JSON object per file.
 pub fn run(python: &Path, check: &Path, args: &[&str], files: &[PathBuf]) -> Vec<serde_json::Value> {

@@ -10,7 +10,7 @@
 //!   10 km/h (83 m in 30 s) to use every step; a row says so when an episode stopped early.
 //! - **Scenic.** The same scenarios built for Scenic's Newtonian simulator and simulated
 //!   for as many steps, headless, by the fidelity suite's tracer
-//!   (`compiler/backends/scenic/tools/scenic_trace.py` through `tad_test_support::trace`):
+//!   (`compiler/backends/scenic/tools/scenic_trace.py` through `tad_scenic_run::trace`):
 //!   its `sim_s` (simulation only, not compiling or sampling), one simulation per scenario,
 //!   as a Scenic run takes seconds to a minute. Four lanes each way let all 50 actors fit
 //!   on CARLA's Town04, so both simulators run the same actors (checked).
@@ -203,7 +203,7 @@ fn scenic_program(db: &mut Database, m: &Measured, maps: &Path) -> Option<String
 /// Each scenario's run in Scenic's Newtonian simulator, in `measured`'s order; `Err` (why)
 /// when Scenic is not available.
 fn simulate_in_scenic(args: &RuntimeArgs, measured: &[Measured]) -> Result<Vec<Result<Peer, String>>, String> {
-    use tad_test_support::{scenic, trace};
+    use tad_scenic_run::{self as scenic, trace};
     let python = match &args.scenic_python {
         Some(p) if scenic::imports_scenic(p) => p.clone(),
         Some(p) => return Err(format!("`{}` is not a Python that imports scenic", p.display())),
