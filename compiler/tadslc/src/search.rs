@@ -102,14 +102,14 @@ fn search_in(args: &SearchArgs, color: bool, status: &mut Status) -> Result<(), 
     progress.finish_and_clear();
     let seconds = started.elapsed().as_secs_f64();
 
-    let mut taken = HashSet::new();
+    let mut writer = Writer { args, ego: &ego, mode, color, taken: HashSet::new() };
     let mut summary = Vec::new();
     outln!("{:<40} {:>5} {:>9}  {:<24} chosen (OS)", "scenario", "slots", "episodes", "collisions by round")?;
     for (loaded, outcome) in scenes.iter().zip(&outcomes) {
         let mut written = Vec::new();
         for (k, &i) in outcome.chosen.iter().enumerate() {
             let trial = &outcome.trials[i];
-            let (file, reproduced) = match write_scene(args, loaded, outcome, i, k, &ego, mode, &mut taken, color)? {
+            let (file, reproduced) = match write_scene(&mut writer, loaded, outcome, i, k)? {
                 Ok((file, reproduced)) => (Some(file), Some(reproduced)),
                 Err(e) => {
                     *status = (*status).max(Status::Failed);
@@ -188,20 +188,27 @@ fn search_in(args: &SearchArgs, color: bool, status: &mut Status) -> Result<(), 
     )
 }
 
+/// What writing the chosen scenes shares: the search's arguments, its ego and scoring, and
+/// the file names taken so far.
+struct Writer<'a> {
+    args: &'a SearchArgs,
+    ego: &'a EgoSpec,
+    mode: Mode,
+    color: bool,
+    taken: HashSet<String>,
+}
+
 /// Writes chosen scene `k` (trial `i`) of `loaded` as TAD, then runs it again: (file name,
 /// reproduced). The outer error is closed output; the inner one why it was not written.
-#[allow(clippy::too_many_arguments)]
 fn write_scene(
-    args: &SearchArgs,
+    w: &mut Writer,
     loaded: &Loaded,
     outcome: &Outcome,
     i: usize,
     k: usize,
-    ego: &EgoSpec,
-    mode: Mode,
-    taken: &mut HashSet<String>,
-    color: bool,
 ) -> Result<Result<(String, bool), String>, Closed> {
+    let (args, ego, mode, color) = (w.args, w.ego, w.mode, w.color);
+    let taken = &mut w.taken;
     let Some(input) = &loaded.source else {
         return Ok(Err("a bytecode file has no source to write".into()));
     };

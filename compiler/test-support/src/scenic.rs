@@ -12,16 +12,12 @@ use std::process::Command;
 use crate::shared;
 pub use tad_scenic_run::{imports_scenic, map_dir, python, shared_maps, turn};
 
-
-
 /// The oracle script.
 pub fn check_script() -> Option<PathBuf> {
     let candidates =
         [std::env::var_os("TADSL_SCENIC_CHECK").map(PathBuf::from), shared().map(|s| s.join("scenic/scenic_check.py"))];
     candidates.into_iter().flatten().find(|p| p.is_file())
 }
-
-
 
 /// The oracle's python, script and map directory; `None` (after saying so where a user
 /// sees it) when it is not installed, a panic when `TAD_REQUIRE_SCENIC=1`.
@@ -49,7 +45,6 @@ pub fn unavailable(why: &str) {
     use std::io::Write;
     let _ = writeln!(std::io::stderr().lock(), "warning: SKIPPED: {why}");
 }
-
 
 /// Run the oracle on `files` in one process; one JSON object per file.
 pub fn run(python: &Path, check: &Path, args: &[&str], files: &[PathBuf]) -> Vec<serde_json::Value> {

@@ -257,7 +257,6 @@ impl Default for TraceOptions {
     }
 }
 
-
 /// The map a program names (`param map = '...'`), to keep programs of one map together.
 fn map_of(file: &Path) -> String {
     std::fs::read_to_string(file)
