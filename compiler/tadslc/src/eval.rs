@@ -18,7 +18,7 @@ use tad_eval::{Item, Journal, Kept, Plan, Results, Setup, TableFormat, Unit};
 use tad_policy::EgoSpec;
 use tad_train::{Config, TrainError};
 
-use crate::output::Closed;
+use crate::output::{CliError, Closed};
 use crate::{Status, errln, out, outln, plural};
 
 /// What `eval` and `merge` print.
@@ -314,47 +314,34 @@ fn scenarios(
 
 /// `tadslc merge FILES`: the table of several results files (the shards of one command).
 pub fn merge(files: &[PathBuf], format: EvalFormat, plot: Option<&Path>) -> Status {
-    crate::output::run(|status| {
-        let mut all: Vec<Results> = Vec::new();
-        for path in files {
-            match Results::read(path) {
-                Ok(r) => all.push(r),
-                Err(e) => {
-                    *status = Status::Usage;
-                    return errln!("error: {}: {e}", path.display());
-                }
-            }
+    crate::output::finish(merge_in(files, format, plot))
+}
+
+fn merge_in(files: &[PathBuf], format: EvalFormat, plot: Option<&Path>) -> Result<Status, CliError> {
+    let all = files
+        .iter()
+        .map(|path| Results::read(path).map_err(|e| CliError::usage(format!("{}: {e}", path.display()))))
+        .collect::<Result<Vec<Results>, CliError>>()?;
+    let shown = |index: usize| files[index].display();
+    let missing = results::check_merge(&all).map_err(|e| match e {
+        MergeError::OtherSetup { index } => CliError::usage(format!(
+            "{} comes from another command than {} (regions, generators, egos, sizes or seed differ)",
+            shown(index),
+            shown(0)
+        )),
+        MergeError::OtherCount { index, shard, count } => {
+            CliError::usage(format!("{} is shard {shard} but {} is of {count}", shown(index), shown(0)))
         }
-        match results::check_merge(&all) {
-            Ok(missing) if missing.is_empty() => {}
-            Ok(missing) => {
-                *status = (*status).max(Status::Failed);
-                let missing: Vec<String> = missing.iter().map(Shard::to_string).collect();
-                errln!("warning: shards {} are missing: the table covers part of the work", missing.join(", "))?;
-            }
-            Err(MergeError::OtherSetup { index }) => {
-                *status = Status::Usage;
-                return errln!(
-                    "error: {} comes from another command than {} (regions, generators, egos, sizes or seed differ)",
-                    files[index].display(),
-                    files[0].display()
-                );
-            }
-            Err(MergeError::OtherCount { index, shard, count }) => {
-                *status = Status::Usage;
-                return errln!(
-                    "error: {} is shard {shard} but {} is of {count}",
-                    files[index].display(),
-                    files[0].display()
-                );
-            }
-            Err(e @ (MergeError::Empty | MergeError::Twice(_))) => {
-                *status = Status::Usage;
-                return errln!("error: {e}");
-            }
-        }
-        print(&all, format, plot, status)
-    })
+        e @ (MergeError::Empty | MergeError::Twice(_)) => CliError::usage(e),
+    })?;
+    let mut status = Status::Ok;
+    if !missing.is_empty() {
+        status = Status::Failed;
+        let missing: Vec<String> = missing.iter().map(Shard::to_string).collect();
+        errln!("warning: shards {} are missing: the table covers part of the work", missing.join(", "))?;
+    }
+    print(&all, format, plot, &mut status)?;
+    Ok(status)
 }
 
 /// The table of `all` on standard output, and its plot.

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use tad_finetune::{Config, FinetuneError, Progress, Target};
 
-use crate::output::Closed;
+use crate::output::CliError;
 use crate::{Status, errln, outln};
 
 /// Fine-tune the local model with LoRA on chat examples
@@ -94,49 +94,57 @@ impl FinetuneArgs {
 /// Runs `tadslc finetune`: 0 when the adapter is written, 2 for a usage or I/O error (bad
 /// flags, unreadable examples, no model, a checkpoint of another run), 1 when training fails.
 pub fn finetune(args: &FinetuneArgs) -> Status {
-    crate::output::run(|status| finetune_in(args, status))
+    crate::output::finish(finetune_in(args))
 }
 
-fn finetune_in(args: &FinetuneArgs, status: &mut Status) -> Result<(), Closed> {
-    let config = match args.config() {
-        Ok(c) => c,
-        Err(e) => {
-            *status = Status::Usage;
-            return errln!("error: {e}");
-        }
-    };
+fn finetune_in(args: &FinetuneArgs) -> Result<Status, CliError> {
+    let config = args.config().map_err(CliError::usage)?;
     let file = data_file(&args.data);
-    let examples = match std::fs::read_to_string(&file)
-        .map_err(|e| format!("cannot read {}: {e}", file.display()))
-        .and_then(|text| tad_finetune::read_jsonl(&text).map_err(|e| format!("{}: {e}", file.display())))
-    {
-        Ok(x) if x.is_empty() => {
-            *status = Status::Usage;
-            return errln!("error: {} holds no examples", file.display());
-        }
-        Ok(x) => x,
-        Err(e) => {
-            *status = Status::Usage;
-            return errln!("error: {e}");
-        }
-    };
-    let gguf = match tad_local::model(&args.model) {
-        Some(model) => model.require(),
-        None => Err(format!("unknown local model `{}`", args.model)),
-    };
-    let gguf = match gguf {
-        Ok(p) => p,
-        Err(e) => {
-            *status = Status::Usage;
-            return errln!("error: {e}");
-        }
-    };
+    let text =
+        std::fs::read_to_string(&file).map_err(|e| CliError::usage(format!("cannot read {}: {e}", file.display())))?;
+    let examples = tad_finetune::read_jsonl(&text).map_err(|e| CliError::usage(format!("{}: {e}", file.display())))?;
+    if examples.is_empty() {
+        return Err(CliError::usage(format!("{} holds no examples", file.display())));
+    }
+    let model = tad_local::model(&args.model)
+        .ok_or_else(|| CliError::usage(format!("unknown local model `{}`", args.model)))?;
+    let gguf = model.require().map_err(CliError::usage)?;
+    let report = train(args, &gguf, &examples, &config).map_err(|e| match e {
+        // what could not be read or written, or set up, is the caller's to fix
+        FinetuneError::Setup(_) | FinetuneError::Io(_) => CliError::usage(e),
+        FinetuneError::Training(_) => CliError::failed(e),
+    })?;
+    for w in &report.warnings {
+        errln!("warning: {w}")?;
+    }
+    if let Some(step) = report.resumed_at {
+        errln!("resumed after step {step}")?;
+    }
+    let first = report.losses.first().copied().unwrap_or(f32::NAN);
+    let last = report.losses.last().copied().unwrap_or(f32::NAN);
+    outln!(
+        "wrote the adapter to {}: {} examples, {} steps, loss {first:.4} -> {last:.4}, {:.1} tokens/s",
+        report.adapter.display(),
+        report.examples,
+        report.steps,
+        report.tokens_per_s
+    )?;
+    Ok(Status::Ok)
+}
+
+/// Training with a progress bar at a terminal, a line per step elsewhere.
+fn train(
+    args: &FinetuneArgs,
+    gguf: &Path,
+    examples: &[tad_finetune::Example],
+    config: &Config,
+) -> Result<tad_finetune::Report, FinetuneError> {
     let mut progress: Option<indicatif::ProgressBar> = None;
     let terminal = {
         use std::io::IsTerminal;
         std::io::stderr().is_terminal()
     };
-    let result = tad_finetune::train(&gguf, &examples, &config, &args.out, &mut |p: &Progress| {
+    let result = tad_finetune::train(gguf, examples, config, &args.out, &mut |p: &Progress| {
         let bar = progress.get_or_insert_with(|| crate::output::progress(p.steps, "steps"));
         bar.set_position(p.step as u64);
         bar.set_message(format!("epoch {} loss {:.4} {:.0} tokens/s", p.epoch + 1, p.loss, p.tokens_per_s));
@@ -157,30 +165,5 @@ fn finetune_in(args: &FinetuneArgs, status: &mut Status) -> Result<(), Closed> {
     if let Some(bar) = progress {
         bar.finish_and_clear();
     }
-    let report = match result {
-        Ok(report) => report,
-        Err(e) => {
-            // what could not be read or written, or set up, is the caller's to fix
-            *status = match e {
-                FinetuneError::Setup(_) | FinetuneError::Io(_) => Status::Usage,
-                FinetuneError::Training(_) => Status::Failed,
-            };
-            return errln!("error: {e}");
-        }
-    };
-    for w in &report.warnings {
-        errln!("warning: {w}")?;
-    }
-    if let Some(step) = report.resumed_at {
-        errln!("resumed after step {step}")?;
-    }
-    let first = report.losses.first().copied().unwrap_or(f32::NAN);
-    let last = report.losses.last().copied().unwrap_or(f32::NAN);
-    outln!(
-        "wrote the adapter to {}: {} examples, {} steps, loss {first:.4} -> {last:.4}, {:.1} tokens/s",
-        report.adapter.display(),
-        report.examples,
-        report.steps,
-        report.tokens_per_s
-    )
+    result
 }

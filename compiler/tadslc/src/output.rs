@@ -7,6 +7,9 @@
 //! [`Closed::status`]. A closed pipe is not a failure of the run: it is quiet and leaves
 //! the status as it was. Any other write error (a full disk) is reported on standard
 //! error, if it can be, and makes the status 2 (`spec/output.md`).
+//!
+//! Subcommands return `Result<Status, CliError>` ([`finish`] reports the error); those not
+//! yet converted raise a `&mut Status` inside [`run`] (tidy lists them, a list that shrinks).
 
 use crate::Status;
 use std::io::Write;
@@ -105,4 +108,48 @@ pub fn progress(total: usize, unit: &str) -> indicatif::ProgressBar {
         indicatif::ProgressStyle::with_template(&template).unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
     bar
+}
+
+/// Why a subcommand stopped: a message for standard error and the exit status it ends with.
+/// A subcommand returns `Result<Status, CliError>`: the status of what it did (1 when some
+/// inputs had errors), or the failure that ended it; [`finish`] reports it.
+#[derive(Debug)]
+pub enum CliError {
+    /// Usage or I/O (status 2).
+    Usage(String),
+    /// The input has errors, or the work failed (status 1).
+    Failed(String),
+    /// A standard stream could not be written (already reported where it could be).
+    Closed(Closed),
+}
+
+impl CliError {
+    pub fn usage(message: impl std::fmt::Display) -> CliError {
+        CliError::Usage(message.to_string())
+    }
+
+    pub fn failed(message: impl std::fmt::Display) -> CliError {
+        CliError::Failed(message.to_string())
+    }
+}
+
+impl From<Closed> for CliError {
+    fn from(closed: Closed) -> CliError {
+        CliError::Closed(closed)
+    }
+}
+
+/// The exit status of a subcommand's result, its error reported on standard error.
+pub fn finish(result: Result<Status, CliError>) -> Status {
+    let status = match result {
+        Ok(status) => return flush().map_or_else(|closed| closed.merge(status), |()| status),
+        Err(CliError::Usage(message)) => (Status::Usage, message),
+        Err(CliError::Failed(message)) => (Status::Failed, message),
+        Err(CliError::Closed(closed)) => return closed.merge(Status::Ok),
+    };
+    let (status, message) = status;
+    match err(format_args!("error: {message}\n")) {
+        Ok(()) => status,
+        Err(closed) => closed.merge(status),
+    }
 }
