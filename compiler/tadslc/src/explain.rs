@@ -4,41 +4,37 @@
 //! and `0203` are E0203; `600`, `w600` and `E0600` are W0600. Where an error and a
 //! warning share a number, the letter given chooses, and a bare number means the error.
 
-use crate::output::Closed;
+use crate::output::CliError;
 use crate::{Status, errln, outln};
 use tad_diagnostics::Code;
 
 pub fn run(code: Option<&str>) -> Status {
-    crate::output::run(|status| run_in(code, status))
+    crate::output::finish(run_in(code))
 }
 
-fn run_in(code: Option<&str>, status: &mut Status) -> Result<(), Closed> {
+fn run_in(code: Option<&str>) -> Result<Status, CliError> {
     let Some(text) = code else {
         for code in Code::ALL {
             outln!("{code}  {}", code.title())?;
         }
-        return Ok(());
+        return Ok(Status::Ok);
     };
-    match resolve(text) {
-        Ok(code) => {
-            outln!("{}", code.reference().trim_start_matches("## "))?;
-            if let Some(twin) = twin(code) {
-                errln!("note: {twin} ({}) has the same number: `tadslc explain {twin}`", twin.title())?;
-            }
-        }
-        Err(nearest) => {
-            *status = Status::Usage;
-            errln!("error: `{text}` is not a TADSL diagnostic code")?;
-            if nearest.is_empty() {
-                errln!("note: a code is a number such as `203`, with or without its letter (`E0203`)")?;
-            } else {
-                let names: Vec<String> = nearest.iter().map(|c| format!("{c} ({})", c.title())).collect();
-                errln!("help: the closest codes are {}", names.join(", "))?;
-            }
-            errln!("note: `tadslc explain` without a code lists them all")?;
-        }
+    let code = resolve(text).map_err(|nearest| {
+        let hint = if nearest.is_empty() {
+            "note: a code is a number such as `203`, with or without its letter (`E0203`)".to_string()
+        } else {
+            let names: Vec<String> = nearest.iter().map(|c| format!("{c} ({})", c.title())).collect();
+            format!("help: the closest codes are {}", names.join(", "))
+        };
+        CliError::usage(format!(
+            "`{text}` is not a TADSL diagnostic code\n{hint}\nnote: `tadslc explain` without a code lists them all"
+        ))
+    })?;
+    outln!("{}", code.reference().trim_start_matches("## "))?;
+    if let Some(twin) = twin(code) {
+        errln!("note: {twin} ({}) has the same number: `tadslc explain {twin}`", twin.title())?;
     }
-    Ok(())
+    Ok(Status::Ok)
 }
 
 /// The number of a code: 203 for E0203.

@@ -2,7 +2,7 @@
 //! (`clap_complete`) and the manual pages (`clap_mangen`), generated from the command
 //! line's own definition, so they never disagree with it.
 
-use crate::output::Closed;
+use crate::output::CliError;
 use crate::{Status, errln, plural};
 use clap_complete::Shell;
 use std::path::Path;
@@ -19,28 +19,22 @@ pub fn completions(mut command: clap::Command, shell: Shell) -> Status {
 /// Print `tadslc.1`, or write it and a page per subcommand (`tadslc-check.1`, ...) into
 /// `dir`.
 pub fn man(command: clap::Command, dir: Option<&Path>) -> Status {
-    crate::output::run(|status| man_in(command, dir, status))
+    crate::output::finish(man_in(command, dir))
 }
 
-fn man_in(command: clap::Command, dir: Option<&Path>, status: &mut Status) -> Result<(), Closed> {
+fn man_in(command: clap::Command, dir: Option<&Path>) -> Result<Status, CliError> {
     let Some(dir) = dir else {
         let mut page = Vec::new();
-        if let Err(e) = clap_mangen::Man::new(command).render(&mut page) {
-            *status = Status::Usage;
-            return errln!("error: cannot render the manual page: {e}");
-        }
-        return crate::output::out_bytes(&page);
+        clap_mangen::Man::new(command)
+            .render(&mut page)
+            .map_err(|e| CliError::usage(format!("cannot render the manual page: {e}")))?;
+        crate::output::out_bytes(&page)?;
+        return Ok(Status::Ok);
     };
-    if let Err(e) = std::fs::create_dir_all(dir) {
-        *status = Status::Usage;
-        return errln!("error: cannot create `{}`: {e}", dir.display());
-    }
+    std::fs::create_dir_all(dir).map_err(|e| CliError::usage(format!("cannot create `{}`: {e}", dir.display())))?;
     let pages = 1 + command.get_subcommands().filter(|s| !s.is_hide_set() && s.get_name() != "help").count();
-    match clap_mangen::generate_to(command, dir) {
-        Ok(()) => errln!("wrote {} into {}", plural(pages, "manual page"), dir.display()),
-        Err(e) => {
-            *status = Status::Usage;
-            errln!("error: cannot write the manual pages into `{}`: {e}", dir.display())
-        }
-    }
+    clap_mangen::generate_to(command, dir)
+        .map_err(|e| CliError::usage(format!("cannot write the manual pages into `{}`: {e}", dir.display())))?;
+    errln!("wrote {} into {}", plural(pages, "manual page"), dir.display())?;
+    Ok(Status::Ok)
 }
