@@ -15,7 +15,7 @@ use tad_metrics::Mode;
 use tad_policy::EgoPolicy;
 use tad_search::{Config, Outcome};
 
-use crate::output::Closed;
+use crate::output::{CliError, Closed};
 use crate::run::Loaded;
 use crate::{Status, errln, outln};
 use tad_policy::EgoSpec;
@@ -52,7 +52,7 @@ pub struct SearchArgs {
 }
 
 pub fn run(args: &SearchArgs, color: bool) -> Status {
-    crate::output::run(|status| search_in(args, color, status))
+    crate::output::finish(search_in(args, color))
 }
 
 /// One written scene.
@@ -68,23 +68,16 @@ pub struct Written {
     pub reproduced: Option<bool>,
 }
 
-fn search_in(args: &SearchArgs, color: bool, status: &mut Status) -> Result<(), Closed> {
-    let ego = match EgoSpec::parse(&args.ego) {
-        Ok(ego) => ego,
-        Err(e) => {
-            *status = Status::Usage;
-            return errln!("error: --ego {}: {e}", args.ego);
-        }
-    };
-    let scenes = crate::run::load_shard(&args.paths, args.shard, color, status)?;
+fn search_in(args: &SearchArgs, color: bool) -> Result<Status, CliError> {
+    let ego = EgoSpec::parse(&args.ego).map_err(|e| CliError::usage(format!("--ego {}: {e}", args.ego)))?;
+    // raised by inputs that do not load, and scenes that could not be written
+    let mut status = Status::Ok;
+    let scenes = crate::run::load_shard(&args.paths, args.shard, color, &mut status)?;
     if scenes.is_empty() {
-        *status = (*status).max(Status::Usage);
-        return errln!("error: nothing to search");
+        return Err(CliError::usage("nothing to search"));
     }
-    if let Err(e) = std::fs::create_dir_all(&args.out) {
-        *status = Status::Usage;
-        return errln!("error: cannot create `{}`: {e}", args.out.display());
-    }
+    std::fs::create_dir_all(&args.out)
+        .map_err(|e| CliError::usage(format!("cannot create `{}`: {e}", args.out.display())))?;
     let mode = if args.compat { Mode::Compat } else { Mode::Fixed };
     let config = Config { samples: args.samples, round: args.round, keep: args.keep, seed: args.seed, mode };
     let total: usize =
@@ -112,7 +105,7 @@ fn search_in(args: &SearchArgs, color: bool, status: &mut Status) -> Result<(), 
             let (file, reproduced) = match write_scene(&mut writer, loaded, outcome, i, k)? {
                 Ok((file, reproduced)) => (Some(file), Some(reproduced)),
                 Err(e) => {
-                    *status = (*status).max(Status::Failed);
+                    status = status.max(Status::Failed);
                     errln!("{}: scene {} not written: {e}", loaded.name, trial.index)?;
                     (None, None)
                 }
@@ -174,10 +167,8 @@ fn search_in(args: &SearchArgs, color: bool, status: &mut Status) -> Result<(), 
         "scenarios": summary,
     });
     let text = serde_json::to_string_pretty(&value).unwrap_or_default();
-    if let Err(e) = std::fs::write(&file, text + "\n") {
-        *status = Status::Usage;
-        return errln!("error: cannot write `{}`: {e}", file.display());
-    }
+    std::fs::write(&file, text + "\n")
+        .map_err(|e| CliError::usage(format!("cannot write `{}`: {e}", file.display())))?;
     errln!(
         "searched {} with {}: {episodes} episodes in {seconds:.1} s on {}; scenes and {} in {}",
         crate::plural(scenes.len(), "scenario"),
@@ -185,7 +176,8 @@ fn search_in(args: &SearchArgs, color: bool, status: &mut Status) -> Result<(), 
         crate::plural(rayon::current_num_threads(), "thread"),
         file.file_name().map_or(String::new(), |f| f.to_string_lossy().into_owned()),
         args.out.display()
-    )
+    )?;
+    Ok(status)
 }
 
 /// What writing the chosen scenes shares: the search's arguments, its ego and scoring, and
