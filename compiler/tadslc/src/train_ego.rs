@@ -11,7 +11,7 @@ use std::path::PathBuf;
 use tad_eval::train::{Start, TrainScene};
 use tad_train::{Config, TrainError, Trainer};
 
-use crate::output::Closed;
+use crate::output::{CliError, Closed};
 use crate::run::Loaded;
 use crate::{Status, errln, outln, plural};
 
@@ -83,72 +83,26 @@ fn behaviour_key(loaded: &Loaded) -> String {
 }
 
 pub fn train_ego(args: &TrainEgoArgs, color: bool) -> Status {
-    crate::output::run(|status| train_in(args, color, status))
+    crate::output::finish(train_in(args, color))
 }
 
-fn train_in(args: &TrainEgoArgs, color: bool, status: &mut Status) -> Result<(), Closed> {
+fn train_in(args: &TrainEgoArgs, color: bool) -> Result<Status, CliError> {
     let config = args.config();
-    if let Err(e) = config.check() {
-        *status = Status::Usage;
-        return errln!("error: {e}");
-    }
-    let scenes = crate::run::load(&args.paths, color, status)?;
+    config.check().map_err(CliError::usage)?;
+    // raised by inputs that do not load
+    let mut status = Status::Ok;
+    let scenes = crate::run::load(&args.paths, color, &mut status)?;
     let scenes: &[Loaded] = &scenes;
     if scenes.is_empty() {
-        *status = (*status).max(Status::Usage);
-        return errln!("error: no scenario to train on");
+        return Err(CliError::usage("no scenario to train on"));
     }
-    if let Some(parent) = args.out.parent().filter(|p| !p.as_os_str().is_empty())
-        && let Err(e) = std::fs::create_dir_all(parent)
-    {
-        *status = Status::Usage;
-        return errln!("error: cannot create `{}`: {e}", parent.display());
+    if let Some(parent) = args.out.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent)
+            .map_err(|e| CliError::usage(format!("cannot create `{}`: {e}", parent.display())))?;
     }
-    let (train, test): (Vec<usize>, Vec<usize>) = if args.split {
-        let keys: Vec<String> = scenes.iter().map(behaviour_key).collect();
-        tad_train::split(&keys, args.seed)
-    } else {
-        ((0..scenes.len()).collect(), Vec::new())
-    };
-    if args.split {
-        let names = |list: &[usize]| list.iter().map(|&i| scenes[i].name.clone()).collect::<Vec<_>>();
-        let value = serde_json::json!({ "seed": args.seed, "train": names(&train), "test": names(&test) });
-        let path = tad_train::beside(&args.out, ".split.json");
-        if let Err(e) = std::fs::write(&path, serde_json::to_string_pretty(&value).unwrap_or_default() + "\n") {
-            *status = Status::Usage;
-            return errln!("error: cannot write `{}`: {e}", path.display());
-        }
-        errln!("split: {} for training, {} held out ({})", train.len(), test.len(), path.display())?;
-    }
+    let (train, test) = split(args, scenes)?;
     let checkpoint = args.checkpoint.clone().unwrap_or_else(|| tad_train::default_checkpoint_dir(&args.out));
-    let mut trainer = if args.resume && checkpoint.join("state.json").exists() {
-        match Trainer::load_checkpoint(&checkpoint) {
-            Ok(t) if t.config().seed == config.seed && t.config().hidden == config.hidden => {
-                errln!("resumed from {} after {}", checkpoint.display(), plural(t.episodes() as usize, "episode"))?;
-                t
-            }
-            Ok(_) => {
-                *status = Status::Usage;
-                return errln!(
-                    "error: {} was trained with another seed or other widths: resume with the same --seed and --hidden",
-                    checkpoint.display()
-                );
-            }
-            Err(e) => {
-                *status = Status::Usage;
-                return errln!("error: {e}");
-            }
-        }
-    } else {
-        let start = args.init.as_deref().map_or(Start::Scratch, Start::Actor);
-        match start.trainer(config.clone()) {
-            Ok((t, _)) => t,
-            Err(e) => {
-                *status = Status::Usage;
-                return errln!("error: {e}");
-            }
-        }
-    };
+    let mut trainer = trainer(args, config, &checkpoint)?;
     let total = args.episodes;
     let start = trainer.episodes() as usize;
     let progress = crate::output::progress(total.saturating_sub(start), "episodes");
@@ -181,21 +135,14 @@ fn train_in(args: &TrainEgoArgs, color: bool, status: &mut Status) -> Result<(),
     progress.finish_and_clear();
     match trained {
         Ok(()) => {}
-        Err(Stop::Closed(closed)) => return Err(closed),
-        Err(Stop::Checkpoint(e)) => {
-            *status = Status::Usage;
-            return errln!("error: {e}");
-        }
+        Err(Stop::Closed(closed)) => return Err(closed.into()),
+        Err(Stop::Checkpoint(e)) => return Err(CliError::usage(e)),
         Err(Stop::Train(e)) => {
-            *status = Status::Failed;
             let _ = trainer.save_checkpoint(&checkpoint);
-            return errln!("error: training stopped at episode {}: {e}", trainer.episodes());
+            return Err(CliError::failed(format!("training stopped at episode {}: {e}", trainer.episodes())));
         }
     }
-    if let Err(e) = trainer.save_checkpoint(&checkpoint).and_then(|_| trainer.save_actor(&args.out)) {
-        *status = Status::Usage;
-        return errln!("error: {e}");
-    }
+    trainer.save_checkpoint(&checkpoint).and_then(|_| trainer.save_actor(&args.out)).map_err(CliError::usage)?;
     // the deterministic actor on the held-out scenarios (or the training ones)
     let judged = if test.is_empty() { &train } else { &test };
     let mut hits = 0;
@@ -221,7 +168,43 @@ fn train_in(args: &TrainEgoArgs, color: bool, status: &mut Status) -> Result<(),
         args.out.display(),
         args.out.display(),
         checkpoint.display()
-    )
+    )?;
+    Ok(status)
+}
+
+/// The scenarios trained on and held out: all and none, or with `--split` 3/5 of each
+/// behaviour's and the rest (listed in `OUT.split.json`).
+fn split(args: &TrainEgoArgs, scenes: &[Loaded]) -> Result<(Vec<usize>, Vec<usize>), CliError> {
+    if !args.split {
+        return Ok(((0..scenes.len()).collect(), Vec::new()));
+    }
+    let keys: Vec<String> = scenes.iter().map(behaviour_key).collect();
+    let (train, test) = tad_train::split(&keys, args.seed);
+    let names = |list: &[usize]| list.iter().map(|&i| scenes[i].name.clone()).collect::<Vec<_>>();
+    let value = serde_json::json!({ "seed": args.seed, "train": names(&train), "test": names(&test) });
+    let path = tad_train::beside(&args.out, ".split.json");
+    std::fs::write(&path, serde_json::to_string_pretty(&value).unwrap_or_default() + "\n")
+        .map_err(|e| CliError::usage(format!("cannot write `{}`: {e}", path.display())))?;
+    errln!("split: {} for training, {} held out ({})", train.len(), test.len(), path.display())?;
+    Ok((train, test))
+}
+
+/// The trainer: the checkpoint's with `--resume` (of the same seed and widths), else a new
+/// one from scratch or from `--init`'s actor.
+fn trainer(args: &TrainEgoArgs, config: Config, checkpoint: &std::path::Path) -> Result<Trainer, CliError> {
+    if !(args.resume && checkpoint.join("state.json").exists()) {
+        let start = args.init.as_deref().map_or(Start::Scratch, Start::Actor);
+        return start.trainer(config).map(|(t, _)| t).map_err(CliError::usage);
+    }
+    let t = Trainer::load_checkpoint(checkpoint).map_err(CliError::usage)?;
+    if t.config().seed != config.seed || t.config().hidden != config.hidden {
+        return Err(CliError::usage(format!(
+            "{} was trained with another seed or other widths: resume with the same --seed and --hidden",
+            checkpoint.display()
+        )));
+    }
+    errln!("resumed from {} after {}", checkpoint.display(), plural(t.episodes() as usize, "episode"))?;
+    Ok(t)
 }
 
 /// Why a training loop stopped early.

@@ -39,7 +39,6 @@ const STATUS_BY_SIDE_EFFECT: &[(&str, usize)] = &[
     ("compiler/tadslc/src/fmt.rs", 4),
     ("compiler/tadslc/src/interchange.rs", 4),
     ("compiler/tadslc/src/run.rs", 10),
-    ("compiler/tadslc/src/train_ego.rs", 10),
     ("compiler/tadslc/src/bench/align.rs", 2),
     ("compiler/tadslc/src/bench/llm.rs", 1),
     ("compiler/tadslc/src/bench/lsp.rs", 1),
