@@ -100,32 +100,27 @@ pub struct EvalArgs {
 }
 
 pub fn eval(args: &EvalArgs, color: bool) -> Status {
-    crate::output::run(|status| eval_in(args, color, status))
+    crate::output::finish(eval_in(args, color))
 }
 
-fn eval_in(args: &EvalArgs, _color: bool, status: &mut Status) -> Result<(), Closed> {
+fn eval_in(args: &EvalArgs, _color: bool) -> Result<Status, CliError> {
     let mut egos = Vec::new();
     for spec in args.egos.iter().chain(std::iter::once(&args.search_ego)) {
-        match EgoSpec::parse(spec) {
-            Ok(ego) => egos.push(ego),
-            Err(e) => {
-                *status = Status::Usage;
-                return errln!("error: ego `{spec}`: {e}");
-            }
-        }
+        egos.push(EgoSpec::parse(spec).map_err(|e| CliError::usage(format!("ego `{spec}`: {e}")))?);
     }
     let surrogate = egos.pop().expect("the search ego was pushed last");
     if args.finetune > 0 && args.shard != Shard::ALL {
-        *status = Status::Usage;
-        return errln!("error: --finetune trains on every kept scene: run it without --shard");
+        return Err(CliError::usage("--finetune trains on every kept scene: run it without --shard"));
     }
+    // raised by files that cannot be read, and by what fails without ending the run
+    let mut status = Status::Ok;
     let corpus = if args.corpus.is_empty() {
-        crate::align::report(tad_eval::examples::corpus("examples", "examples/"), status)?
+        crate::align::report(tad_eval::examples::corpus("examples", "examples/"), &mut status)?
     } else {
-        crate::align::load(&args.corpus, status)?
+        crate::align::load(&args.corpus, &mut status)?
     };
     if corpus.items.is_empty() {
-        return Ok(());
+        return Ok(status);
     }
     // regions: the ones asked for, else every region with at least 3 scenarios
     let mut by_region: BTreeMap<String, Vec<&Item>> = BTreeMap::new();
@@ -140,11 +135,10 @@ fn eval_in(args: &EvalArgs, _color: bool, status: &mut Status) -> Result<(), Clo
         args.regions.clone()
     };
     if regions.is_empty() {
-        *status = Status::Usage;
-        return errln!(
-            "error: corpus `{}` has no region with 3 scenarios or more: name one with --region",
+        return Err(CliError::usage(format!(
+            "corpus `{}` has no region with 3 scenarios or more: name one with --region",
             corpus.name
-        );
+        )));
     }
     let plan = Plan {
         setup: Setup {
@@ -169,7 +163,7 @@ fn eval_in(args: &EvalArgs, _color: bool, status: &mut Status) -> Result<(), Clo
         let own: &[&Item] = by_region.get(region).map_or(&[], |v| v.as_slice());
         for name in &args.generators {
             let generator = Generator::parse(name);
-            let Some(texts) = scenarios(&mut db, args, &generator, region, own, status)? else { return Ok(()) };
+            let texts = scenarios(&mut db, args, &generator, region, own, &mut status)?;
             for (scenario, text) in texts {
                 let path = PathBuf::from(format!("{name}/{scenario}.tad"));
                 let file = db.set_source(path, text, tad_db::Language::Tad, &tad_db::RealFs);
@@ -190,13 +184,11 @@ fn eval_in(args: &EvalArgs, _color: bool, status: &mut Status) -> Result<(), Clo
 
     // the journal of a run killed before: its units are not run again
     let (journal, done) = match &args.out {
-        Some(dir) => match Journal::open(dir, &plan.setup, plan.shard) {
-            Ok((journal, done)) => (Some(journal), done),
-            Err(e) => {
-                *status = Status::Usage;
-                return errln!("error: cannot write the journal in `{}`: {e}", dir.display());
-            }
-        },
+        Some(dir) => {
+            let (journal, done) = Journal::open(dir, &plan.setup, plan.shard)
+                .map_err(|e| CliError::usage(format!("cannot write the journal in `{}`: {e}", dir.display())))?;
+            (Some(journal), done)
+        }
         None => (None, BTreeMap::new()),
     };
     let mine = plan.mine(&units);
@@ -219,18 +211,15 @@ fn eval_in(args: &EvalArgs, _color: bool, status: &mut Status) -> Result<(), Clo
     let evaluated = plan.evaluate(&units, &done, &record, &|| progress.inc(1));
     progress.finish_and_clear();
     if let Some(e) = failed_journal.into_inner().unwrap_or_else(|p| p.into_inner()) {
-        *status = Status::Usage;
+        status = Status::Usage;
         errln!("error: cannot write the journal: {e}")?;
     }
     let results = evaluated.results;
     if let Some(dir) = &args.out {
-        match results.write(dir) {
-            Ok(path) => errln!("rows in {}", path.display())?,
-            Err(e) => {
-                *status = Status::Usage;
-                return errln!("error: cannot write `{}`: {e}", Results::path(dir, args.shard).display());
-            }
-        }
+        let path = results.write(dir).map_err(|e| {
+            CliError::usage(format!("cannot write `{}`: {e}", Results::path(dir, args.shard).display()))
+        })?;
+        errln!("rows in {}", path.display())?;
     }
     errln!(
         "evaluated {} ({} of {}) in {:.1} s on {}",
@@ -240,15 +229,15 @@ fn eval_in(args: &EvalArgs, _color: bool, status: &mut Status) -> Result<(), Clo
         started.elapsed().as_secs_f64(),
         plural(rayon::current_num_threads(), "thread")
     )?;
-    print(&[results], args.format, args.plot.as_deref(), status)?;
+    status = status.max(print(&[results], args.format, args.plot.as_deref())?);
     if args.finetune > 0 {
-        finetune(args, &plan, &evaluated.kept, status)?;
+        status = status.max(finetune(args, &plan, &evaluated.kept)?);
     }
-    Ok(())
+    Ok(status)
 }
 
-/// The scenarios of `generator` for `region`: (name, TAD text), each one that counts;
-/// `None` after an error that stops the command.
+/// The scenarios of `generator` for `region`: (name, TAD text), each one that counts; the
+/// files it cannot read raise `status`.
 fn scenarios(
     db: &mut Database,
     args: &EvalArgs,
@@ -256,15 +245,15 @@ fn scenarios(
     region: &str,
     own: &[&Item],
     status: &mut Status,
-) -> Result<Option<Vec<(String, String)>>, Closed> {
+) -> Result<Vec<(String, String)>, CliError> {
     let (n, seed) = (args.n, args.llm.seed);
     let dir = match generator {
         Generator::Fitted if own.is_empty() => {
             errln!("note: region `{region}` has no scenario to fit: no fitted scenarios")?;
-            return Ok(Some(Vec::new()));
+            return Ok(Vec::new());
         }
-        Generator::Fitted => return Ok(Some(generator::fitted(db, own, region, n, seed))),
-        Generator::Baseline => return Ok(Some(generator::baseline(db, region, n, seed))),
+        Generator::Fitted => return Ok(generator::fitted(db, own, region, n, seed)),
+        Generator::Baseline => return Ok(generator::baseline(db, region, n, seed)),
         Generator::Llm(prompt) => {
             // through `tadslc gen`'s loop, into the results directory or a temporary one
             let base = args
@@ -272,11 +261,8 @@ fn scenarios(
                 .clone()
                 .unwrap_or_else(|| std::env::temp_dir().join(format!("tadsl-eval-{}", std::process::id())));
             let dir = generator::llm_dir(&base, region, generator);
-            if let Err(e) = std::fs::create_dir_all(&dir) {
-                *status = Status::Usage;
-                errln!("error: cannot create `{}`: {e}", dir.display())?;
-                return Ok(None);
-            }
+            std::fs::create_dir_all(&dir)
+                .map_err(|e| CliError::usage(format!("cannot create `{}`: {e}", dir.display())))?;
             errln!(
                 "{region}: generating {} with the language model ({generator}) into {}",
                 plural(n, "scenario"),
@@ -294,22 +280,19 @@ fn scenarios(
             };
             let done = crate::llm::generate(&request, &args.llm);
             if done != Status::Ok {
-                *status = (*status).max(done);
-                errln!("error: {region}: the language model generated nothing usable ({generator})")?;
-                return Ok(None);
+                let message = format!("{region}: the language model generated nothing usable ({generator})");
+                return Err(CliError::Exit((*status).max(done), message));
             }
             dir
         }
         Generator::Directory(dir) if dir.is_dir() => dir.clone(),
         Generator::Directory(_) => {
-            *status = Status::Usage;
-            errln!("error: generator `{generator}` is not {}", Generator::NAMES)?;
-            return Ok(None);
+            return Err(CliError::usage(format!("generator `{generator}` is not {}", Generator::NAMES)));
         }
     };
     let corpus = crate::align::load(std::slice::from_ref(&dir), status)?;
     let texts = corpus.items.into_iter().map(|i| (i.name, i.tad)).collect();
-    Ok(Some(tad_eval::corpus::counting(db, &generator.to_string(), texts)))
+    Ok(tad_eval::corpus::counting(db, &generator.to_string(), texts))
 }
 
 /// `tadslc merge FILES`: the table of several results files (the shards of one command).
@@ -340,31 +323,31 @@ fn merge_in(files: &[PathBuf], format: EvalFormat, plot: Option<&Path>) -> Resul
         let missing: Vec<String> = missing.iter().map(Shard::to_string).collect();
         errln!("warning: shards {} are missing: the table covers part of the work", missing.join(", "))?;
     }
-    print(&all, format, plot, &mut status)?;
-    Ok(status)
+    Ok(status.max(print(&all, format, plot)?))
 }
 
-/// The table of `all` on standard output, and its plot.
-pub fn print(all: &[Results], format: EvalFormat, plot: Option<&Path>, status: &mut Status) -> Result<(), Closed> {
+/// The table of `all` on standard output, and its plot; a plot that cannot be written is
+/// reported (the table still printed) and makes the status 2.
+pub fn print(all: &[Results], format: EvalFormat, plot: Option<&Path>) -> Result<Status, Closed> {
     out!("{}", results::table(all, format.into()))?;
     if let Some(path) = plot
         && let Err(e) = std::fs::write(path, results::plot(all))
     {
-        *status = Status::Usage;
         errln!("error: cannot write `{}`: {e}", path.display())?;
+        return Ok(Status::Usage);
     }
-    Ok(())
+    Ok(Status::Ok)
 }
 
 /// The "after fine-tuning" table of `eval --finetune`: a learned ego trained with SAC on
 /// 3/5 of each behaviour's kept scenes (from `--finetune-from`, else from scratch), then
 /// it, the ego it started from and the `--egos` on the held-out 2/5.
-pub fn finetune(args: &EvalArgs, plan: &Plan, kept: &[Kept], status: &mut Status) -> Result<(), Closed> {
+pub fn finetune(args: &EvalArgs, plan: &Plan, kept: &[Kept]) -> Result<Status, CliError> {
     let keys: Vec<String> = kept.iter().map(|k| k.unit.key.clone()).collect();
     let (train, test) = tad_train::split(&keys, args.llm.seed);
     if train.is_empty() || test.is_empty() {
-        *status = (*status).max(Status::Failed);
-        return errln!("warning: no fine-tuning: {} kept scenes are too few to hold some out", kept.len());
+        errln!("warning: no fine-tuning: {} kept scenes are too few to hold some out", kept.len())?;
+        return Ok(Status::Failed);
     }
     let config = Config {
         episodes: args.finetune,
@@ -373,13 +356,7 @@ pub fn finetune(args: &EvalArgs, plan: &Plan, kept: &[Kept], status: &mut Status
         ..Config::default()
     };
     let start = args.finetune_from.as_deref().map_or(Start::Scratch, Start::from_path);
-    let (mut trainer, before) = match start.trainer(config) {
-        Ok(made) => made,
-        Err(e) => {
-            *status = Status::Usage;
-            return errln!("error: --finetune-from: {e}");
-        }
-    };
+    let (mut trainer, before) = start.trainer(config).map_err(|e| CliError::usage(format!("--finetune-from: {e}")))?;
     let first = trainer.episodes() as usize;
     errln!(
         "fine-tuning a learned ego on {} ({} held out), {}",
@@ -398,23 +375,11 @@ pub fn finetune(args: &EvalArgs, plan: &Plan, kept: &[Kept], status: &mut Status
             Ok(())
         });
     progress.finish_and_clear();
-    if let Err(e) = trained {
-        *status = Status::Failed;
-        return errln!("error: fine-tuning stopped: {e}");
-    }
-    let after = match trainer.actor() {
-        Ok(a) => a,
-        Err(e) => {
-            *status = Status::Failed;
-            return errln!("error: {e}");
-        }
-    };
+    trained.map_err(|e| CliError::failed(format!("fine-tuning stopped: {e}")))?;
+    let after = trainer.actor().map_err(CliError::failed)?;
     if let Some(dir) = &args.out {
         let path = dir.join("finetuned.safetensors");
-        if let Err(e) = after.save(&path) {
-            *status = Status::Usage;
-            return errln!("error: {e}");
-        }
+        after.save(&path).map_err(CliError::usage)?;
         errln!("the fine-tuned ego in {}", path.display())?;
     }
     // the held-out scenes, every ego
@@ -444,10 +409,10 @@ pub fn finetune(args: &EvalArgs, plan: &Plan, kept: &[Kept], status: &mut Status
     let was = tad_eval::harness::collision_rate(&rows, "learned (before)");
     let now = tad_eval::harness::collision_rate(&rows, "learned (fine-tuned)");
     let results = Results::new(setup, tad_base::Shard::ALL, scenarios, rows);
-    print(&[results], args.format, None, status)?;
+    let status = print(&[results], args.format, None)?;
     if drivers.iter().any(|(n, _)| n == "learned (before)") {
         let change = if was > 0.0 { format!("{:+.0} %", 100.0 * (now - was) / was) } else { "–".into() };
         errln!("held-out collision rate of the learned ego: {was:.3} before, {now:.3} after fine-tuning ({change})")?;
     }
-    Ok(())
+    Ok(status)
 }

@@ -115,21 +115,21 @@ pub fn progress(total: usize, unit: &str) -> indicatif::ProgressBar {
 /// inputs had errors), or the failure that ended it; [`finish`] reports it.
 #[derive(Debug)]
 pub enum CliError {
-    /// Usage or I/O (status 2).
-    Usage(String),
-    /// The input has errors, or the work failed (status 1).
-    Failed(String),
+    /// The run ends with this status, saying why.
+    Exit(Status, String),
     /// A standard stream could not be written (already reported where it could be).
     Closed(Closed),
 }
 
 impl CliError {
+    /// Usage or I/O (status 2).
     pub fn usage(message: impl std::fmt::Display) -> CliError {
-        CliError::Usage(message.to_string())
+        CliError::Exit(Status::Usage, message.to_string())
     }
 
+    /// The input has errors, or the work failed (status 1).
     pub fn failed(message: impl std::fmt::Display) -> CliError {
-        CliError::Failed(message.to_string())
+        CliError::Exit(Status::Failed, message.to_string())
     }
 }
 
@@ -141,13 +141,11 @@ impl From<Closed> for CliError {
 
 /// The exit status of a subcommand's result, its error reported on standard error.
 pub fn finish(result: Result<Status, CliError>) -> Status {
-    let status = match result {
+    let (status, message) = match result {
         Ok(status) => return flush().map_or_else(|closed| closed.merge(status), |()| status),
-        Err(CliError::Usage(message)) => (Status::Usage, message),
-        Err(CliError::Failed(message)) => (Status::Failed, message),
+        Err(CliError::Exit(status, message)) => (status, message),
         Err(CliError::Closed(closed)) => return closed.merge(Status::Ok),
     };
-    let (status, message) = status;
     match err(format_args!("error: {message}\n")) {
         Ok(()) => status,
         Err(closed) => closed.merge(status),

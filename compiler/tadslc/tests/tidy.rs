@@ -34,7 +34,6 @@ const STATUS_BY_SIDE_EFFECT: &[(&str, usize)] = &[
     ("compiler/tadslc/src/build.rs", 6),
     ("compiler/tadslc/src/bytecode.rs", 8),
     ("compiler/tadslc/src/check.rs", 1),
-    ("compiler/tadslc/src/eval.rs", 15),
     ("compiler/tadslc/src/files.rs", 2),
     ("compiler/tadslc/src/fmt.rs", 4),
     ("compiler/tadslc/src/interchange.rs", 4),
