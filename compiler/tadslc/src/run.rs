@@ -12,7 +12,7 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 use crate::files::{self, Search};
-use crate::output::Closed;
+use crate::output::{CliError, Closed};
 use crate::{Status, errln, out, outln};
 use tad_check::Options as CheckOptions;
 use tad_db::Database;
@@ -147,7 +147,7 @@ pub fn load_shard(
 }
 
 pub fn run(args: &RunArgs, color: bool) -> Status {
-    crate::output::run(|status| run_in(args, color, status))
+    crate::output::finish(run_in(args, color))
 }
 
 /// One finished episode with its scores.
@@ -158,21 +158,16 @@ struct Done {
     score: tad_metrics::EpisodeScore,
 }
 
-fn run_in(args: &RunArgs, color: bool, status: &mut Status) -> Result<(), Closed> {
+fn run_in(args: &RunArgs, color: bool) -> Result<Status, CliError> {
     let mut policies = Vec::new();
     for spec in &args.egos {
-        match tad_policy::parse_policy(spec) {
-            Ok(p) => policies.push(p),
-            Err(e) => {
-                *status = Status::Usage;
-                return errln!("error: --ego {spec}: {e}");
-            }
-        }
+        policies.push(tad_policy::parse_policy(spec).map_err(|e| CliError::usage(format!("--ego {spec}: {e}")))?);
     }
-    let scenes = load_shard(&args.paths, args.shard, color, status)?;
+    // raised by inputs that do not load, and by output that cannot be written
+    let mut status = Status::Ok;
+    let scenes = load_shard(&args.paths, args.shard, color, &mut status)?;
     if scenes.is_empty() {
-        *status = (*status).max(Status::Usage);
-        return errln!("error: nothing to run");
+        return Err(CliError::usage("nothing to run"));
     }
     let mode = if args.compat { Mode::Compat } else { Mode::Fixed };
     let keep_frames = args.trace.is_some() || args.render.is_some();
@@ -180,13 +175,10 @@ fn run_in(args: &RunArgs, color: bool, status: &mut Status) -> Result<(), Closed
     let total = scenes.len() * policies.len() * (args.seeds.end - args.seeds.start) as usize;
     let progress = crate::output::progress(total, "episodes");
     let mut trace = match &args.trace {
-        Some(path) => match std::fs::File::create(path) {
-            Ok(f) => Some(std::io::BufWriter::new(f)),
-            Err(e) => {
-                *status = Status::Usage;
-                return errln!("error: cannot write `{}`: {e}", path.display());
-            }
-        },
+        Some(path) => Some(std::io::BufWriter::new(
+            std::fs::File::create(path)
+                .map_err(|e| CliError::usage(format!("cannot write `{}`: {e}", path.display())))?,
+        )),
         None => None,
     };
     let mut done: Vec<Done> = Vec::new();
@@ -199,8 +191,7 @@ fn run_in(args: &RunArgs, color: bool, status: &mut Status) -> Result<(), Closed
                 if let Some(w) = trace.as_mut()
                     && let Err(err) = write_trace(w, &loaded.name, policy.name(), &loaded.scene, &episode)
                 {
-                    *status = Status::Usage;
-                    return errln!("error: cannot write the trace: {err}");
+                    return Err(CliError::usage(format!("cannot write the trace: {err}")));
                 }
                 if args.format == RunFormat::Json {
                     outln!("{}", episode_json(&loaded.name, policy.name(), &episode, &score))?;
@@ -218,14 +209,14 @@ fn run_in(args: &RunArgs, color: bool, status: &mut Status) -> Result<(), Closed
     if let Some(w) = trace.as_mut()
         && let Err(e) = w.flush()
     {
-        *status = Status::Usage;
+        status = Status::Usage;
         errln!("error: cannot write the trace: {e}")?;
     }
     let names: Vec<String> = policies.iter().map(|p| p.name().to_string()).collect();
     if let Some(dir) = &args.out
         && let Err(e) = write_results(dir, args, &scenes, &done)
     {
-        *status = Status::Usage;
+        status = Status::Usage;
         errln!("error: cannot write the results to `{}`: {e}", dir.display())?;
     }
     match args.format {
@@ -254,7 +245,7 @@ fn run_in(args: &RunArgs, color: bool, status: &mut Status) -> Result<(), Closed
     if let (Some(path), Some(first)) = (&args.render, done.first()) {
         let loaded = &scenes[first.file];
         if let Err(e) = render(path, &loaded.scene, &names[first.ego], &first.episode) {
-            *status = Status::Usage;
+            status = Status::Usage;
             errln!("error: cannot write `{}`: {e}", path.display())?;
         } else {
             errln!(
@@ -266,7 +257,7 @@ fn run_in(args: &RunArgs, color: bool, status: &mut Status) -> Result<(), Closed
             )?;
         }
     }
-    Ok(())
+    Ok(status)
 }
 
 /// The episodes as a results file of `eval`'s form (one region `all`, one generator

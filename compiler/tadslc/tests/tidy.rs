@@ -37,7 +37,7 @@ const STATUS_BY_SIDE_EFFECT: &[(&str, usize)] = &[
     ("compiler/tadslc/src/files.rs", 2),
     ("compiler/tadslc/src/fmt.rs", 4),
     ("compiler/tadslc/src/interchange.rs", 4),
-    ("compiler/tadslc/src/run.rs", 10),
+    ("compiler/tadslc/src/run.rs", 3),
     ("compiler/tadslc/src/bench/align.rs", 2),
     ("compiler/tadslc/src/bench/llm.rs", 1),
     ("compiler/tadslc/src/bench/lsp.rs", 1),
