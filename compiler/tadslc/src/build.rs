@@ -10,7 +10,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::files::{self, Search};
-use crate::output::Closed;
+use crate::output::{CliError, Closed};
 use crate::{Status, err, errln, out, plural};
 use tad_check::Options;
 use tad_db::Database;
@@ -69,7 +69,7 @@ impl From<SimulatorArg> for Simulator {
 
 /// `tadslc build --target scenic`.
 pub fn run(args: &BuildArgs, color: bool) -> Status {
-    crate::output::run(|status| run_in(args, color, status))
+    crate::output::finish(run_in(args, color))
 }
 
 /// Where a program written to `out` (a directory, or standard output) will look for its
@@ -79,20 +79,21 @@ struct MissingMap {
     programs: Vec<String>,
 }
 
-fn run_in(args: &BuildArgs, color: bool, status: &mut Status) -> Result<(), Closed> {
+fn run_in(args: &BuildArgs, color: bool) -> Result<Status, CliError> {
     let (paths, out, map_dir, map) =
         (&args.paths, args.output.as_deref(), args.map_dir.as_deref(), args.map.as_deref());
     let simulator = Simulator::from(args.simulator);
-    let inputs = files::load(paths, Search::Tad, status)?;
+    // raised by files with errors and outputs that cannot be written; the others still build
+    let mut status = Status::Ok;
+    let inputs = files::load(paths, Search::Tad, &mut status)?;
     if out.is_none() && inputs.len() > 1 {
-        *status = Status::Usage;
-        return errln!("error: {} to build: give an output directory with -o", plural(inputs.len(), "file"));
+        return Err(CliError::usage(format!(
+            "{} to build: give an output directory with -o",
+            plural(inputs.len(), "file")
+        )));
     }
-    if let Some(dir) = out
-        && let Err(e) = std::fs::create_dir_all(dir)
-    {
-        *status = Status::Usage;
-        return errln!("error: cannot create `{}`: {e}", dir.display());
+    if let Some(dir) = out {
+        std::fs::create_dir_all(dir).map_err(|e| CliError::usage(format!("cannot create `{}`: {e}", dir.display())))?;
     }
     // The program names its map by path: make a relative map directory absolute, so the
     // program finds it wherever it is written.
@@ -104,7 +105,7 @@ fn run_in(args: &BuildArgs, color: bool, status: &mut Status) -> Result<(), Clos
     for input in &inputs {
         let checked = crate::check::diagnose_in(&mut db, input);
         if checked.diagnostics.iter().any(|d| d.is_error()) {
-            *status = (*status).max(Status::Failed);
+            status = status.max(Status::Failed);
             let errors: Vec<_> = checked.diagnostics.iter().filter(|d| d.is_error()).cloned().collect();
             let report = FileReport::new(&input.name, &input.text, &errors);
             err!("{}", human::render(&report, color))?;
@@ -124,7 +125,7 @@ fn run_in(args: &BuildArgs, color: bool, status: &mut Status) -> Result<(), Clos
         let report = FileReport::new(&input.name, &input.text, &emitted.diagnostics);
         err!("{}", human::render(&report, color))?;
         if emitted.diagnostics.iter().any(|d| d.is_error()) {
-            *status = (*status).max(Status::Failed);
+            status = status.max(Status::Failed);
             errln!("{}: not built", input.name)?;
             continue;
         }
@@ -147,7 +148,7 @@ fn run_in(args: &BuildArgs, color: bool, status: &mut Status) -> Result<(), Clos
                     .map_or_else(|| "stdin".to_string(), |s| s.to_string_lossy().into_owned());
                 let target = dir.join(format!("{stem}.scenic"));
                 if written.contains(&target) {
-                    *status = (*status).max(Status::Usage);
+                    status = status.max(Status::Usage);
                     errln!(
                         "error: {} would overwrite `{}`, written for an earlier file",
                         input.name,
@@ -156,7 +157,7 @@ fn run_in(args: &BuildArgs, color: bool, status: &mut Status) -> Result<(), Clos
                     continue;
                 }
                 if let Err(e) = std::fs::write(&target, &emitted.text) {
-                    *status = (*status).max(Status::Usage);
+                    status = status.max(Status::Usage);
                     errln!("error: cannot write `{}`: {e}", target.display())?;
                     continue;
                 }
@@ -184,7 +185,7 @@ fn run_in(args: &BuildArgs, color: bool, status: &mut Status) -> Result<(), Clos
              save it beside the CARLA maps, or build with `--map-dir DIR`, DIR the directory of the CARLA maps"
         )?;
     }
-    Ok(())
+    Ok(status)
 }
 
 /// Remember that `program` loads `file`, if `file` does not exist.

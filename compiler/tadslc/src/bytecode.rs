@@ -10,7 +10,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::files::{self, Search};
-use crate::output::Closed;
+use crate::output::{CliError, Closed};
 use crate::{Status, err, errln, out, plural};
 use tad_check::Options;
 use tad_db::Database;
@@ -19,34 +19,24 @@ use tad_diagnostics::render::{FileReport, human};
 /// `build --target bytecode`; `scenic_options`: a Scenic-only option (`--map`,
 /// `--map-dir`) was given.
 pub fn build(paths: &[PathBuf], out: Option<&Path>, scenic_options: bool, color: bool) -> Status {
-    crate::output::run(|status| build_in(paths, out, scenic_options, color, status))
+    crate::output::finish(build_in(paths, out, scenic_options, color))
 }
 
-fn build_in(
-    paths: &[PathBuf],
-    out: Option<&Path>,
-    scenic_options: bool,
-    color: bool,
-    status: &mut Status,
-) -> Result<(), Closed> {
+fn build_in(paths: &[PathBuf], out: Option<&Path>, scenic_options: bool, color: bool) -> Result<Status, CliError> {
     if scenic_options {
-        *status = Status::Usage;
-        return errln!("error: `--map` and `--map-dir` are options of the scenic target");
+        return Err(CliError::usage("`--map` and `--map-dir` are options of the scenic target"));
     }
-    let Some(dir) = out else {
-        *status = Status::Usage;
-        return errln!("error: the bytecode target writes binary files: give an output directory with -o");
-    };
-    let inputs = files::load(paths, Search::Tad, status)?;
-    if let Err(e) = std::fs::create_dir_all(dir) {
-        *status = Status::Usage;
-        return errln!("error: cannot create `{}`: {e}", dir.display());
-    }
+    let dir = out
+        .ok_or_else(|| CliError::usage("the bytecode target writes binary files: give an output directory with -o"))?;
+    // raised by files with errors and outputs that cannot be written; the others still build
+    let mut status = Status::Ok;
+    let inputs = files::load(paths, Search::Tad, &mut status)?;
+    std::fs::create_dir_all(dir).map_err(|e| CliError::usage(format!("cannot create `{}`: {e}", dir.display())))?;
     let mut written: Vec<PathBuf> = Vec::new();
     let mut db = Database::new(Options::default());
     for input in &inputs {
         let Some(program) = compile(&mut db, input, "built", color)? else {
-            *status = (*status).max(Status::Failed);
+            status = status.max(Status::Failed);
             continue;
         };
         let bytes = tad_bytecode::encode(&program);
@@ -57,12 +47,12 @@ fn build_in(
             .map_or_else(|| "stdin".to_string(), |s| s.to_string_lossy().into_owned());
         let target = dir.join(format!("{stem}.tadc"));
         if written.contains(&target) {
-            *status = (*status).max(Status::Usage);
+            status = status.max(Status::Usage);
             errln!("error: {} would overwrite `{}`, written for an earlier file", input.name, target.display())?;
             continue;
         }
         if let Err(e) = std::fs::write(&target, &bytes) {
-            *status = (*status).max(Status::Usage);
+            status = status.max(Status::Usage);
             errln!("error: cannot write `{}`: {e}", target.display())?;
             continue;
         }
@@ -77,7 +67,7 @@ fn build_in(
         )?;
         written.push(target);
     }
-    Ok(())
+    Ok(status)
 }
 
 /// A scenario file's program: checked (errors printed, then `NAME: not VERB`), resolved,
@@ -109,22 +99,15 @@ pub fn compile(
 
 /// `disasm FILE.tadc`: the listing on standard output.
 pub fn disasm(path: &Path) -> Status {
-    crate::output::run(|status| {
-        let bytes = match std::fs::read(path) {
-            Ok(bytes) => bytes,
-            Err(e) => {
-                *status = Status::Usage;
-                return errln!("error: cannot read `{}`: {e}", path.display());
-            }
-        };
-        match tad_bytecode::decode(&bytes) {
-            Ok(program) => out!("{}", tad_bytecode::disasm(&program)),
-            Err(e) => {
-                *status = Status::Failed;
-                errln!("error: {}: {e}", path.display())
-            }
-        }
-    })
+    crate::output::finish(disasm_in(path))
+}
+
+fn disasm_in(path: &Path) -> Result<Status, CliError> {
+    let bytes = std::fs::read(path).map_err(|e| CliError::usage(format!("cannot read `{}`: {e}", path.display())))?;
+    // a file that does not load is input with errors (status 1), as under `run`
+    let program = tad_bytecode::decode(&bytes).map_err(|e| CliError::failed(format!("{}: {e}", path.display())))?;
+    out!("{}", tad_bytecode::disasm(&program))?;
+    Ok(Status::Ok)
 }
 
 #[cfg(test)]
