@@ -1,7 +1,7 @@
 //! `tadslc fmt`: rewrite files in the canonical layout, or check that they are.
 
 use crate::files::{self, Search};
-use crate::output::Closed;
+use crate::output::CliError;
 use crate::{Status, err, errln, out, plural};
 use tad_diagnostics::render::{FileReport, human};
 
@@ -29,22 +29,18 @@ pub fn canonicalize(db: &mut tad_db::Database, input: &files::Input) -> String {
 /// Format every `.tad` file `paths` name (directories are searched for `*.tad` only:
 /// YAML is not TAD, and is skipped).
 pub fn run(paths: &[std::path::PathBuf], check: bool, canonical: bool, color: bool) -> Status {
-    crate::output::run(|status| run_in(paths, check, canonical, color, status))
+    crate::output::finish(run_in(paths, check, canonical, color))
 }
 
-fn run_in(
-    paths: &[std::path::PathBuf],
-    check: bool,
-    canonical: bool,
-    color: bool,
-    status: &mut Status,
-) -> Result<(), Closed> {
+fn run_in(paths: &[std::path::PathBuf], check: bool, canonical: bool, color: bool) -> Result<Status, CliError> {
     let mut db = tad_db::Database::new(tad_check::Options::default());
-    let inputs = files::load(paths, Search::Tad, status)?;
+    // raised by files that cannot be formatted or written, and by unformatted ones with --check
+    let mut status = Status::Ok;
+    let inputs = files::load(paths, Search::Tad, &mut status)?;
     let mut unformatted = 0;
     for input in &inputs {
         if input.invalid_utf8.is_some() {
-            *status = (*status).max(Status::Failed);
+            status = status.max(Status::Failed);
             errln!("error: `{}` is not valid UTF-8; not formatted", input.name)?;
             continue;
         }
@@ -52,7 +48,7 @@ fn run_in(
         let formatted = match tad_syntax::format::format(&source) {
             Ok(formatted) => formatted,
             Err(diagnostics) => {
-                *status = (*status).max(Status::Failed);
+                status = status.max(Status::Failed);
                 let report = FileReport::new(&input.name, &input.text, &diagnostics);
                 err!("{}", human::render(&report, color))?;
                 errln!("error: `{}` has syntax errors; not formatted", input.name)?;
@@ -68,11 +64,11 @@ fn run_in(
         }
         unformatted += 1;
         if check {
-            *status = (*status).max(Status::Failed);
+            status = status.max(Status::Failed);
             let line = first_difference(&input.text, &formatted);
             errln!("{}: not formatted (first difference at line {line})", input.name)?;
         } else if let Err(e) = write_atomically(target, &formatted) {
-            *status = Status::Usage;
+            status = Status::Usage;
             errln!("error: cannot write `{}`: {e}", input.name)?;
         } else {
             errln!("formatted {}", input.name)?;
@@ -86,7 +82,7 @@ fn run_in(
             if unformatted == 1 { "it" } else { "them" }
         )?;
     }
-    Ok(())
+    Ok(status)
 }
 
 fn first_difference(a: &str, b: &str) -> usize {

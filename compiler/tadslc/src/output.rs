@@ -2,23 +2,24 @@
 //!
 //! `print!` panics when the reader of a pipe has gone (`tadslc check DIR | head`). Every
 //! subcommand writes through [`out`] and [`err`] instead (the [`outln!`](crate::outln)
-//! family of macros), which return [`Closed`] when a stream cannot be written; the
-//! subcommand then stops writing and returns the status it had reached, merged with
-//! [`Closed::status`]. A closed pipe is not a failure of the run: it is quiet and leaves
-//! the status as it was. Any other write error (a full disk) is reported on standard
-//! error, if it can be, and makes the status 2 (`spec/output.md`).
+//! family of macros). A closed pipe is not a failure of the run: from then on that stream
+//! is quiet (nothing more is written to it) and the run goes on to the status it reaches,
+//! its files written. Any other write error (a full disk) is reported on standard error,
+//! if it can be, and returns [`Closed`], which stops the subcommand with status 2
+//! (`spec/output.md`).
 //!
 //! Subcommands return `Result<Status, CliError>` ([`finish`] reports the error); those not
 //! yet converted raise a `&mut Status` inside [`run`] (tidy lists them, a list that shrinks).
 
 use crate::Status;
 use std::io::Write;
+use std::sync::atomic::{AtomicBool, Ordering};
 
-/// A standard stream could not be written: stop writing.
+/// A standard stream could not be written for another reason than a closed pipe (a full
+/// disk): stop.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Closed {
-    /// What the failure adds to the run's status: [`Status::Ok`] for a closed pipe,
-    /// [`Status::Usage`] for any other write error.
+    /// What the failure adds to the run's status: [`Status::Usage`].
     pub status: Status,
 }
 
@@ -29,34 +30,60 @@ impl Closed {
     }
 }
 
-fn closed(stream: &str, error: std::io::Error) -> Closed {
-    if error.kind() == std::io::ErrorKind::BrokenPipe {
-        return Closed { status: Status::Ok };
+/// Whether the reader of standard output, or of standard error, has gone.
+static STDOUT_GONE: AtomicBool = AtomicBool::new(false);
+static STDERR_GONE: AtomicBool = AtomicBool::new(false);
+
+/// The outcome of a write to `stream`: a closed pipe quiets the stream (`Ok`), any other
+/// error is reported and stops the run.
+fn written(stream: &str, gone: &AtomicBool, result: std::io::Result<()>) -> Result<(), Closed> {
+    match result {
+        Ok(()) => Ok(()),
+        Err(error) if error.kind() == std::io::ErrorKind::BrokenPipe => {
+            gone.store(true, Ordering::Relaxed);
+            Ok(())
+        }
+        Err(error) => {
+            // best effort: standard error may be the stream that failed
+            if !STDERR_GONE.load(Ordering::Relaxed) {
+                let _ = writeln!(std::io::stderr().lock(), "error: cannot write to {stream}: {error}");
+            }
+            Err(Closed { status: Status::Usage })
+        }
     }
-    // best effort: standard error may be the stream that failed
-    let _ = writeln!(std::io::stderr().lock(), "error: cannot write to {stream}: {error}");
-    Closed { status: Status::Usage }
 }
 
 /// Write to standard output.
 pub fn out(args: std::fmt::Arguments<'_>) -> Result<(), Closed> {
-    std::io::stdout().lock().write_fmt(args).map_err(|e| closed("standard output", e))
+    if STDOUT_GONE.load(Ordering::Relaxed) {
+        return Ok(());
+    }
+    written("standard output", &STDOUT_GONE, std::io::stdout().lock().write_fmt(args))
 }
 
 /// Write raw bytes to standard output, then flush it.
 pub fn out_bytes(bytes: &[u8]) -> Result<(), Closed> {
+    if STDOUT_GONE.load(Ordering::Relaxed) {
+        return Ok(());
+    }
     let mut stdout = std::io::stdout().lock();
-    stdout.write_all(bytes).and_then(|()| stdout.flush()).map_err(|e| closed("standard output", e))
+    written("standard output", &STDOUT_GONE, stdout.write_all(bytes).and_then(|()| stdout.flush()))
 }
 
 /// Flush standard output (what a `print!` without a newline left in its buffer).
 pub fn flush() -> Result<(), Closed> {
-    std::io::stdout().lock().flush().map_err(|e| closed("standard output", e))
+    if STDOUT_GONE.load(Ordering::Relaxed) {
+        return Ok(());
+    }
+    written("standard output", &STDOUT_GONE, std::io::stdout().lock().flush())
 }
 
 /// Write to standard error.
 pub fn err(args: std::fmt::Arguments<'_>) -> Result<(), Closed> {
-    std::io::stderr().lock().write_fmt(args).map_err(|e| closed("standard error", e))
+    if STDERR_GONE.load(Ordering::Relaxed) {
+        return Ok(());
+    }
+    written("standard error", &STDERR_GONE, std::io::stderr().lock().write_fmt(args))
 }
 
 /// `print!` that returns [`Closed`] instead of panicking.

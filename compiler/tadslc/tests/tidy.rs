@@ -33,7 +33,6 @@ const STATUS_BY_SIDE_EFFECT: &[(&str, usize)] = &[
     ("compiler/tadslc/src/bench.rs", 2),
     ("compiler/tadslc/src/check.rs", 1),
     ("compiler/tadslc/src/files.rs", 2),
-    ("compiler/tadslc/src/fmt.rs", 4),
     ("compiler/tadslc/src/interchange.rs", 4),
     ("compiler/tadslc/src/run.rs", 3),
     ("compiler/tadslc/src/bench/align.rs", 2),
