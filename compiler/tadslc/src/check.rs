@@ -5,7 +5,7 @@
 //! an input and having errors is reported once, in its own file, after the inputs.
 
 use crate::files::{self, Input, Search};
-use crate::output::Closed;
+use crate::output::CliError;
 use crate::{Format, Status, err, errln, outln, plural};
 use tad_check::{Checked, Class, Options};
 use tad_db::{Database, Language, RealFs, SourceFile};
@@ -103,7 +103,7 @@ pub fn run(
     color: bool,
     options: Options,
 ) -> Status {
-    crate::output::run(|status| run_in(paths, format, deny_warnings, limit, color, options, status))
+    crate::output::finish(run_in(paths, format, deny_warnings, limit, color, options))
 }
 
 fn run_in(
@@ -113,9 +113,10 @@ fn run_in(
     limit: usize,
     color: bool,
     options: Options,
-    status: &mut Status,
-) -> Result<(), Closed> {
-    let inputs = files::load(paths, Search::Scenarios, status)?;
+) -> Result<Status, CliError> {
+    // raised by unreadable paths, then by errors (and warnings with --deny-warnings)
+    let mut status = Status::Ok;
+    let inputs = files::load(paths, Search::Scenarios, &mut status)?;
     let mut db = Database::new(options);
     let mut done: Vec<Checked1> = Vec::new();
     for input in &inputs {
@@ -157,7 +158,7 @@ fn run_in(
         }
     }
     if errors > 0 || (deny_warnings && warnings > 0) {
-        *status = (*status).max(Status::Failed);
+        status = status.max(Status::Failed);
     }
 
     let mut sarif_reports = Vec::new();
@@ -232,7 +233,7 @@ fn run_in(
         Format::Human => errln!("{}", summary(inputs.len(), errors, warnings, hints, classes))?,
         Format::Json => {}
     }
-    Ok(())
+    Ok(status)
 }
 
 fn summary(files: usize, errors: usize, warnings: usize, hints: usize, classes: [usize; Class::ALL.len()]) -> String {
