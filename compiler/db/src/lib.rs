@@ -293,6 +293,19 @@ pub fn check(db: &dyn Db, file: SourceFile) -> Checked {
     checked
 }
 
+/// Every standard module but the prelude, by name.
+pub fn standard_modules() -> Vec<String> {
+    stdlib::MODULES.iter().map(|(name, _)| name.to_string()).filter(|m| m != PRELUDE).collect()
+}
+
+/// The vocabulary a file that `use`s `modules` (standard ones) sees: the prelude's and theirs.
+pub fn vocabulary_of(modules: &[String]) -> Vocabulary {
+    let mut db = Database::new(Options::default());
+    let text: String = modules.iter().map(|m| format!("use {m}\n")).collect();
+    let file = db.set_file("<vocabulary>.tad".into(), text);
+    vocabulary(&db, file).vocabulary.clone()
+}
+
 /// The standard module a region's scenarios see: the `module` its declaration names (the
 /// one place the region → module map is read).
 pub fn region_module(vocabulary: &tad_check::Vocabulary, region: &str) -> Option<String> {

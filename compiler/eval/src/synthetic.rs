@@ -142,14 +142,7 @@ fn max_speed(behavior: &str) -> Option<u32> {
     use tad_syntax::schema::{ClosedSet, Motion};
     static LIMITS: std::sync::OnceLock<Vec<(String, u32)>> = std::sync::OnceLock::new();
     let limits = LIMITS.get_or_init(|| {
-        let mut db = tad_db::Database::new(tad_check::Options::default());
-        let modules: String = tad_db::stdlib::MODULES
-            .iter()
-            .filter(|(name, _)| *name != tad_db::PRELUDE)
-            .map(|(name, _)| format!("use {name}\n"))
-            .collect();
-        let file = db.set_file("<vocabulary>.tad".into(), modules);
-        let vocabulary = &tad_db::vocabulary(&db, file).vocabulary;
+        let vocabulary = tad_db::vocabulary_of(&tad_db::standard_modules());
         vocabulary
             .names("behavior")
             .into_iter()

@@ -22,14 +22,10 @@ pub use json::json_schema;
 /// The vocabulary a model may write for `region` (the prelude and the region's module), or
 /// for any region (every standard module), and the modules a `use` line may name.
 pub fn scope(region: Option<&str>) -> Result<(Vocabulary, Vec<String>), String> {
-    let all: Vec<String> =
-        tad_db::stdlib::MODULES.iter().map(|(name, _)| name.to_string()).filter(|m| m != tad_db::PRELUDE).collect();
-    let mut db = tad_db::Database::new(tad_check::Options::default());
-    let prelude = db.set_file("<grammar>.tad".into(), String::new());
-    let core = tad_db::vocabulary(&db, prelude).vocabulary.clone();
     let modules = match region {
-        None => all,
+        None => tad_db::standard_modules(),
         Some(region) => {
+            let core = tad_db::vocabulary_of(&[]);
             if core.get("region", region).is_none() {
                 return Err(format!(
                     "unknown region `{region}` (the regions are: {})",
@@ -39,9 +35,7 @@ pub fn scope(region: Option<&str>) -> Result<(Vocabulary, Vec<String>), String> 
             tad_db::region_module(&core, region).into_iter().collect()
         }
     };
-    let text: String = modules.iter().map(|m| format!("use {m}\n")).collect();
-    let file = db.set_file("<grammar>.tad".into(), text);
-    Ok((tad_db::vocabulary(&db, file).vocabulary.clone(), modules))
+    Ok((tad_db::vocabulary_of(&modules), modules))
 }
 
 /// The notations `tadslc grammar` prints.
