@@ -290,9 +290,9 @@ fn scenarios(
             return Err(CliError::usage(format!("generator `{generator}` is not {}", Generator::NAMES)));
         }
     };
+    // a corpus holds only the scenarios that count
     let corpus = crate::align::load(std::slice::from_ref(&dir), status)?;
-    let texts = corpus.items.into_iter().map(|i| (i.name, i.tad)).collect();
-    Ok(tad_eval::corpus::counting(db, &generator.to_string(), texts))
+    Ok(corpus.items.into_iter().map(|i| (i.name, i.tad)).collect())
 }
 
 /// `tadslc merge FILES`: the table of several results files (the shards of one command).
