@@ -40,6 +40,8 @@ use tad_check::{Checked, Layer, Options, Vocabulary};
 use tad_diagnostics::{Code, Diagnostic, FileId, FileSpan, Payload};
 use tad_syntax::model::Module;
 
+pub mod host;
+
 /// The standard modules, embedded at build time.
 pub mod stdlib {
     include!(concat!(env!("OUT_DIR"), "/stdlib.rs"));

@@ -8,47 +8,11 @@ use crate::files::{self, Input, Search};
 use crate::output::CliError;
 use crate::{Format, Status, err, errln, outln, plural};
 use tad_check::{Checked, Class, Options};
-use tad_db::{Database, Language, RealFs, SourceFile};
+use tad_db::host::checked;
+pub use tad_db::host::{diagnose_in, register};
+use tad_db::{Database, SourceFile};
 use tad_diagnostics::render::{FileReport, Source, human, json, sarif};
-use tad_diagnostics::{Code, Diagnostic, Payload, Severity, Span};
-
-/// Register one input in the database, in the language its path suggests.
-pub fn register(db: &mut Database, input: &Input) -> SourceFile {
-    let path = input.path.clone().unwrap_or_else(|| std::path::PathBuf::from(&input.name));
-    let language = Language::guess(&path, &input.text);
-    db.set_source(path, input.text.clone(), language, &RealFs)
-}
-
-/// Check one input through the database: a non-UTF-8 file is reported, then checked as
-/// decoded.
-pub fn diagnose_in(db: &mut Database, input: &Input) -> Checked {
-    let file = register(db, input);
-    checked(db, file, input)
-}
-
-fn checked(db: &Database, file: SourceFile, input: &Input) -> Checked {
-    let mut checked = tad_db::check(db, file).clone();
-    if let Some(at) = input.invalid_utf8 {
-        // The lossy text has U+FFFD (3 bytes) where the invalid sequence was.
-        checked.diagnostics.insert(
-            0,
-            Diagnostic::new(
-                Code::E0006,
-                "this file is not valid UTF-8",
-                Span::new(at, at + 3),
-                "invalid bytes start here",
-            )
-            .in_file(file.id(db))
-            .with_payload(Payload::WrongValue {
-                field: "encoding".into(),
-                expected: "UTF-8".into(),
-                found: "invalid bytes".into(),
-            })
-            .with_help("save the file as UTF-8"),
-        );
-    }
-    checked
-}
+use tad_diagnostics::{Diagnostic, Severity};
 
 /// Every diagnostic of one input, with the default options.
 pub fn diagnose(input: &Input) -> Vec<Diagnostic> {
