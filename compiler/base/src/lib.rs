@@ -5,7 +5,8 @@
 //!   workspace takes a seed and draws from it);
 //! - [`fnv1a`]: the one stable hash (FNV-1a, 64 bits), for names turned into seeds and
 //!   content-addressed folders;
-//! - [`Shard`]: one job of a job array (`--shard I/N`) and its files' names.
+//! - [`Shard`]: one job of a job array (`--shard I/N`) and its files' names;
+//! - [`plural`]: a count with its noun in the right number, for messages.
 //!
 //! Each is written once here and read everywhere else; the crate depends on serde only.
 
@@ -16,3 +17,8 @@ mod shard;
 pub use hash::{fnv1a, fnv1a_seeded};
 pub use rng::{Rng, SplitMix64};
 pub use shard::Shard;
+
+/// `1 file`, `2 files`: a count with its noun in the right number (regular plurals).
+pub fn plural(n: usize, word: &str) -> String {
+    if n == 1 { format!("1 {word}") } else { format!("{n} {word}s") }
+}

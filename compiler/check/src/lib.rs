@@ -106,3 +106,19 @@ pub fn check(module: &Module, vocabulary: &Vocabulary, options: &Options, prior:
     tad_diagnostics::sort(&mut out.diagnostics);
     out
 }
+
+/// E0700: a backend was asked to build a file that declares names but holds no scenario.
+pub fn no_scenario(module: &Module) -> Diagnostic {
+    let span = module.declarations.first().map_or(tad_diagnostics::Span::new(0, 0), |d| d.span);
+    Diagnostic::new(
+        tad_diagnostics::Code::E0700,
+        "there is no scenario to build",
+        span,
+        "this file only declares names",
+    )
+    .with_help("build a file with a `scenario`; modules of declarations are used by scenarios")
+    .with_payload(tad_diagnostics::Payload::Syntax {
+        expected: vec!["scenario".into()],
+        found: Some("declarations only".into()),
+    })
+}

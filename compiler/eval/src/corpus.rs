@@ -5,8 +5,9 @@
 //! Facts the harness needs later (the region, the behaviour the fine-tuning split keys
 //! on) are read here from the resolved IR, not from the text again.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
+use tad_base::plural;
 use tad_check::Class;
 use tad_db::{Database, Language, RealFs, SourceFile};
 use tad_ir::{Field, Param};
@@ -77,6 +78,64 @@ impl Corpus {
     /// Files that did not count.
     pub fn skipped(&self) -> usize {
         self.invalid + self.non_scenarios
+    }
+
+    /// The scenarios of each region their `source` names.
+    pub fn by_region(&self) -> std::collections::BTreeMap<String, Vec<&Item>> {
+        let mut by_region: std::collections::BTreeMap<String, Vec<&Item>> = Default::default();
+        for item in &self.items {
+            if let Some(region) = &item.region {
+                by_region.entry(region.clone()).or_default().push(item);
+            }
+        }
+        by_region
+    }
+
+    /// What a user should know about the files that did not count, if any did not.
+    pub fn skipped_note(&self) -> Option<String> {
+        (self.skipped() > 0).then(|| {
+            format!(
+                "corpus `{}`: {} skipped ({} with errors, {} not scenarios; `tadslc check` says why)",
+                self.name,
+                plural(self.skipped(), "file"),
+                self.invalid,
+                self.non_scenarios
+            )
+        })
+    }
+}
+
+/// A corpus's name: its directory's or file's name.
+pub fn name_of(path: &Path) -> String {
+    let base = if path.is_dir() { path.file_name() } else { path.file_stem() };
+    base.map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| path.display().to_string())
+}
+
+/// Every scenario under `paths` (files, or directories searched for `.tad` and `.yaml`)
+/// that counts, as one corpus named after the first path; and why the paths that could
+/// not be read were not.
+pub fn read(paths: &[PathBuf]) -> (Corpus, Vec<String>) {
+    let name = paths.first().map(|p| name_of(p)).unwrap_or_default();
+    let (files, mut errors) = tad_db::host::collect(paths, tad_db::host::Search::Scenarios);
+    let mut sources = Vec::with_capacity(files.len());
+    for path in &files {
+        match tad_db::host::read(path) {
+            Ok(input) => {
+                sources.push(Source { path: input.path.unwrap_or_else(|| PathBuf::from(input.name)), text: input.text })
+            }
+            Err(e) => errors.push(e),
+        }
+    }
+    (Corpus::new(name, sources), errors)
+}
+
+/// Corpora named apart: a second `a` becomes `a#2`.
+pub fn unique_names(corpora: &mut [Corpus]) {
+    for i in 0..corpora.len() {
+        let taken = corpora[..i].iter().filter(|c| c.name == corpora[i].name).count();
+        if taken > 0 {
+            corpora[i].name = format!("{}#{}", corpora[i].name, taken + 1);
+        }
     }
 }
 

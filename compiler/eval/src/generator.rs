@@ -101,6 +101,75 @@ pub fn draw_fitted(
     (None, attempts.max(1))
 }
 
+/// What a run of the fitted generator did (`gen --generator fitted:` writes it as
+/// `summary.json`).
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct FittedSummary {
+    pub generator: String,
+    pub region: Option<String>,
+    pub requested: usize,
+    pub generated: usize,
+    pub complete: usize,
+    pub incomplete: usize,
+    pub draws: usize,
+    pub rejected: usize,
+    pub seed: u64,
+}
+
+/// One scenario of [`draw_many`]: its name, seed, and text (`None` when no draw counted).
+pub struct Drawn {
+    pub index: usize,
+    pub name: String,
+    pub seed: u64,
+    pub text: Option<String>,
+}
+
+/// A run of the fitted generator: `n` scenarios named `STEM_fitted_00i`, scenario `i`
+/// drawn with seed `seed + i`, at most `attempts` draws each.
+pub struct Draws<'a> {
+    /// How the summary names the generator (`fitted:PATH`).
+    pub generator: &'a str,
+    pub stem: &'a str,
+    pub n: usize,
+    pub seed: u64,
+    pub attempts: usize,
+}
+
+/// The scenarios of `run` drawn from `fitted` by [`draw_fitted`]; `each` takes them in
+/// order and may stop the run.
+pub fn draw_many<E>(
+    fitted: &tad_fit::Fitted,
+    run: &Draws,
+    mut each: impl FnMut(Drawn) -> Result<(), E>,
+) -> Result<FittedSummary, E> {
+    let Draws { generator, stem, n, seed, attempts } = *run;
+    let mut db = Database::new(tad_check::Options::default());
+    let mut summary = FittedSummary {
+        generator: generator.to_string(),
+        region: fitted.region.clone(),
+        requested: n,
+        seed,
+        ..FittedSummary::default()
+    };
+    for index in 0..n {
+        let seed = seed.wrapping_add(index as u64);
+        let name = format!("{stem}_fitted_{:03}", index + 1);
+        let (accepted, draws) = draw_fitted(&mut db, fitted, &name, seed, attempts);
+        summary.draws += draws;
+        summary.rejected += draws - usize::from(accepted.is_some());
+        if let Some((_, class)) = &accepted {
+            summary.generated += 1;
+            if *class == Class::Complete {
+                summary.complete += 1;
+            } else {
+                summary.incomplete += 1;
+            }
+        }
+        each(Drawn { index, name, seed, text: accepted.map(|(text, _)| text) })?;
+    }
+    Ok(summary)
+}
+
 /// `n` scenarios of the generator fitted on `own` (the region's scenarios): (name, TAD).
 pub fn fitted(db: &mut Database, own: &[&Item], region: &str, n: usize, seed: u64) -> Vec<(String, String)> {
     let (fitted, _) = fit(own.iter().copied());

@@ -29,6 +29,34 @@ pub struct Unit {
     pub key: String,
 }
 
+/// The units of one generator's scenarios `texts` (name, TAD) for `region`, each set in
+/// `db` as `GENERATOR/NAME.tad` and built through the [`pipeline`](crate::pipeline); a
+/// scenario whose scene cannot be set up comes back as a note instead.
+pub fn units(
+    db: &mut tad_db::Database,
+    region: &str,
+    generator: &str,
+    texts: Vec<(String, String)>,
+) -> (Vec<Unit>, Vec<String>) {
+    let (mut units, mut notes) = (Vec::new(), Vec::new());
+    for (name, text) in texts {
+        let path = std::path::PathBuf::from(format!("{generator}/{name}.tad"));
+        let file = db.set_source(path, text, tad_db::Language::Tad, &tad_db::RealFs);
+        match crate::pipeline::scene(db, file, &name) {
+            None => {}
+            Some(Ok(scene)) => units.push(Unit {
+                region: region.to_string(),
+                generator: generator.to_string(),
+                key: crate::corpus::behaviour_of(db, file),
+                name,
+                scene,
+            }),
+            Some(Err(e)) => notes.push(format!("{generator}/{name}: not run: {e}")),
+        }
+    }
+    (units, notes)
+}
+
 /// A kept scene: its unit with the search's parameters and seed.
 pub struct Kept<'a> {
     pub unit: &'a Unit,

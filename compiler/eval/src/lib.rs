@@ -9,18 +9,22 @@
 //! ```
 //!
 //! [`pipeline`] is the one path from a scenario to a scene; [`corpus::counts`] the one
-//! predicate for which scenarios count; [`results`] the one results format. Hosts read
+//! predicate for which scenarios count; [`results`] the one results format; [`record`] what `run` leaves of its episodes, [`searched`] what
+//! `search` writes. Hosts read
 //! files, print and choose exit statuses; nothing here writes to a terminal.
 
 pub mod baseline;
 pub mod corpus;
 pub mod examples;
+pub mod finetune;
 pub mod generator;
 pub mod harness;
 pub mod journal;
 pub mod pipeline;
+pub mod record;
 pub mod recovery;
 pub mod results;
+pub mod searched;
 pub mod synthetic;
 pub mod train;
 

@@ -9,13 +9,51 @@
 
 use std::path::PathBuf;
 
+use tad_db::host::Input;
 use tad_db::{Database, Language, RealFs, SourceFile};
+use tad_diagnostics::Diagnostic;
 use tad_runtime::{Scene, SetupError};
 
 /// The bytecode program of a resolved scenario: laid out, then lowered.
 pub fn program(scenario: &tad_ir::Scenario, name: &str) -> tad_bytecode::Program {
     let layout = tad_layout::lay_out(scenario);
     tad_bytecode::lower(scenario, &layout, name)
+}
+
+/// Why an input has no program.
+#[derive(Debug)]
+pub enum Refusal {
+    /// The input has errors (these).
+    Errors(Vec<Diagnostic>),
+    /// The input checks but holds no scenario (E0700).
+    NoScenario(Box<Diagnostic>),
+}
+
+impl Refusal {
+    /// The refusal as people read it: the diagnostics, then `NAME: not VERB` (and why).
+    pub fn render(&self, input: &Input, verb: &str, color: bool) -> String {
+        use tad_diagnostics::render::{FileReport, human};
+        let (diagnostics, why) = match self {
+            Refusal::Errors(errors) => (errors.as_slice(), ": it has errors"),
+            Refusal::NoScenario(d) => (std::slice::from_ref(d.as_ref()), ""),
+        };
+        let shown = human::render(&FileReport::new(&input.name, &input.text, diagnostics), color);
+        format!("{shown}{}: not {verb}{why}\n", input.name)
+    }
+}
+
+/// An input's program: checked (a file with errors is refused), resolved, laid out and
+/// lowered. What `build --target bytecode` writes and `run` and `search` run.
+pub fn compile(db: &mut Database, input: &Input) -> Result<tad_bytecode::Program, Refusal> {
+    let checked = tad_db::host::diagnose_in(db, input);
+    if checked.diagnostics.iter().any(Diagnostic::is_error) {
+        return Err(Refusal::Errors(checked.diagnostics.into_iter().filter(Diagnostic::is_error).collect()));
+    }
+    let file = tad_db::host::register(db, input);
+    let Some(scenario) = tad_db::resolve(db, file) else {
+        return Err(Refusal::NoScenario(Box::new(tad_check::no_scenario(&tad_db::analyze(db, file).module))));
+    };
+    Ok(program(scenario, &input.name))
 }
 
 /// The scene of a file the database holds; `None` when it holds no scenario.

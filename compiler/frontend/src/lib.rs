@@ -10,18 +10,22 @@
 //! [`prompt`] renders the versioned templates (the vocabulary from the declarations in
 //! scope), [`extract`] finds the program in an answer, [`session`] runs the
 //! check-and-repair loop on `tad-db` (the same checks as `tadslc check`) over `tad-llm`,
-//! [`synth`] and [`generate`] are the pipelines, [`store`] writes what they produce (sanitised
-//! names, atomic files, JSON Lines), [`summary`] counts what happened. Everything a model
+//! [`synth`], [`generate`] and [`translate`] are the pipelines, [`backend`] picks who
+//! answers (a server or the model in process), [`store`] writes what they produce (sanitised
+//! names, atomic files, JSON Lines), [`summary`] counts what happened, [`sft`] turns a corpus into fine-tuning data. Everything a model
 //! writes is untrusted: it never names a path, never breaks a record, and every loop is
 //! bounded in rounds, tokens and time.
 
+pub mod backend;
 pub mod extract;
 pub mod generate;
 pub mod prompt;
 pub mod session;
+pub mod sft;
 pub mod store;
 pub mod summary;
 pub mod synth;
+pub mod translate;
 
 use tad_check::Vocabulary;
 use tad_llm::{Constraint, Dialect};

@@ -175,6 +175,13 @@ pub struct Outcome {
     pub diagnostics: Vec<String>,
 }
 
+impl Outcome {
+    /// Whether the model could not be used: no program, and the loop stopped early.
+    pub fn unreachable(&self) -> bool {
+        self.class.is_none() && self.stopped.is_some()
+    }
+}
+
 pub struct Session<'a> {
     pub client: &'a dyn Chat,
     pub checker: &'a Checker,

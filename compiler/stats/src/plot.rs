@@ -5,7 +5,7 @@
 
 use std::fmt::Write;
 
-use crate::stats::Histogram;
+use crate::stats::{Histogram, Stats};
 
 const COLOURS: &[&str] = &["#0072B2", "#E69F00", "#009E73", "#CC79A7", "#56B4E9", "#D55E00", "#F0E442", "#000000"];
 const FONT: &str = "font-family=\"Helvetica, Arial, sans-serif\"";
@@ -27,6 +27,23 @@ fn legend(out: &mut String, names: &[&str], x: f64, y: f64) {
             escape(name)
         );
     }
+}
+
+/// The plots of corpora's statistics, as (name, SVG): one bar chart per attribute, and
+/// the actors per scenario.
+pub fn corpora(all: &[Stats]) -> Vec<(String, String)> {
+    let mut plots = Vec::new();
+    for a in crate::ATTRIBUTES {
+        let sets: Vec<(&str, &Histogram)> = all.iter().map(|s| (s.corpus.as_str(), &s.histograms[a.key])).collect();
+        plots.push((a.key.to_string(), bars(a.title, &sets, 20)));
+    }
+    let counts: Vec<(String, Histogram)> = all
+        .iter()
+        .map(|s| (s.corpus.clone(), s.actor_counts.iter().map(|(n, c)| (format!("{n:>3}"), *c)).collect()))
+        .collect();
+    let sets: Vec<(&str, &Histogram)> = counts.iter().map(|(n, h)| (n.as_str(), h)).collect();
+    plots.push(("actors".to_string(), bars("Actors per scenario", &sets, 30)));
+    plots
 }
 
 /// Values in `[0, 1]` as bars: one cluster per group (the first item), one colour per

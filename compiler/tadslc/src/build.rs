@@ -85,7 +85,8 @@ fn run_in(args: &BuildArgs, color: bool) -> Result<Status, CliError> {
     let simulator = Simulator::from(args.simulator);
     // raised by files with errors and outputs that cannot be written; the others still build
     let mut status = Status::Ok;
-    let inputs = files::load(paths, Search::Tad, &mut status)?;
+    let (inputs, read) = files::load(paths, Search::Tad)?;
+    status = status.max(read);
     if out.is_none() && inputs.len() > 1 {
         return Err(CliError::usage(format!(
             "{} to build: give an output directory with -o",

@@ -14,7 +14,6 @@ use crate::output::{CliError, Closed};
 use crate::{Status, err, errln, out, plural};
 use tad_check::Options;
 use tad_db::Database;
-use tad_diagnostics::render::{FileReport, human};
 
 /// `build --target bytecode`; `scenic_options`: a Scenic-only option (`--map`,
 /// `--map-dir`) was given.
@@ -30,7 +29,8 @@ fn build_in(paths: &[PathBuf], out: Option<&Path>, scenic_options: bool, color: 
         .ok_or_else(|| CliError::usage("the bytecode target writes binary files: give an output directory with -o"))?;
     // raised by files with errors and outputs that cannot be written; the others still build
     let mut status = Status::Ok;
-    let inputs = files::load(paths, Search::Tad, &mut status)?;
+    let (inputs, read) = files::load(paths, Search::Tad)?;
+    status = status.max(read);
     std::fs::create_dir_all(dir).map_err(|e| CliError::usage(format!("cannot create `{}`: {e}", dir.display())))?;
     let mut written: Vec<PathBuf> = Vec::new();
     let mut db = Database::new(Options::default());
@@ -79,22 +79,13 @@ pub fn compile(
     verb: &str,
     color: bool,
 ) -> Result<Option<tad_bytecode::Program>, Closed> {
-    let checked = crate::check::diagnose_in(db, input);
-    if checked.diagnostics.iter().any(|d| d.is_error()) {
-        let errors: Vec<_> = checked.diagnostics.iter().filter(|d| d.is_error()).cloned().collect();
-        err!("{}", human::render(&FileReport::new(&input.name, &input.text, &errors), color))?;
-        errln!("{}: not {verb}: it has errors", input.name)?;
-        return Ok(None);
+    match tad_eval::pipeline::compile(db, input) {
+        Ok(program) => Ok(Some(program)),
+        Err(refusal) => {
+            err!("{}", refusal.render(input, verb, color))?;
+            Ok(None)
+        }
     }
-    let file = crate::check::register(db, input);
-    let Some(scenario) = tad_db::resolve(db, file) else {
-        let module = &tad_db::analyze(db, file).module;
-        let diagnostics = tad_scenic::no_scenario(module).diagnostics;
-        err!("{}", human::render(&FileReport::new(&input.name, &input.text, &diagnostics), color))?;
-        errln!("{}: not {verb}", input.name)?;
-        return Ok(None);
-    };
-    Ok(Some(tad_eval::pipeline::program(scenario, &input.name)))
 }
 
 /// `disasm FILE.tadc`: the listing on standard output.

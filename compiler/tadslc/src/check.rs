@@ -80,7 +80,8 @@ fn run_in(
 ) -> Result<Status, CliError> {
     // raised by unreadable paths, then by errors (and warnings with --deny-warnings)
     let mut status = Status::Ok;
-    let inputs = files::load(paths, Search::Scenarios, &mut status)?;
+    let (inputs, read) = files::load(paths, Search::Scenarios)?;
+    status = status.max(read);
     let mut db = Database::new(options);
     let mut done: Vec<Checked1> = Vec::new();
     for input in &inputs {

@@ -11,12 +11,13 @@ use std::path::{Path, PathBuf};
 
 use tad_base::Shard;
 use tad_db::Database;
+use tad_eval::finetune::{self, FinetuneError};
 use tad_eval::generator::{self, Generator};
 use tad_eval::results::{self, MergeError};
-use tad_eval::train::{Start, TrainScene};
+use tad_eval::train::Start;
 use tad_eval::{Item, Journal, Kept, Plan, Results, Setup, TableFormat, Unit};
 use tad_policy::EgoSpec;
-use tad_train::{Config, TrainError};
+use tad_train::Config;
 
 use crate::output::{CliError, Closed};
 use crate::{Status, errln, out, outln, plural};
@@ -113,22 +114,13 @@ fn eval_in(args: &EvalArgs, _color: bool) -> Result<Status, CliError> {
         return Err(CliError::usage("--finetune trains on every kept scene: run it without --shard"));
     }
     // raised by files that cannot be read, and by what fails without ending the run
-    let mut status = Status::Ok;
-    let corpus = if args.corpus.is_empty() {
-        crate::align::report(tad_eval::examples::corpus("examples", "examples/"), &mut status)?
+    let (corpus, mut status) = if args.corpus.is_empty() {
+        (crate::align::counted(tad_eval::examples::corpus("examples", "examples/"))?, Status::Ok)
     } else {
-        crate::align::load(&args.corpus, &mut status)?
+        crate::align::load(&args.corpus)?
     };
-    if corpus.items.is_empty() {
-        return Ok(status);
-    }
     // regions: the ones asked for, else every region with at least 3 scenarios
-    let mut by_region: BTreeMap<String, Vec<&Item>> = BTreeMap::new();
-    for item in &corpus.items {
-        if let Some(region) = &item.region {
-            by_region.entry(region.clone()).or_default().push(item);
-        }
-    }
+    let by_region = corpus.by_region();
     let regions: Vec<String> = if args.regions.is_empty() {
         by_region.iter().filter(|(_, items)| items.len() >= 3).map(|(r, _)| r.clone()).collect()
     } else {
@@ -163,22 +155,13 @@ fn eval_in(args: &EvalArgs, _color: bool) -> Result<Status, CliError> {
         let own: &[&Item] = by_region.get(region).map_or(&[], |v| v.as_slice());
         for name in &args.generators {
             let generator = Generator::parse(name);
-            let texts = scenarios(&mut db, args, &generator, region, own, &mut status)?;
-            for (scenario, text) in texts {
-                let path = PathBuf::from(format!("{name}/{scenario}.tad"));
-                let file = db.set_source(path, text, tad_db::Language::Tad, &tad_db::RealFs);
-                match tad_eval::pipeline::scene(&db, file, &scenario) {
-                    None => {}
-                    Some(Ok(scene)) => units.push(Unit {
-                        region: region.clone(),
-                        generator: name.clone(),
-                        key: tad_eval::corpus::behaviour_of(&db, file),
-                        name: scenario,
-                        scene,
-                    }),
-                    Some(Err(e)) => errln!("note: {name}/{scenario}: not run: {e}")?,
-                }
+            let (texts, read) = scenarios(&mut db, args, &generator, region, own)?;
+            status = status.max(read);
+            let (mine, notes) = tad_eval::harness::units(&mut db, region, name, texts);
+            for note in notes {
+                errln!("note: {note}")?;
             }
+            units.extend(mine);
         }
     }
 
@@ -236,24 +219,23 @@ fn eval_in(args: &EvalArgs, _color: bool) -> Result<Status, CliError> {
     Ok(status)
 }
 
-/// The scenarios of `generator` for `region`: (name, TAD text), each one that counts; the
-/// files it cannot read raise `status`.
+/// The scenarios of `generator` for `region`: (name, TAD text), each one that counts, and
+/// the status reading them reached (2 when a file could not be read).
 fn scenarios(
     db: &mut Database,
     args: &EvalArgs,
     generator: &Generator,
     region: &str,
     own: &[&Item],
-    status: &mut Status,
-) -> Result<Vec<(String, String)>, CliError> {
+) -> Result<(Vec<(String, String)>, Status), CliError> {
     let (n, seed) = (args.n, args.llm.seed);
     let dir = match generator {
         Generator::Fitted if own.is_empty() => {
             errln!("note: region `{region}` has no scenario to fit: no fitted scenarios")?;
-            return Ok(Vec::new());
+            return Ok((Vec::new(), Status::Ok));
         }
-        Generator::Fitted => return Ok(generator::fitted(db, own, region, n, seed)),
-        Generator::Baseline => return Ok(generator::baseline(db, region, n, seed)),
+        Generator::Fitted => return Ok((generator::fitted(db, own, region, n, seed), Status::Ok)),
+        Generator::Baseline => return Ok((generator::baseline(db, region, n, seed), Status::Ok)),
         Generator::Llm(prompt) => {
             // through `tadslc gen`'s loop, into the results directory or a temporary one
             let base = args
@@ -281,7 +263,7 @@ fn scenarios(
             let done = crate::llm::generate(&request, &args.llm);
             if done != Status::Ok {
                 let message = format!("{region}: the language model generated nothing usable ({generator})");
-                return Err(CliError::Exit((*status).max(done), message));
+                return Err(CliError::Exit(done, message));
             }
             dir
         }
@@ -291,8 +273,8 @@ fn scenarios(
         }
     };
     // a corpus holds only the scenarios that count
-    let corpus = crate::align::load(std::slice::from_ref(&dir), status)?;
-    Ok(corpus.items.into_iter().map(|i| (i.name, i.tad)).collect())
+    let (corpus, read) = crate::align::load(std::slice::from_ref(&dir))?;
+    Ok((corpus.items.into_iter().map(|i| (i.name, i.tad)).collect(), read))
 }
 
 /// `tadslc merge FILES`: the table of several results files (the shards of one command).
@@ -339,12 +321,9 @@ pub fn print(all: &[Results], format: EvalFormat, plot: Option<&Path>) -> Result
     Ok(Status::Ok)
 }
 
-/// The "after fine-tuning" table of `eval --finetune`: a learned ego trained with SAC on
-/// 3/5 of each behaviour's kept scenes (from `--finetune-from`, else from scratch), then
-/// it, the ego it started from and the `--egos` on the held-out 2/5.
+/// The "after fine-tuning" table of `eval --finetune` (`tad_eval::finetune`).
 pub fn finetune(args: &EvalArgs, plan: &Plan, kept: &[Kept]) -> Result<Status, CliError> {
-    let keys: Vec<String> = kept.iter().map(|k| k.unit.key.clone()).collect();
-    let (train, test) = tad_train::split(&keys, args.llm.seed);
+    let (train, test) = finetune::split(kept, args.llm.seed);
     if train.is_empty() || test.is_empty() {
         errln!("warning: no fine-tuning: {} kept scenes are too few to hold some out", kept.len())?;
         return Ok(Status::Failed);
@@ -356,8 +335,6 @@ pub fn finetune(args: &EvalArgs, plan: &Plan, kept: &[Kept]) -> Result<Status, C
         ..Config::default()
     };
     let start = args.finetune_from.as_deref().map_or(Start::Scratch, Start::from_path);
-    let (mut trainer, before) = start.trainer(config).map_err(|e| CliError::usage(format!("--finetune-from: {e}")))?;
-    let first = trainer.episodes() as usize;
     errln!(
         "fine-tuning a learned ego on {} ({} held out), {}",
         plural(train.len(), "scene"),
@@ -365,38 +342,19 @@ pub fn finetune(args: &EvalArgs, plan: &Plan, kept: &[Kept]) -> Result<Status, C
         plural(args.finetune, "episode")
     )?;
     let progress = crate::output::progress(args.finetune, "episodes");
-    let scenes: Vec<TrainScene> = train
-        .iter()
-        .map(|&i| TrainScene { scene: &kept[i].unit.scene, fixed: Some((kept[i].params.clone(), kept[i].seed)) })
-        .collect();
-    let trained =
-        tad_eval::train::train(&mut trainer, first + args.finetune, &scenes, |_, _| -> Result<(), TrainError> {
-            progress.inc(1);
-            Ok(())
-        });
+    let tuned = finetune::tune(kept, &train, start, config, || progress.inc(1));
     progress.finish_and_clear();
-    trained.map_err(|e| CliError::failed(format!("fine-tuning stopped: {e}")))?;
-    let after = trainer.actor().map_err(CliError::failed)?;
+    let tuned = tuned.map_err(|e| match e {
+        FinetuneError::Start(e) => CliError::usage(format!("--finetune-from: {e}")),
+        FinetuneError::Training(e) => CliError::failed(format!("fine-tuning stopped: {e}")),
+        FinetuneError::Actor(e) => CliError::failed(e),
+    })?;
     if let Some(dir) = &args.out {
         let path = dir.join("finetuned.safetensors");
-        after.save(&path).map_err(CliError::usage)?;
+        tuned.after.save(&path).map_err(CliError::usage)?;
         errln!("the fine-tuned ego in {}", path.display())?;
     }
-    // the held-out scenes, every ego
-    let mut drivers: Vec<(String, EgoSpec)> = Vec::new();
-    if let Some(actor) = before {
-        drivers.push(("learned (before)".into(), EgoSpec::Learned(actor)));
-    }
-    drivers.push(("learned (fine-tuned)".into(), EgoSpec::Learned(after)));
-    drivers.extend(plan.setup.egos.iter().cloned().zip(plan.egos.iter().cloned()));
-    let rows = tad_eval::harness::held_out(kept, &test, &drivers);
-    let setup = Setup {
-        regions: vec!["held-out".into()],
-        generators: vec!["searched".into()],
-        egos: drivers.iter().map(|(n, _)| n.clone()).collect(),
-        ..plan.setup.clone()
-    };
-    let scenarios = [("held-out/searched".to_string(), test.len())].into_iter().collect();
+    let held_out = finetune::held_out(plan, kept, &test, tuned);
     if args.format == EvalFormat::Markdown {
         outln!()?;
         outln!(
@@ -406,11 +364,8 @@ pub fn finetune(args: &EvalArgs, plan: &Plan, kept: &[Kept]) -> Result<Status, C
         )?;
         outln!()?;
     }
-    let was = tad_eval::harness::collision_rate(&rows, "learned (before)");
-    let now = tad_eval::harness::collision_rate(&rows, "learned (fine-tuned)");
-    let results = Results::new(setup, tad_base::Shard::ALL, scenarios, rows);
-    let status = print(&[results], args.format, None)?;
-    if drivers.iter().any(|(n, _)| n == "learned (before)") {
+    let status = print(&[held_out.results], args.format, None)?;
+    if let Some((was, now)) = held_out.collision_rates {
         let change = if was > 0.0 { format!("{:+.0} %", 100.0 * (now - was) / was) } else { "–".into() };
         errln!("held-out collision rate of the learned ego: {was:.3} before, {now:.3} after fine-tuning ({change})")?;
     }

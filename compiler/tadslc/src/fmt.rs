@@ -36,7 +36,8 @@ fn run_in(paths: &[std::path::PathBuf], check: bool, canonical: bool, color: boo
     let mut db = tad_db::Database::new(tad_check::Options::default());
     // raised by files that cannot be formatted or written, and by unformatted ones with --check
     let mut status = Status::Ok;
-    let inputs = files::load(paths, Search::Tad, &mut status)?;
+    let (inputs, read) = files::load(paths, Search::Tad)?;
+    status = status.max(read);
     let mut unformatted = 0;
     for input in &inputs {
         if input.invalid_utf8.is_some() {

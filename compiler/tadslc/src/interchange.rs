@@ -8,7 +8,7 @@
 //! missing, and the status is 1.
 
 use crate::files::{self, Input};
-use crate::output::Closed;
+use crate::output::{CliError, Closed};
 use crate::{Status, err, errln, out, plural};
 use std::path::{Path, PathBuf};
 use tad_check::Options;
@@ -21,16 +21,14 @@ fn report(input: &Input, diagnostics: &[Diagnostic], color: bool) -> Result<usiz
     Ok(diagnostics.iter().filter(|d| d.severity == Severity::Error).count())
 }
 
-fn write_output(out: Option<&Path>, text: &str, status: &mut Status) -> Result<(), Closed> {
+fn write_output(out: Option<&Path>, text: &str) -> Result<(), CliError> {
     match out {
-        None => out!("{text}"),
-        Some(path) => match std::fs::write(path, text) {
-            Ok(()) => errln!("wrote {}", path.display()),
-            Err(e) => {
-                *status = (*status).max(Status::Usage);
-                errln!("error: cannot write `{}`: {e}", path.display())
-            }
-        },
+        None => Ok(out!("{text}")?),
+        Some(path) => {
+            std::fs::write(path, text)
+                .map_err(|e| CliError::usage(format!("cannot write `{}`: {e}", path.display())))?;
+            Ok(errln!("wrote {}", path.display())?)
+        }
     }
 }
 
@@ -56,54 +54,37 @@ pub fn import(db: &mut Database, input: &Input) -> (String, Vec<Diagnostic>) {
     (text, diagnostics)
 }
 
-/// Read one input, or say why not.
-fn read(path: &Path, status: &mut Status) -> Result<Option<Input>, Closed> {
-    match files::read(path) {
-        Ok(input) => Ok(Some(input)),
-        Err(e) => {
-            *status = Status::Usage;
-            errln!("error: {e}")?;
-            Ok(None)
-        }
-    }
+pub fn run_import(path: &Path, out: Option<&Path>, color: bool) -> Status {
+    crate::output::finish(import_in(path, out, color))
 }
 
-pub fn run_import(path: &Path, out: Option<&Path>, color: bool) -> Status {
-    crate::output::run(|status| {
-        let Some(input) = read(path, status)? else {
-            return Ok(());
-        };
-        let mut db = Database::new(Options::default());
-        let (text, diagnostics) = import(&mut db, &input);
-        let errors = report(&input, &diagnostics, color)?;
-        if errors > 0 {
-            *status = (*status).max(Status::Failed);
-        }
-        write_output(out, &text, status)?;
-        if errors > 0 {
-            errln!("imported `{}` with {}: the output lacks what they name", input.name, plural(errors, "error"))?;
-        }
-        Ok(())
-    })
+fn import_in(path: &Path, out: Option<&Path>, color: bool) -> Result<Status, CliError> {
+    let input = files::read(path).map_err(CliError::usage)?;
+    let mut db = Database::new(Options::default());
+    let (text, diagnostics) = import(&mut db, &input);
+    let errors = report(&input, &diagnostics, color)?;
+    write_output(out, &text)?;
+    if errors == 0 {
+        return Ok(Status::Ok);
+    }
+    errln!("imported `{}` with {}: the output lacks what they name", input.name, plural(errors, "error"))?;
+    Ok(Status::Failed)
 }
 
 pub fn run_export(path: &Path, out: Option<&Path>, color: bool) -> Status {
-    crate::output::run(|status| {
-        let Some(input) = read(path, status)? else {
-            return Ok(());
-        };
-        let mut db = Database::new(Options::default());
-        let checked = crate::check::diagnose_in(&mut db, &input);
-        let errors = checked.diagnostics.iter().filter(|d| d.severity == Severity::Error).count();
-        if errors > 0 {
-            *status = Status::Failed;
-        }
-        report(&input, &checked.diagnostics, color)?;
-        if errors > 0 {
-            return errln!("error: `{}` has errors; not exported", input.name);
-        }
-        let file = crate::check::register(&mut db, &input);
-        let module = &tad_db::analyze(&db, file).module;
-        write_output(out, &tad_yaml::export(module, &input.text), status)
-    })
+    crate::output::finish(export_in(path, out, color))
+}
+
+fn export_in(path: &Path, out: Option<&Path>, color: bool) -> Result<Status, CliError> {
+    let input = files::read(path).map_err(CliError::usage)?;
+    let mut db = Database::new(Options::default());
+    let checked = crate::check::diagnose_in(&mut db, &input);
+    let errors = report(&input, &checked.diagnostics, color)?;
+    if errors > 0 {
+        return Err(CliError::failed(format!("`{}` has errors; not exported", input.name)));
+    }
+    let file = crate::check::register(&mut db, &input);
+    let module = &tad_db::analyze(&db, file).module;
+    write_output(out, &tad_yaml::export(module, &input.text))?;
+    Ok(Status::Ok)
 }

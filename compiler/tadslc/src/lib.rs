@@ -60,7 +60,4 @@ impl From<Status> for std::process::ExitCode {
     }
 }
 
-/// `1 file`, `2 files`: a count with its noun in the right number (regular plurals).
-pub fn plural(n: usize, word: &str) -> String {
-    if n == 1 { format!("1 {word}") } else { format!("{n} {word}s") }
-}
+pub use tad_base::plural;

@@ -9,15 +9,16 @@
 
 use std::io::Write;
 use std::ops::Range;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use crate::files::{self, Search};
 use crate::output::{CliError, Closed};
 use crate::{Status, errln, out, outln};
 use tad_check::Options as CheckOptions;
 use tad_db::Database;
+use tad_eval::record::{self, Played};
 use tad_metrics::Mode;
-use tad_runtime::{Episode, Options, Scene};
+use tad_runtime::{Options, Scene};
 
 /// What `run` prints.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -92,16 +93,20 @@ pub struct Loaded {
     pub key: Option<String>,
 }
 
-/// Every input as a scene: sources compiled, `.tadc` files loaded.
-pub fn load(paths: &[PathBuf], color: bool, status: &mut Status) -> Result<Vec<Loaded>, Closed> {
+/// Every input as a scene (sources compiled, `.tadc` files loaded), and the status
+/// loading them reached: an input that does not load is reported and skipped.
+pub fn load(paths: &[PathBuf], color: bool) -> Result<(Vec<Loaded>, Status), Closed> {
     let (bytecode, sources): (Vec<PathBuf>, Vec<PathBuf>) =
         paths.iter().cloned().partition(|p| p.extension().is_some_and(|e| e == "tadc"));
     let mut loaded = Vec::new();
+    let mut status = Status::Ok;
     let mut db = Database::new(CheckOptions::default());
     if !sources.is_empty() {
-        for input in files::load(&sources, Search::Scenarios, status)? {
+        let (inputs, read) = files::load(&sources, Search::Scenarios)?;
+        status = status.max(read);
+        for input in inputs {
             let Some(program) = crate::bytecode::compile(&mut db, &input, "run", color)? else {
-                *status = (*status).max(Status::Failed);
+                status = status.max(Status::Failed);
                 continue;
             };
             let file = crate::check::register(&mut db, &input);
@@ -111,7 +116,7 @@ pub fn load(paths: &[PathBuf], color: bool, status: &mut Status) -> Result<Vec<L
                     loaded.push(Loaded { name: input.name.clone(), scene, source: Some(input.clone()), key: Some(key) })
                 }
                 Err(e) => {
-                    *status = (*status).max(Status::Failed);
+                    status = status.max(Status::Failed);
                     errln!("{}: not run: {e}", input.name)?;
                 }
             }
@@ -128,34 +133,22 @@ pub fn load(paths: &[PathBuf], color: bool, status: &mut Status) -> Result<Vec<L
         match program.and_then(|p| Scene::new(&p).map_err(|e| (Status::Failed, e.to_string()))) {
             Ok(scene) => loaded.push(Loaded { name, scene, source: None, key: None }),
             Err((failed, e)) => {
-                *status = (*status).max(failed);
+                status = status.max(failed);
                 errln!("error: {name}: {e}")?;
             }
         }
     }
-    Ok(loaded)
+    Ok((loaded, status))
 }
 
-/// The inputs of one shard: every N-th loaded scenario from I.
-pub fn load_shard(
-    paths: &[PathBuf],
-    shard: tad_base::Shard,
-    color: bool,
-    status: &mut Status,
-) -> Result<Vec<Loaded>, Closed> {
-    Ok(load(paths, color, status)?.into_iter().enumerate().filter(|(k, _)| shard.takes(*k)).map(|(_, l)| l).collect())
+/// The inputs of one shard (every N-th loaded scenario from I), and the loading's status.
+pub fn load_shard(paths: &[PathBuf], shard: tad_base::Shard, color: bool) -> Result<(Vec<Loaded>, Status), Closed> {
+    let (loaded, status) = load(paths, color)?;
+    Ok((loaded.into_iter().enumerate().filter(|(k, _)| shard.takes(*k)).map(|(_, l)| l).collect(), status))
 }
 
 pub fn run(args: &RunArgs, color: bool) -> Status {
     crate::output::finish(run_in(args, color))
-}
-
-/// One finished episode with its scores.
-struct Done {
-    file: usize,
-    ego: usize,
-    episode: Episode,
-    score: tad_metrics::EpisodeScore,
 }
 
 fn run_in(args: &RunArgs, color: bool) -> Result<Status, CliError> {
@@ -164,8 +157,7 @@ fn run_in(args: &RunArgs, color: bool) -> Result<Status, CliError> {
         policies.push(tad_policy::parse_policy(spec).map_err(|e| CliError::usage(format!("--ego {spec}: {e}")))?);
     }
     // raised by inputs that do not load, and by output that cannot be written
-    let mut status = Status::Ok;
-    let scenes = load_shard(&args.paths, args.shard, color, &mut status)?;
+    let (scenes, mut status) = load_shard(&args.paths, args.shard, color)?;
     if scenes.is_empty() {
         return Err(CliError::usage("nothing to run"));
     }
@@ -181,7 +173,7 @@ fn run_in(args: &RunArgs, color: bool) -> Result<Status, CliError> {
         )),
         None => None,
     };
-    let mut done: Vec<Done> = Vec::new();
+    let mut done: Vec<Played> = Vec::new();
     for (f, loaded) in scenes.iter().enumerate() {
         for (e, policy) in policies.iter_mut().enumerate() {
             for seed in args.seeds.clone() {
@@ -189,18 +181,18 @@ fn run_in(args: &RunArgs, color: bool) -> Result<Status, CliError> {
                 let episode = tad_runtime::run(&loaded.scene, Some(seed), params, policy.as_mut(), &opts);
                 let Ok(score) = tad_metrics::score_episode(&episode.records, mode) else { continue };
                 if let Some(w) = trace.as_mut()
-                    && let Err(err) = write_trace(w, &loaded.name, policy.name(), &loaded.scene, &episode)
+                    && let Err(err) = record::write_trace(w, &loaded.name, policy.name(), &loaded.scene, &episode)
                 {
                     return Err(CliError::usage(format!("cannot write the trace: {err}")));
                 }
                 if args.format == RunFormat::Json {
-                    outln!("{}", episode_json(&loaded.name, policy.name(), &episode, &score))?;
+                    outln!("{}", record::episode_json(&loaded.name, policy.name(), &episode, &score))?;
                 }
                 let mut episode = episode;
                 if args.render.is_none() || !done.is_empty() {
                     episode.frames = Vec::new();
                 }
-                done.push(Done { file: f, ego: e, episode, score });
+                done.push(Played { scenario: f, ego: e, episode, score });
                 progress.inc(1);
             }
         }
@@ -213,38 +205,31 @@ fn run_in(args: &RunArgs, color: bool) -> Result<Status, CliError> {
         errln!("error: cannot write the trace: {e}")?;
     }
     let names: Vec<String> = policies.iter().map(|p| p.name().to_string()).collect();
-    if let Some(dir) = &args.out
-        && let Err(e) = write_results(dir, args, &scenes, &done)
-    {
-        status = Status::Usage;
-        errln!("error: cannot write the results to `{}`: {e}", dir.display())?;
+    if let Some(dir) = &args.out {
+        let files: Vec<&str> = scenes.iter().map(|s| s.name.as_str()).collect();
+        if let Err(e) = record::results(&files, &args.egos, args.seeds.clone(), args.shard, &done).write(dir) {
+            status = Status::Usage;
+            errln!("error: cannot write the results to `{}`: {e}", dir.display())?;
+        }
     }
     match args.format {
         RunFormat::Json => {
             for (e, name) in names.iter().enumerate() {
-                let scores: Vec<tad_metrics::EpisodeScore> =
-                    done.iter().filter(|d| d.ego == e).map(|d| d.score.clone()).collect();
-                let Ok(agg) = tad_metrics::aggregate(&scores, mode) else { continue };
-                let value = serde_json::json!({
-                    "aggregate": true,
-                    "ego": name,
-                    "episodes": agg.episodes,
-                    "completed": agg.completed,
-                    "mode": mode.as_str(),
-                    "metrics": agg.raw,
-                    "normalised": agg.normalised,
-                    "safety": agg.safety,
-                    "task": agg.task,
-                    "comfort": agg.comfort,
-                });
-                outln!("{value}")?;
+                let scores: Vec<_> = done.iter().filter(|d| d.ego == e).map(|d| d.score.clone()).collect();
+                if let Some(value) = record::aggregate_json(name, &scores, mode) {
+                    outln!("{value}")?;
+                }
             }
         }
-        RunFormat::Table => print_table(&scenes, &names, &done, mode)?,
+        RunFormat::Table => {
+            let scenarios: Vec<&str> = scenes.iter().map(|s| s.scene.name.as_str()).collect();
+            out!("{}", record::table(&scenarios, &names, &done, mode))?;
+        }
     }
     if let (Some(path), Some(first)) = (&args.render, done.first()) {
-        let loaded = &scenes[first.file];
-        if let Err(e) = render(path, &loaded.scene, &names[first.ego], &first.episode) {
+        let loaded = &scenes[first.scenario];
+        let gif = path.extension().is_some_and(|x| x.eq_ignore_ascii_case("gif"));
+        if let Err(e) = std::fs::write(path, record::picture(&loaded.scene, &names[first.ego], &first.episode, gif)) {
             status = Status::Usage;
             errln!("error: cannot write `{}`: {e}", path.display())?;
         } else {
@@ -258,190 +243,6 @@ fn run_in(args: &RunArgs, color: bool) -> Result<Status, CliError> {
         }
     }
     Ok(status)
-}
-
-/// The episodes as a results file of `eval`'s form (one region `all`, one generator
-/// `files`), for `tadslc merge`.
-fn write_results(dir: &Path, args: &RunArgs, scenes: &[Loaded], done: &[Done]) -> std::io::Result<()> {
-    use tad_eval::{Results, Row, Setup};
-    let rows: Vec<Row> = done
-        .iter()
-        .map(|d| Row {
-            region: "all".into(),
-            generator: "files".into(),
-            ego: args.egos[d.ego].clone(),
-            scenario: scenes[d.file].name.clone(),
-            trial: 0,
-            seed: d.episode.seed.unwrap_or(0),
-            score: d.score.clone(),
-        })
-        .collect();
-    let results = Results::new(
-        Setup {
-            regions: vec!["all".into()],
-            generators: vec!["files".into()],
-            egos: args.egos.clone(),
-            search_ego: String::new(),
-            n: 0,
-            samples: (args.seeds.end - args.seeds.start) as usize,
-            keep: 0,
-            seed: args.seeds.start,
-        },
-        args.shard,
-        [("all/files".to_string(), scenes.len())].into_iter().collect(),
-        rows,
-    );
-    results.write(dir).map(|_| ())
-}
-
-fn episode_json(file: &str, ego: &str, e: &Episode, score: &tad_metrics::EpisodeScore) -> serde_json::Value {
-    serde_json::json!({
-        "file": file,
-        "seed": e.seed,
-        "ego": ego,
-        "steps": e.steps,
-        "stop_reason": e.stop_reason.as_str(),
-        "metrics": score.metrics,
-    })
-}
-
-fn write_trace(w: &mut impl Write, file: &str, ego: &str, scene: &Scene, e: &Episode) -> std::io::Result<()> {
-    let labels: Vec<String> =
-        std::iter::once("ego".to_string()).chain(scene.actors.iter().map(|a| a.label.clone())).collect();
-    for (step, frame) in e.frames.iter().enumerate() {
-        let actors: Vec<serde_json::Value> = frame
-            .poses
-            .iter()
-            .zip(&frame.speeds)
-            .zip(&labels)
-            .map(|((&(x, y, yaw), &v), label)| {
-                serde_json::json!({"id": label, "x": round(x), "y": round(y), "yaw": round(yaw), "v": round(v)})
-            })
-            .collect();
-        let lights: serde_json::Map<String, serde_json::Value> = frame
-            .lights
-            .iter()
-            .map(|(arm, l)| (arm.as_str().to_string(), format!("{l:?}").to_lowercase().into()))
-            .collect();
-        let line = serde_json::json!({
-            "file": file, "seed": e.seed, "ego": ego, "step": step,
-            "t": round(step as f64 * scene.limits.dt), "actors": actors, "lights": lights,
-        });
-        writeln!(w, "{line}")?;
-    }
-    Ok(())
-}
-
-fn round(x: f64) -> f64 {
-    (x * 1000.0).round() / 1000.0
-}
-
-fn render(path: &Path, scene: &Scene, ego: &str, e: &Episode) -> std::io::Result<()> {
-    use tad_render::{ActorInfo, Frame, Kind};
-    let size = scene.ego.size;
-    let actors =
-        std::iter::once(ActorInfo { label: "ego".into(), kind: Kind::Ego, length: size.length, width: size.width })
-            .chain(scene.actors.iter().map(|a| ActorInfo {
-                label: a.label.clone(),
-                kind: match a.body {
-                    tad_layout::Body::Vehicle => Kind::Vehicle,
-                    tad_layout::Body::Walker => Kind::Walker,
-                    tad_layout::Body::Object => Kind::Object,
-                },
-                length: a.size.length,
-                width: a.size.width,
-            }))
-            .collect();
-    let frames = e
-        .frames
-        .iter()
-        .map(|f| Frame {
-            poses: f.poses.iter().map(|&(x, y, yaw)| Some([x, y, yaw])).collect(),
-            lights: f.lights.clone(),
-        })
-        .collect();
-    let (start, length) = (scene.ego.start, scene.ego.route_length);
-    let route = (0..=(length / 2.0).ceil() as usize)
-        .map(|k| scene.ego.route.pose(start + (2.0 * k as f64).min(length)).position)
-        .map(|p| [p.x, p.y])
-        .collect();
-    let events = e
-        .events
-        .iter()
-        .map(|ev| tad_render::Event {
-            step: ev.step as usize,
-            position: [ev.position.x, ev.position.y],
-            label: match ev.other {
-                Some(k) => {
-                    format!("{} with {}", ev.kind.as_str(), scene.actors.get(k).map_or("?", |a| a.label.as_str()))
-                }
-                None => ev.kind.as_str().replace('_', " "),
-            },
-        })
-        .collect();
-    let picture = tad_render::Scene {
-        road: &scene.world.road,
-        title: format!("{} · seed {} · ego {ego}", scene.name, e.seed.unwrap_or(0)),
-        actors,
-        frames,
-        dt: scene.limits.dt,
-        route,
-        events,
-    };
-    let bytes = if path.extension().is_some_and(|x| x.eq_ignore_ascii_case("gif")) {
-        tad_render::gif(&picture, tad_render::GifOptions::default())
-    } else {
-        tad_render::svg(&picture).into_bytes()
-    };
-    std::fs::write(path, bytes)
-}
-
-/// One row per scenario and ego (aggregated over the seeds), then one per ego over all
-/// scenarios: the paper's normalised values (value / max) and OS.
-fn print_table(scenes: &[Loaded], egos: &[String], done: &[Done], mode: Mode) -> Result<(), Closed> {
-    let width = scenes.iter().map(|s| s.scene.name.len()).max().unwrap_or(8).clamp(8, 40);
-    let header: Vec<&str> = tad_metrics::METRICS.iter().map(|m| m.key).collect();
-    out!("{:<width$}  {:<10} {:>4}", "scenario", "ego", "runs")?;
-    for key in &header {
-        out!(" {key:>6}")?;
-    }
-    outln!(" {:>6}  stops", "OS")?;
-    let row = |label: &str, ego: &str, rows: &[&Done]| -> Result<(), Closed> {
-        let scores: Vec<tad_metrics::EpisodeScore> = rows.iter().map(|d| d.score.clone()).collect();
-        let Ok(agg) = tad_metrics::aggregate(&scores, mode) else { return Ok(()) };
-        out!("{label:<width$}  {ego:<10} {:>4}", rows.len())?;
-        for m in tad_metrics::METRICS.iter() {
-            match agg.normalised.get(m.metric) {
-                Some(v) => out!(" {v:>6.3}")?,
-                None => out!(" {:>6}", "-")?,
-            }
-        }
-        let mut stops: Vec<(&str, usize)> = Vec::new();
-        for d in rows {
-            let name = d.episode.stop_reason.as_str();
-            match stops.iter_mut().find(|(n, _)| *n == name) {
-                Some((_, k)) => *k += 1,
-                None => stops.push((name, 1)),
-            }
-        }
-        let stops: Vec<String> = stops.iter().map(|(n, k)| format!("{n} {k}")).collect();
-        outln!(" {:>6.3}  {}", agg.normalised.os, stops.join(", "))
-    };
-    for (f, loaded) in scenes.iter().enumerate() {
-        for (e, ego) in egos.iter().enumerate() {
-            let rows: Vec<&Done> = done.iter().filter(|d| d.file == f && d.ego == e).collect();
-            let name: String = loaded.scene.name.chars().take(width).collect();
-            row(&name, ego, &rows)?;
-        }
-    }
-    if scenes.len() > 1 {
-        for (e, ego) in egos.iter().enumerate() {
-            let rows: Vec<&Done> = done.iter().filter(|d| d.ego == e).collect();
-            row("all", ego, &rows)?;
-        }
-    }
-    outln!()?;
-    outln!("values normalised as in TrafficAlign's tables (value / max; OS 1 is perfect); {} scoring", mode.as_str())
 }
 
 #[cfg(test)]

@@ -90,8 +90,7 @@ fn train_in(args: &TrainEgoArgs, color: bool) -> Result<Status, CliError> {
     let config = args.config();
     config.check().map_err(CliError::usage)?;
     // raised by inputs that do not load
-    let mut status = Status::Ok;
-    let scenes = crate::run::load(&args.paths, color, &mut status)?;
+    let (scenes, status) = crate::run::load(&args.paths, color)?;
     let scenes: &[Loaded] = &scenes;
     if scenes.is_empty() {
         return Err(CliError::usage("no scenario to train on"));

@@ -33,7 +33,7 @@ pub mod plan;
 pub mod print;
 pub mod python;
 
-use tad_diagnostics::{Code, Diagnostic, Payload, Span};
+use tad_diagnostics::Diagnostic;
 use tad_ir::Scenario;
 use tad_syntax::model::Module;
 
@@ -115,19 +115,7 @@ pub fn emit(scenario: &Scenario, options: &EmitOptions) -> Emitted {
 /// What building a module without a scenario gives: nothing, and E0700 at its first
 /// declaration.
 pub fn no_scenario(module: &Module) -> Emitted {
-    let span = module.declarations.first().map_or(Span::new(0, 0), |d| d.span);
-    Emitted {
-        text: String::new(),
-        diagnostics: vec![
-            Diagnostic::new(Code::E0700, "there is no scenario to build", span, "this file only declares names")
-                .with_help("build a file with a `scenario`; modules of declarations are used by scenarios")
-                .with_payload(Payload::Syntax {
-                    expected: vec!["scenario".into()],
-                    found: Some("declarations only".into()),
-                }),
-        ],
-        map: String::new(),
-    }
+    Emitted { text: String::new(), diagnostics: vec![tad_check::no_scenario(module)], map: String::new() }
 }
 
 /// The program for `module` resolved as `scenario` (`tad_db::resolve`): [`emit`], or

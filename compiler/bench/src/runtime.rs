@@ -1,10 +1,10 @@
-//! `tadslc bench --runtime`: the runtime's speed on one core, against Scenic's Newtonian
+//! `bench --runtime`: the runtime's speed on one core, against Scenic's Newtonian
 //! simulator as a peer, and the throughput of ChatScene's parameter search.
 //!
 //! - **Episodes.** Traffic scenarios with 1, 14 (Los Angeles density) and 50 actors,
 //!   generated as TAD text ([`traffic`]): a straight road of four lanes each way, the ego
 //!   and NPC vehicles driving their lanes (IDM, MOBIL for background traffic). They are
-//!   compiled as `run` compiles a file, and each episode runs with the `idm` ego for the
+//!   compiled as `tadslc run` compiles a file, and each episode runs with the `idm` ego for the
 //!   program's 300 steps; the time is the best of `runs` (sampling the parameters and the
 //!   episode, not scoring it). A straight road's route is 100 m, so the ego drives at
 //!   10 km/h (83 m in 30 s) to use every step; a row says so when an episode stopped early.
@@ -25,10 +25,10 @@ use std::hint::black_box;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use crate::files::Input;
-use crate::output::Closed;
-use crate::{Status, errln, outln, plural};
+use crate::{BenchError, Outcome, Report, best_of};
+use tad_base::plural;
 use tad_db::Database;
+use tad_db::host::{Input, register};
 use tad_metrics::Mode;
 use tad_runtime::{Options, Scene, sample::sample};
 use tad_scenic::{EmitOptions, Simulator};
@@ -128,66 +128,83 @@ struct Peer {
     objects: usize,
 }
 
-pub fn run(args: &RuntimeArgs) -> Status {
-    crate::output::run(|status| run_in(args, status))
+/// A scenario's program, as `tadslc run` compiles a file: checked (refused when it has
+/// errors), resolved, laid out and lowered. `Err`: why not, as the CLI says it (the
+/// diagnostics rendered without colour, then `NAME: not VERB`).
+fn compile(db: &mut Database, input: &Input, verb: &str) -> Result<tad_bytecode::Program, String> {
+    tad_eval::pipeline::compile(db, input).map_err(|refusal| refusal.render(input, verb, false).trim_end().to_string())
 }
 
-fn run_in(args: &RuntimeArgs, status: &mut Status) -> Result<(), Closed> {
-    let mut policy = match tad_policy::parse_policy(EGO) {
-        Ok(p) => p,
-        Err(e) => {
-            *status = Status::Usage;
-            return errln!("error: the {EGO} ego: {e}");
-        }
-    };
+/// `bench --runtime`: the episodes, Scenic's runs, the search. Errors of a scenario (it is
+/// left out) and what takes long go to `progress` as they come.
+pub fn run(args: &RuntimeArgs, progress: &mut dyn FnMut(&str)) -> Result<Report, BenchError> {
+    let mut policy = tad_policy::parse_policy(EGO).map_err(|e| format!("the {EGO} ego: {e}"))?;
+    let mut report = Report::default();
+    let measured = episodes(args, policy.as_mut(), &mut report, progress);
+    let peers =
+        if args.no_scenic { Err("--no-scenic".to_string()) } else { simulate_in_scenic(args, &measured, progress) };
+    report.lines.extend(table(args, &measured, &peers));
+    search(args, policy.as_mut(), &mut report, progress);
+    Ok(report)
+}
+
+/// Each generated scenario of [`ACTORS`] compiled and its episode timed; one that does not
+/// compile or run is said and left out.
+fn episodes(
+    args: &RuntimeArgs,
+    policy: &mut dyn tad_policy::EgoPolicy,
+    report: &mut Report,
+    progress: &mut dyn FnMut(&str),
+) -> Vec<Measured> {
     let mut db = Database::new(tad_check::Options::default());
     let mut measured = Vec::new();
     for actors in ACTORS {
         let name = format!("traffic_{actors}");
         let input = Input { name: format!("{name}.tad"), path: None, text: traffic(actors), invalid_utf8: None };
-        let Some(program) = crate::bytecode::compile(&mut db, &input, "measured", false)? else {
-            *status = Status::Failed;
-            continue;
+        let program = match compile(&mut db, &input, "measured") {
+            Ok(program) => program,
+            Err(why) => {
+                report.outcome = report.outcome.max(Outcome::InputErrors);
+                progress(&why);
+                continue;
+            }
         };
         let spawns = program.code.iter().filter(|i| matches!(i, tad_bytecode::Instr::Spawn { .. })).count();
         if spawns + 1 != actors {
-            *status = Status::Failed;
-            errln!(
+            report.outcome = report.outcome.max(Outcome::InputErrors);
+            progress(&format!(
                 "error: {name}: the program has {} (the ego and its spawns), not {actors}",
                 plural(spawns + 1, "actor")
-            )?;
+            ));
             continue;
         }
         let mut scene = match Scene::new(&program) {
             Ok(scene) => scene,
             Err(e) => {
-                *status = Status::Failed;
-                errln!("error: {name}: not run: {e}")?;
+                report.outcome = report.outcome.max(Outcome::InputErrors);
+                progress(&format!("error: {name}: not run: {e}"));
                 continue;
             }
         };
         scene.limits.max_steps = args.steps;
         let mut last = None;
-        let time = super::best_of(args.runs, || {
+        let time = best_of(args.runs, || {
             let params = sample(&scene.program.params, Some(0));
-            let episode = tad_runtime::run(&scene, Some(0), params, policy.as_mut(), &Options::default());
+            let episode = tad_runtime::run(&scene, Some(0), params, &mut *policy, &Options::default());
             last = Some((episode.steps, episode.stop_reason));
             black_box(episode);
         });
         let (steps, stop) = last.unwrap_or((0, tad_runtime::StopReason::MaxSteps));
         measured.push(Measured { name, actors, text: input.text, steps, stop, time });
     }
-
-    let peers = if args.no_scenic { Err("--no-scenic".to_string()) } else { simulate_in_scenic(args, &measured) };
-    print_table(args, &measured, &peers)?;
-    search(args, policy.as_mut(), status)
+    measured
 }
 
 /// The Newtonian Scenic program of a generated scenario, loading its map from `maps`;
 /// `None` when the backend refuses it.
 fn scenic_program(db: &mut Database, m: &Measured, maps: &Path) -> Option<String> {
     let input = Input { name: format!("{}.tad", m.name), path: None, text: m.text.clone(), invalid_utf8: None };
-    let file = crate::check::register(db, &input);
+    let file = register(db, &input);
     let module = &tad_db::analyze(db, file).module;
     let scenario = tad_db::resolve(db, file);
     let options = EmitOptions {
@@ -202,7 +219,11 @@ fn scenic_program(db: &mut Database, m: &Measured, maps: &Path) -> Option<String
 
 /// Each scenario's run in Scenic's Newtonian simulator, in `measured`'s order; `Err` (why)
 /// when Scenic is not available.
-fn simulate_in_scenic(args: &RuntimeArgs, measured: &[Measured]) -> Result<Vec<Result<Peer, String>>, String> {
+fn simulate_in_scenic(
+    args: &RuntimeArgs,
+    measured: &[Measured],
+    progress: &mut dyn FnMut(&str),
+) -> Result<Vec<Result<Peer, String>>, String> {
     use tad_scenic_run::{self as scenic, trace};
     let python = match &args.scenic_python {
         Some(p) if scenic::imports_scenic(p) => p.clone(),
@@ -225,10 +246,10 @@ fn simulate_in_scenic(args: &RuntimeArgs, measured: &[Measured]) -> Result<Vec<R
         std::fs::write(&file, text).map_err(|e| format!("cannot write `{}`: {e}", file.display()))?;
         files.push(file);
     }
-    let _ = crate::errln!(
+    progress(&format!(
         "bench: simulating {} in Scenic's Newtonian simulator (a minute or two)",
         plural(files.len(), "scenario")
-    );
+    ));
     let options = trace::TraceOptions { seeds: vec![0], steps: args.steps, jobs: 1, args: Vec::new() };
     let traces = trace::try_run(&python, &script, &files, &options);
     let _ = std::fs::remove_dir_all(&dir);
@@ -248,27 +269,17 @@ fn simulate_in_scenic(args: &RuntimeArgs, measured: &[Measured]) -> Result<Vec<R
         .collect())
 }
 
-fn print_table(
-    args: &RuntimeArgs,
-    measured: &[Measured],
-    peers: &Result<Vec<Result<Peer, String>>, String>,
-) -> Result<(), Closed> {
-    outln!(
+/// The episodes' table, a row per scenario, then its notes.
+fn table(args: &RuntimeArgs, measured: &[Measured], peers: &Result<Vec<Result<Peer, String>>, String>) -> Vec<String> {
+    let mut lines = vec![format!(
         "runtime: straight road, {LANES} lanes each way, NPC vehicles at {NPC_SPEED} km/h (IDM), {EGO} ego at {EGO_SPEED} km/h; \
          best of {}, one core",
         plural(args.runs.max(1), "run")
-    )?;
-    outln!(
+    )];
+    lines.push(format!(
         "{:<12} {:>6} {:>6} {:>11} {:>9} {:>14} {:>9} {:>15}",
-        "scenario",
-        "actors",
-        "steps",
-        "ms/episode",
-        "µs/step",
-        "actor-steps/s",
-        "Scenic s",
-        "Scenic/runtime"
-    )?;
+        "scenario", "actors", "steps", "ms/episode", "µs/step", "actor-steps/s", "Scenic s", "Scenic/runtime"
+    ));
     let mut notes = Vec::new();
     for (k, m) in measured.iter().enumerate() {
         let secs = m.time.as_secs_f64().max(1e-9);
@@ -278,7 +289,7 @@ fn print_table(
             Some(Ok(p)) => (format!("{:.3}", p.sim_s), format!("{:.0}x", p.sim_s / secs)),
             _ => ("-".to_string(), "-".to_string()),
         };
-        outln!(
+        lines.push(format!(
             "{:<12} {:>6} {:>6} {:>11.3} {:>9.2} {:>14.0} {scenic:>9} {ratio:>15}",
             m.name,
             m.actors,
@@ -286,7 +297,7 @@ fn print_table(
             secs * 1e3,
             secs * 1e6 / steps,
             m.actors as f64 * steps / secs
-        )?;
+        ));
         if m.steps < args.steps {
             notes.push(format!(
                 "{}: the episode stopped at step {} ({}); its figures are for the steps it ran",
@@ -313,28 +324,31 @@ fn print_table(
         )),
         Err(why) => notes.push(format!("Scenic peer skipped: {why}")),
     }
-    for note in notes {
-        outln!("{note}")?;
-    }
-    Ok(())
+    lines.extend(notes);
+    lines
 }
 
-/// ChatScene's search: the safety examples round robin, seeds 0.. each.
-fn search(args: &RuntimeArgs, policy: &mut dyn tad_policy::EgoPolicy, status: &mut Status) -> Result<(), Closed> {
+/// ChatScene's search: the safety examples round robin, seeds 0.. each; its line.
+fn search(
+    args: &RuntimeArgs,
+    policy: &mut dyn tad_policy::EgoPolicy,
+    report: &mut Report,
+    progress: &mut dyn FnMut(&str),
+) {
     let mut db = Database::new(tad_check::Options::default());
     let mut scenes = Vec::new();
     let safety =
         tad_eval::examples::EXAMPLES.iter().filter(|(p, _)| p.starts_with("examples/safety/") && p.ends_with(".tad"));
     for (path, text) in safety {
-        let input = crate::files::Input {
-            name: path.to_string(),
-            path: Some(path.into()),
-            text: text.to_string(),
-            invalid_utf8: None,
-        };
-        let Some(program) = crate::bytecode::compile(&mut db, &input, "searched", false)? else {
-            *status = Status::Failed;
-            continue;
+        let input =
+            Input { name: path.to_string(), path: Some(path.into()), text: text.to_string(), invalid_utf8: None };
+        let program = match compile(&mut db, &input, "searched") {
+            Ok(program) => program,
+            Err(why) => {
+                report.outcome = report.outcome.max(Outcome::InputErrors);
+                progress(&why);
+                continue;
+            }
         };
         match Scene::new(&program) {
             Ok(mut scene) => {
@@ -342,14 +356,15 @@ fn search(args: &RuntimeArgs, policy: &mut dyn tad_policy::EgoPolicy, status: &m
                 scenes.push(scene);
             }
             Err(e) => {
-                *status = Status::Failed;
-                errln!("error: {}: not run: {e}", input.name)?;
+                report.outcome = report.outcome.max(Outcome::InputErrors);
+                progress(&format!("error: {}: not run: {e}", input.name));
             }
         }
     }
     if scenes.is_empty() {
-        *status = (*status).max(Status::Usage);
-        return errln!("error: no safety example to search (examples/safety/ is embedded)");
+        report.outcome = report.outcome.max(Outcome::Unusable);
+        progress("error: no safety example to search (examples/safety/ is embedded)");
+        return;
     }
     let mut steps = 0u64;
     let mut stops: Vec<(&'static str, usize)> = Vec::new();
@@ -370,7 +385,7 @@ fn search(args: &RuntimeArgs, policy: &mut dyn tad_policy::EgoPolicy, status: &m
     let secs = start.elapsed().as_secs_f64().max(1e-9);
     let seeds = args.episodes.div_ceil(scenes.len());
     let stops: Vec<String> = stops.iter().map(|(r, n)| format!("{r} {n}")).collect();
-    outln!(
+    report.lines.push(format!(
         "search: {} of the {} (examples/safety, round robin, seeds 0..{seeds} each, parameters per seed, {EGO} ego, \
          scored), one core: {secs:.2} s, {:.0} episodes/s; {steps} steps, {:.0} steps/s; stops: {}",
         plural(args.episodes, "episode"),
@@ -378,7 +393,7 @@ fn search(args: &RuntimeArgs, policy: &mut dyn tad_policy::EgoPolicy, status: &m
         args.episodes as f64 / secs,
         steps as f64 / secs,
         stops.join(", ")
-    )
+    ));
 }
 
 #[cfg(test)]
@@ -388,9 +403,9 @@ mod tests {
     fn program(actors: usize) -> tad_bytecode::Program {
         let mut db = Database::new(tad_check::Options::default());
         let input = Input { name: "t.tad".into(), path: None, text: traffic(actors), invalid_utf8: None };
-        let diagnostics = crate::check::diagnose_in(&mut db, &input).diagnostics;
+        let diagnostics = tad_db::host::diagnose_in(&mut db, &input).diagnostics;
         assert!(diagnostics.is_empty(), "{actors} actors: {diagnostics:?}");
-        crate::bytecode::compile(&mut db, &input, "tested", false).unwrap().expect("the scenario compiles")
+        compile(&mut db, &input, "tested").expect("the scenario compiles")
     }
 
     #[test]

@@ -1,4 +1,4 @@
-//! `tadslc bench --llm`: the local model (`tad-local`, candle) against llama.cpp's
+//! `bench --llm`: the local model (`tad-local`, candle) against llama.cpp's
 //! `llama-server` on the same GGUF file, the same prompt tokens and the same thread count,
 //! one after the other in one run.
 //!
@@ -20,11 +20,12 @@ use serde_json::{Value, json};
 use tad_llm::{Constraint, Request};
 use tad_local::Engine;
 
-use super::proc_status_kib;
-use crate::output::Closed;
-use crate::{Status, errln, outln};
+use crate::{BenchError, Report, proc_status_kib};
 
+/// What `bench --llm` measures.
 pub struct LlmArgs {
+    /// llama.cpp's server for the peer (else `TADSL_LLAMA_SERVER`; without one the peer is
+    /// skipped).
     pub llama_server: Option<PathBuf>,
     pub threads: usize,
     pub prompts: usize,
@@ -58,18 +59,8 @@ impl Side {
     }
 }
 
-pub fn run(args: &LlmArgs) -> Status {
-    crate::output::run(|status| match run_in(args) {
-        Ok(()) => Ok(()),
-        Err(error) => {
-            *status = Status::Usage;
-            errln!("error: bench --llm: {error}")
-        }
-    })
-}
-
 fn requests(args: &LlmArgs) -> Result<(Vec<Request>, String, String), String> {
-    let mut files = crate::files::with_extension(&args.descriptions, "txt");
+    let mut files = tad_db::host::with_extension(&args.descriptions, "txt");
     files.sort();
     if files.is_empty() {
         return Err(format!(
@@ -93,44 +84,49 @@ fn requests(args: &LlmArgs) -> Result<(Vec<Request>, String, String), String> {
     Ok((out, lark, gbnf))
 }
 
-fn run_in(args: &LlmArgs) -> Result<(), String> {
+/// `bench --llm`: the local model, then llama-server, on the default model's GGUF; what
+/// each side is about to do goes to `progress` as it starts.
+pub fn run(args: &LlmArgs, progress: &mut dyn FnMut(&str)) -> Result<Report, BenchError> {
     let model = tad_local::model(tad_local::DEFAULT).ok_or("no default model")?;
     let gguf = model.require()?;
     let (requests, lark, gbnf) = requests(args)?;
-    errln!(
+    progress(&format!(
         "bench --llm: {} prompts, answers of at most {} tokens, {} thread{}, {}",
         requests.len(),
         args.max_tokens,
         args.threads,
         if args.threads == 1 { "" } else { "s" },
         gguf.display()
-    )
-    .map_err(|_| "stderr closed")?;
+    ));
 
-    let (local, prompts, local_texts) = measure_local(&gguf, args.threads, &requests, &lark)?;
+    let (local, prompts, local_texts) = measure_local(&gguf, args.threads, &requests, &lark, progress)?;
     let peer = match args.llama_server.clone().or_else(|| std::env::var_os("TADSL_LLAMA_SERVER").map(PathBuf::from)) {
         Some(server) => Some(measure_server(&server, &gguf, args.threads, &prompts, args.max_tokens, &gbnf)?),
         None => {
-            errln!("no llama-server (--llama-server PATH or TADSL_LLAMA_SERVER): the peer is skipped")
-                .map_err(|_| "stderr closed")?;
+            progress("no llama-server (--llama-server PATH or TADSL_LLAMA_SERVER): the peer is skipped");
             None
         }
     };
-    print(&local, peer.as_ref().map(|(s, _)| s), &prompts).map_err(|_| "stdout closed")?;
+    let mut lines = table(&local, peer.as_ref().map(|(s, _)| s), &prompts);
     if let Some((_, texts)) = &peer {
         let same = local_texts.iter().zip(texts).filter(|(a, b)| a.trim() == b.trim()).count();
-        outln!("greedy answers identical to llama-server's: {same}/{}", texts.len()).map_err(|_| "stdout closed")?;
+        lines.push(format!("greedy answers identical to llama-server's: {same}/{}", texts.len()));
     }
-    Ok(())
+    Ok(Report { lines, ..Report::default() })
 }
 
 type Local = (Side, Vec<Vec<u32>>, Vec<String>);
 
-fn measure_local(gguf: &Path, threads: usize, requests: &[Request], lark: &str) -> Result<Local, String> {
+fn measure_local(
+    gguf: &Path,
+    threads: usize,
+    requests: &[Request],
+    lark: &str,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Local, String> {
     let mut engine = Engine::load(gguf, threads).map_err(|e| e.to_string())?;
     let (bytes, kernels) = engine.describe();
-    errln!("tad-local: {:.0} MiB of weights, {kernels} kernels", bytes as f64 / 1048576.0)
-        .map_err(|_| "stderr closed")?;
+    progress(&format!("tad-local: {:.0} MiB of weights, {kernels} kernels", bytes as f64 / 1048576.0));
     // warm-up, not counted
     let mut warm = requests[0].clone();
     warm.max_tokens = 4;
@@ -284,31 +280,32 @@ fn dechunk(mut rest: &str) -> String {
     out
 }
 
-fn print(local: &Side, peer: Option<&Side>, prompts: &[Vec<u32>]) -> Result<(), Closed> {
+/// The report's lines: the prompts, then a row per measurement.
+fn table(local: &Side, peer: Option<&Side>, prompts: &[Vec<u32>]) -> Vec<String> {
     let mean = prompts.iter().map(Vec::len).sum::<usize>() as f64 / prompts.len().max(1) as f64;
-    outln!("prompts: {}, {mean:.0} tokens on average, read whole on both sides", prompts.len())?;
-    outln!("{:<34} {:>12} {:>14} {:>9}", "", "tad-local", "llama-server", "ratio")?;
-    let row = |what: &str, a: f64, b: Option<f64>, digits: usize| -> Result<(), Closed> {
-        match b {
-            Some(b) => outln!("{what:<34} {a:>12.digits$} {b:>14.digits$} {:>8.2}x", a / b.max(1e-12)),
-            None => outln!("{what:<34} {a:>12.digits$} {:>14} {:>9}", "-", "-"),
-        }
+    let mut lines = vec![
+        format!("prompts: {}, {mean:.0} tokens on average, read whole on both sides", prompts.len()),
+        format!("{:<34} {:>12} {:>14} {:>9}", "", "tad-local", "llama-server", "ratio"),
+    ];
+    let row = |what: &str, a: f64, b: Option<f64>, digits: usize| match b {
+        Some(b) => format!("{what:<34} {a:>12.digits$} {b:>14.digits$} {:>8.2}x", a / b.max(1e-12)),
+        None => format!("{what:<34} {a:>12.digits$} {:>14} {:>9}", "-", "-"),
     };
-    row("prefill tokens/s", local.prefill(), peer.map(Side::prefill), 1)?;
-    row("decode tokens/s", local.decode(), peer.map(Side::decode), 1)?;
-    row("decode tokens/s, constrained", local.constrained(), peer.map(Side::constrained), 1)?;
+    lines.push(row("prefill tokens/s", local.prefill(), peer.map(Side::prefill), 1));
+    lines.push(row("decode tokens/s", local.decode(), peer.map(Side::decode), 1));
+    lines.push(row("decode tokens/s, constrained", local.constrained(), peer.map(Side::constrained), 1));
     let slowdown = |s: &Side| s.decode() / s.constrained().max(1e-12);
-    row("constrained/unconstrained time", slowdown(local), peer.map(slowdown), 2)?;
-    outln!(
+    lines.push(row("constrained/unconstrained time", slowdown(local), peer.map(slowdown), 2));
+    lines.push(format!(
         "{:<34} {:>12.2} {:>14} {:>9}",
         "mask ms/token (llguidance)",
         1e3 * local.mask_s / local.constrained_tokens.max(1.0),
         "-",
         "-"
-    )?;
+    ));
     let mib = |s: &Side| s.peak_kib.map_or(f64::NAN, |k| k as f64 / 1024.0);
-    row("peak memory MiB", mib(local), peer.map(mib), 0)?;
-    outln!(
+    lines.push(row("peak memory MiB", mib(local), peer.map(mib), 0));
+    lines.push(format!(
         "tokens: prefill {:.0}, decode {:.0}, constrained {:.0} (tad-local){}",
         local.prefill_tokens,
         local.decode_tokens,
@@ -318,5 +315,6 @@ fn print(local: &Side, peer: Option<&Side>, prompts: &[Vec<u32>]) -> Result<(), 
             p.prefill_tokens, p.decode_tokens, p.constrained_tokens
         ))
         .unwrap_or_default()
-    )
+    ));
+    lines
 }

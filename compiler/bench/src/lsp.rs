@@ -1,6 +1,6 @@
-//! `tadslc bench --lsp`: the language server as an editor feels it, over its real stdio
-//! transport (this binary's `lsp`, a child process), against peers measured in the same
-//! run.
+//! `bench --lsp`: the language server as an editor feels it, over its real stdio
+//! transport (`tadslc lsp`, a child process: the host names its `tadslc`), against peers
+//! measured in the same run.
 //!
 //! - didChange → publishDiagnostics: a one-line edit of a 2,000-line file, waited for
 //!   each time, p50/p99 over `samples` edits; the peers are checking that text from
@@ -11,20 +11,22 @@
 //!   example and waiting for its diagnostics.
 
 use std::io::{BufRead, BufReader, Read, Write};
+use std::path::Path;
 use std::process::{Child, ChildStdin, Command, Stdio};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 use serde_json::{Value, json};
 
-use crate::output::Closed;
-use crate::{Status, errln, outln};
+use crate::{BenchError, Report, best_of, long_scenario, proc_status_kib};
 
-struct Server {
+struct Server<'p> {
     child: Child,
     input: ChildStdin,
     messages: mpsc::Receiver<Value>,
     next_id: i64,
+    /// Where the messages go with `TADSL_BENCH_DEBUG` set.
+    progress: &'p mut dyn FnMut(&str),
 }
 
 fn frame(message: &Value) -> Vec<u8> {
@@ -34,9 +36,8 @@ fn frame(message: &Value) -> Vec<u8> {
     out
 }
 
-impl Server {
-    fn start() -> std::io::Result<Server> {
-        let exe = std::env::current_exe()?;
+impl<'p> Server<'p> {
+    fn start(exe: &Path, progress: &'p mut dyn FnMut(&str)) -> std::io::Result<Server<'p>> {
         let mut child =
             Command::new(exe).arg("lsp").stdin(Stdio::piped()).stdout(Stdio::piped()).stderr(Stdio::null()).spawn()?;
         let input = child.stdin.take().ok_or_else(|| std::io::Error::other("no stdin"))?;
@@ -70,7 +71,7 @@ impl Server {
                 }
             }
         });
-        Ok(Server { child, input, messages, next_id: 1 })
+        Ok(Server { child, input, messages, next_id: 1, progress })
     }
 
     fn send(&mut self, message: &Value) -> std::io::Result<()> {
@@ -96,7 +97,7 @@ impl Server {
                 continue;
             }
             if std::env::var_os("TADSL_BENCH_DEBUG").is_some() {
-                let _ = crate::errln!("{}", message.to_string().chars().take(200).collect::<String>());
+                (self.progress)(&message.to_string().chars().take(200).collect::<String>());
             }
             if pred(&message) {
                 return Ok(message);
@@ -121,7 +122,7 @@ impl Server {
 
     /// Resident memory in bytes (Linux), if known.
     fn rss(&self) -> Option<u64> {
-        super::proc_status_kib(&self.child.id().to_string(), "VmRSS").map(|kib| kib * 1024)
+        proc_status_kib(&self.child.id().to_string(), "VmRSS").map(|kib| kib * 1024)
     }
 
     fn stop(mut self) {
@@ -138,18 +139,15 @@ fn percentiles(mut times: Vec<Duration>) -> (f64, f64) {
     (at(50).as_secs_f64() * 1e3, at(99).as_secs_f64() * 1e3)
 }
 
-pub fn run(samples: usize, runs: usize) -> Status {
-    crate::output::run(|status| match measure(samples.max(10), runs.max(1)) {
-        Ok(result) => result,
-        Err(error) => {
-            *status = Status::Usage;
-            errln!("error: bench --lsp: {error}")
-        }
-    })
+/// `bench --lsp` of `exe` (a `tadslc`: its `lsp` is measured, its `check FILE` is a peer):
+/// `samples` of each measurement (at least 10), the peers the best of `runs`. The server's
+/// messages go to `progress` when `TADSL_BENCH_DEBUG` is set.
+pub fn run(exe: &Path, samples: usize, runs: usize, progress: &mut dyn FnMut(&str)) -> Result<Report, BenchError> {
+    measure(exe, samples.max(10), runs.max(1), progress).map_err(BenchError::from)
 }
 
-fn measure(samples: usize, runs: usize) -> std::io::Result<Result<(), Closed>> {
-    let text = super::long_scenario(2000);
+fn measure(exe: &Path, samples: usize, runs: usize, progress: &mut dyn FnMut(&str)) -> std::io::Result<Report> {
+    let text = long_scenario(2000);
     let lines = text.lines().count();
     let dir = std::env::temp_dir().join(format!("tadsl-bench-lsp-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;
@@ -157,7 +155,7 @@ fn measure(samples: usize, runs: usize) -> std::io::Result<Result<(), Closed>> {
     std::fs::write(&path, &text)?;
     let uri = format!("file://{}", path.display());
 
-    let mut server = Server::start()?;
+    let mut server = Server::start(exe, progress)?;
     server.request("initialize", json!({"capabilities": {}, "processId": std::process::id()}))?;
     server.notify("initialized", json!({}))?;
     std::thread::sleep(Duration::from_millis(200));
@@ -217,14 +215,13 @@ fn measure(samples: usize, runs: usize) -> std::io::Result<Result<(), Closed>> {
     server.stop();
 
     // peers: a check from scratch in process, and the CLI as a process
-    let scratch = super::best_of(runs, || {
+    let scratch = best_of(runs, || {
         let mut db = tad_db::Database::new(tad_check::Options::default());
         let file = db.set_source(path.clone(), text.clone(), tad_db::Language::Tad, &tad_db::NoFs);
         std::hint::black_box(tad_db::check(&db, file));
     });
-    let exe = std::env::current_exe()?;
-    let cli = super::best_of(runs, || {
-        let _ = Command::new(&exe).arg("check").arg(&path).stdout(Stdio::null()).stderr(Stdio::null()).status();
+    let cli = best_of(runs, || {
+        let _ = Command::new(exe).arg("check").arg(&path).stdout(Stdio::null()).stderr(Stdio::null()).status();
     });
     std::fs::remove_dir_all(&dir).ok();
 
@@ -233,28 +230,28 @@ fn measure(samples: usize, runs: usize) -> std::io::Result<Result<(), Closed>> {
     let (hover50, hover99) = percentiles(hover);
     let ms = |d: Duration| d.as_secs_f64() * 1e3;
     let mib = |b: Option<u64>| b.map_or("?".to_string(), |b| format!("{:.1} MiB", b as f64 / (1 << 20) as f64));
-    let out = (|| {
-        outln!("language server over stdio, {lines}-line file, {samples} samples each")?;
-        outln!("  open → diagnostics            {:>8.2} ms", ms(open))?;
-        outln!("  didChange → diagnostics       p50 {change50:>6.2} ms  p99 {change99:>6.2} ms   (goal: p99 < 10 ms)")?;
-        outln!(
+    let out = vec![
+        format!("language server over stdio, {lines}-line file, {samples} samples each"),
+        format!("  open → diagnostics            {:>8.2} ms", ms(open)),
+        format!("  didChange → diagnostics       p50 {change50:>6.2} ms  p99 {change99:>6.2} ms   (goal: p99 < 10 ms)"),
+        format!(
             "  completion ({offered:>3} items)       p50 {completion50:>6.2} ms  p99 {completion99:>6.2} ms   (goal: p99 < 5 ms)"
-        )?;
-        outln!("  hover                         p50 {hover50:>6.2} ms  p99 {hover99:>6.2} ms")?;
-        outln!(
+        ),
+        format!("  hover                         p50 {hover50:>6.2} ms  p99 {hover99:>6.2} ms"),
+        format!(
             "peers: check from scratch in process {:.2} ms (the p50 change is {:.2}x of it); `tadslc check FILE` as a process {:.2} ms ({:.2}x)",
             ms(scratch),
             change50 / ms(scratch).max(1e-9),
             ms(cli),
             change50 / ms(cli).max(1e-9)
-        )?;
-        outln!(
+        ),
+        format!(
             "memory: {} after initialize, {} with the 2,000-line file and all {} examples ({} KiB of source) open",
             mib(idle),
             mib(loaded),
             examples.len(),
             bytes / 1024
-        )
-    })();
-    Ok(out)
+        ),
+    ];
+    Ok(Report { lines: out, ..Report::default() })
 }
