@@ -1,33 +1,16 @@
-//! The `tadslc` library: the command line's subcommands, shared with its tests.
+//! The `tadslc` library: the command line's subcommands ([`cmd`]), what several of them
+//! share (reading corpora, files and scenes, the language-model flags), and the output
+//! module, the only one that prints; shared with its tests.
 //!
 //! Exit statuses are [`Status`]; [`EXIT_STATUSES`] says them in one sentence, the same in
 //! `--help`, README.md and spec/output.md (a test holds them together).
 
-pub mod align;
-pub mod bench;
-pub mod build;
-pub mod bytecode;
-pub mod check;
-pub mod eval;
-pub mod explain;
+pub mod cmd;
+pub mod corpus;
 pub mod files;
-pub mod finetune;
-pub mod fmt;
-pub mod interchange;
 pub mod llm;
-pub mod manual;
 pub mod output;
-pub mod run;
-pub mod search;
-pub mod train_ego;
-
-/// Output format of `check`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum Format {
-    Human,
-    Json,
-    Sarif,
-}
+pub mod scenes;
 
 /// The exit statuses in one sentence (a macro, so `--help` can `concat!` it).
 #[macro_export]

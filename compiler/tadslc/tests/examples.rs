@@ -15,8 +15,8 @@ fn every_example_checks_and_is_formatted() {
     let mut db = tad_db::Database::new(tad_check::Options::default());
     for path in &files {
         let relative = path.strip_prefix(&root).unwrap().to_str().unwrap().to_string();
-        let input = tadslc::files::read(path).unwrap();
-        let checked = tadslc::check::diagnose_in(&mut db, &input);
+        let input = tad_db::host::read(path).unwrap();
+        let checked = tad_db::host::diagnose_in(&mut db, &input);
         let unexpected: Vec<_> =
             checked.diagnostics.iter().filter(|d| d.code != tad_diagnostics::Code::W0600).collect();
         assert!(unexpected.is_empty(), "{relative}: {unexpected:#?}");

@@ -31,8 +31,8 @@ fn realistic_answers_get_their_class_without_false_errors() {
         let region = REGIONS.iter().find(|(t, _)| *t == tag).map(|(_, r)| r.to_string());
         assert!(region.is_some(), "{file}: no region for `{tag}`");
         let options = tad_check::Options { region, ..Default::default() };
-        let input = tadslc::files::read(&dir.join(file)).expect("readable");
-        let checked = tadslc::check::diagnose_in(&mut tad_db::Database::new(options), &input);
+        let input = tad_db::host::read(&dir.join(file)).expect("readable");
+        let checked = tad_db::host::diagnose_in(&mut tad_db::Database::new(options), &input);
         let class = checked.class.map_or("none", |c| c.as_str()).to_string();
         total += 1;
         right += usize::from(class == expected);
@@ -62,8 +62,8 @@ fn trafficcomposer_forms_check_without_false_errors() {
     let files = files(&repo().join("tests/yaml/composer"), "yaml");
     assert!(files.len() >= 4);
     for path in files {
-        let input = tadslc::files::read(&path).expect("readable");
-        let checked = tadslc::check::diagnose_in(&mut tad_db::Database::new(Default::default()), &input);
+        let input = tad_db::host::read(&path).expect("readable");
+        let checked = tad_db::host::diagnose_in(&mut tad_db::Database::new(Default::default()), &input);
         let errors: Vec<_> = checked.diagnostics.iter().filter(|d| d.is_error()).collect();
         assert!(errors.is_empty(), "{}: {errors:#?}", path.display());
         assert!(checked.class.is_some(), "{}: a scenario", path.display());

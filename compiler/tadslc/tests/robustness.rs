@@ -30,14 +30,14 @@ fn codes(text: &str) -> Vec<String> {
 fn exercise(db: &mut tad_db::Database, input: &str, what: &str, iteration: usize) {
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         // the whole checker, with the standard library, through the database
-        let file = tadslc::files::Input {
+        let file = tad_db::host::Input {
             name: "mutated.tad".into(),
             path: Some(std::env::temp_dir().join("tadsl-mutated.tad")),
             text: input.to_string(),
             invalid_utf8: None,
         };
         // one database for the whole run: each input replaces the last, as edits would
-        let checked = tadslc::check::diagnose_in(db, &file);
+        let checked = tad_db::host::diagnose_in(db, &file);
         for d in &checked.diagnostics {
             assert!(
                 d.primary.span.start <= d.primary.span.end && d.primary.span.end <= input.len(),

@@ -28,13 +28,13 @@ fn tad_blocks(text: &str) -> Vec<String> {
 
 /// Check `text` as a file of its own, with the standard library.
 fn check(text: &str, options: tad_check::Options) -> Vec<tad_diagnostics::Diagnostic> {
-    let input = tadslc::files::Input {
+    let input = tad_db::host::Input {
         name: "example.tad".into(),
         path: Some(std::env::temp_dir().join("tadsl-spec-example.tad")),
         text: text.to_string(),
         invalid_utf8: None,
     };
-    tadslc::check::diagnose_in(&mut tad_db::Database::new(options), &input).diagnostics
+    tad_db::host::diagnose_in(&mut tad_db::Database::new(options), &input).diagnostics
 }
 
 #[test]

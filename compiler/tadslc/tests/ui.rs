@@ -67,7 +67,7 @@ fn annotation(severity: &str, code: &str, range: &str) -> String {
 }
 
 fn run_fixture(path: &Path) -> Result<(), Failed> {
-    let input = tadslc::files::read(path).map_err(|e| format!("cannot read fixture: {e}"))?;
+    let input = tad_db::host::read(path).map_err(|e| format!("cannot read fixture: {e}"))?;
     let text = input.text.clone();
     let name = format!("tests/ui/{}", path.strip_prefix(root()).unwrap_or(path).display());
     let mut options = tad_check::Options::default();
@@ -75,9 +75,9 @@ fn run_fixture(path: &Path) -> Result<(), Failed> {
         options.profile = tad_check::Profile::Dashcam;
     }
     let mut db = tad_db::Database::new(options);
-    let file = tadslc::check::register(&mut db, &input);
-    let diagnostics = tadslc::check::diagnose_in(&mut db, &input).diagnostics;
-    let related = tadslc::check::related(&db, file, &diagnostics);
+    let file = tad_db::host::register(&mut db, &input);
+    let diagnostics = tad_db::host::diagnose_in(&mut db, &input).diagnostics;
+    let related = tadslc::cmd::check::related(&db, file, &diagnostics);
 
     let index = LineIndex::new(&text);
     let mut actual: Vec<(String, String, String)> = diagnostics
@@ -106,7 +106,7 @@ fn run_fixture(path: &Path) -> Result<(), Failed> {
     }
 
     // paths inside messages are shown relative to the repository
-    let rendered = human::render(&tadslc::check::report(&name, &text, &diagnostics, &related), false)
+    let rendered = human::render(&tadslc::cmd::check::report(&name, &text, &diagnostics, &related), false)
         .replace(&format!("{}/", repo().display()), "");
     compare(&path.with_extension("stderr"), &rendered, &mut problems);
 

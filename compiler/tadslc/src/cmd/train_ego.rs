@@ -12,7 +12,7 @@ use tad_eval::train::{Start, TrainScene};
 use tad_train::{Config, TrainError, Trainer};
 
 use crate::output::{CliError, Closed};
-use crate::run::Loaded;
+use crate::scenes::Loaded;
 use crate::{Status, errln, outln, plural};
 
 /// Train a learned ego with SAC on scenarios
@@ -82,15 +82,11 @@ fn behaviour_key(loaded: &Loaded) -> String {
     loaded.key.clone().unwrap_or_else(|| "none".into())
 }
 
-pub fn train_ego(args: &TrainEgoArgs, color: bool) -> Status {
-    crate::output::finish(train_in(args, color))
-}
-
-fn train_in(args: &TrainEgoArgs, color: bool) -> Result<Status, CliError> {
+pub fn run(args: &TrainEgoArgs, color: bool) -> Result<Status, CliError> {
     let config = args.config();
     config.check().map_err(CliError::usage)?;
     // raised by inputs that do not load
-    let (scenes, status) = crate::run::load(&args.paths, color)?;
+    let (scenes, status) = crate::scenes::load(&args.paths, color)?;
     let scenes: &[Loaded] = &scenes;
     if scenes.is_empty() {
         return Err(CliError::usage("no scenario to train on"));

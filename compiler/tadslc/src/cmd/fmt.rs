@@ -5,6 +5,22 @@ use crate::output::CliError;
 use crate::{Status, err, errln, out, plural};
 use tad_diagnostics::render::{FileReport, human};
 
+/// `tadslc fmt`'s arguments.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Files or directories (searched recursively for *.tad; YAML is skipped); `-`
+    /// formats standard input to standard output
+    #[arg(required = true)]
+    pub paths: Vec<std::path::PathBuf>,
+    /// Change nothing; exit 1 if any file is not formatted
+    #[arg(long)]
+    pub check: bool,
+    /// Also replace aliases, non-canonical units and 0-based lane indexes by their
+    /// canonical forms (the fixes of W0401, W0402 and W0403)
+    #[arg(long)]
+    pub canonicalize: bool,
+}
+
 /// The codes whose fixes `--canonicalize` applies (their machine-applicable ones).
 pub const CANONICAL: &[tad_diagnostics::Code] =
     &[tad_diagnostics::Code::W0401, tad_diagnostics::Code::W0402, tad_diagnostics::Code::W0403];
@@ -15,7 +31,7 @@ pub fn canonicalize(db: &mut tad_db::Database, input: &files::Input) -> String {
     let mut text = input.text.clone();
     for _ in 0..8 {
         let probe = files::Input { text: text.clone(), ..input.clone() };
-        let checked = crate::check::diagnose_in(db, &probe);
+        let checked = tad_db::host::diagnose_in(db, &probe);
         let (fixed, applied) =
             tad_diagnostics::apply_fixes(&text, checked.diagnostics.iter().filter(|d| CANONICAL.contains(&d.code)));
         if applied == 0 {
@@ -28,11 +44,9 @@ pub fn canonicalize(db: &mut tad_db::Database, input: &files::Input) -> String {
 
 /// Format every `.tad` file `paths` name (directories are searched for `*.tad` only:
 /// YAML is not TAD, and is skipped).
-pub fn run(paths: &[std::path::PathBuf], check: bool, canonical: bool, color: bool) -> Status {
-    crate::output::finish(run_in(paths, check, canonical, color))
-}
-
-fn run_in(paths: &[std::path::PathBuf], check: bool, canonical: bool, color: bool) -> Result<Status, CliError> {
+pub fn run(args: &Args, color: bool) -> Result<Status, CliError> {
+    let Args { paths, check, canonicalize: canonical } = args;
+    let (check, canonical) = (*check, *canonical);
     let mut db = tad_db::Database::new(tad_check::Options::default());
     // raised by files that cannot be formatted or written, and by unformatted ones with --check
     let mut status = Status::Ok;

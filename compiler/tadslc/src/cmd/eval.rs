@@ -7,38 +7,20 @@
 //! table (`--finetune`, through `tad-eval`'s one training driver), and the exit status.
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use tad_base::Shard;
 use tad_db::Database;
 use tad_eval::finetune::{self, FinetuneError};
 use tad_eval::generator::{self, Generator};
-use tad_eval::results::{self, MergeError};
 use tad_eval::train::Start;
-use tad_eval::{Item, Journal, Kept, Plan, Results, Setup, TableFormat, Unit};
+use tad_eval::{Item, Journal, Kept, Plan, Results, Setup, Unit};
 use tad_policy::EgoSpec;
 use tad_train::Config;
 
-use crate::output::{CliError, Closed};
-use crate::{Status, errln, out, outln, plural};
-
-/// What `eval` and `merge` print.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum EvalFormat {
-    Markdown,
-    Csv,
-    Json,
-}
-
-impl From<EvalFormat> for TableFormat {
-    fn from(format: EvalFormat) -> TableFormat {
-        match format {
-            EvalFormat::Markdown => TableFormat::Markdown,
-            EvalFormat::Csv => TableFormat::Csv,
-            EvalFormat::Json => TableFormat::Json,
-        }
-    }
-}
+use super::merge::EvalFormat;
+use crate::output::CliError;
+use crate::{Status, errln, outln, plural};
 
 /// `tadslc eval`'s arguments.
 #[derive(clap::Args)]
@@ -73,8 +55,8 @@ pub struct EvalArgs {
     /// Requests in flight to the model's server, for the `llm` generators
     #[arg(long, default_value_t = 1)]
     pub jobs: usize,
-    #[arg(long, value_enum, default_value_t = crate::eval::EvalFormat::Markdown)]
-    pub format: crate::eval::EvalFormat,
+    #[arg(long, value_enum, default_value_t = EvalFormat::Markdown)]
+    pub format: EvalFormat,
     /// Write the scored episodes to DIR/results.json (DIR/results.I-of-N.json with --shard)
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
@@ -100,11 +82,7 @@ pub struct EvalArgs {
     pub llm: crate::llm::LlmArgs,
 }
 
-pub fn eval(args: &EvalArgs, color: bool) -> Status {
-    crate::output::finish(eval_in(args, color))
-}
-
-fn eval_in(args: &EvalArgs, _color: bool) -> Result<Status, CliError> {
+pub fn run(args: &EvalArgs) -> Result<Status, CliError> {
     let mut egos = Vec::new();
     for spec in args.egos.iter().chain(std::iter::once(&args.search_ego)) {
         egos.push(EgoSpec::parse(spec).map_err(|e| CliError::usage(format!("ego `{spec}`: {e}")))?);
@@ -115,9 +93,9 @@ fn eval_in(args: &EvalArgs, _color: bool) -> Result<Status, CliError> {
     }
     // raised by files that cannot be read, and by what fails without ending the run
     let (corpus, mut status) = if args.corpus.is_empty() {
-        (crate::align::counted(tad_eval::examples::corpus("examples", "examples/"))?, Status::Ok)
+        (crate::corpus::counted(tad_eval::examples::corpus("examples", "examples/"))?, Status::Ok)
     } else {
-        crate::align::load(&args.corpus)?
+        crate::corpus::load(&args.corpus)?
     };
     // regions: the ones asked for, else every region with at least 3 scenarios
     let by_region = corpus.by_region();
@@ -212,7 +190,7 @@ fn eval_in(args: &EvalArgs, _color: bool) -> Result<Status, CliError> {
         started.elapsed().as_secs_f64(),
         plural(rayon::current_num_threads(), "thread")
     )?;
-    status = status.max(print(&[results], args.format, args.plot.as_deref())?);
+    status = status.max(super::merge::print(&[results], args.format, args.plot.as_deref())?);
     if args.finetune > 0 {
         status = status.max(finetune(args, &plan, &evaluated.kept)?);
     }
@@ -250,7 +228,7 @@ fn scenarios(
                 plural(n, "scenario"),
                 dir.display()
             )?;
-            let request = crate::llm::GenArgs {
+            let request = super::generate::GenArgs {
                 region,
                 n,
                 out: Some(&dir),
@@ -260,7 +238,8 @@ fn scenarios(
                 embedded: "examples/",
                 jobs: args.jobs,
             };
-            let done = crate::llm::generate(&request, &args.llm);
+            // its errors said, as `gen` says them; the status says whether anything came
+            let done = crate::output::finish(super::generate::generate(&request, &args.llm));
             if done != Status::Ok {
                 let message = format!("{region}: the language model generated nothing usable ({generator})");
                 return Err(CliError::Exit(done, message));
@@ -273,52 +252,8 @@ fn scenarios(
         }
     };
     // a corpus holds only the scenarios that count
-    let (corpus, read) = crate::align::load(std::slice::from_ref(&dir))?;
+    let (corpus, read) = crate::corpus::load(std::slice::from_ref(&dir))?;
     Ok((corpus.items.into_iter().map(|i| (i.name, i.tad)).collect(), read))
-}
-
-/// `tadslc merge FILES`: the table of several results files (the shards of one command).
-pub fn merge(files: &[PathBuf], format: EvalFormat, plot: Option<&Path>) -> Status {
-    crate::output::finish(merge_in(files, format, plot))
-}
-
-fn merge_in(files: &[PathBuf], format: EvalFormat, plot: Option<&Path>) -> Result<Status, CliError> {
-    let all = files
-        .iter()
-        .map(|path| Results::read(path).map_err(|e| CliError::usage(format!("{}: {e}", path.display()))))
-        .collect::<Result<Vec<Results>, CliError>>()?;
-    let shown = |index: usize| files[index].display();
-    let missing = results::check_merge(&all).map_err(|e| match e {
-        MergeError::OtherSetup { index } => CliError::usage(format!(
-            "{} comes from another command than {} (regions, generators, egos, sizes or seed differ)",
-            shown(index),
-            shown(0)
-        )),
-        MergeError::OtherCount { index, shard, count } => {
-            CliError::usage(format!("{} is shard {shard} but {} is of {count}", shown(index), shown(0)))
-        }
-        e @ (MergeError::Empty | MergeError::Twice(_)) => CliError::usage(e),
-    })?;
-    let mut status = Status::Ok;
-    if !missing.is_empty() {
-        status = Status::Failed;
-        let missing: Vec<String> = missing.iter().map(Shard::to_string).collect();
-        errln!("warning: shards {} are missing: the table covers part of the work", missing.join(", "))?;
-    }
-    Ok(status.max(print(&all, format, plot)?))
-}
-
-/// The table of `all` on standard output, and its plot; a plot that cannot be written is
-/// reported (the table still printed) and makes the status 2.
-pub fn print(all: &[Results], format: EvalFormat, plot: Option<&Path>) -> Result<Status, Closed> {
-    out!("{}", results::table(all, format.into()))?;
-    if let Some(path) = plot
-        && let Err(e) = std::fs::write(path, results::plot(all))
-    {
-        errln!("error: cannot write `{}`: {e}", path.display())?;
-        return Ok(Status::Usage);
-    }
-    Ok(Status::Ok)
 }
 
 /// The "after fine-tuning" table of `eval --finetune` (`tad_eval::finetune`).
@@ -364,7 +299,7 @@ pub fn finetune(args: &EvalArgs, plan: &Plan, kept: &[Kept]) -> Result<Status, C
         )?;
         outln!()?;
     }
-    let status = print(&[held_out.results], args.format, None)?;
+    let status = super::merge::print(&[held_out.results], args.format, None)?;
     if let Some((was, now)) = held_out.collision_rates {
         let change = if was > 0.0 { format!("{:+.0} %", 100.0 * (now - was) / was) } else { "–".into() };
         errln!("held-out collision rate of the learned ego: {was:.3} before, {now:.3} after fine-tuning ({change})")?;

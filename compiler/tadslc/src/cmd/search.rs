@@ -49,14 +49,10 @@ pub struct SearchArgs {
     pub compat: bool,
 }
 
-pub fn run(args: &SearchArgs, color: bool) -> Status {
-    crate::output::finish(search_in(args, color))
-}
-
-fn search_in(args: &SearchArgs, color: bool) -> Result<Status, CliError> {
+pub fn run(args: &SearchArgs, color: bool) -> Result<Status, CliError> {
     let ego = EgoSpec::parse(&args.ego).map_err(|e| CliError::usage(format!("--ego {}: {e}", args.ego)))?;
     // raised by inputs that do not load, and scenes that could not be written
-    let (scenes, mut status) = crate::run::load_shard(&args.paths, args.shard, color)?;
+    let (scenes, mut status) = crate::scenes::load_shard(&args.paths, args.shard, color)?;
     if scenes.is_empty() {
         return Err(CliError::usage("nothing to search"));
     }

@@ -4,15 +4,105 @@
 //! (a used module, the prelude) is rendered with that file's text. A local module used by
 //! an input and having errors is reported once, in its own file, after the inputs.
 
+use std::path::PathBuf;
+
 use crate::files::{self, Input, Search};
 use crate::output::CliError;
-use crate::{Format, Status, err, errln, outln, plural};
+use crate::{Status, err, errln, outln, plural};
 use tad_check::{Checked, Class, Options};
 use tad_db::host::checked;
-pub use tad_db::host::{diagnose_in, register};
+use tad_db::host::{diagnose_in, register};
 use tad_db::{Database, SourceFile};
 use tad_diagnostics::render::{FileReport, Source, human, json, sarif};
 use tad_diagnostics::{Diagnostic, Severity};
+
+/// `tadslc check`'s arguments.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Files or directories (searched recursively for *.tad, *.yaml and *.yml);
+    /// `-` reads standard input
+    #[arg(required = true)]
+    pub paths: Vec<PathBuf>,
+    /// Output format
+    #[arg(long, value_enum, default_value_t = Format::Human)]
+    pub format: Format,
+    /// Treat warnings as errors for the exit code
+    #[arg(long)]
+    pub deny_warnings: bool,
+    /// In human output, show at most this many diagnostics per file, then how many more
+    /// there are (0: all); JSON and SARIF always carry all
+    #[arg(long, value_name = "N", default_value_t = 50)]
+    pub max_diagnostics: usize,
+    #[command(flatten)]
+    pub rules: Rules,
+}
+
+/// Output format of `check`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Format {
+    Human,
+    Json,
+    Sarif,
+}
+
+/// Checking rules.
+#[derive(clap::Args)]
+pub struct Rules {
+    /// Camera rules: `dashcam` applies TrafficAlign's extraction rules for dash-cam frames
+    /// (nothing behind the ego); `auto` applies them to YAML answers and to scenarios whose
+    /// `source` names a video, frame or time; `default` never
+    #[arg(long, value_enum, default_value_t = ProfileArg::Auto)]
+    pub profile: ProfileArg,
+    /// The region of scenarios that state none (e.g. `yellowstone`): its vocabulary module
+    /// is in scope
+    #[arg(long, value_name = "REGION")]
+    pub region: Option<String>,
+    /// The essentials whose absence together makes a non-scenario
+    #[arg(long, value_delimiter = ',', default_value = "weather,time,road")]
+    pub non_scenario: Vec<EssentialArg>,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ProfileArg {
+    Auto,
+    Default,
+    Dashcam,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum EssentialArg {
+    Weather,
+    Time,
+    Road,
+    Ego,
+    Actors,
+}
+
+impl Rules {
+    pub fn options(&self) -> tad_check::Options {
+        use tad_check::{Essential, Profile};
+        tad_check::Options {
+            profile: match self.profile {
+                ProfileArg::Auto => Profile::Auto,
+                ProfileArg::Default => Profile::Default,
+                ProfileArg::Dashcam => Profile::Dashcam,
+            },
+            region: self.region.clone(),
+            answer: false,
+            non_scenario: self
+                .non_scenario
+                .iter()
+                .map(|e| match e {
+                    EssentialArg::Weather => Essential::Weather,
+                    EssentialArg::Time => Essential::Time,
+                    EssentialArg::Road => Essential::Road,
+                    EssentialArg::Ego => Essential::Ego,
+                    EssentialArg::Actors => Essential::Actors,
+                })
+                .collect(),
+        }
+    }
+}
 
 /// Every diagnostic of one input, with the default options.
 pub fn diagnose(input: &Input) -> Vec<Diagnostic> {
@@ -59,25 +149,9 @@ struct Checked1 {
 /// Check every file `paths` name, then report. Every file is checked before anything is
 /// reported, so the status is the whole run's even if the reader of the report stops
 /// reading early (`spec/output.md`).
-pub fn run(
-    paths: &[std::path::PathBuf],
-    format: Format,
-    deny_warnings: bool,
-    limit: usize,
-    color: bool,
-    options: Options,
-) -> Status {
-    crate::output::finish(run_in(paths, format, deny_warnings, limit, color, options))
-}
-
-fn run_in(
-    paths: &[std::path::PathBuf],
-    format: Format,
-    deny_warnings: bool,
-    limit: usize,
-    color: bool,
-    options: Options,
-) -> Result<Status, CliError> {
+pub fn run(args: &Args, color: bool) -> Result<Status, CliError> {
+    let Args { paths, format, deny_warnings, max_diagnostics: limit, rules } = args;
+    let (format, deny_warnings, limit, options) = (*format, *deny_warnings, *limit, rules.options());
     // raised by unreadable paths, then by errors (and warnings with --deny-warnings)
     let mut status = Status::Ok;
     let (inputs, read) = files::load(paths, Search::Scenarios)?;

@@ -11,14 +11,11 @@ use std::io::Write;
 use std::ops::Range;
 use std::path::PathBuf;
 
-use crate::files::{self, Search};
-use crate::output::{CliError, Closed};
+use crate::output::CliError;
 use crate::{Status, errln, out, outln};
-use tad_check::Options as CheckOptions;
-use tad_db::Database;
 use tad_eval::record::{self, Played};
 use tad_metrics::Mode;
-use tad_runtime::{Options, Scene};
+use tad_runtime::Options;
 
 /// What `run` prints.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -39,12 +36,12 @@ pub struct RunArgs {
     #[arg(long = "ego", value_delimiter = ',', default_values_t = ["idm".to_string(), "naive".to_string()])]
     pub egos: Vec<String>,
     /// Seeds `A..B` (B excluded, as in Rust), `A..=B` (B included) or one seed `A`
-    #[arg(long, default_value = "0..3", value_parser = crate::run::parse_seeds)]
+    #[arg(long, default_value = "0..3", value_parser = parse_seeds)]
     pub seeds: std::ops::Range<u64>,
     /// Output format: a table for people, or JSON lines (one object per episode, then
     /// one aggregate object per ego)
-    #[arg(long, value_enum, default_value_t = crate::run::RunFormat::Table)]
-    pub format: crate::run::RunFormat,
+    #[arg(long, value_enum, default_value_t = RunFormat::Table)]
+    pub format: RunFormat,
     /// Write every actor's pose at every step as JSON lines
     #[arg(long, value_name = "FILE")]
     pub trace: Option<PathBuf>,
@@ -83,81 +80,13 @@ pub fn parse_seeds(text: &str) -> Result<Range<u64>, String> {
     Ok(range)
 }
 
-/// One scenario ready to run, named for people.
-pub struct Loaded {
-    pub name: String,
-    pub scene: Scene,
-    /// The source it was compiled from (`None` for a `.tadc` file).
-    pub source: Option<files::Input>,
-    /// Its behaviour, the key of the fine-tuning split (`None` for a `.tadc` file).
-    pub key: Option<String>,
-}
-
-/// Every input as a scene (sources compiled, `.tadc` files loaded), and the status
-/// loading them reached: an input that does not load is reported and skipped.
-pub fn load(paths: &[PathBuf], color: bool) -> Result<(Vec<Loaded>, Status), Closed> {
-    let (bytecode, sources): (Vec<PathBuf>, Vec<PathBuf>) =
-        paths.iter().cloned().partition(|p| p.extension().is_some_and(|e| e == "tadc"));
-    let mut loaded = Vec::new();
-    let mut status = Status::Ok;
-    let mut db = Database::new(CheckOptions::default());
-    if !sources.is_empty() {
-        let (inputs, read) = files::load(&sources, Search::Scenarios)?;
-        status = status.max(read);
-        for input in inputs {
-            let Some(program) = crate::bytecode::compile(&mut db, &input, "run", color)? else {
-                status = status.max(Status::Failed);
-                continue;
-            };
-            let file = crate::check::register(&mut db, &input);
-            let key = tad_eval::corpus::behaviour_of(&db, file);
-            match Scene::new(&program) {
-                Ok(scene) => {
-                    loaded.push(Loaded { name: input.name.clone(), scene, source: Some(input.clone()), key: Some(key) })
-                }
-                Err(e) => {
-                    status = status.max(Status::Failed);
-                    errln!("{}: not run: {e}", input.name)?;
-                }
-            }
-        }
-    }
-    for path in bytecode {
-        let name = path.display().to_string();
-        // a file that cannot be read is an I/O failure (2); one that does not load is
-        // input with errors (1), as under `disasm`
-        let program = match std::fs::read(&path) {
-            Ok(bytes) => tad_bytecode::decode(&bytes).map_err(|e| (Status::Failed, e.to_string())),
-            Err(e) => Err((Status::Usage, format!("cannot read it: {e}"))),
-        };
-        match program.and_then(|p| Scene::new(&p).map_err(|e| (Status::Failed, e.to_string()))) {
-            Ok(scene) => loaded.push(Loaded { name, scene, source: None, key: None }),
-            Err((failed, e)) => {
-                status = status.max(failed);
-                errln!("error: {name}: {e}")?;
-            }
-        }
-    }
-    Ok((loaded, status))
-}
-
-/// The inputs of one shard (every N-th loaded scenario from I), and the loading's status.
-pub fn load_shard(paths: &[PathBuf], shard: tad_base::Shard, color: bool) -> Result<(Vec<Loaded>, Status), Closed> {
-    let (loaded, status) = load(paths, color)?;
-    Ok((loaded.into_iter().enumerate().filter(|(k, _)| shard.takes(*k)).map(|(_, l)| l).collect(), status))
-}
-
-pub fn run(args: &RunArgs, color: bool) -> Status {
-    crate::output::finish(run_in(args, color))
-}
-
-fn run_in(args: &RunArgs, color: bool) -> Result<Status, CliError> {
+pub fn run(args: &RunArgs, color: bool) -> Result<Status, CliError> {
     let mut policies = Vec::new();
     for spec in &args.egos {
         policies.push(tad_policy::parse_policy(spec).map_err(|e| CliError::usage(format!("--ego {spec}: {e}")))?);
     }
     // raised by inputs that do not load, and by output that cannot be written
-    let (scenes, mut status) = load_shard(&args.paths, args.shard, color)?;
+    let (scenes, mut status) = crate::scenes::load_shard(&args.paths, args.shard, color)?;
     if scenes.is_empty() {
         return Err(CliError::usage("nothing to run"));
     }

@@ -1,11 +1,14 @@
-//! `tadslc build --target scenic`: a Scenic 3 program per scenario.
+//! `tadslc build`: a Scenic 3 program per scenario (`--target scenic`), or a bytecode
+//! program for the runtime (`--target bytecode`, `spec/bytecode.md`).
 //!
 //! Each file is checked first: a file with errors is refused (its errors are printed and
 //! the status is 1); the others are resolved (`tad_db::resolve`, the typed IR) and emitted
 //! by `tad-scenic`, whose warnings (W07xx) are printed. One file without `-o` goes to standard output; otherwise `NAME.scenic` is
 //! written into the `-o` directory. A map file that is not where a program will load it
 //! from (`--map-dir`, or beside the program) is a warning, once per map
-//! (`spec/output.md`).
+//! (`spec/output.md`). The bytecode target checks each file the same way, lays the
+//! scenario out and lowers it (`tad_eval::pipeline`), and writes `NAME.tadc` into the `-o`
+//! directory, which it requires.
 
 use std::path::{Path, PathBuf};
 
@@ -67,9 +70,12 @@ impl From<SimulatorArg> for Simulator {
     }
 }
 
-/// `tadslc build --target scenic`.
-pub fn run(args: &BuildArgs, color: bool) -> Status {
-    crate::output::finish(run_in(args, color))
+/// `tadslc build`, for either target.
+pub fn run(args: &BuildArgs, color: bool) -> Result<Status, CliError> {
+    match args.target {
+        Target::Scenic => scenic(args, color),
+        Target::Bytecode => bytecode(args, color),
+    }
 }
 
 /// Where a program written to `out` (a directory, or standard output) will look for its
@@ -79,7 +85,8 @@ struct MissingMap {
     programs: Vec<String>,
 }
 
-fn run_in(args: &BuildArgs, color: bool) -> Result<Status, CliError> {
+/// `--target scenic`: a Scenic program per scenario.
+fn scenic(args: &BuildArgs, color: bool) -> Result<Status, CliError> {
     let (paths, out, map_dir, map) =
         (&args.paths, args.output.as_deref(), args.map_dir.as_deref(), args.map.as_deref());
     let simulator = Simulator::from(args.simulator);
@@ -104,7 +111,7 @@ fn run_in(args: &BuildArgs, color: bool) -> Result<Status, CliError> {
     let mut to_stdout: Option<(String, String)> = None;
     let mut db = Database::new(Options::default());
     for input in &inputs {
-        let checked = crate::check::diagnose_in(&mut db, input);
+        let checked = tad_db::host::diagnose_in(&mut db, input);
         if checked.diagnostics.iter().any(|d| d.is_error()) {
             status = status.max(Status::Failed);
             let errors: Vec<_> = checked.diagnostics.iter().filter(|d| d.is_error()).cloned().collect();
@@ -113,7 +120,7 @@ fn run_in(args: &BuildArgs, color: bool) -> Result<Status, CliError> {
             errln!("{}: not built: it has errors", input.name)?;
             continue;
         }
-        let file = crate::check::register(&mut db, input);
+        let file = tad_db::host::register(&mut db, input);
         let module = &tad_db::analyze(&db, file).module;
         let scenario = tad_db::resolve(&db, file);
         let options = EmitOptions {
@@ -189,6 +196,58 @@ fn run_in(args: &BuildArgs, color: bool) -> Result<Status, CliError> {
     Ok(status)
 }
 
+/// `--target bytecode`: `NAME.tadc` per scenario into the `-o` directory (the bytes are
+/// binary: an output directory is required).
+fn bytecode(args: &BuildArgs, color: bool) -> Result<Status, CliError> {
+    let (paths, out) = (&args.paths, args.output.as_deref());
+    if args.map_dir.is_some() || args.map.is_some() {
+        return Err(CliError::usage("`--map` and `--map-dir` are options of the scenic target"));
+    }
+    let dir = out
+        .ok_or_else(|| CliError::usage("the bytecode target writes binary files: give an output directory with -o"))?;
+    // raised by files with errors and outputs that cannot be written; the others still build
+    let mut status = Status::Ok;
+    let (inputs, read) = files::load(paths, Search::Tad)?;
+    status = status.max(read);
+    std::fs::create_dir_all(dir).map_err(|e| CliError::usage(format!("cannot create `{}`: {e}", dir.display())))?;
+    let mut written: Vec<PathBuf> = Vec::new();
+    let mut db = Database::new(Options::default());
+    for input in &inputs {
+        let Some(program) = crate::scenes::compile(&mut db, input, "built", color)? else {
+            status = status.max(Status::Failed);
+            continue;
+        };
+        let bytes = tad_bytecode::encode(&program);
+        let stem = input
+            .path
+            .as_deref()
+            .and_then(Path::file_stem)
+            .map_or_else(|| "stdin".to_string(), |s| s.to_string_lossy().into_owned());
+        let target = dir.join(format!("{stem}.tadc"));
+        if written.contains(&target) {
+            status = status.max(Status::Usage);
+            errln!("error: {} would overwrite `{}`, written for an earlier file", input.name, target.display())?;
+            continue;
+        }
+        if let Err(e) = std::fs::write(&target, &bytes) {
+            status = status.max(Status::Usage);
+            errln!("error: cannot write `{}`: {e}", target.display())?;
+            continue;
+        }
+        let actors = program.code.iter().filter(|i| matches!(i, tad_bytecode::Instr::Spawn { .. })).count();
+        errln!(
+            "{}: wrote {} ({}, {}, {} bytes)",
+            input.name,
+            target.display(),
+            plural(actors, "actor"),
+            plural(program.code.len(), "instruction"),
+            bytes.len()
+        )?;
+        written.push(target);
+    }
+    Ok(status)
+}
+
 /// Remember that `program` loads `file`, if `file` does not exist.
 fn note_missing(missing: &mut Vec<MissingMap>, file: PathBuf, program: &str) {
     if file.is_file() {
@@ -226,6 +285,7 @@ fn report_missing_maps(missing: &[MissingMap], map_dir_given: bool) -> Result<()
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::output::finish;
 
     fn scratch(name: &str) -> PathBuf {
         let dir = std::env::temp_dir().join(format!("tadslc-build-{name}-{}", std::process::id()));
@@ -255,7 +315,7 @@ mod tests {
         let inputs =
             [example("examples/safety/right_turn.tad"), example("examples/regions/yosemite_deer_on_curve.tad")];
         let args = build(&inputs, Some(&out), Some("maps"), SimulatorArg::Newtonian);
-        let status = run(&args, false);
+        let status = finish(run(&args, false));
         assert_eq!(status, Status::Ok);
         let text = std::fs::read_to_string(out.join("right_turn.scenic")).unwrap();
         assert!(text.contains("model scenic.simulators.newtonian.driving_model"));
@@ -270,11 +330,35 @@ mod tests {
         let bad = dir.join("bad.tad");
         std::fs::write(&bad, "scenario bad {\n  environment {\n    weather: sunnyy\n  }\n}\n").unwrap();
         assert_eq!(
-            run(&build(std::slice::from_ref(&bad), Some(&dir), None, SimulatorArg::Carla), false),
+            finish(run(&build(std::slice::from_ref(&bad), Some(&dir), None, SimulatorArg::Carla), false)),
             Status::Failed
         );
         assert!(!dir.join("bad.scenic").exists());
         let good = example("examples/safety/right_turn.tad");
-        assert_eq!(run(&build(&[good.clone(), good], None, None, SimulatorArg::Carla), false), Status::Usage);
+        assert_eq!(finish(run(&build(&[good.clone(), good], None, None, SimulatorArg::Carla), false)), Status::Usage);
+    }
+
+    #[test]
+    fn builds_a_program_per_input_and_refuses_without_an_output_directory() {
+        let out = scratch("bytecode");
+        let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/safety/right_turn.tad");
+        let bytecode = |output: Option<&Path>, map_dir: Option<&str>| {
+            let args = BuildArgs {
+                target: Target::Bytecode,
+                ..build(std::slice::from_ref(&example), output, map_dir, SimulatorArg::Carla)
+            };
+            finish(run(&args, false))
+        };
+        let disasm = |path: PathBuf| finish(crate::cmd::disasm::run(&crate::cmd::disasm::Args { path }));
+        assert_eq!(bytecode(Some(&out), None), Status::Ok);
+        let bytes = std::fs::read(out.join("right_turn.tadc")).unwrap();
+        let program = tad_bytecode::decode(&bytes).unwrap();
+        assert_eq!(program.name, "right_turn");
+        assert_eq!(disasm(out.join("right_turn.tadc")), Status::Ok);
+        assert_eq!(bytecode(None, None), Status::Usage);
+        assert_eq!(bytecode(Some(&out), Some("maps")), Status::Usage);
+        std::fs::write(out.join("bad.tadc"), b"TADC\x09\x00").unwrap();
+        assert_eq!(disasm(out.join("bad.tadc")), Status::Failed);
+        assert_eq!(disasm(out.join("missing.tadc")), Status::Usage);
     }
 }

@@ -93,11 +93,7 @@ impl FinetuneArgs {
 
 /// Runs `tadslc finetune`: 0 when the adapter is written, 2 for a usage or I/O error (bad
 /// flags, unreadable examples, no model, a checkpoint of another run), 1 when training fails.
-pub fn finetune(args: &FinetuneArgs) -> Status {
-    crate::output::finish(finetune_in(args))
-}
-
-fn finetune_in(args: &FinetuneArgs) -> Result<Status, CliError> {
+pub fn run(args: &FinetuneArgs) -> Result<Status, CliError> {
     let config = args.config().map_err(CliError::usage)?;
     let file = data_file(&args.data);
     let text =

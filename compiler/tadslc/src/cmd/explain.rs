@@ -8,12 +8,16 @@ use crate::output::CliError;
 use crate::{Status, errln, outln};
 use tad_diagnostics::Code;
 
-pub fn run(code: Option<&str>) -> Status {
-    crate::output::finish(run_in(code))
+/// `tadslc explain`'s arguments.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The code, or its number whatever its letter (`203`, `w600`); omit it to list
+    /// every code
+    pub code: Option<String>,
 }
 
-fn run_in(code: Option<&str>) -> Result<Status, CliError> {
-    let Some(text) = code else {
+pub fn run(args: &Args) -> Result<Status, CliError> {
+    let Some(text) = args.code.as_deref() else {
         for code in Code::ALL {
             outln!("{code}  {}", code.title())?;
         }

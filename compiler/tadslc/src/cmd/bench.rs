@@ -1,0 +1,188 @@
+//! `tadslc bench`: the experiments of `tad-bench`, their reports printed.
+//!
+//! Check throughput against serde_json by default; `--runtime`, `--lsp`, `--llm` and
+//! `--align` choose another experiment. A report's lines go to standard output, its notes
+//! and an experiment's progress to standard error; its outcome is the exit status.
+
+use std::path::PathBuf;
+
+use crate::Status;
+use crate::cmd::compare::{Embedding, embed};
+use crate::output::CliError;
+use tad_bench::{BenchError, Outcome, Report};
+use tad_eval::recovery::Extra;
+
+/// `tadslc bench`'s arguments: check throughput, or one of the other experiments.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Number of generated scenarios
+    #[arg(long, default_value_t = 10_000, conflicts_with_all = ["runtime", "lsp", "llm", "align"])]
+    pub scenarios: usize,
+    /// Seed of the corpus generator (and of the alignment experiment)
+    #[arg(long, default_value_t = 1, conflicts_with_all = ["runtime", "lsp", "llm"])]
+    pub seed: u64,
+    /// Directory of real scenarios to measure as well
+    #[arg(long, conflicts_with_all = ["runtime", "lsp", "llm"])]
+    pub examples: Option<PathBuf>,
+    /// Timed repetitions of each measurement (the best is reported)
+    #[arg(long, default_value_t = 5)]
+    pub runs: usize,
+    /// Measure the runtime instead: episode time with 1, 14 and 50 actors, Scenic's
+    /// Newtonian simulator on the same scenarios, and a parameter search's episodes per
+    /// second
+    #[arg(long, conflicts_with_all = ["lsp", "llm"])]
+    pub runtime: bool,
+    /// Measure the language server instead: didChange → diagnostics, completion and
+    /// hover latency on a 2,000-line file, and its memory with every example open
+    #[arg(long, conflicts_with = "llm")]
+    pub lsp: bool,
+    /// Measure the local model instead: prefill and decode tokens/s, unconstrained and
+    /// constrained, and peak memory, against llama.cpp's llama-server on the same GGUF
+    /// and thread count
+    #[arg(long)]
+    pub llm: bool,
+    /// The llama-server binary for the peer (default: TADSL_LLAMA_SERVER); without one
+    /// the peer is skipped
+    #[arg(long, value_name = "PATH", requires = "llm")]
+    pub llama_server: Option<PathBuf>,
+    /// Threads of both models
+    #[arg(long, value_name = "N", default_value_t = 1, requires = "llm")]
+    pub threads: usize,
+    /// Translate prompts measured (the first N descriptions)
+    #[arg(long, value_name = "N", default_value_t = 4, requires = "llm")]
+    pub prompts: usize,
+    /// Tokens per answer
+    #[arg(long, value_name = "N", default_value_t = 256, requires = "llm")]
+    pub max_tokens: u32,
+    /// The descriptions the prompts are made of
+    #[arg(long, value_name = "DIR", default_value = "tests/llm/descriptions", requires = "llm")]
+    pub descriptions: PathBuf,
+    /// Samples of each language server measurement
+    #[arg(long, value_name = "N", default_value_t = 200, requires = "lsp")]
+    pub samples: usize,
+    /// The Python with Scenic 3.1.1 for the Scenic peer (default: TADSL_SCENIC_PYTHON);
+    /// without one the peer is skipped
+    #[arg(long, value_name = "PATH", requires = "runtime")]
+    pub scenic_python: Option<PathBuf>,
+    /// Skip the Scenic peer
+    #[arg(long, requires = "runtime", conflicts_with = "scenic_python")]
+    pub no_scenic: bool,
+    /// Episodes of the parameter search (the safety examples round robin)
+    #[arg(long, value_name = "N", default_value_t = 20_000, requires = "runtime")]
+    pub episodes: usize,
+    /// Steps per episode (fewer for tests)
+    #[arg(long, default_value_t = 300, requires = "runtime", hide = true)]
+    pub steps: u32,
+    /// Run the alignment recovery experiment instead: labelled synthetic regions, the
+    /// fitted generator against the unaligned baseline on held-out samples
+    #[arg(long, conflicts_with_all = ["runtime", "lsp", "llm"])]
+    pub align: bool,
+    /// Scenarios per sample (training, held-out, generated)
+    #[arg(long, value_name = "N", default_value_t = 100, requires = "align")]
+    pub per_region: usize,
+    /// The embedding of the MMD and Fréchet columns
+    #[arg(long, value_enum, default_value_t = Embedding::Features, requires = "align")]
+    pub embedding: Embedding,
+    /// Bootstrap resamples
+    #[arg(long, value_name = "N", default_value_t = 200, requires = "align")]
+    pub resamples: usize,
+    /// Where the corpora are written (default: a directory under the system's temporary one)
+    #[arg(long, value_name = "DIR", requires = "align")]
+    pub out: Option<PathBuf>,
+    /// Another generator's output to compare with a region's held-out sample
+    #[arg(long = "corpus", value_name = "LABEL=REGION:DIR", value_parser = tad_bench::align::parse_extra, requires = "align")]
+    pub extra: Vec<(String, String, PathBuf)>,
+    /// Print the rows as JSON
+    #[arg(long, requires = "align")]
+    pub json: bool,
+}
+
+pub fn run(args: &Args) -> Result<Status, CliError> {
+    if args.align {
+        return align(args);
+    }
+    if args.lsp {
+        return streamed("bench --lsp: ", |progress| {
+            let exe = std::env::current_exe()?;
+            tad_bench::lsp::run(&exe, args.samples, args.runs, progress)
+        });
+    }
+    if args.llm {
+        let llm = tad_bench::llm::LlmArgs {
+            llama_server: args.llama_server.clone(),
+            threads: args.threads,
+            prompts: args.prompts,
+            max_tokens: args.max_tokens,
+            descriptions: args.descriptions.clone(),
+        };
+        return streamed("bench --llm: ", |progress| tad_bench::llm::run(&llm, progress));
+    }
+    if args.runtime {
+        let runtime = tad_bench::runtime::RuntimeArgs {
+            runs: args.runs,
+            episodes: args.episodes,
+            steps: args.steps,
+            scenic_python: args.scenic_python.clone(),
+            no_scenic: args.no_scenic,
+        };
+        return streamed("", |progress| tad_bench::runtime::run(&runtime, progress));
+    }
+    print(Ok(tad_bench::run(args.scenarios, args.seed, args.examples.as_deref(), args.runs)), "")
+}
+
+/// `experiment` run with its progress streamed to standard error, then its report printed.
+fn streamed(
+    context: &str,
+    experiment: impl FnOnce(&mut dyn FnMut(&str)) -> Result<Report, BenchError>,
+) -> Result<Status, CliError> {
+    // the first failed write to standard error, for the status
+    let mut closed = None;
+    let report = experiment(&mut |line| {
+        if closed.is_none() {
+            closed = crate::errln!("{line}").err();
+        }
+    });
+    match closed {
+        Some(closed) => Err(closed.into()),
+        None => print(report, context),
+    }
+}
+
+/// `report` printed (an error as `error: {context}{error}`, status 2), its status.
+fn print(report: Result<Report, BenchError>, context: &str) -> Result<Status, CliError> {
+    let report = report.map_err(|e| CliError::usage(format!("{context}{e}")))?;
+    report.lines.iter().try_for_each(|line| crate::outln!("{line}"))?;
+    report.notes.iter().try_for_each(|note| crate::errln!("{note}"))?;
+    Ok(match report.outcome {
+        Outcome::Complete => Status::Ok,
+        Outcome::InputErrors => Status::Failed,
+        Outcome::Unusable => Status::Usage,
+    })
+}
+
+/// `bench --align`: the extra corpora read and the sentences embedded as `compare` does.
+fn align(args: &Args) -> Result<Status, CliError> {
+    let out = args.out.clone().unwrap_or_else(|| std::env::temp_dir().join("tadsl-bench-align"));
+    let corpora = tad_bench::align::corpora(args.per_region, args.seed, &out).map_err(CliError::usage)?;
+    // an extra corpus that cannot be read or has no valid scenario is said (status 2);
+    // the experiment goes on without it
+    let mut status = Status::Ok;
+    let mut extra = Vec::new();
+    for (label, region, dir) in &args.extra {
+        let (corpus, read) = crate::corpus::read(std::slice::from_ref(dir))?;
+        status = status.max(read);
+        let features = match crate::corpus::counted(corpus) {
+            Ok(corpus) => corpus.items.into_iter().map(|i| i.features).collect(),
+            Err(CliError::Exit(failed, why)) => {
+                status = status.max(failed);
+                crate::errln!("error: {why}")?;
+                Vec::new()
+            }
+            Err(closed) => return Err(closed),
+        };
+        extra.push(Extra { label: label.clone(), region: region.clone(), features });
+    }
+    let embed = |a: &[tad_stats::Features], b: &[tad_stats::Features]| embed(args.embedding, a, b);
+    let report = tad_bench::align::report(&corpora, &extra, &embed, args.resamples, args.seed, args.json);
+    Ok(print(report, "")?.max(status))
+}

@@ -1,0 +1,132 @@
+//! `tadslc translate`: a description to a TAD program with a language model, the compiler
+//! in the loop (`tad_frontend::translate`): one description to a file or standard output,
+//! or several (or directories of `*.txt`) into `-o DIR` with a manifest and a summary. The
+//! exit status names the class it ended in (`spec/output.md`).
+
+use std::path::PathBuf;
+
+use tad_frontend::backend;
+use tad_frontend::translate::{self, Translator};
+use tad_frontend::{Round, Session, store};
+use tad_llm::Constraint;
+
+use crate::llm::{LlmArgs, report_summary, status_of};
+use crate::output::CliError;
+use crate::{Status, errln, out};
+
+/// `tadslc translate`'s arguments.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The description (a text file; `-` reads standard input), or several, or
+    /// directories of `*.txt` descriptions
+    #[arg(required = true)]
+    pub description: Vec<PathBuf>,
+    /// Write the program here (default: standard output); with several descriptions, the
+    /// directory for their programs, `translate.jsonl` and `summary.json`
+    #[arg(short, long, value_name = "PATH")]
+    pub output: Option<PathBuf>,
+    /// Append every round (request, answer, diagnostics) as JSON lines
+    #[arg(long, value_name = "FILE")]
+    pub transcript: Option<PathBuf>,
+    /// The region: its module's names are in scope and in the prompt
+    #[arg(long, value_name = "REGION")]
+    pub region: Option<String>,
+    /// Show the model's answers on standard error as they are written (one description)
+    #[arg(long)]
+    pub stream: bool,
+    #[command(flatten)]
+    pub llm: LlmArgs,
+}
+
+pub fn run(t: &Args) -> Result<Status, CliError> {
+    let args = &t.llm;
+    let (paths, output, transcript, region, stream) =
+        (&t.description, t.output.as_deref(), t.transcript.as_deref(), t.region.as_deref(), t.stream);
+    let files = translate::descriptions(paths).map_err(CliError::usage)?;
+    let batch = files.len() > 1 || paths.iter().any(|p| p.is_dir());
+    if batch && stream {
+        return Err(CliError::usage("--stream shows one description's answers; a batch reports in translate.jsonl"));
+    }
+    let backend = args.open(1).map_err(CliError::usage)?;
+    let show = |piece: &str| {
+        let _ = crate::output::err(format_args!("{piece}"));
+    };
+    let checker = backend::checker(region).map_err(CliError::usage)?;
+    let constraint = backend.constraint_for(args.constrained(&backend), region).map_err(CliError::usage)?;
+    let session = Session {
+        on_text: stream.then_some(&show as &tad_llm::OnText),
+        ..args.session(&backend, &checker, constraint, 0.0)
+    };
+    let mut transcript_file = match transcript {
+        Some(p) => {
+            Some(store::Jsonl::append(p).map_err(|e| CliError::usage(format!("cannot write {}: {e}", p.display())))?)
+        }
+        None => None,
+    };
+    let mut write_error = None;
+    let mut on_round = |r: &Round| {
+        if let Some(t) = transcript_file.as_mut()
+            && let Err(e) = t.write(r)
+        {
+            write_error.get_or_insert(e);
+        }
+        let _ = errln!(
+            "{}{} round {}: {}{}",
+            if stream { "\n" } else { "" },
+            r.item,
+            r.round,
+            r.error
+                .as_deref()
+                .map(|e| format!("error: {e}"))
+                .unwrap_or_else(|| r.class.unwrap_or("no program").to_string()),
+            if r.diagnostics.is_empty() { String::new() } else { format!(" ({} diagnostics)", r.diagnostics.len()) }
+        );
+    };
+    let runtime = backend::runtime().map_err(CliError::usage)?;
+    let tool = format!("tadslc {}", env!("CARGO_PKG_VERSION"));
+    let translator = Translator { session: &session, runtime: &runtime, region, tool: &tool };
+    if !batch {
+        let text = translate::read_description(&files[0]).map_err(CliError::usage)?;
+        let (outcome, program) = translator.one(&files[0], &text, &mut on_round);
+        match (&program, output) {
+            (Some(p), Some(path)) => store::write_atomic(path, p.as_bytes())
+                .map_err(|e| CliError::usage(format!("cannot write {}: {e}", path.display())))?,
+            (Some(p), None) => out!("{p}")?,
+            (None, _) => {}
+        }
+        for line in &outcome.diagnostics {
+            errln!("  {line}")?;
+        }
+        errln!(
+            "{} after {} round{}; {} tokens{}",
+            outcome.class.unwrap_or("no program"),
+            outcome.rounds,
+            if outcome.rounds == 1 { "" } else { "s" },
+            outcome.usage.total(),
+            outcome.stopped.as_deref().map(|s| format!("; stopped: {s}")).unwrap_or_default()
+        )?;
+        if let Some(e) = write_error {
+            return Err(CliError::usage(format!("cannot write the transcript: {e}")));
+        }
+        return Ok(status_of(&outcome));
+    }
+    let dir = output.ok_or_else(|| CliError::usage("several descriptions need an output directory: -o DIR"))?;
+    let bar = crate::output::progress(files.len(), "descriptions");
+    let (summary, unreachable) = translator
+        .batch(&files, dir, &mut on_round, &mut |item| match item {
+            Ok(_) => bar.inc(1),
+            Err(e) => bar.println(format!("error: {e}")),
+        })
+        .map_err(CliError::usage)?;
+    bar.finish_and_clear();
+    if let Some(e) = write_error {
+        return Err(CliError::usage(format!("cannot write the transcript: {e}")));
+    }
+    let constrained = !matches!(session.constraint, Constraint::None);
+    report_summary(
+        Some(dir),
+        &summary,
+        serde_json::json!({ "model": backend.chat().label(), "constrained": constrained, "max_rounds": args.max_rounds }),
+    )?;
+    Ok(if unreachable == files.len() { Status::Unreachable } else { Status::Ok })
+}
