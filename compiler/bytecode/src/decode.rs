@@ -8,8 +8,8 @@
 //! instruction, a slot, a path) becomes the byte offset where that item starts.
 //! Nothing here panics, whatever the bytes.
 
-use tad_layout::road::Junction;
-use tad_layout::{Arm, Road, Shape};
+use tad_road::road::Junction;
+use tad_road::{Arm, Road, Shape};
 
 use crate::error::{ErrorKind, Item, LoadError};
 use crate::format::{self, FORMAT_VERSION, HEADER_LEN, MAGIC, Op, Tag};

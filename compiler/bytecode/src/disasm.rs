@@ -5,7 +5,7 @@
 
 use std::fmt::Write;
 
-use tad_layout::{Facing, Place, Road, Shape, Side};
+use tad_road::{Facing, Place, Road, Shape, Side};
 
 use crate::format::{self, FORMAT_VERSION, Op};
 use crate::program::{Instr, Phase, Program, Size, Value};

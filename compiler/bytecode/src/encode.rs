@@ -112,7 +112,7 @@ impl Pool {
                 op(out, Op::Road);
                 out.push(road.shape.tag());
                 out.push(match road.shape {
-                    tad_layout::Shape::Junction { arms, .. } => arms,
+                    tad_road::Shape::Junction { arms, .. } => arms,
                     _ => 0,
                 });
                 for n in [road.lanes, road.opposite, road.cross_lanes] {

@@ -4,7 +4,7 @@
 
 use crate::program::Light;
 use tad_ir::Signal;
-use tad_layout::{Arm, Body, Facing, Place, Shape, Side, Turn};
+use tad_road::{Arm, Body, Facing, Place, Shape, Side, Turn};
 
 /// The first four bytes of every `.tadc` file.
 pub const MAGIC: [u8; 4] = *b"TADC";

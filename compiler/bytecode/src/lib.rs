@@ -9,7 +9,9 @@
 //! [`Program`] is the decoded form; the runtime reads it, never the bytes. Modules:
 //! `program` (the types, the runtime's contract), `format` (magic, version, opcodes and
 //! tags, declared once), `encode`, `decode` (byte-level checks), `verify` (the rules the
-//! runtime relies on), `error`, `lower` (from the layout), `disasm` (the listing).
+//! runtime relies on), `error`, `lower` (from the layout), `disasm` (the listing). The road
+//! and the words an actor is described by are `tad-road`'s contract; only `lower` reads
+//! `tad-layout`.
 
 mod decode;
 mod disasm;

@@ -12,8 +12,9 @@
 use std::collections::HashMap;
 
 use tad_ir::{GroupId, Motion, Param, Reference, Scenario, Signal};
-use tad_layout::geom::{Path, Vec2};
-use tad_layout::{Agent, Arm, Body, Facing, GroupLayout, Layout, Place, Road};
+use tad_layout::{Agent, GroupLayout, Layout};
+use tad_road::geom::{Path, Vec2};
+use tad_road::{Arm, Body, Facing, Place, Road};
 
 use crate::program::{ActorId, Instr, Light, ParamSlot, PathId, Phase, Polyline, Program, Size, Slot, Value};
 

@@ -5,7 +5,7 @@
 //! `Cross`, `Speed`, `ChangeLane`, `Stop`, `Signals`, `Mobil`) or blocks the actor's script
 //! until it holds (`Wait`, `WaitNear`); the motion it set goes on meanwhile.
 
-use tad_layout::{Arm, Body, Facing, Place, Turn};
+use tad_road::{Arm, Body, Facing, Place, Turn};
 
 /// A parameter slot's index in [`Program::params`].
 pub type Slot = u16;
@@ -133,8 +133,8 @@ pub struct Size {
 #[derive(Clone, Debug, PartialEq)]
 pub enum Instr {
     // ── set-up, before step 0 ────────────────────────────────────────────────────────
-    /// The road; exactly one, first. The runtime rebuilds `tad_layout::Road` from it.
-    Road(tad_layout::Road),
+    /// The road; exactly one, first. The runtime rebuilds `tad_road::Road` from it.
+    Road(tad_road::Road),
     /// When a run ends: step length (s), steps, the ego's driven distance (m), time (s).
     Limits { dt: f64, max_steps: u32, max_distance: f64, timeout: f64 },
     /// The phase program of the lights facing an arm's incoming traffic; it repeats.
@@ -155,7 +155,7 @@ pub enum Instr {
         arm: Arm,
         lane: i64,
         place: Place,
-        /// The station's `along` (see `tad_layout::Station`), sampled shifts included.
+        /// The station's `along` (see `tad_road::Station`), sampled shifts included.
         along: Value,
         /// Left of the arm's centre line, m.
         lateral: f64,

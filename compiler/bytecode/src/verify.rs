@@ -3,7 +3,7 @@
 //! actor index valid, the set-up complete and before the behaviour. The loader runs them
 //! on every file; [`crate::lower()`]'s programs keep them (its tests check).
 
-use tad_layout::{Arm, Road, Shape};
+use tad_road::{Arm, Road, Shape};
 
 use crate::error::{ErrorKind, Invalid, Item};
 use crate::program::{Instr, Program, Size, Value};

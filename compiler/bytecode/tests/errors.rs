@@ -4,7 +4,7 @@
 
 use tad_bytecode::format::{HEADER_LEN, Op};
 use tad_bytecode::{ErrorKind, Instr, LoadError, ParamSlot, Polyline, Program, Size, Value, decode, encode, verify};
-use tad_layout::{Arm, Body, Facing, Place, Road, Shape, Turn};
+use tad_road::{Arm, Body, Facing, Place, Road, Shape, Turn};
 
 fn road() -> Road {
     Road {
@@ -359,7 +359,7 @@ fn a_junctions_arms_are_a_set_in_order() {
     let junction = |arms: Vec<Arm>| {
         Instr::Road(Road {
             shape: Shape::Junction { arms: arms.len() as u8, roundabout: false },
-            junction: Some(tad_layout::road::Junction {
+            junction: Some(tad_road::road::Junction {
                 arms,
                 roundabout: false,
                 half: 10.0,

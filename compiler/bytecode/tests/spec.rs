@@ -5,7 +5,7 @@ mod common;
 
 use tad_bytecode::format::{self, Op, Tag};
 use tad_bytecode::{FORMAT_VERSION, Light};
-use tad_layout::{Arm, Body, Place, Turn};
+use tad_road::{Arm, Body, Place, Turn};
 
 fn spec() -> String {
     std::fs::read_to_string(tad_test_support::repo().join("spec/bytecode.md")).expect("spec/bytecode.md")

@@ -3,48 +3,12 @@
 //! scenario leaves unsaid are chosen here by fixed rules and recorded as [`Chosen`], so
 //! every target reports the same choice.
 
-use tad_ir::{
-    ActorType, Behavior, ClosedSet, Entry, Field, Group, Id, Motion, Named, Param, Scenario, SimulatedAs, Span,
-};
+use tad_ir::{ActorType, Behavior, ClosedSet, Entry, Field, Group, Id, Motion, Named, Param, Scenario, Span};
+/// The body an actor is simulated as: the road contract's (`tad-road`).
+pub use tad_road::Body;
 
 /// The most actors one group becomes.
 pub const MAX_GROUP: usize = 20;
-
-/// The body an actor is simulated as (its type's `simulated_as`, else its kind's).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Body {
-    Vehicle,
-    Walker,
-    Object,
-}
-
-impl Body {
-    pub fn of(simulated: SimulatedAs) -> Body {
-        match simulated {
-            SimulatedAs::Car => Body::Vehicle,
-            SimulatedAs::Pedestrian => Body::Walker,
-            SimulatedAs::Object => Body::Object,
-        }
-    }
-
-    /// Length and width of a body whose type states none, m.
-    pub fn default_size(self) -> (f64, f64) {
-        match self {
-            Body::Vehicle => (4.5, 1.8),
-            Body::Walker => (0.5, 0.6),
-            Body::Object => (0.5, 0.5),
-        }
-    }
-
-    /// The motion of a body whose behavior is not given.
-    pub fn default_motion(self) -> Motion {
-        match self {
-            Body::Vehicle => Motion::Follow,
-            Body::Walker => Motion::Stand,
-            Body::Object => Motion::Parked,
-        }
-    }
-}
 
 /// A value the scenario does not state, chosen by the layout.
 #[derive(Clone, Debug, PartialEq)]

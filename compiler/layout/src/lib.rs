@@ -9,50 +9,29 @@
 //!              ──timing─▶ each adversary started so it meets the ego at their conflict point
 //! ```
 //!
-//! Modules: `geom` (points, paths, footprints), `facts`, `road`, `place` (the steps above),
-//! `predict` (a kinematic roll-out of the layout: constant speeds, IDM following), and
-//! `fidelity` (what a simulated run must show: relations at the start, no overlap,
-//! adversaries reaching the ego; the same checks for the roll-out and for a simulator's
-//! trace).
+//! Modules: `facts`, `place` (the steps above), `predict` (a kinematic roll-out of the
+//! layout: constant speeds, IDM following), and `fidelity` (what a simulated run must show:
+//! relations at the start, no overlap, adversaries reaching the ego; the same checks for the
+//! roll-out and for a simulator's trace). The road it decides is `tad-road`'s contract,
+//! re-exported here: `geom` (points, paths, footprints), `road`, [`Body`], [`Place`],
+//! [`Facing`].
 
 pub mod facts;
 pub mod fidelity;
-pub mod geom;
 pub mod idm;
 mod place;
 pub mod predict;
-pub mod road;
 
 pub use facts::{Body, Chosen, Facts, MAX_GROUP};
 pub use place::lay_out;
 pub use road::{Arm, Road, Shape, Side, Station, Turn};
 /// What a traffic light shows: the schema's closed set, the one light state of the workspace.
 pub use tad_ir::{ClosedSet, Signal};
+/// The road contract the layout decides (`tad-road`), under the paths it always had here.
+pub use tad_road::{Facing, Place, geom, road};
 
 use geom::{Footprint, Path, Pose};
 use tad_ir::{GroupId, Motion, Span};
-
-/// Where across its lane an actor stands.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Place {
-    /// The lane's centre.
-    Lane,
-    /// The curb side of an outermost lane.
-    Curb,
-    /// Just outside the outermost lane: on the shoulder or in a parking strip.
-    Shoulder,
-    /// The sidewalk beside the road.
-    Sidewalk,
-}
-
-/// Which way an actor faces at the start.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Facing {
-    /// Along its lane's traffic.
-    Along,
-    /// Across the road, from the sidewalk of `from` towards the other side.
-    Across { from: Side },
-}
 
 /// When an actor starts doing its behavior.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

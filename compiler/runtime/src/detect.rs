@@ -5,7 +5,7 @@
 
 use crate::world::{Spot, World};
 use tad_bytecode::Light;
-use tad_layout::geom::{Footprint, Path};
+use tad_road::geom::{Footprint, Path};
 
 /// Route completion counts as complete past this share within [`END_DISTANCE`] of the end.
 const COMPLETE_SHARE: f64 = 0.99;
@@ -110,7 +110,7 @@ impl Detectors {
             if !self.red_counted
                 && rear >= line
                 && rear - speed * 0.1 - 1.0 < line
-                && world.light(tad_layout::Arm::Ego, t) == Light::Red
+                && world.light(tad_road::Arm::Ego, t) == Light::Red
             {
                 red = true;
                 self.red_counted = true;

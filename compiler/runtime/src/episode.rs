@@ -13,11 +13,11 @@ use crate::physics::{Physics, Shape};
 use crate::scene::Scene;
 use crate::world::Spot;
 use tad_bytecode::{Instr, Light, Value};
-use tad_layout::geom::{Footprint, Path, Pose, Vec2, wrap};
-use tad_layout::road::Station;
-use tad_layout::{Arm, Body, Turn};
 use tad_metrics::{Mode, StepRecord, StopReason};
 use tad_policy::{ACCEL_MAX, ACCEL_MIN, Action, EgoPolicy, EgoView, IdmParams, MAX_WHEEL_ANGLE, Preview};
+use tad_road::geom::{Footprint, Path, Pose, Vec2, wrap};
+use tad_road::road::Station;
+use tad_road::{Arm, Body, Turn};
 
 /// How an episode runs.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -2,7 +2,7 @@
 //! vehicles), pure-pursuit steering onto a track, and the Intelligent Driver Model for speed
 //! (`tad_layout::idm::IdmParams`, the one IDM of the workspace, which the layout's roll-out follows with too).
 
-use tad_layout::geom::{Path, Pose, Vec2};
+use tad_road::geom::{Path, Pose, Vec2};
 
 /// Wheelbase as a share of a vehicle's length.
 pub const WHEELBASE: f64 = 0.6;
@@ -26,7 +26,7 @@ impl Kinematics {
         let beta = (0.5 * wheel.tan()).atan();
         let v = self.speed;
         self.position = self.position + Vec2::from_yaw(self.yaw + beta) * (v * dt);
-        self.yaw = tad_layout::geom::wrap(self.yaw + v * beta.sin() / (wheelbase / 2.0) * dt);
+        self.yaw = tad_road::geom::wrap(self.yaw + v * beta.sin() / (wheelbase / 2.0) * dt);
         self.speed = (v + accel * dt).max(0.0);
     }
 }
@@ -55,7 +55,7 @@ pub fn curve_speed(track: &Path, s: f64, speed: f64) -> f64 {
     let mut sharpest: f64 = 0.0;
     let mut x = s;
     while x < s + reach {
-        let turn = tad_layout::geom::wrap(track.pose(x + 2.0).yaw - track.pose(x).yaw).abs() / 2.0;
+        let turn = tad_road::geom::wrap(track.pose(x + 2.0).yaw - track.pose(x).yaw).abs() / 2.0;
         sharpest = sharpest.max(turn);
         x += 1.0;
     }
@@ -67,7 +67,7 @@ pub fn curve_speed(track: &Path, s: f64, speed: f64) -> f64 {
 pub fn bend(track: &Path) -> f64 {
     let mut headings = track.points().windows(2).map(|w| (w[1] - w[0]).yaw());
     let Some(first) = headings.next() else { return 0.0 };
-    headings.map(|y| tad_layout::geom::wrap(y - first).abs()).fold(0.0, f64::max)
+    headings.map(|y| tad_road::geom::wrap(y - first).abs()).fold(0.0, f64::max)
 }
 
 /// [`curve_speed`] of a path whose [`bend`] is known: where no two headings differ by 1e-4

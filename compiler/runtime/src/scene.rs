@@ -4,8 +4,8 @@
 
 use crate::world::World;
 use tad_bytecode::{ActorId, Instr, Program, Size};
-use tad_layout::geom::{Path, Pose, Vec2};
-use tad_layout::{Arm, Body, Facing, Place, Turn};
+use tad_road::geom::{Path, Pose, Vec2};
+use tad_road::{Arm, Body, Facing, Place, Turn};
 
 /// Why a program cannot run.
 #[derive(Clone, Debug, PartialEq, Eq)]

@@ -2,15 +2,15 @@
 //! point, for lane invasions and off-road), the stop line of every arm, and the lights'
 //! phase programs.
 //!
-//! Lanes are found geometrically from `tad_layout::Road`, the same road the layout placed
+//! Lanes are found geometrically from `tad_road::Road`, the same road the layout placed
 //! everything on: on the ego's road (straight or curved) by the point's offset from the
 //! centre line, on a junction's other arms by its offset in that arm's frame, and inside the
 //! junction's box (or the roundabout's ring) as the junction itself, which has no markings.
 
 use tad_bytecode::{Light, Phase};
-use tad_layout::geom::{Pose, Vec2};
-use tad_layout::road::CURVE_RADIUS;
-use tad_layout::{Arm, Road, Shape, Station};
+use tad_road::geom::{Pose, Vec2};
+use tad_road::road::CURVE_RADIUS;
+use tad_road::{Arm, Road, Shape, Station};
 
 /// Where a point is on the road.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -137,7 +137,7 @@ fn lane_at(road: &Road, arm: Arm, lateral: f64, w: f64) -> Option<i64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use tad_layout::road::{Junction, LANE_WIDTH};
+    use tad_road::road::{Junction, LANE_WIDTH};
 
     pub(crate) fn crossroads(signalised: bool) -> Road {
         Road {

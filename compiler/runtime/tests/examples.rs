@@ -2,7 +2,7 @@
 //! examples produce their conflict with `naive` and `idm` avoids most; runs repeat exactly.
 
 use std::path::Path;
-use tad_layout::geom::{Footprint, Pose, Vec2};
+use tad_road::geom::{Footprint, Pose, Vec2};
 use tad_runtime::{Episode, Options, Scene, StopReason, run, sample::sample};
 
 fn scene(path: &Path) -> Scene {

@@ -1,9 +1,9 @@
 //! Episodes on hand-built programs: each detector on a scenario built for it.
 
 use tad_bytecode::{Instr, Polyline, Program, Size, Value};
-use tad_layout::road::{LANE_WIDTH, RUN};
-use tad_layout::{Arm, Body, Facing, Place, Road, Shape, Turn};
 use tad_policy::{Action, EgoPolicy, EgoView};
+use tad_road::road::{LANE_WIDTH, RUN};
+use tad_road::{Arm, Body, Facing, Place, Road, Shape, Turn};
 use tad_runtime::{Options, Scene, StopReason, run};
 
 const CAR: Size = Size { length: 4.5, width: 1.8, height: 1.5 };
@@ -24,7 +24,7 @@ fn straight() -> Road {
 }
 
 fn program(road: Road, speed: f64, extra: Vec<Instr>) -> Program {
-    let (path, start) = road.vehicle_path(tad_layout::Station { arm: Arm::Ego, along: 0.0 }, 1, Turn::Straight);
+    let (path, start) = road.vehicle_path(tad_road::Station { arm: Arm::Ego, along: 0.0 }, 1, Turn::Straight);
     let mut code = vec![
         Instr::Road(road),
         Instr::Limits { dt: 0.1, max_steps: 300, max_distance: 200.0, timeout: 60.0 },
@@ -177,7 +177,7 @@ fn junction(signalised: bool) -> Road {
     Road {
         shape: Shape::Junction { arms: 4, roundabout: false },
         cross_lanes: 1,
-        junction: Some(tad_layout::road::Junction {
+        junction: Some(tad_road::road::Junction {
             arms: Arm::ALL.to_vec(),
             roundabout: false,
             half: 8.0,
