@@ -23,7 +23,7 @@ mod place;
 pub mod predict;
 
 pub use facts::{Body, Chosen, Facts, MAX_GROUP};
-pub use place::lay_out;
+pub use place::{lay_out, lay_out_within};
 pub use road::{Arm, Road, Shape, Side, Station, Turn};
 /// What a traffic light shows: the schema's closed set, the one light state of the workspace.
 pub use tad_ir::{ClosedSet, Signal};
@@ -132,6 +132,31 @@ pub enum Finding {
     NoArm { group: GroupId, arm: Arm, span: Span },
     /// More actors than [`MAX_GROUP`].
     Capped { group: GroupId, wanted: usize, placed: usize, span: Span },
+    /// A written lane of the ego's road that the target's road lacks ([`Limits`]): moved to
+    /// the nearest lane it has. `group` is `None` for the ego.
+    Moved { group: Option<GroupId>, from: i64, to: i64, span: Span },
+}
+
+/// The lanes a target's road has (a map's), when a layout must fit on it: `same` in the
+/// ego's direction, `other` in the opposite one.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Limits {
+    pub same: u32,
+    pub other: u32,
+}
+
+impl Limits {
+    /// The nearest lane to `lane` that the road has: a lane past the last one in its
+    /// direction is the last one; an opposite lane on a road without any is lane 1.
+    pub fn fit(self, lane: i64) -> i64 {
+        if lane > 0 {
+            lane.min(i64::from(self.same.max(1)))
+        } else if self.other > 0 {
+            lane.max(-i64::from(self.other))
+        } else {
+            1
+        }
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]

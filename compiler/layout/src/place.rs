@@ -27,6 +27,7 @@ use std::collections::HashMap;
 
 use tad_ir::{GroupId, Lane, Lateral, Longitudinal, Motion, Position, Reference, Scenario, Span};
 
+use crate::Limits;
 use crate::facts::{self, Body, Chosen, Facts};
 use crate::geom::{Path, Pose, Vec2};
 use crate::road::{self, Arm, CROSSWALK, Junction, Road, Shape, Side, Station, Turn};
@@ -99,7 +100,14 @@ fn crosses(f: &Facts) -> bool {
 
 /// The layout of a resolved scenario.
 pub fn lay_out(scenario: &Scenario) -> Layout {
-    let mut planner = Planner::facts(scenario);
+    lay_out_within(scenario, None)
+}
+
+/// The layout of a resolved scenario on a road with at most `limits`' lanes (a target's
+/// map): the road is that narrow, and a written lane on the ego's road that it lacks moves
+/// to the nearest one it has ([`Finding::Moved`]).
+pub fn lay_out_within(scenario: &Scenario, limits: Option<Limits>) -> Layout {
+    let mut planner = Planner::facts(scenario, limits);
     planner.arms();
     let mut road = planner.road();
     planner.ego_road(&mut road);
@@ -124,6 +132,8 @@ struct Planner<'a> {
     ego_facts: Facts,
     group_facts: Vec<Facts>,
     ego_lane: i64,
+    /// The lanes a target's road has, when it has fewer than the scenario uses.
+    limits: Option<Limits>,
     /// The ego's road's lanes in its direction and in the other (none on a one-way road).
     lanes: u32,
     opposite: u32,
@@ -141,11 +151,12 @@ struct Planner<'a> {
 
 impl<'a> Planner<'a> {
     /// Step 1: the facts of the ego, of every group and of the road.
-    fn facts(scenario: &'a Scenario) -> Planner<'a> {
+    fn facts(scenario: &'a Scenario, limits: Option<Limits>) -> Planner<'a> {
         let mut chosen: Vec<Chosen> = Vec::new();
         let mut findings: Vec<Finding> = Vec::new();
         let scenario_span = scenario.name.as_ref().map_or(scenario.span, |n| n.span);
-        let ego_section = scenario.ego.span.unwrap_or(scenario_span);
+        // the `ego` keyword, where what the ego section leaves unsaid is reported
+        let ego_section = scenario.ego.span.map_or(scenario_span, |s| Span::new(s.start, s.start + "ego".len()));
         let ego_facts = facts::ego(scenario, ego_section, &mut chosen);
         let group_facts: Vec<Facts> =
             scenario.groups().map(|(id, g)| facts::group(scenario, id, g, &mut chosen)).collect();
@@ -161,8 +172,15 @@ impl<'a> Planner<'a> {
             }
         }
         let written_lanes = scenario.road.lanes.get().filter(|n| *n >= 1).map(|n| n.min(12) as u32);
+        let written_lanes = written_lanes.map(|n| limits.map_or(n, |l| n.min(l.same.max(1))));
         let ego_lane = ego_lane(scenario, written_lanes, ego_section, &mut chosen);
-        let (lanes, opposite, one_way) = road_lanes(scenario, written_lanes, ego_lane);
+        let fitted = limits.map_or(ego_lane, |l| l.fit(ego_lane));
+        if fitted != ego_lane {
+            let span = scenario.ego.lane.span().unwrap_or(ego_section);
+            findings.push(Finding::Moved { group: None, from: ego_lane, to: fitted, span });
+        }
+        let ego_lane = fitted;
+        let (lanes, opposite, one_way) = road_lanes(scenario, written_lanes, ego_lane, limits);
         let (shape, junction_road) = road_kind(scenario, &ego_facts);
         let n = scenario.groups.len();
         Planner {
@@ -172,6 +190,7 @@ impl<'a> Planner<'a> {
             ego_facts,
             group_facts,
             ego_lane,
+            limits,
             lanes,
             opposite,
             one_way,
@@ -215,6 +234,16 @@ impl<'a> Planner<'a> {
         };
         let written = group.lane.get().map(Lane::index);
         let mut slot = self.slot(relation, written, f);
+        // a written lane of the ego's road that the target's road lacks: the nearest it has
+        if let (Some(lane), Some(limits)) = (written, self.limits)
+            && slot.arm == Arm::Ego
+            && limits.fit(lane) != lane
+        {
+            let to = limits.fit(lane);
+            let span = group.lane.span().unwrap_or(group.name_span);
+            self.findings.push(Finding::Moved { group: Some(self.ids[i]), from: lane, to, span });
+            slot = self.slot(relation, Some(to), f);
+        }
         if written.is_none() {
             self.chosen.push(Chosen {
                 group: Some(self.ids[i]),
@@ -775,7 +804,12 @@ fn ego_lane(scenario: &Scenario, written_lanes: Option<u32>, ego_section: Span, 
 
 /// The ego's road's lanes in its direction and in the other (as written, else as many as
 /// the lanes used), and whether it is one way (then none in the other).
-fn road_lanes(scenario: &Scenario, written_lanes: Option<u32>, ego_lane: i64) -> (u32, u32, bool) {
+fn road_lanes(
+    scenario: &Scenario,
+    written_lanes: Option<u32>,
+    ego_lane: i64,
+    limits: Option<Limits>,
+) -> (u32, u32, bool) {
     let one_way =
         scenario.road.direction.given().and_then(|d| scenario.entries.resolved(d)).and_then(|e| e.attrs.opposite_lanes)
             == Some(false);
@@ -784,6 +818,7 @@ fn road_lanes(scenario: &Scenario, written_lanes: Option<u32>, ego_lane: i64) ->
             .groups
             .iter()
             .filter_map(|g| g.lane.get().map(Lane::index))
+            .map(|l| limits.map_or(l, |limits| limits.fit(l)))
             .chain([ego_lane])
             .filter(|l| (*l > 0) == positive)
             .map(|l| l.unsigned_abs().min(12) as u32)
@@ -792,7 +827,10 @@ fn road_lanes(scenario: &Scenario, written_lanes: Option<u32>, ego_lane: i64) ->
     };
     let lanes = written_lanes.unwrap_or_else(|| used(true).max(1)).max(ego_lane as u32);
     let opposite = if one_way { 0 } else { lanes.max(used(false)) };
-    (lanes, opposite, one_way)
+    match limits {
+        Some(l) => (lanes.min(l.same.max(1)), opposite.min(l.other), one_way),
+        None => (lanes, opposite, one_way),
+    }
 }
 
 /// The road's shape, and whether it leads to a junction: by its shape, or a light that

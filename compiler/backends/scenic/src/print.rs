@@ -12,10 +12,11 @@ use tad_ir::{Motion, Scenario};
 
 use crate::mapping::{self, Class};
 use crate::maps;
-use crate::plan::{Actor, Light, Place, Plan, Sampled};
+use crate::plan::{Actor, Light, Plan, Sampled};
 use crate::python::{comment_lines, comment_text, number, string};
 use crate::{EmitOptions, PRELUDE_BEHAVIORS, PRELUDE_PARAMS, PRELUDE_PLACEMENT, Simulator};
 use tad_layout::Arm;
+use tad_layout::Place;
 
 /// The source section's fields as header lines: (label, value).
 fn source_lines(scenario: &Scenario) -> Vec<(&'static str, String)> {
@@ -314,7 +315,7 @@ fn params(out: &mut String, p: &Sampled) {
 /// at SPOT[0], facing SPOT[1], ...`.
 fn actor(out: &mut String, a: &Actor, spot: &str, needs: &maps::Needs) {
     let place = match a.place {
-        Place::Centre => String::new(),
+        Place::Lane => String::new(),
         Place::Curb => format!(", 'curb', {}", number(a.width)),
         Place::Sidewalk => ", 'sidewalk'".to_string(),
         Place::Shoulder => format!(", 'shoulder', {}", number(a.width)),

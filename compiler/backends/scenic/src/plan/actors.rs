@@ -4,11 +4,11 @@
 //! sidewalk, facing, speeds and timing.
 
 use tad_ir::Scenario;
-use tad_layout::{Arm, Facing, Layout, Side};
+use tad_layout::{Arm, Facing, Layout, Place, Side};
 
 use super::ego::EgoPlan;
 use super::groups::Resolved;
-use super::{Actor, Group, Place, Sampled};
+use super::{Actor, Group, Sampled};
 use crate::mapping::{self, Class};
 use crate::python::Names;
 
@@ -18,15 +18,6 @@ pub struct Actors {
     pub ego: Actor,
     pub ego_summary: String,
     pub groups: Vec<Group>,
-}
-
-fn place(p: tad_layout::Place) -> Place {
-    match p {
-        tad_layout::Place::Lane => Place::Centre,
-        tad_layout::Place::Curb => Place::Curb,
-        tad_layout::Place::Sidewalk => Place::Sidewalk,
-        tad_layout::Place::Shoulder => Place::Shoulder,
-    }
 }
 
 /// `junction`: the map choice kept the junction (else actors of other arms stand on the
@@ -49,10 +40,9 @@ pub fn build(
         length: ego.length,
         width: ego.width,
         lane: ego.lane,
-        moved: false,
         arm: Arm::Ego,
         offset: 0.0,
-        place: Place::Centre,
+        place: Place::Lane,
         cross: None,
         motion: ego.motion,
         target_speed: ego.speed,
@@ -122,9 +112,6 @@ pub fn build(
                 // no junction on the map: beyond where it would be, on the ego's road
                 (Arm::Ego, laid.road.approach + a.station.along + moved_by + 10.0)
             };
-            let lane =
-                if a.station.arm == Arm::Ego && a.lane == first.map_or(a.lane, |f| f.lane) { g.lane } else { a.lane };
-            let moved = a.station.arm == Arm::Ego && lane != a.lane;
             let cross = match a.facing {
                 Facing::Across { from } => Some((from == Side::Right, (a.lateral - row_start).abs())),
                 Facing::Along => None,
@@ -136,11 +123,10 @@ pub fn build(
                 is_ego: false,
                 length: g.length,
                 width: g.width,
-                lane,
-                moved,
+                lane: a.lane,
                 arm,
                 offset,
-                place: place(a.place),
+                place: a.place,
                 cross,
                 motion: g.motion,
                 target_speed: g.speed,
@@ -150,37 +136,7 @@ pub fn build(
         }
         out.push(Group { summary: g.summary.clone(), actors });
     }
-    moved_clear(&ego_actor, &mut out);
     Actors { ego: ego_actor, ego_summary: ego_summary(scenario, ego.lane), groups: out }
-}
-
-/// Actors the map choice moved into another lane (W0701) are placed ahead of everything
-/// already in it, one after the other, so a lane the map lacks never puts two in one place.
-fn moved_clear(ego: &Actor, groups: &mut [Group]) {
-    // the ego moved too: whatever now shares its place moves on as well
-    for a in groups.iter_mut().flat_map(|g| &mut g.actors) {
-        let beside = (a.offset.abs() - a.length / 2.0) < ego.length / 2.0 + 1.0;
-        if a.arm == Arm::Ego && a.cross.is_none() && a.lane == ego.lane && beside {
-            a.moved = true;
-        }
-    }
-    let mut fronts: std::collections::HashMap<i64, f64> = std::collections::HashMap::new();
-    fronts.insert(ego.lane, ego.length / 2.0);
-    for a in groups.iter().flat_map(|g| &g.actors).filter(|a| a.arm == Arm::Ego && a.cross.is_none() && !a.moved) {
-        let front = fronts.entry(a.lane).or_insert(f64::NEG_INFINITY);
-        *front = front.max(a.offset + a.length / 2.0);
-    }
-    for g in groups.iter_mut() {
-        for a in g.actors.iter_mut().filter(|a| a.moved) {
-            let front = fronts.entry(a.lane).or_insert(f64::NEG_INFINITY);
-            let at = front.max(a.offset - a.length / 2.0 - 2.0)
-                + 2.0
-                + a.length / 2.0
-                + a.params.shift.map_or(0.0, |(s, _)| s);
-            a.offset = at;
-            *front = at + a.length / 2.0;
-        }
-    }
 }
 
 /// `ego vehicle: BEHAVIOR, SPEED, lane N`, for a comment.

@@ -1,10 +1,12 @@
 //! The choice of map: the road features the scenario asks for, in priority order, and the
 //! map that keeps the most important ones with every actor in place (`spec/backends/scenic.md`
-//! §3). When no map has every lane the actors use, they move to the nearest lanes of the
-//! closest layout (W0701); every feature the chosen map lacks is a W0701.
+//! §3). When no map has every lane the actors use, the choice names the closest road
+//! (a map and its lanes) for the layout to be laid out within ([`Choice::relayout`]): the
+//! layout moves what that road lacks (W0701 from its findings). Every feature the chosen map
+//! lacks is a W0701.
 
 use tad_diagnostics::{Code, Payload, Span};
-use tad_ir::{Motion, Scenario};
+use tad_ir::Motion;
 
 use super::ego::EgoPlan;
 use super::groups::{Resolved, Target};
@@ -116,10 +118,11 @@ pub struct Choice {
     /// Descriptions of the features kept and of those left out, for comments.
     pub kept: Vec<String>,
     pub dropped: Vec<String>,
-    /// The ego, in the lane the map has.
-    pub ego: EgoPlan,
     /// Whether the ego is placed before a junction.
     pub junction: bool,
+    /// No map has every lane the layout uses: the map of the closest road, and its lanes,
+    /// for the layout to be laid out within before choosing again.
+    pub relayout: Option<(String, tad_layout::Limits)>,
 }
 
 /// Every feature the scenario asks for, sorted by priority: the road's, the ego's turn, a
@@ -150,18 +153,16 @@ fn lane_needs(groups: &[Resolved], ego_lane: i64, needs: &mut Needs) {
     needs.index = ego_lane as u32;
 }
 
-/// The map and what of the road it keeps (see the module's header); the ego and the groups
-/// on its road move to lanes the map has when none has all they use.
+/// The map and what of the road it keeps (see the module's header).
 pub fn choose(
-    scenario: &Scenario,
     road: &RoadRequest,
-    mut ego: EgoPlan,
-    groups: &mut [Resolved],
+    ego: &EgoPlan,
+    groups: &[Resolved],
     laid: &tad_layout::Layout,
     requested: Option<&str>,
     report: &mut Report,
 ) -> Choice {
-    let features = features(road, &ego, groups);
+    let features = features(road, ego, groups);
     let junction = features_need_junction(&features);
     let preference: Vec<&str> = road.preference.iter().map(String::as_str).collect();
     let mut needs = Needs::default();
@@ -176,21 +177,16 @@ pub fn choose(
     } else {
         maps::KNOWN.to_vec()
     };
-    let mut full = full_windows(laid, &needs);
-    let mut best = select(&needs, &full, &features, &candidates, &preference);
+    let full = full_windows(laid, &needs);
+    let best = select(&needs, &full, &features, &candidates, &preference);
+    let mut relayout = None;
     if let Some((false, m, _)) = best
         && map_known
     {
-        // No map has every lane the scenario uses: move actors into the lanes of the
-        // closest layout, and choose again on its map.
+        // No map has every lane the scenario uses: the closest road, for the layout.
         let pool: Vec<&str> = if requested.is_some() { vec![m] } else { candidates.clone() };
-        if let Some(closest) = maps::closest_layout(&pool, (needs.min_same, needs.min_other)) {
-            move_into_lanes(scenario, closest, &mut ego, groups, report);
-            lane_needs(groups, ego.lane, &mut needs);
-            layout::windows(laid, &mut needs, junction, Some(&first));
-            full = full_windows(laid, &needs);
-            best = select(&needs, &full, &features, &[closest.0], &preference);
-        }
+        relayout = maps::closest_layout(&pool, (needs.min_same, needs.min_other))
+            .map(|(m, same, other)| (m.to_string(), tad_layout::Limits { same, other }));
     }
     let (map, kept_flags) = match best {
         Some((base_ok, m, kept)) => {
@@ -213,7 +209,7 @@ pub fn choose(
         })
         .collect();
     let junction = chosen.junction.is_some();
-    Choice { map, map_known, needs: chosen, kept, dropped, ego, junction }
+    Choice { map, map_known, needs: chosen, kept, dropped, junction, relayout }
 }
 
 /// The map asked for with `--map`: (its name, whether the backend knows it; W0705 when
@@ -250,47 +246,6 @@ fn full_windows(laid: &tad_layout::Layout, needs: &Needs) -> [Needs; 2] {
     layout::windows(laid, &mut away, false, None);
     layout::windows(laid, &mut before, true, None);
     [away, before]
-}
-
-/// The ego and the groups on its road move into the lanes of map `m`'s closest layout
-/// (`same` lanes the ego's way, `other` the other way): a W0701 for each that moves.
-fn move_into_lanes(
-    scenario: &Scenario,
-    (m, same, other): (&str, u32, u32),
-    ego: &mut EgoPlan,
-    groups: &mut [Resolved],
-    report: &mut Report,
-) {
-    let remap = |lane: i64| -> i64 {
-        if lane > 0 {
-            lane.min(i64::from(same))
-        } else if other > 0 {
-            lane.max(-i64::from(other))
-        } else {
-            1
-        }
-    };
-    let mut allowed: Vec<String> = (1..=same).map(|l| format!("lane {l}")).collect();
-    allowed.extend((1..=other).map(|l| format!("lane -{l}")));
-    let mut moved = |lane: i64, span: Span, who: &str| {
-        let to = remap(lane);
-        if to != lane {
-            report.warn(
-                Code::W0701,
-                format!("{m} has no lane {lane} for {who}"),
-                span,
-                format!("placed in lane {to}"),
-                Payload::Incompatible { subject: m.to_string(), value: format!("lane {lane}"), allowed: allowed.clone() },
-            )
-            .note(format!("no map has all the lanes the scenario uses; {m} has a road with {} in the ego's direction and {} in the other", plural(same as usize, "lane"), plural(other as usize, "lane")));
-        }
-        to
-    };
-    ego.lane = moved(ego.lane, ego.lane_span, "the ego vehicle");
-    for (g, group) in groups.iter_mut().zip(&scenario.groups).filter(|(g, _)| g.arm == tad_layout::Arm::Ego) {
-        let span = group.lane.span().unwrap_or(group.name_span);
-        g.lane = moved(g.lane, span, &format!("group `{}`", group.name));
-    }
 }
 
 /// W0701: no place on map `m` has every lane the scenario uses.

@@ -1,15 +1,14 @@
-//! The ego vehicle: a `Car` of the actor type its `reference` declares (`reference ego {
-//! actor_type: car }`) for its size and typical speed, its behavior's motion, its speed and
-//! its lane (the middle lane when not given; never an opposite lane).
+//! The ego vehicle as the program renders it: a `Car` with the layout's size, motion,
+//! speed and lane (`tad_layout::Layout::ego`, its facts), the speed range and choice of
+//! behaviors Scenic samples, and where Scenic only approximates its behavior (W0703).
 
 use tad_diagnostics::{Code, Span};
 use tad_ir::{ActorType, Entry, Motion, Scenario};
+use tad_layout::Layout;
 
 use super::report::{Annotate, Report, unsupported};
-use super::{ends, keyword, motion, nominal};
+use super::{ends, keyword, motion};
 use crate::mapping::Class;
-
-const WHO: &str = "the ego vehicle";
 
 /// The ego vehicle, resolved.
 #[derive(Clone, Debug, PartialEq)]
@@ -33,57 +32,39 @@ pub struct EgoPlan {
 
 /// The actor type the ego vehicle is: the first `reference` that declares one.
 pub fn actor_type(scenario: &Scenario) -> Option<&Entry<ActorType>> {
-    let id = scenario.entries.reference_points.iter().find_map(|(_, e)| e.attrs.actor_type)?;
-    scenario.entries.get(id)
+    tad_layout::facts::ego_type(scenario)
 }
 
-pub fn plan(scenario: &Scenario, scenario_span: Span, report: &mut Report) -> EgoPlan {
+pub fn plan(scenario: &Scenario, laid: &Layout, scenario_span: Span, report: &mut Report) -> EgoPlan {
     let ego = &scenario.ego;
     let section = keyword(ego.span, "ego", scenario_span);
-    let kind = actor_type(scenario).map(|e| &e.attrs);
-    let positive = |m: Option<tad_ir::Metres>| m.map(|m| m.0).filter(|v| *v > 0.0);
-    let length = positive(kind.and_then(|k| k.length)).unwrap_or(4.5);
-    let width = positive(kind.and_then(|k| k.width)).unwrap_or(1.8);
     let behavior_span = ego.behavior.span().unwrap_or(section);
-    let (motion, behavior) = motion::of(scenario, &nominal(&ego.behavior), Class::Car, WHO, behavior_span, report);
-    let motions = motion::choices(scenario, &ego.behavior, Class::Car, WHO, behavior_span, report);
-    let typical = kind.and_then(|k| k.typical_speed).map_or(50.0 / 3.6, |s| s.0);
+    motion::approximate(scenario, &ego.behavior, Class::Car, report);
+    let motions = motion::choices(scenario, &ego.behavior, Class::Car, report);
     let speed_range = ends(&ego.speed, |s| s.0.max(0.0)).filter(|(low, high)| low < high);
-    // the layout keeps room for the fastest
-    let fastest = ego.speed.clone().map(|p| p.max());
-    let speed = motion::speed(&fastest, typical, behavior, WHO, section, report);
     let lane_span = ego.lane.span().unwrap_or(section);
-    let lanes = scenario.road.lanes.get().filter(|n| *n >= 1).map(|n| n.min(1000));
-    let lane = match ego.lane.get() {
-        Some(lane) => lane.index(),
-        None => {
-            let lane = lanes.map_or(1, |n| (n + 1) / 2);
-            report
-                .warn(
-                    Code::W0706,
-                    "the lane of the ego vehicle is not given",
-                    lane_span,
-                    format!("lane {lane} chosen"),
-                    unsupported("ego.lane", Some(format!("lane {lane}"))),
-                )
-                .note("the middle lane (the left one of the two middle lanes)");
-            lane
-        }
-    };
-    let lane = if lane < 0 {
+    if ego.lane.get().is_some_and(|lane| lane.index() < 0) {
         // The ego drives in its own direction: lane indexes are relative to it.
         report
             .warn(
                 Code::W0703,
                 "the ego vehicle cannot be in an opposite lane",
                 lane_span,
-                "lane 1 used",
-                unsupported("ego.lane", Some("lane 1".into())),
+                format!("lane {} used", laid.ego.lane),
+                unsupported("ego.lane", Some(format!("lane {}", laid.ego.lane))),
             )
             .note("lane indexes are relative to the ego's direction of travel");
-        1
-    } else {
-        lane
-    };
-    EgoPlan { length, width, speed, motion, lane, lane_span, behavior_span, speed_range, motions }
+    }
+    let facts = &laid.ego_facts;
+    EgoPlan {
+        length: facts.length,
+        width: facts.width,
+        speed: facts.speed,
+        motion: facts.motion,
+        lane: laid.ego.lane,
+        lane_span,
+        behavior_span,
+        speed_range,
+        motions,
+    }
 }

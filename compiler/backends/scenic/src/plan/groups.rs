@@ -1,13 +1,14 @@
 //! Every actor group resolved but for its place: the Scenic class and CARLA blueprint its
 //! actor type declares (`simulated_as`, `carla_blueprint`, `carla_note`; else its kind's),
-//! its size, count, motion, speed, what its position refers to, and its lane (from the
-//! relation's `lateral` part when not written).
+//! what its position refers to, and the layout's facts of it (size, count, motion, speed,
+//! lane and arm: `tad_layout::GroupLayout`), with where Scenic renders them only
+//! approximately (W0703, W0707).
 
 use tad_diagnostics::{Code, Span};
 use tad_ir::{ActorType, Entry, Field, Lane, Lateral, Longitudinal, Reference, Scenario};
 
 use super::report::{Annotate, Report, named, unsupported};
-use super::{MAX_GROUP, ends, kmh, motion, nominal};
+use super::{ends, kmh, motion};
 use crate::mapping::{self, Class};
 
 /// Where a group's position points.
@@ -38,12 +39,12 @@ pub struct Resolved {
     pub mapping: Mapping,
     pub length: f64,
     pub width: f64,
-    /// At most [`MAX_GROUP`].
+    /// The layout's (at most `tad_layout::MAX_GROUP`).
     pub count: usize,
     pub motion: Option<tad_ir::Motion>,
     /// m/s.
     pub speed: f64,
-    /// TAD lane index (on its arm); 0 until [`lanes_from`] when not written.
+    /// TAD lane index (on its arm), the layout's.
     pub lane: i64,
     /// The junction arm its first actor stands on (`Ego` without a junction).
     pub arm: tad_layout::Arm,
@@ -102,10 +103,11 @@ pub fn reference_name<'s>(scenario: &'s Scenario, reference: &'s Reference) -> &
 }
 
 /// Every group of `scenario`, in source order.
-pub fn resolve(scenario: &Scenario, report: &mut Report) -> Vec<Resolved> {
+pub fn resolve(scenario: &Scenario, laid: &tad_layout::Layout, report: &mut Report) -> Vec<Resolved> {
     let entries = &scenario.entries;
     let mut out = Vec::new();
-    for group in &scenario.groups {
+    for (group, layout) in scenario.groups.iter().zip(&laid.groups) {
+        let facts = &layout.facts;
         let who = format!("group `{}`", group.name);
         let (type_name, entry) = match &group.actor_type {
             Field::Given(written, _) => (entries.name(written).to_string(), entries.resolved(written)),
@@ -124,10 +126,6 @@ pub fn resolve(scenario: &Scenario, report: &mut Report) -> Vec<Resolved> {
                 )
                 .note(why.clone());
         }
-        let (default_length, default_width) = mapping.class.default_size();
-        let positive = |m: Option<tad_ir::Metres>| m.map(|m| m.0).filter(|v| *v > 0.0);
-        let length = positive(entry.and_then(|e| e.attrs.length)).unwrap_or(default_length);
-        let width = positive(entry.and_then(|e| e.attrs.width)).unwrap_or(default_width);
         let count_span = group.count.span().unwrap_or(group.name_span);
         let count_param = group.count_param();
         if let Some(tad_ir::Param::Range { min, max }) = &count_param {
@@ -142,57 +140,13 @@ pub fn resolve(scenario: &Scenario, report: &mut Report) -> Vec<Resolved> {
                 )
                 .note("a Scenic program creates a fixed set of objects: how many cannot depend on a sampled value");
         }
-        let count = match count_param.as_ref().map(tad_ir::Param::nominal) {
-            Some(n) if n >= 1 => usize::try_from(n).unwrap_or(usize::MAX),
-            Some(_) => 1,
-            None => {
-                report.warn(
-                    Code::W0706,
-                    format!("the number of actors of {who} is not given"),
-                    count_span,
-                    "1 chosen",
-                    unsupported("actor.count", Some("1".into())),
-                );
-                1
-            }
-        };
-        let count = if count > MAX_GROUP {
-            report
-                .warn(
-                    Code::W0702,
-                    format!("{who} is capped at {MAX_GROUP} actors"),
-                    count_span,
-                    format!("{count} written"),
-                    unsupported(format!("{count} actors in {who}"), Some(format!("{MAX_GROUP} actors"))),
-                )
-                .note("a Scenic scene with very many objects samples slowly and rarely fits on one stretch of road");
-            MAX_GROUP
-        } else {
-            count
-        };
-        let (motion, behavior) =
-            motion::of(scenario, &nominal(&group.behavior), mapping.class, &who, group.name_span, report);
-        let motions = motion::choices(scenario, &group.behavior, mapping.class, &who, group.name_span, report);
-        let typical = entry.and_then(|e| e.attrs.typical_speed).map_or(0.0, |s| s.0);
+        motion::approximate(scenario, &group.behavior, mapping.class, report);
         let debris = mapping.class == Class::Debris;
+        let motions = motion::choices(scenario, &group.behavior, mapping.class, report);
         let speed_range = ends(&group.speed, |s| s.0.max(0.0)).filter(|(low, high)| low < high && !debris);
-        let speed = if debris {
-            0.0
-        } else {
-            // the layout keeps room for the fastest
-            motion::speed(&group.speed.clone().map(|p| p.max()), typical, behavior, &who, group.name_span, report)
-        };
         let (target, longitudinal, lateral) = match group.position.given() {
-            None => {
-                report.warn(
-                    Code::W0706,
-                    format!("the position of {who} is not given"),
-                    group.position.span().unwrap_or(group.name_span),
-                    "`front of ego` chosen",
-                    unsupported("actor.position", Some("`front of ego`".into())),
-                );
-                (Target::Ego, Longitudinal::Front, None)
-            }
+            // the layout's choice (W0706 from its findings)
+            None => (Target::Ego, Longitudinal::Front, None),
             Some(p) => {
                 let relation = entries.resolved(&p.relation.value).map(|r| r.attrs);
                 let longitudinal = match relation.and_then(|r| r.longitudinal) {
@@ -222,18 +176,19 @@ pub fn resolve(scenario: &Scenario, report: &mut Report) -> Vec<Resolved> {
                 (target, longitudinal, relation.and_then(|r| r.lateral))
             }
         };
-        let summary = summary(scenario, group, &type_name, count);
+        let summary = summary(scenario, group, &type_name, facts.count);
+        let first = layout.agents.first();
         out.push(Resolved {
             name: group.name.clone(),
             summary,
             mapping,
-            length,
-            width,
-            count,
-            motion,
-            speed,
-            lane: group.lane.get().map_or(0, Lane::index),
-            arm: tad_layout::Arm::Ego,
+            length: facts.length,
+            width: facts.width,
+            count: facts.count,
+            motion: facts.motion,
+            speed: facts.speed,
+            lane: first.map_or_else(|| group.lane.get().map_or(0, Lane::index), |a| a.lane),
+            arm: first.map_or(tad_layout::Arm::Ego, |a| a.station.arm),
             target,
             longitudinal,
             lateral,
@@ -247,45 +202,6 @@ pub fn resolve(scenario: &Scenario, report: &mut Report) -> Vec<Resolved> {
         });
     }
     out
-}
-
-/// Lanes and arms from the layout; the lanes it chose are reported (W0706).
-pub fn lanes_from(scenario: &Scenario, laid: &tad_layout::Layout, groups: &mut [Resolved], report: &mut Report) {
-    for g in &laid.groups {
-        let Some(first) = g.agents.first() else { continue };
-        let Some(resolved) = groups.get_mut(g.group.index()) else { continue };
-        resolved.lane = first.lane;
-        resolved.arm = first.station.arm;
-    }
-    for finding in &laid.findings {
-        match finding {
-            tad_layout::Finding::Chosen(c) if c.field == "lane" => {
-                let Some(group) = c.group.and_then(|id| scenario.group(id)) else { continue };
-                report
-                    .warn(
-                        Code::W0706,
-                        format!("the lane of group `{}` is not given", group.name),
-                        c.span,
-                        format!("{} chosen", c.value),
-                        unsupported("actor.lane", Some(c.value.clone())),
-                    )
-                    .note(c.rule);
-            }
-            tad_layout::Finding::NoArm { group, arm, span } => {
-                let Some(group) = scenario.group(*group) else { continue };
-                report
-                    .warn(
-                        Code::W0701,
-                        format!("the junction has no {} arm for group `{}`", arm.as_str(), group.name),
-                        *span,
-                        "placed on the ego's road instead",
-                        unsupported("actor.position", Some("the ego's road".into())),
-                    )
-                    .note("a three-way junction keeps the arms the ego and most groups need");
-            }
-            _ => {}
-        }
-    }
 }
 
 /// `group `NAME`: COUNT TYPE, BEHAVIOR, SPEED, RELATION of REFERENCE, lane N`: what the

@@ -10,15 +10,17 @@
 //!
 //! [`plan`] runs the steps in order, each in its own module with a typed result:
 //!
-//! 1. [`road`]: what the road section asks of the map ([`road::RoadRequest`]);
-//! 2. [`ego`]: the ego vehicle's size, motion, speed and lane ([`ego::EgoPlan`]);
-//! 3. [`groups`]: every actor group's mapping, count, motion, speed, reference, and its lane
-//!    and arm from the layout ([`groups::Resolved`]);
-//! 4. [`choice`]: the road features in priority order and the map that keeps the most
+//! 1. [`findings`]: the layout's findings (values it chose, arms the road lacks, capped
+//!    groups) as the backend's diagnostics;
+//! 2. [`ego`]: the ego vehicle as the layout decided it ([`ego::EgoPlan`]);
+//! 3. [`road`]: what the road section asks of the map ([`road::RoadRequest`]);
+//! 4. [`groups`]: every actor group's mapping and reference, with the layout's facts of it
+//!    ([`groups::Resolved`]);
+//! 5. [`choice`]: the road features in priority order and the map that keeps the most
 //!    important ones ([`choice::Choice`]), moving actors into lanes the map has;
-//! 5. [`layout`]: the stretch of road the layout needs, and capping groups to what the map has;
-//! 6. [`actors`]: the objects of the program, with their identifiers;
-//! 7. [`environment`]: CARLA's weather parameters, and the traffic light.
+//! 6. [`layout`]: the stretch of road the layout needs, and capping groups to what the map has;
+//! 7. [`actors`]: the objects of the program, with their identifiers;
+//! 8. [`environment`]: CARLA's weather parameters, and the traffic light.
 //!
 //! Every step reads names through the IR's typed entries: what a name maps to is declared
 //! with it in TAD (see `crate::mapping`).
@@ -27,6 +29,7 @@ pub mod actors;
 pub mod choice;
 pub mod ego;
 pub mod environment;
+pub mod findings;
 pub mod groups;
 pub mod layout;
 pub mod motion;
@@ -41,21 +44,6 @@ use crate::mapping::Class;
 use crate::maps::Needs;
 use report::Report;
 
-/// The most actors one group becomes.
-pub const MAX_GROUP: usize = 20;
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Place {
-    /// The centre of the lane.
-    Centre,
-    /// The curb side of the lane, when it is the outermost lane of its direction.
-    Curb,
-    /// The sidewalk beside the lane, when it is the outermost lane and has one.
-    Sidewalk,
-    /// Just outside the outermost lane (a shoulder or parking strip).
-    Shoulder,
-}
-
 /// One object of the Scenic program.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Actor {
@@ -69,14 +57,13 @@ pub struct Actor {
     pub width: f64,
     /// TAD lane index on its arm.
     pub lane: i64,
-    /// Moved by the map choice into another lane than the layout's (W0701).
-    pub moved: bool,
     /// The junction arm it stands on (`Ego`: the ego's road).
     pub arm: tad_layout::Arm,
     /// On the ego's road: metres along the ego's lane from the ego's centre. On another
     /// arm: metres before its stop line (outgoing lanes: after the junction).
     pub offset: f64,
-    pub place: Place,
+    /// Where across its lane it stands: the layout's.
+    pub place: tad_layout::Place,
     /// About to walk across the road: from its right-hand side (as the arm's incoming
     /// traffic, or the ego, sees it), and how much further from the road it stands.
     pub cross: Option<(bool, f64)>,
@@ -122,12 +109,6 @@ impl Sampled {
     }
 }
 
-/// A parameter's value as one value, for the steps that need one: its nominal value (the
-/// midpoint of a range, the first of a choice).
-pub(crate) fn nominal<T: ParamValue>(field: &Field<Param<T>>) -> Field<T> {
-    field.clone().map(|p| p.nominal())
-}
-
 /// A range's or a value's ends, in SI.
 pub(crate) fn ends<T: ParamValue + PartialOrd>(field: &Field<Param<T>>, si: impl Fn(&T) -> f64) -> Option<(f64, f64)> {
     field.given().map(|p| (si(&p.min()), si(&p.max())))
@@ -165,6 +146,9 @@ pub struct Plan {
     /// The road features asked for, and those left out, for comments.
     pub kept: Vec<String>,
     pub dropped: Vec<String>,
+    /// The layout the program renders: laid out within the map's lanes when the map has
+    /// fewer than the scenario uses.
+    pub layout: tad_layout::Layout,
 }
 
 /// The span of a section's keyword (the section's span starts with it), or `fallback`.
@@ -190,21 +174,42 @@ pub(crate) fn list(names: &[&str]) -> String {
     }
 }
 
+/// Steps 1 to 5 on a layout: its findings, the ego, the road's needs, the groups, the map
+/// (`requested`, else chosen); `fitted`: the map the layout was laid out within.
+fn decide(
+    scenario: &Scenario,
+    laid: &tad_layout::Layout,
+    requested: Option<&str>,
+    fitted: Option<&findings::Fitted>,
+    report: &mut Report,
+) -> (ego::EgoPlan, road::RoadRequest, Vec<groups::Resolved>, choice::Choice) {
+    let scenario_span = scenario.name.as_ref().map_or(scenario.span, |n| n.span);
+    let road_span = keyword(scenario.road.span, "road", scenario_span);
+    findings::report(scenario, laid, fitted, report);
+    let ego = ego::plan(scenario, laid, scenario_span, report);
+    let road = road::request(scenario, road_span, report);
+    let groups = groups::resolve(scenario, laid, report);
+    let choice = choice::choose(&road, &ego, &groups, laid, requested, report);
+    (ego, road, groups, choice)
+}
+
 /// The plan of `scenario`'s program, and the backend's diagnostics (unsorted).
 pub fn plan(scenario: &Scenario, options: &EmitOptions) -> (Plan, Vec<Diagnostic>) {
     let mut report = Report::default();
-    let scenario_span = scenario.name.as_ref().map_or(scenario.span, |n| n.span);
-    let road_span = keyword(scenario.road.span, "road", scenario_span);
 
-    let ego = ego::plan(scenario, scenario_span, &mut report);
-    let road = road::request(scenario, road_span, &mut report);
-    let laid = tad_layout::lay_out(scenario);
-    let mut groups = groups::resolve(scenario, &mut report);
-    groups::lanes_from(scenario, &laid, &mut groups, &mut report);
-
-    let choice = choice::choose(scenario, &road, ego, &mut groups, &laid, options.map.as_deref(), &mut report);
-    let ego = choice.ego.clone();
-
+    // the layout, then the map; when no map has every lane it uses, the layout again within
+    // the closest map's lanes (it moves what that road lacks), and the map chosen on it
+    let mut laid = tad_layout::lay_out(scenario);
+    let mut first = Report::default();
+    let (mut ego, mut road, mut groups, mut choice) = decide(scenario, &laid, options.map.as_deref(), None, &mut first);
+    match choice.relayout.take() {
+        None => report.diagnostics.extend(first.diagnostics),
+        Some((map, limits)) => {
+            laid = tad_layout::lay_out_within(scenario, Some(limits));
+            let fitted = findings::Fitted { map: &map, limits };
+            (ego, road, groups, choice) = decide(scenario, &laid, Some(&map), Some(&fitted), &mut report);
+        }
+    }
     let kept = if choice.map_known {
         layout::fit(scenario, &laid, &choice.needs, &choice.map, choice.junction, &mut report)
     } else {
@@ -236,6 +241,7 @@ pub fn plan(scenario: &Scenario, options: &EmitOptions) -> (Plan, Vec<Diagnostic
         light: environment.light,
         kept: choice.kept,
         dropped: choice.dropped,
+        layout: laid,
     };
     (plan, report.diagnostics)
 }
