@@ -15,7 +15,7 @@ use crate::palette::{self, Colour};
 use crate::view::{self, View};
 use crate::{GifOptions, Scene};
 use std::collections::HashMap;
-use tad_layout::geom::Vec2;
+use tad_road::geom::Vec2;
 use tiny_skia::{FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, Rect, Stroke, StrokeDash, Transform};
 
 /// The largest picture drawn, px a side.

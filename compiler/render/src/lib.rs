@@ -23,7 +23,7 @@ mod tests;
 
 pub use anim::gif;
 pub use svg::svg;
-pub use tad_layout::{Arm, Road};
+pub use tad_road::{Arm, Road};
 
 /// A simulated scenario to draw.
 #[derive(Clone, Debug)]
@@ -76,8 +76,8 @@ pub struct Frame {
     pub lights: Vec<(Arm, Light)>,
 }
 
-/// What a traffic light shows (`tad_layout::Signal`, the workspace's one light state).
-pub use tad_layout::Signal as Light;
+/// What a traffic light shows (`tad_ir::Signal`, the workspace's one light state).
+pub use tad_ir::Signal as Light;
 
 /// The lights in the order the legend lists them.
 pub const LIGHTS: [Light; 4] = [Light::Green, Light::Yellow, Light::Red, Light::Off];

@@ -18,9 +18,9 @@
 use crate::palette::{self, Colour};
 use crate::view::Bounds;
 use crate::{Kind, Scene};
-use tad_layout::geom::{Path, Vec2};
-use tad_layout::road::{CROSSWALK, RING, RUN, SIDEWALK_WIDTH, Station};
-use tad_layout::{Arm, Road, Shape};
+use tad_road::geom::{Path, Vec2};
+use tad_road::road::{CROSSWALK, RING, RUN, SIDEWALK_WIDTH, Station};
+use tad_road::{Arm, Road, Shape};
 
 /// A shape in metres.
 #[derive(Clone, Debug, PartialEq)]

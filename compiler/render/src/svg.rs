@@ -12,7 +12,7 @@ use crate::palette;
 use crate::view::{self, Bounds, View};
 use crate::{Kind, Light, Scene};
 use std::fmt::Write;
-use tad_layout::geom::Vec2;
+use tad_road::geom::Vec2;
 
 /// A number as SVG gets it: one decimal, never `-0.0`, 0 for what is not finite.
 fn n(v: f64) -> String {
@@ -336,7 +336,7 @@ fn actors(s: &mut Svg) {
 }
 
 /// The front share of a body, painted dark to show which way it faces.
-pub fn front(body: &tad_layout::geom::Footprint) -> [Vec2; 4] {
+pub fn front(body: &tad_road::geom::Footprint) -> [Vec2; 4] {
     let c = body.corners();
     let back = palette::FRONT.min(1.0);
     // corners 0 and 1 are the front ones; 3 and 2 the back ones on the same sides
@@ -345,7 +345,7 @@ pub fn front(body: &tad_layout::geom::Footprint) -> [Vec2; 4] {
 
 /// Each arm's light: a dot in its state at the first frame, ringed by its state at the last
 /// when that differs.
-fn signals(s: &mut Svg, places: &[(tad_layout::Arm, Vec2)]) {
+fn signals(s: &mut Svg, places: &[(tad_road::Arm, Vec2)]) {
     let scene = s.scene;
     let state =
         |frame: Option<&crate::Frame>, arm| frame.and_then(|f| f.lights.iter().find(|(a, _)| *a == arm)).map(|l| l.1);
@@ -595,7 +595,7 @@ fn draw_legend(s: &mut Svg, entries: &[Entry], x: f64, y: f64, h: f64) {
                     palette::light(*l).hex(),
                     palette::INK.hex()
                 ),
-                format!("light {}", tad_layout::ClosedSet::as_str(*l)),
+                format!("light {}", tad_ir::ClosedSet::as_str(*l)),
             ),
             Entry::Note(t) => (String::new(), t.clone()),
         };

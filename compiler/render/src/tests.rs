@@ -3,9 +3,9 @@
 
 use crate::view::View;
 use crate::{ActorInfo, Event, Frame, GifOptions, Kind, Light, Scene, anim, gif, palette, svg};
-use tad_layout::geom::Vec2;
-use tad_layout::road::{Junction, LANE_WIDTH, Station, Turn};
-use tad_layout::{Arm, Road, Shape};
+use tad_road::geom::Vec2;
+use tad_road::road::{Junction, LANE_WIDTH, Station, Turn};
+use tad_road::{Arm, Road, Shape};
 
 fn road(shape: Shape, crosswalks: bool) -> Road {
     let junction = match shape {
@@ -339,7 +339,7 @@ fn samples() {
         };
         // a walker crosses the ego's road (at a junction, on its crosswalk), a car is parked
         // on the far side facing the oncoming traffic, a dog shows up late on the sidewalk
-        let cross = if road.junction.is_some() { road.approach + tad_layout::road::CROSSWALK } else { 45.0 };
+        let cross = if road.junction.is_some() { road.approach + tad_road::road::CROSSWALK } else { 45.0 };
         let right = -(road.lanes as f64) * road.lane_width - 1.5;
         let walker: Vec<Option<[f64; 3]>> = (0..steps)
             .map(|k| {

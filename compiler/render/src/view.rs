@@ -1,6 +1,6 @@
 //! The window onto the road: what the picture shows and how metres become pixels.
 //!
-//! The road runs [`tad_layout::road::RUN`] metres each way, far more than a scenario uses,
+//! The road runs [`tad_road::road::RUN`] metres each way, far more than a scenario uses,
 //! so the window is fitted to what moved (every actor whose position changed by more than
 //! [`MOVED`] m, and the ego always), the events, and the junction when it is near; plus
 //! [`palette::MARGIN`] and at least [`palette::MIN_VIEW`] metres each way. A scene where
@@ -8,7 +8,7 @@
 //! Pixels have `y` down, so the road's `y` (to the left of `x`) is flipped.
 
 use crate::{Scene, palette};
-use tad_layout::geom::{Footprint, Pose, Vec2};
+use tad_road::geom::{Footprint, Pose, Vec2};
 
 /// Actors that moved less than this are "static" for the window, m.
 const MOVED: f64 = 0.5;
