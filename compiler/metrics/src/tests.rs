@@ -14,36 +14,50 @@ fn assert_close(actual: f64, expected: f64) {
     assert!(close(actual, expected), "{actual} != {expected}");
 }
 
-/// A record at `time` with the fields the scorer reads.
-#[allow(clippy::too_many_arguments)]
-fn rec(
-    time: f64,
-    acceleration: [f64; 3],
-    yaw_deg: f64,
-    driven_distance: f64,
-    off_road: bool,
-    distance_to_route: f64,
-    route_complete: f64,
-) -> StepRecord {
-    StepRecord {
-        time,
-        acceleration,
-        yaw_deg,
-        driven_distance,
-        off_road,
-        distance_to_route,
-        route_complete,
-        ..StepRecord::default()
-    }
-}
-
 /// Four steps, 0.1 s apart, ending in a collision.
 fn crash() -> Vec<StepRecord> {
+    // motion and route in full, as `one_episode_by_hand` adds them up; the event counts below
     let mut r = vec![
-        rec(0.0, [3.0, 4.0, 0.0], 10.0, 0.0, false, 1.0, 0.0),
-        rec(0.1, [0.0, 0.0, 0.0], 20.0, 1.0, true, 2.0, 10.0),
-        rec(0.2, [1.0, 0.0, 0.0], 15.0, 3.0, false, 0.0, 20.0),
-        rec(0.3, [0.0, 2.0, 0.0], 15.0, 6.0, false, 1.0, 30.0),
+        StepRecord {
+            time: 0.0,
+            acceleration: [3.0, 4.0, 0.0],
+            yaw_deg: 10.0,
+            driven_distance: 0.0,
+            off_road: false,
+            distance_to_route: 1.0,
+            route_complete: 0.0,
+            ..StepRecord::default()
+        },
+        StepRecord {
+            time: 0.1,
+            acceleration: [0.0, 0.0, 0.0],
+            yaw_deg: 20.0,
+            driven_distance: 1.0,
+            off_road: true,
+            distance_to_route: 2.0,
+            route_complete: 10.0,
+            ..StepRecord::default()
+        },
+        StepRecord {
+            time: 0.2,
+            acceleration: [1.0, 0.0, 0.0],
+            yaw_deg: 15.0,
+            driven_distance: 3.0,
+            off_road: false,
+            distance_to_route: 0.0,
+            route_complete: 20.0,
+            ..StepRecord::default()
+        },
+        StepRecord {
+            time: 0.3,
+            acceleration: [0.0, 2.0, 0.0],
+            yaw_deg: 15.0,
+            driven_distance: 6.0,
+            off_road: false,
+            distance_to_route: 1.0,
+            route_complete: 30.0,
+            ..StepRecord::default()
+        },
     ];
     r[1].lane_invasion = 1;
     r[2].lane_invasion = 1;
@@ -106,14 +120,17 @@ fn yaw_crossing_180() {
     // 170° → −170° → −160°: Compat sums |−340| + |10| = 350°; Fixed wraps −340° to 20°:
     // 20 + 10 = 30°. T = 0.2 s.
     let r = [
-        rec(0.0, [0.0; 3], 170.0, 0.0, false, 0.0, 0.0),
-        rec(0.1, [0.0; 3], -170.0, 1.0, false, 0.0, 0.0),
-        rec(0.2, [0.0; 3], -160.0, 2.0, false, 0.0, 0.0),
+        StepRecord { time: 0.0, yaw_deg: 170.0, ..StepRecord::default() },
+        StepRecord { time: 0.1, yaw_deg: -170.0, driven_distance: 1.0, ..StepRecord::default() },
+        StepRecord { time: 0.2, yaw_deg: -160.0, driven_distance: 2.0, ..StepRecord::default() },
     ];
     assert_close(score_episode(&r, Mode::Compat).unwrap().metrics.yv, 350.0_f64.to_radians() / 0.2);
     assert_close(score_episode(&r, Mode::Fixed).unwrap().metrics.yv, 30.0_f64.to_radians() / 0.2);
     // −180° to 180° is no turn at all once wrapped.
-    let flip = [rec(0.0, [0.0; 3], -180.0, 0.0, false, 0.0, 0.0), rec(0.5, [0.0; 3], 180.0, 0.0, false, 0.0, 0.0)];
+    let flip = [
+        StepRecord { time: 0.0, yaw_deg: -180.0, ..StepRecord::default() },
+        StepRecord { time: 0.5, yaw_deg: 180.0, ..StepRecord::default() },
+    ];
     assert_close(score_episode(&flip, Mode::Fixed).unwrap().metrics.yv, 0.0);
     assert_close(score_episode(&flip, Mode::Compat).unwrap().metrics.yv, 2.0 * PI / 0.5);
 }
@@ -144,8 +161,14 @@ fn nothing_completes() {
 #[test]
 fn time_spent_averages_completed_episodes_only() {
     // Completed in 2 s; the other (5 s, 50 %) does not count: TS = 2, Comp = 0.75.
-    let done = [rec(1.0, [0.0; 3], 0.0, 0.0, false, 0.0, 0.0), rec(3.0, [0.0; 3], 0.0, 20.0, false, 0.0, 100.0)];
-    let half = [rec(0.0, [0.0; 3], 0.0, 0.0, false, 0.0, 0.0), rec(5.0, [0.0; 3], 0.0, 10.0, false, 0.0, 50.0)];
+    let done = [
+        StepRecord { time: 1.0, ..StepRecord::default() },
+        StepRecord { time: 3.0, driven_distance: 20.0, route_complete: 100.0, ..StepRecord::default() },
+    ];
+    let half = [
+        StepRecord { time: 0.0, ..StepRecord::default() },
+        StepRecord { time: 5.0, driven_distance: 10.0, route_complete: 50.0, ..StepRecord::default() },
+    ];
     for mode in [Mode::Compat, Mode::Fixed] {
         let eps = [score_episode(&done, mode).unwrap(), score_episode(&half, mode).unwrap()];
         assert_eq!(eps[0].metrics.ts, Some(2.0));
@@ -160,14 +183,14 @@ fn time_spent_averages_completed_episodes_only() {
 fn route_following_aggregates_the_mean_distance() {
     // Mean distances 0 m and 10 m: RF = max(1 − 5/5, 0) = 0, not the mean of the
     // per-episode stabilities (1 + 0) / 2.
-    let near = [rec(0.0, [0.0; 3], 0.0, 0.0, false, 0.0, 0.0)];
-    let far = [rec(0.0, [0.0; 3], 0.0, 0.0, false, 10.0, 0.0)];
+    let near = [StepRecord { time: 0.0, ..StepRecord::default() }];
+    let far = [StepRecord { time: 0.0, distance_to_route: 10.0, ..StepRecord::default() }];
     let eps = [score_episode(&near, Mode::Fixed).unwrap(), score_episode(&far, Mode::Fixed).unwrap()];
     assert_eq!((eps[0].metrics.rf, eps[1].metrics.rf), (1.0, 0.0));
     assert_eq!(aggregate(&eps, Mode::Fixed).unwrap().raw.rf, 0.0);
     // 2 m and 4 m: 1 − 3/5 = 0.4.
-    let a = [rec(0.0, [0.0; 3], 0.0, 0.0, false, 2.0, 0.0)];
-    let b = [rec(0.0, [0.0; 3], 0.0, 0.0, false, 4.0, 0.0)];
+    let a = [StepRecord { time: 0.0, distance_to_route: 2.0, ..StepRecord::default() }];
+    let b = [StepRecord { time: 0.0, distance_to_route: 4.0, ..StepRecord::default() }];
     let eps = [score_episode(&a, Mode::Fixed).unwrap(), score_episode(&b, Mode::Fixed).unwrap()];
     assert_close(aggregate(&eps, Mode::Fixed).unwrap().raw.rf, 0.4);
 }
@@ -177,10 +200,10 @@ fn off_road_dilation_at_the_edges() {
     // Off road at step 0 only: dilated to step 1, which counts 4 m; step 0 never counts.
     // Off road at the last step: counts its own 1 m, nothing after it.
     let r = [
-        rec(0.0, [0.0; 3], 0.0, 0.0, true, 0.0, 0.0),
-        rec(0.1, [0.0; 3], 0.0, 4.0, false, 0.0, 0.0),
-        rec(0.2, [0.0; 3], 0.0, 6.0, false, 0.0, 0.0),
-        rec(0.3, [0.0; 3], 0.0, 7.0, true, 0.0, 0.0),
+        StepRecord { time: 0.0, off_road: true, ..StepRecord::default() },
+        StepRecord { time: 0.1, driven_distance: 4.0, ..StepRecord::default() },
+        StepRecord { time: 0.2, driven_distance: 6.0, ..StepRecord::default() },
+        StepRecord { time: 0.3, driven_distance: 7.0, off_road: true, ..StepRecord::default() },
     ];
     assert_close(score_episode(&r, Mode::Compat).unwrap().metrics.or, 5.0);
 }
@@ -204,7 +227,7 @@ fn perfect_scores_one() {
     assert_eq!((s.os, s.safety, s.task, s.comfort), (1.0, 1.0, 1.0, 1.0));
     assert_eq!(scores(&Metrics { ts: None, ..best }).os, 1.0);
     // A one-step episode on the route, complete at once, calm: OS 1 in both modes.
-    let r = [rec(0.0, [0.0; 3], 90.0, 0.0, false, 0.0, 100.0)];
+    let r = [StepRecord { time: 0.0, yaw_deg: 90.0, route_complete: 100.0, ..StepRecord::default() }];
     for mode in [Mode::Compat, Mode::Fixed] {
         let e = score_episode(&r, mode).unwrap();
         assert_eq!((e.metrics.os, e.metrics.yv), (1.0, 0.0));

@@ -39,6 +39,17 @@ enum SignState {
     Done,
 }
 
+/// The ego as the criteria read it after a step.
+#[derive(Clone, Copy, Debug)]
+pub struct EgoState {
+    pub footprint: Footprint,
+    /// Its arc on the route, and its (signed) distance from it, m.
+    pub s: f64,
+    pub off_route: f64,
+    /// m/s.
+    pub speed: f64,
+}
+
 /// What the criteria say after a step.
 pub struct Reading {
     pub off_road: bool,
@@ -67,19 +78,9 @@ impl Detectors {
         }
     }
 
-    /// Read the criteria with the ego at `ego` (its arc `s` on the route and its distance
-    /// from it), at time `t`, at `speed`.
-    #[allow(clippy::too_many_arguments)]
-    pub fn read(
-        &mut self,
-        world: &World,
-        route: &Path,
-        ego: Footprint,
-        s: f64,
-        off_route: f64,
-        speed: f64,
-        t: f64,
-    ) -> Reading {
+    /// Read the criteria with the ego as `ego` says, on `route`, at time `t`.
+    pub fn read(&mut self, world: &World, route: &Path, ego: &EgoState, t: f64) -> Reading {
+        let EgoState { footprint: ego, s, off_route, speed } = *ego;
         // lane invasion: any corner now in another lane of the same road than before
         let corners = ego.corners().map(|c| world.spot(c));
         let mut invasion = false;

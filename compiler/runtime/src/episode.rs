@@ -7,7 +7,7 @@
 //! bicycle with pure pursuit and IDM, walkers along their track); rapier reports the ego's new
 //! contacts; the criteria read the new state; the record is stored; the stop rules run.
 
-use crate::detect::{Detectors, Reading};
+use crate::detect::{Detectors, EgoState, Reading};
 use crate::models::{self, Kinematics, WHEELBASE, pursue};
 use crate::physics::{Physics, Shape};
 use crate::scene::Scene;
@@ -338,8 +338,9 @@ impl<'a> Runner<'a> {
         let route = &scene.ego.route;
         let (s_now, off_route) = route.locate(self.ego.position, self.ego_s, 10.0);
         self.ego_s = s_now;
-        let fp = Footprint { pose: self.ego.pose(), length: scene.ego.size.length, width: scene.ego.size.width };
-        let reading = self.detectors.read(&scene.world, route, fp, self.ego_s, off_route, self.ego.speed, t);
+        let footprint = Footprint { pose: self.ego.pose(), length: scene.ego.size.length, width: scene.ego.size.width };
+        let ego = EgoState { footprint, s: self.ego_s, off_route, speed: self.ego.speed };
+        let reading = self.detectors.read(&scene.world, route, &ego, t);
         for (happened, kind) in [
             (reading.lane_invasion, EventKind::LaneInvasion),
             (reading.red_light, EventKind::RedLight),
@@ -440,8 +441,8 @@ impl<'a> Runner<'a> {
         });
         let lookahead = models::lookahead(ego.speed);
         let target = Pose { position: ego.position, yaw: ego.yaw }.local(route.pose(s + lookahead).position);
-        let leader =
-            ahead_on(route, ego.position, ego.yaw, s, size.length, size.width, ego.speed, true, before.iter().copied());
+        let corridor = Corridor { track: route, s, length: size.length, width: size.width };
+        let leader = ahead_on(corridor, *ego, true, before.iter().copied());
         let stop = self.ego_stop.and_then(|line| {
             let gap = line - (s + size.length / 2.0);
             (gap > -0.5 && must_stop(scene, Arm::Ego, gap, ego.speed, t, self.detectors.stopped_at_sign()))
@@ -675,17 +676,8 @@ fn leader_of(scene: &Scene, actors: &[Actor], k: usize, before: &[Seen], ego: Se
     let track = me.track.as_ref()?;
     let others = before.iter().enumerate().filter(|(j, _)| *j != k).map(|(_, &o)| o);
     let ego_entry = me.obey.then_some(ego);
-    let mut best = ahead_on(
-        track,
-        me.kin.position,
-        me.kin.yaw,
-        me.s,
-        me.length,
-        me.width,
-        me.kin.speed,
-        me.obey,
-        others.chain(ego_entry),
-    );
+    let corridor = Corridor { track, s: me.s, length: me.length, width: me.width };
+    let mut best = ahead_on(corridor, me.kin, me.obey, others.chain(ego_entry));
     if me.obey
         && let Some((line, arm)) = me.stop_line
     {
@@ -711,25 +703,31 @@ fn must_stop(scene: &Scene, arm: Arm, gap: f64, speed: f64, t: f64, stopped_at_s
     }
 }
 
-/// The nearest of `others` ahead on `track` within a vehicle's corridor: `(gap, speed
-/// along)`. Something going its way (or against it) counts where it is; something moving
-/// across counts only if, going on straight at its speed, it will be in the corridor when
-/// this vehicle (at `speed`, at least 1 m/s) gets there, within [`CROSS_HORIZON`] s, and then
-/// as standing where they meet: crossing traffic that will have gone is no obstacle, and
-/// one about to cross is one before it arrives. One that does not `yield` (an adversary)
-/// only stops for crossing traffic already in front of it.
-#[allow(clippy::too_many_arguments)]
-fn ahead_on(
-    track: &Path,
-    position: Vec2,
-    yaw: f64,
+/// The strip a vehicle sweeps ahead along its track: from its arc `s` on `track`, as wide as
+/// the vehicle, its front bumper `length / 2` ahead of `s`.
+#[derive(Clone, Copy)]
+struct Corridor<'a> {
+    track: &'a Path,
     s: f64,
     length: f64,
     width: f64,
-    speed: f64,
+}
+
+/// The nearest of `others` ahead in a vehicle's `corridor`, the vehicle moving as `kin` says
+/// (its heading may be turned round, to look behind): `(gap, speed along)`. Something going
+/// its way (or against it) counts where it is; something moving across counts only if,
+/// going on straight at its speed, it will be in the corridor when this vehicle (at its
+/// speed, at least 1 m/s) gets there, within [`CROSS_HORIZON`] s, and then as standing where
+/// they meet: crossing traffic that will have gone is no obstacle, and one about to cross is
+/// one before it arrives. One that does not `yield` (an adversary) only stops for crossing
+/// traffic already in front of it.
+fn ahead_on(
+    corridor: Corridor,
+    kin: Kinematics,
     yields: bool,
     others: impl Iterator<Item = Seen>,
 ) -> Option<(f64, f64)> {
+    let Kinematics { position, yaw, speed } = kin;
     let heading = Vec2::from_yaw(yaw);
     let mut best: Option<(f64, f64)> = None;
     let mut keep = |gap: f64, along: f64| {
@@ -747,7 +745,8 @@ fn ahead_on(
             if d.dot(heading) <= 0.0 {
                 continue;
             }
-            if let Some((gap, rel)) = in_corridor(track, s, length, width, p, other_yaw, l, w, d.dot(heading)) {
+            let other = Footprint { pose: Pose { position: p, yaw: other_yaw }, length: l, width: w };
+            if let Some((gap, rel)) = in_corridor(&corridor, &other, d.dot(heading)) {
                 let along = v * rel.cos();
                 if along >= 0.0 {
                     keep(gap, along);
@@ -767,7 +766,8 @@ fn ahead_on(
             if ahead <= 0.0 {
                 continue;
             }
-            if let Some((gap, _)) = in_corridor(track, s, length, width, q, other_yaw, l, w, ahead) {
+            let other = Footprint { pose: Pose { position: q, yaw: other_yaw }, length: l, width: w };
+            if let Some((gap, _)) = in_corridor(&corridor, &other, ahead) {
                 let arrive = gap.max(0.0) / speed.max(1.0);
                 if (arrive - tau).abs() <= CROSS_MARGIN || (k == 0 && gap < 3.0) {
                     keep(gap, 0.0);
@@ -795,20 +795,11 @@ const CROSS_HORIZON: f64 = 4.0;
 const CROSS_SAMPLES: usize = 8;
 const CROSS_MARGIN: f64 = 1.5;
 
-/// Whether a box at `p` reaches into the corridor of a vehicle at arc `s` of `track`: the
-/// bumper gap and the box's heading relative to the track there.
-#[allow(clippy::too_many_arguments)]
-fn in_corridor(
-    track: &Path,
-    s: f64,
-    length: f64,
-    width: f64,
-    p: Vec2,
-    yaw: f64,
-    l: f64,
-    w: f64,
-    ahead: f64,
-) -> Option<(f64, f64)> {
+/// Whether the box `other`, `ahead` metres in front of the vehicle along its heading, reaches
+/// into its `corridor`: the bumper gap and the box's heading relative to the track there.
+fn in_corridor(corridor: &Corridor, other: &Footprint, ahead: f64) -> Option<(f64, f64)> {
+    let Corridor { track, s, length, width } = *corridor;
+    let Footprint { pose: Pose { position: p, yaw }, length: l, width: w } = *other;
     // out of reach whatever the headings: the reach below with |sin| and |cos| at 1
     let reach = width / 2.0 + l / 2.0 + w / 2.0 + 0.3;
     let (sj, lat) = track.nearest(p, s + ahead, 8.0, reach)?;
@@ -842,24 +833,11 @@ fn mobil(scene: &Scene, actors: &mut [Actor], k: usize, before: &[Seen], ego: Se
         let (s, _) = track.project_from(me.kin.position, me.s);
         let entries =
             || before.iter().enumerate().filter(|(j, _)| *j != k).map(|(_, &o)| o).chain(std::iter::once(ego));
-        let then = IdmParams::default().accel(
-            me.kin.speed,
-            me.target,
-            ahead_on(track, me.kin.position, me.kin.yaw, s, me.length, me.width, me.kin.speed, me.obey, entries()),
-        );
+        let corridor = Corridor { track, s, length: me.length, width: me.width };
+        let then = IdmParams::default().accel(me.kin.speed, me.target, ahead_on(corridor, me.kin, me.obey, entries()));
         // the new follower: the nearest behind in the target lane, with this vehicle ahead of it
-        let back = me.kin.yaw + std::f64::consts::PI;
-        let behind = ahead_on(
-            track,
-            me.kin.position,
-            back,
-            s,
-            me.length,
-            me.width,
-            me.kin.speed,
-            me.obey,
-            entries().map(Seen::reversed),
-        );
+        let back = Kinematics { yaw: me.kin.yaw + std::f64::consts::PI, ..me.kin };
+        let behind = ahead_on(corridor, back, me.obey, entries().map(Seen::reversed));
         let safe = behind.is_none_or(|(gap, speed_back)| {
             IdmParams::default().accel(speed_back, speed_back.max(me.target), Some((gap, me.kin.speed))) >= -SAFE
                 && gap > 1.0

@@ -669,8 +669,8 @@ impl Importer<'_> {
         );
     }
 
-    #[allow(clippy::too_many_arguments)]
-    fn set(&mut self, target: Target, field: &str, key: &str, at: At, value: Known<Val>, rank: u8, summary: bool) {
+    fn set(&mut self, claim: Claim, value: Known<Val>, summary: bool) {
+        let Claim { target, field, key, at, rank } = claim;
         let def = match target {
             Target::Section(i) => self.sections[i].def.field(field),
             Target::Actor(_) => schema::ACTOR.field(field),
@@ -681,17 +681,17 @@ impl Importer<'_> {
         self.propose(target, prop);
     }
 
-    fn set_symbol(&mut self, target: Target, field: &str, key: &str, v: &Value, at: At, rank: u8) {
-        let example = field_example(target, field);
-        if let Some(s) = self.symbol(key, v, at, example) {
-            self.set(target, field, key, at, known_map(s, Val::Symbol), rank, false);
+    fn set_symbol(&mut self, claim: Claim, v: &Value) {
+        let example = field_example(claim.target, claim.field);
+        if let Some(s) = self.symbol(claim.key, v, claim.at, example) {
+            self.set(claim, known_map(s, Val::Symbol), false);
         }
     }
 
-    fn set_symbols(&mut self, target: Target, field: &str, key: &str, v: &Value, at: At, rank: u8) {
-        let example = field_example(target, field);
-        if let Some(s) = self.symbols(key, v, at, example) {
-            self.set(target, field, key, at, known_map(s, Val::Symbols), rank, false);
+    fn set_symbols(&mut self, claim: Claim, v: &Value) {
+        let example = field_example(claim.target, claim.field);
+        if let Some(s) = self.symbols(claim.key, v, claim.at, example) {
+            self.set(claim, known_map(s, Val::Symbols), false);
         }
     }
 
@@ -699,18 +699,18 @@ impl Importer<'_> {
     fn set_traffic_sign(&mut self, road: Target, key: &str, v: &Value, at: At) {
         if let Some(s) = self.symbols(key, v, at, "stop sign") {
             let summary = matches!(&s, Known::Given(list) if list.len() <= 1);
-            self.set(road, "signs", key, at, known_map(s, Val::Symbols), PAPER, summary);
+            self.set(Claim { target: road, field: "signs", key, at, rank: PAPER }, known_map(s, Val::Symbols), summary);
         }
     }
 
-    fn set_integer(&mut self, target: Target, field: &str, key: &str, v: &Value, at: At, rank: u8) {
-        if let Some(n) = self.integer(key, v, at, "1") {
-            self.set(target, field, key, at, known_map(n, Val::Integer), rank, false);
+    fn set_integer(&mut self, claim: Claim, v: &Value) {
+        if let Some(n) = self.integer(claim.key, v, claim.at, "1") {
+            self.set(claim, known_map(n, Val::Integer), false);
         }
     }
 
-    #[allow(clippy::too_many_arguments)]
-    fn set_quantity(&mut self, target: Target, field: &str, key: &str, v: &Value, at: At, unit: Unit, rank: u8) {
+    fn set_quantity(&mut self, claim: Claim, v: &Value, unit: Unit) {
+        let Claim { field, key, at, .. } = claim;
         let example = if unit == Unit::Seconds { "195 s" } else { "30 km/h" };
         // a range, where the field takes one (`25-30 km/h`, `between 25 and 30 km/h`)
         let takes_range =
@@ -719,11 +719,11 @@ impl Importer<'_> {
             && let Some((low, high, unit)) = norm::parse_quantity_range(s, unit)
         {
             let range = Val::Range(Quantity { value: low, unit }, Quantity { value: high, unit });
-            self.set(target, field, key, at, Known::Given(range), rank, false);
+            self.set(claim, Known::Given(range), false);
             return;
         }
         if let Some(q) = self.quantity(key, v, at, unit, example) {
-            self.set(target, field, key, at, known_map(q, Val::Quantity), rank, false);
+            self.set(claim, known_map(q, Val::Quantity), false);
         }
     }
 
@@ -731,19 +731,20 @@ impl Importer<'_> {
     fn field(&mut self, target: Target, row: &dialect::Key, key: &str, v: &Value, at: At) {
         let Some(def) = row.field() else { return };
         let rank = if row.origin == Origin::Extra { EXTRA } else { PAPER };
+        let claim = Claim { target, field: def.name, key, at, rank };
         match row.form {
             Form::Weather => self.weather(target, key, v, at),
             Form::RoadType => self.road_type(target, key, v, at),
             Form::SignSummary => self.set_traffic_sign(target, key, v, at),
             Form::Value | Form::Direction => match def.ty {
-                ValueType::Symbol => self.set_symbol(target, def.name, key, v, at, rank),
-                ValueType::SymbolList => self.set_symbols(target, def.name, key, v, at, rank),
-                ValueType::Integer => self.set_integer(target, def.name, key, v, at, rank),
-                ValueType::Speed => self.set_quantity(target, def.name, key, v, at, Unit::KilometresPerHour, rank),
-                ValueType::Duration => self.set_quantity(target, def.name, key, v, at, Unit::Seconds, rank),
+                ValueType::Symbol => self.set_symbol(claim, v),
+                ValueType::SymbolList => self.set_symbols(claim, v),
+                ValueType::Integer => self.set_integer(claim, v),
+                ValueType::Speed => self.set_quantity(claim, v, Unit::KilometresPerHour),
+                ValueType::Duration => self.set_quantity(claim, v, Unit::Seconds),
                 ValueType::Text => {
                     if let Some(t) = self.text_value(key, v, at) {
-                        self.set(target, def.name, key, at, known_map(t, Val::Text), rank, false);
+                        self.set(claim, known_map(t, Val::Text), false);
                     }
                 }
                 ValueType::Length | ValueType::Position | ValueType::Flag | ValueType::Choice(_) => {}
@@ -901,23 +902,24 @@ impl Importer<'_> {
 
     /// `weather`, which TrafficComposer also uses for the time of day (`night`).
     fn weather(&mut self, env: Target, key: &str, v: &Value, at: At) {
+        let claim = |field, rank| Claim { target: env, field, key, at, rank };
         let text = match untag(v) {
             Value::String(s) if self.dialect == Dialect::TrafficComposer && !self.missing(v, true) => s.clone(),
-            _ => return self.set_symbol(env, "weather", key, v, at, PAPER),
+            _ => return self.set_symbol(claim("weather", PAPER), v),
         };
         let (weather, time) = norm::split_weather(&text);
         if let Some(time) = time {
             let span = self.sub_span(at.value_span, &time);
             if let Some(sym) = self.symbol_from(key, &time, span, "daytime") {
                 let at = At { value_span: span, ..at };
-                self.set(env, "time", key, at, Known::Given(Val::Symbol(sym)), DERIVED, false);
+                self.set(Claim { at, ..claim("time", DERIVED) }, Known::Given(Val::Symbol(sym)), false);
             }
         }
         if let Some(weather) = weather {
             let span = self.sub_span(at.value_span, &weather);
             if let Some(sym) = self.symbol_from(key, &weather, span, "clear") {
                 let at = At { value_span: span, ..at };
-                self.set(env, "weather", key, at, Known::Given(Val::Symbol(sym)), PAPER, false);
+                self.set(Claim { at, ..claim("weather", PAPER) }, Known::Given(Val::Symbol(sym)), false);
             }
         }
     }
@@ -971,31 +973,25 @@ impl Importer<'_> {
 
     /// `road_type`: its text may also say the direction and special lanes.
     fn road_type(&mut self, road: Target, key: &str, v: &Value, at: At) {
+        let claim = |field, rank| Claim { target: road, field, key, at, rank };
         let text = match untag(v) {
             Value::String(s) if !self.missing(v, true) => s.clone(),
-            _ => return self.set_symbol(road, "type", key, v, at, PAPER),
+            _ => return self.set_symbol(claim("type", PAPER), v),
         };
         let parts = norm::split_road_type(&text);
         match &parts.road_type {
             Some(t) => {
                 let span = self.sub_span(at.value_span, t);
                 if let Some(sym) = self.symbol_from(key, t, span, "straight road") {
-                    self.set(
-                        road,
-                        "type",
-                        key,
-                        At { value_span: span, ..at },
-                        Known::Given(Val::Symbol(sym)),
-                        PAPER,
-                        false,
-                    );
+                    let at = At { value_span: span, ..at };
+                    self.set(Claim { at, ..claim("type", PAPER) }, Known::Given(Val::Symbol(sym)), false);
                 }
             }
-            None => self.set(road, "type", key, at, Known::Unspecified, PAPER, false),
+            None => self.set(claim("type", PAPER), Known::Unspecified, false),
         }
         if let Some(direction) = parts.direction {
             let sym = Symbol { name: direction.to_string(), span: at.value_span };
-            self.set(road, "direction", key, at, Known::Given(Val::Symbol(sym)), DERIVED, false);
+            self.set(claim("direction", DERIVED), Known::Given(Val::Symbol(sym)), false);
         }
         if !parts.special_lanes.is_empty() {
             let mut lanes = Vec::new();
@@ -1005,7 +1001,7 @@ impl Importer<'_> {
                     lanes.push(sym);
                 }
             }
-            self.set(road, "special_lanes", key, at, Known::Given(Val::Symbols(lanes)), DERIVED, false);
+            self.set(claim("special_lanes", DERIVED), Known::Given(Val::Symbols(lanes)), false);
         }
     }
 
@@ -1014,12 +1010,13 @@ impl Importer<'_> {
         let lower = text.trim().to_lowercase();
         let words: Vec<&str> = lower.split_whitespace().collect();
         let key = "road_network";
+        let claim = |field, rank| Claim { target: road, field, key, at, rank };
         if matches!(
             lower.as_str(),
             "traffic light" | "traffic lights" | "traffic signal" | "traffic signals" | "traffic_light"
         ) {
             // a light is there; its state is not said
-            self.set(road, "light", key, at, Known::Unspecified, DERIVED, false);
+            self.set(claim("light", DERIVED), Known::Unspecified, false);
             return;
         }
         if words.last().is_some_and(|w| *w == "sign" || *w == "signs") {
@@ -1035,7 +1032,7 @@ impl Importer<'_> {
         }
         let count = words.first().and_then(|w| norm::parse_integer(w).or_else(|| norm::number_word(w)));
         if let (Some(n), true) = (count, words.len() >= 2 && words[1].starts_with("lane")) {
-            self.set(road, "lanes", key, at, Known::Given(Val::Integer(n)), DERIVED, false);
+            self.set(claim("lanes", DERIVED), Known::Given(Val::Integer(n)), false);
             return;
         }
         if let Some(n) = words
@@ -1043,13 +1040,13 @@ impl Importer<'_> {
             .and_then(|w| w.strip_suffix("-lane"))
             .and_then(|w| norm::parse_integer(w).or_else(|| norm::number_word(w)))
         {
-            self.set(road, "lanes", key, at, Known::Given(Val::Integer(n)), DERIVED, false);
+            self.set(claim("lanes", DERIVED), Known::Given(Val::Integer(n)), false);
             return;
         }
         let parts = norm::split_road_type(text);
         if let Some(direction) = parts.direction {
             let sym = Symbol { name: direction.to_string(), span: at.value_span };
-            self.set(road, "direction", key, at, Known::Given(Val::Symbol(sym)), DERIVED, false);
+            self.set(claim("direction", DERIVED), Known::Given(Val::Symbol(sym)), false);
         }
         let Some(road_type) = parts.road_type else { return };
         if let Some(existing) = self.road_prop(road, "type").and_then(|p| match &p.value {
@@ -1064,7 +1061,7 @@ impl Importer<'_> {
             return;
         }
         if let Some(sym) = self.symbol_from(key, &road_type, at.value_span, "intersection") {
-            self.set(road, "type", key, at, Known::Given(Val::Symbol(sym)), PAPER, false);
+            self.set(claim("type", PAPER), Known::Given(Val::Symbol(sym)), false);
         }
     }
 
@@ -1084,7 +1081,7 @@ impl Importer<'_> {
             p.value_span = p.value_span.to(at.value_span);
             return;
         }
-        self.set(road, field, key, at, value, DERIVED, false);
+        self.set(Claim { target: road, field, key, at, rank: DERIVED }, value, false);
     }
 
     fn source(&mut self, v: &Value, at: At) {
@@ -1288,7 +1285,7 @@ impl Importer<'_> {
             }
             let key = if relation.is_some() { "position_relation" } else { "position_target" };
             let at = At { node: None, key_span, value_span };
-            self.set(me, "position", key, at, value, PAPER, false);
+            self.set(Claim { target: me, field: "position", key, at, rank: PAPER }, value, false);
         }
     }
 
@@ -1333,6 +1330,17 @@ impl Importer<'_> {
 enum Target {
     Section(usize),
     Actor(usize),
+}
+
+/// A key's claim on a field: the section or actor and the field it states, the key as written
+/// and where it is, and how strongly it states the field ([`DERIVED`], [`PAPER`], [`EXTRA`]).
+#[derive(Clone, Copy)]
+struct Claim<'k> {
+    target: Target,
+    field: &'k str,
+    key: &'k str,
+    at: At,
+    rank: u8,
 }
 
 fn attr(p: Prop) -> Attr {
