@@ -3,44 +3,92 @@
 //! It is the unaligned reference of both experiments: a row of `tadslc eval`'s table
 //! (`--generators baseline`, each region drawing its own sample) and the "unaligned
 //! baseline" of the recovery experiment (`tadslc bench --align`). Every choice is uniform
-//! over a fixed list of common names; the same seed gives the same scenarios on every
-//! machine. Each scenario also comes as an equivalent JSON document, so `tadslc bench` can
+//! over the names the prelude (`stdlib/core.tad`) declares of its kind, within what the
+//! prelude says fits together: an actor's behavior among those its type performs, its
+//! speed below the behavior's `max_speed`, its relation one a dash-cam sees (the scenarios
+//! come from a video). The same seed gives the same scenarios on every machine. Each scenario also comes as an equivalent JSON document, so `tadslc bench` can
 //! compare the front end with a production JSON parser on the same content.
 
 use tad_base::{Rng, SplitMix64};
 use tad_db::Database;
 
-const WEATHER: &[&str] = &["clear", "cloudy", "foggy", "rainy", "snowy", "wet"];
-const TIME: &[&str] = &["daytime", "nighttime", "dawn", "dusk"];
-const ROAD: &[&str] = &["straight_road", "curved_road", "intersection", "t_intersection", "roundabout"];
-const CONTEXT: &[&str] = &["urban", "residential", "highway", "country_road", "dirt_road", "hill_road"];
-const SIGNS: &[&str] = &["stop_sign", "speed_limit_sign", "yield_sign", "yield_to_pedestrian_sign", "school_zone"];
-const LIGHT: &[&str] = &["green", "red", "yellow", "broken", "none"];
-const TRAFFIC: &[&str] = &["free_flow", "light", "moderate", "heavy", "jam"];
-const ROADSIDE: &[&str] = &["sidewalk", "buildings", "trees", "shops", "parked_cars", "fields", "forest", "houses"];
-const TYPES: &[&str] = &["sedan", "suv", "car", "truck", "bus", "van", "taxi", "motorcycle", "bicycle", "pedestrian"];
-const BEHAVIORS: &[&str] =
-    &["move_forward", "stopped", "parked", "turn_left", "turn_right", "change_lane_left", "yield"];
-const RELATIONS: &[&str] =
-    &["front", "behind", "left", "right", "left_front", "right_front", "left_behind", "right_behind"];
-const REGIONS: &[&str] = &["los_angeles", "new_york_city", "yellowstone", "yosemite", "switzerland"];
-
-/// The generator's choices by declaration kind: which common names it draws from (its
-/// distribution); every name is declared in `stdlib/`, which a test holds.
-pub const CHOICES: &[(&str, &[&str])] = &[
-    ("weather", WEATHER),
-    ("time_of_day", TIME),
-    ("road_type", ROAD),
-    ("road_context", CONTEXT),
-    ("traffic_sign", SIGNS),
-    ("light_state", LIGHT),
-    ("traffic_density", TRAFFIC),
-    ("roadside", ROADSIDE),
-    ("actor_type", TYPES),
-    ("behavior", BEHAVIORS),
-    ("relation", RELATIONS),
-    ("region", REGIONS),
+/// The kinds the generator draws, each uniformly over the names the prelude declares of
+/// it (`stdlib/core.tad`, in declaration order): its distribution is the vocabulary's,
+/// never a list of its own.
+pub const KINDS: &[&str] = &[
+    "weather",
+    "time_of_day",
+    "road_type",
+    "road_context",
+    "traffic_sign",
+    "light_state",
+    "traffic_density",
+    "roadside",
+    "actor_type",
+    "behavior",
+    "relation",
+    "region",
 ];
+
+/// What the generator draws from, read once from the prelude.
+struct Choices {
+    /// Every kind's names, in declaration order.
+    names: Vec<(&'static str, Vec<String>)>,
+    /// The behaviors each actor type performs (its kind among the behavior's `performers`).
+    performed: Vec<(String, Vec<String>)>,
+    /// The relations a dash-cam sees (`longitudinal` not `behind`): the generator writes a
+    /// video source, so the dash-cam rule (E0510) applies; and those of them a one-way road
+    /// has room for (`lateral` not `opposite`).
+    visible: Vec<String>,
+    one_way: Vec<String>,
+    /// The fastest each actor type moves, km/h (its `max_speed`).
+    fastest: Vec<(String, u32)>,
+}
+
+fn choices() -> &'static Choices {
+    static CHOICES: std::sync::OnceLock<Choices> = std::sync::OnceLock::new();
+    CHOICES.get_or_init(|| {
+        let vocabulary = tad_db::vocabulary_of(&[]);
+        let names = KINDS.iter().map(|k| (*k, vocabulary.names(k).into_iter().map(String::from).collect())).collect();
+        let performed = vocabulary
+            .entries("actor_type")
+            .into_iter()
+            .map(|t| {
+                let kind = t.symbol("kind").unwrap_or("");
+                let behaviors = vocabulary.entries("behavior").into_iter().filter(|b| tad_check::performs(b, kind));
+                (t.name.clone(), behaviors.map(|b| b.name.clone()).collect())
+            })
+            .collect();
+        let seen: Vec<_> =
+            vocabulary.entries("relation").into_iter().filter(|r| r.symbol("longitudinal") != Some("behind")).collect();
+        let visible = seen.iter().map(|r| r.name.clone()).collect();
+        let one_way = seen.iter().filter(|r| r.symbol("lateral") != Some("opposite")).map(|r| r.name.clone()).collect();
+        let fastest = vocabulary
+            .entries("actor_type")
+            .into_iter()
+            .filter_map(|t| Some((t.name.clone(), (t.speed("max_speed")? * 3.6).floor() as u32)))
+            .collect();
+        Choices { names, performed, visible, one_way, fastest }
+    })
+}
+
+/// The prelude's names of `kind` (one of [`KINDS`]).
+pub fn names(kind: &str) -> &'static [String] {
+    choices().names.iter().find(|(k, _)| *k == kind).map_or(&[], |(_, names)| names.as_slice())
+}
+
+fn pick(rng: &mut SplitMix64, kind: &str) -> &'static str {
+    rng.pick(names(kind)).as_str()
+}
+
+/// A behavior an actor of type `actor_type` performs.
+fn behavior_of(rng: &mut SplitMix64, actor_type: &str) -> &'static str {
+    let own = choices().performed.iter().find(|(t, _)| t == actor_type).map(|(_, b)| b.as_slice());
+    match own.filter(|b| !b.is_empty()) {
+        Some(behaviors) => rng.pick(behaviors).as_str(),
+        None => pick(rng, "behavior"),
+    }
+}
 
 /// One generated scenario in TAD and in JSON.
 pub struct Generated {
@@ -53,20 +101,23 @@ pub fn scenario(rng: &mut SplitMix64, index: usize) -> Generated {
     use std::fmt::Write;
     let lanes = 1 + rng.below(4) as i64;
     let two_way = rng.chance(70);
-    let weather = rng.pick(WEATHER);
-    let time = rng.pick(TIME);
-    let road = rng.pick(ROAD);
-    let context = rng.pick(CONTEXT);
-    let light = rng.pick(LIGHT);
-    let traffic = rng.pick(TRAFFIC);
-    let signs: Vec<&str> =
-        (0..rng.below(3)).map(|_| *rng.pick(SIGNS)).collect::<std::collections::BTreeSet<_>>().into_iter().collect();
-    let roadside: Vec<&str> = (0..1 + rng.below(3))
-        .map(|_| *rng.pick(ROADSIDE))
+    let weather = pick(rng, "weather");
+    let time = pick(rng, "time_of_day");
+    let road = pick(rng, "road_type");
+    let context = pick(rng, "road_context");
+    let light = pick(rng, "light_state");
+    let traffic = pick(rng, "traffic_density");
+    let signs: Vec<&str> = (0..rng.below(3))
+        .map(|_| pick(rng, "traffic_sign"))
         .collect::<std::collections::BTreeSet<_>>()
         .into_iter()
         .collect();
-    let region = rng.pick(REGIONS);
+    let roadside: Vec<&str> = (0..1 + rng.below(3))
+        .map(|_| pick(rng, "roadside"))
+        .collect::<std::collections::BTreeSet<_>>()
+        .into_iter()
+        .collect();
+    let region = pick(rng, "region");
     let ego_speed = rng.below(80);
     let ego_lane = 1 + rng.below(lanes as usize) as i64;
     let direction = if two_way { "two_way" } else { "one_way" };
@@ -97,10 +148,13 @@ pub fn scenario(rng: &mut SplitMix64, index: usize) -> Generated {
     let groups = rng.below(8);
     for g in 0..groups {
         let count = 1 + rng.below(10);
-        let kind = rng.pick(TYPES);
-        let behavior = rng.pick(BEHAVIORS);
-        let speed = if *behavior == "parked" { 0 } else { rng.below(60) };
-        let relation = rng.pick(RELATIONS);
+        let kind = pick(rng, "actor_type");
+        let behavior = behavior_of(rng, kind);
+        // below the behavior's and the type's `max_speed` (0 for a standing behavior), and 60 km/h
+        let fastest = choices().fastest.iter().find(|(t, _)| t == kind).map_or(59, |(_, v)| *v);
+        let limit = crate::synthetic::max_speed(behavior).unwrap_or(59).min(fastest).min(59) as usize;
+        let speed = if limit == 0 { 0 } else { rng.below(limit + 1) };
+        let relation = rng.pick(if two_way { &choices().visible } else { &choices().one_way }).as_str();
         let max = lanes as usize;
         let lane = if two_way && rng.chance(30) { -(1 + rng.below(max) as i64) } else { 1 + rng.below(max) as i64 };
         let _ = write!(
@@ -152,16 +206,28 @@ mod tests {
     use super::*;
 
     #[test]
-    fn every_choice_is_a_declared_name_of_its_kind() {
-        let vocabulary = tad_db::vocabulary_of(&[]);
-        for (kind, names) in CHOICES {
-            for name in *names {
-                assert!(
-                    vocabulary.get(kind, name).is_some_and(|e| e.name == *name),
-                    "`{name}` is not a {kind} declared in stdlib/ (under that name)"
-                );
-            }
+    fn what_the_prelude_says_fits_together_checks_without_errors() {
+        // behaviors their types perform, speeds under both `max_speed`s, relations a
+        // dash-cam sees and a one-way road has room for
+        let mut db = Database::new(tad_check::Options::default());
+        for (i, g) in generate(300, 5).into_iter().enumerate() {
+            let file = db.set_source(format!("g{i}.tad").into(), g.tad.clone(), tad_db::Language::Tad, &tad_db::RealFs);
+            let errors: Vec<String> = tad_db::check(&db, file)
+                .diagnostics
+                .iter()
+                .filter(|d| d.is_error())
+                .map(|d| d.message.clone())
+                .collect();
+            assert!(errors.is_empty(), "{errors:#?}\n{}", g.tad);
         }
+    }
+
+    #[test]
+    fn every_kind_draws_from_the_prelude() {
+        for kind in KINDS {
+            assert!(names(kind).len() >= 4, "the prelude declares few {kind}: {:?}", names(kind));
+        }
+        assert!(names("behavior").iter().any(|b| b == "graze"), "the prelude's names, not a list of the generator's");
     }
 
     #[test]

@@ -138,7 +138,7 @@ pub fn synthetic(label: &str) -> Option<&'static SyntheticRegion> {
 /// The fastest a behaviour's actor is drawn, in whole km/h, from the standard vocabulary
 /// (not a list of names): 0 when its motion stands as the layout judges it (stop, parked,
 /// stand), else its declared `max_speed` (1 for `graze`: grazing animals move, slowly).
-fn max_speed(behavior: &str) -> Option<u32> {
+pub(crate) fn max_speed(behavior: &str) -> Option<u32> {
     use tad_syntax::schema::{ClosedSet, Motion};
     static LIMITS: std::sync::OnceLock<Vec<(String, u32)>> = std::sync::OnceLock::new();
     let limits = LIMITS.get_or_init(|| {
