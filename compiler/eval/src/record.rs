@@ -1,7 +1,9 @@
 //! What `tadslc run` leaves of its episodes, as values a host writes: each episode's JSON
 //! record and each ego's aggregate (`--format json`), the trace of every actor's pose per
 //! step (`--trace`), the picture of an episode (`--render`, SVG or GIF through
-//! `tad-render`), the table for people, and the results file `merge` reads.
+//! `tad-render`), the table for people, the results file `merge` reads, and the CI gate:
+//! which episodes met a `--fail-on` criterion, and the JUnit XML report (`--junit`) that
+//! GitLab, Jenkins and GitHub display, one test case per scenario × ego × seed.
 //!
 //! An episode is a [`Played`]: which scenario and which ego, the episode and its score.
 
@@ -9,7 +11,7 @@ use std::io::Write;
 
 use tad_base::Shard;
 use tad_metrics::{EpisodeScore, Mode};
-use tad_runtime::{Episode, Scene};
+use tad_runtime::{Episode, Event, EventKind, Scene};
 
 use crate::{Results, Row, Setup};
 
@@ -229,4 +231,95 @@ pub fn results(
         seed: seeds.start,
     };
     Results::new(setup, shard, [("all/files".to_string(), scenarios.len())].into_iter().collect(), rows)
+}
+
+/// The first event of `episode` that is one of `criteria`: the criterion it failed.
+pub fn failed<'e>(episode: &'e Episode, criteria: &[EventKind]) -> Option<&'e Event> {
+    episode.events.iter().find(|e| criteria.contains(&e.kind))
+}
+
+fn escape(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            // XML 1.0 has no other control characters
+            c if c.is_control() && !matches!(c, '\n' | '\t' | '\r') => out.push('\u{FFFD}'),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// The JUnit XML report: one `<testsuite>` per scenario (`scenarios`, as `played` indexes
+/// them), one `<testcase>` per ego and seed, named `EGO seed N`, with its simulated time;
+/// a `<failure>` for an episode that met one of `criteria` (its type the criterion, its
+/// message the step and time); the stop reason and the ten metrics in `<system-out>`.
+pub fn junit(scenarios: &[&str], egos: &[String], played: &[Played], criteria: &[EventKind], dt: f64) -> String {
+    use std::fmt::Write;
+    let fails = |p: &Played| failed(&p.episode, criteria).is_some();
+    let seconds = |p: &Played| p.episode.steps as f64 * dt;
+    let mut xml = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+    let (all, failures) = (played.len(), played.iter().filter(|p| fails(p)).count());
+    let total: f64 = played.iter().map(seconds).sum();
+    let _ = writeln!(
+        xml,
+        "<testsuites name=\"tadslc run\" tests=\"{all}\" failures=\"{failures}\" errors=\"0\" time=\"{total:.3}\">"
+    );
+    for (k, scenario) in scenarios.iter().enumerate() {
+        let cases: Vec<&Played> = played.iter().filter(|p| p.scenario == k).collect();
+        let failing = cases.iter().filter(|p| fails(p)).count();
+        let time: f64 = cases.iter().map(|p| seconds(p)).sum();
+        let name = escape(scenario);
+        let _ = writeln!(
+            xml,
+            "  <testsuite name=\"{name}\" tests=\"{}\" failures=\"{failing}\" errors=\"0\" skipped=\"0\" time=\"{time:.3}\">",
+            cases.len()
+        );
+        for p in cases {
+            let ego = escape(egos.get(p.ego).map_or("", String::as_str));
+            let seed = p.episode.seed.unwrap_or(0);
+            let _ = writeln!(
+                xml,
+                "    <testcase classname=\"{name}\" name=\"{ego} seed {seed}\" time=\"{:.3}\">",
+                seconds(p)
+            );
+            if let Some(event) = failed(&p.episode, criteria) {
+                let kind = event.kind.as_str();
+                let at = event.step as f64 * dt;
+                let _ = writeln!(
+                    xml,
+                    "      <failure type=\"{kind}\" message=\"{kind} at step {} ({at:.1} s)\">{kind} at step {} ({at:.1} s), at ({:.1}, {:.1}) m</failure>",
+                    event.step, event.step, event.position.x, event.position.y
+                );
+            }
+            let metrics: Vec<String> = tad_metrics::METRICS
+                .iter()
+                .filter_map(|m| Some(format!("{} {:.3}", m.key, p.score.metrics.get(m.metric)?)))
+                .collect();
+            let _ = writeln!(
+                xml,
+                "      <system-out>stop reason: {}; steps: {}; {}</system-out>",
+                p.episode.stop_reason.as_str(),
+                p.episode.steps,
+                metrics.join(", ")
+            );
+            xml.push_str("    </testcase>\n");
+        }
+        xml.push_str("  </testsuite>\n");
+    }
+    xml.push_str("</testsuites>\n");
+    xml
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn names_are_escaped_for_xml() {
+        // a file named by a user, an ego path: nothing breaks the report
+        assert_eq!(super::escape("a&b <c> \"d\"\u{1}e\n"), "a&amp;b &lt;c&gt; &quot;d&quot;\u{FFFD}e\n");
+    }
 }

@@ -46,6 +46,15 @@ pub enum EventKind {
 }
 
 impl EventKind {
+    /// Every kind, in the order above.
+    pub const ALL: [EventKind; 5] =
+        [EventKind::Collision, EventKind::RedLight, EventKind::StopSign, EventKind::LaneInvasion, EventKind::OffRoad];
+
+    /// The kind named `name` ([`EventKind::as_str`]).
+    pub fn parse(name: &str) -> Option<EventKind> {
+        EventKind::ALL.into_iter().find(|k| k.as_str() == name)
+    }
+
     pub fn as_str(self) -> &'static str {
         match self {
             EventKind::Collision => "collision",

@@ -129,3 +129,74 @@ fn bad_input_is_refused_clearly() {
     let run = tadslc(&["run", "examples/safety/right_turn.tad", "--ego", "learned:/nonexistent/actor.safetensors"], "");
     assert_eq!(code(&run), 2);
 }
+
+/// The CI gate: `--fail-on` makes an episode that meets a criterion status 1, and `--junit`
+/// writes a JUnit report (one test suite per scenario, one test case per ego and seed, a
+/// failure for each episode that met a criterion) that XML readers and CI servers accept.
+#[test]
+fn the_ci_gate_fails_on_a_criterion_and_writes_a_junit_report() {
+    let dir = scratch("junit");
+    let report = dir.join("report.xml");
+    let report_arg = report.to_str().unwrap();
+    // the naive ego drives into the conflict of a safety scenario
+    let args = [
+        "run",
+        "examples/safety/crossing_negotiation.tad",
+        "examples/safety/right_turn.tad",
+        "--ego",
+        "naive,idm",
+        "--seeds",
+        "0..2",
+        "--fail-on",
+        "collision,red_light",
+        "--junit",
+        report_arg,
+    ];
+    let out = tadslc(&args, "");
+    assert_eq!(code(&out), 1, "a collision fails the gate: {}", stderr(&out));
+    assert!(stderr(&out).contains("--fail-on: "), "{}", stderr(&out));
+    let xml = std::fs::read_to_string(&report).unwrap();
+    let doc = roxmltree::Document::parse(&xml).expect("well-formed XML");
+    let root = doc.root_element();
+    assert_eq!(root.tag_name().name(), "testsuites");
+    let suites: Vec<_> = root.children().filter(|n| n.has_tag_name("testsuite")).collect();
+    assert_eq!(suites.len(), 2, "one suite per scenario");
+    let cases: Vec<_> = doc.descendants().filter(|n| n.has_tag_name("testcase")).collect();
+    assert_eq!(cases.len(), 8, "2 scenarios × 2 egos × 2 seeds");
+    assert_eq!(root.attribute("tests"), Some("8"));
+    let failures: Vec<_> = doc.descendants().filter(|n| n.has_tag_name("failure")).collect();
+    assert!(!failures.is_empty());
+    assert_eq!(root.attribute("failures"), Some(failures.len().to_string().as_str()));
+    for f in &failures {
+        assert!(matches!(f.attribute("type"), Some("collision" | "red_light")), "{f:?}");
+        let case = f.parent().unwrap();
+        assert!(case.attribute("name").is_some_and(|n| n.contains(" seed ")));
+        assert!(case.attribute("time").and_then(|t| t.parse::<f64>().ok()).is_some());
+    }
+    for case in &cases {
+        let out = case.children().find(|n| n.has_tag_name("system-out")).and_then(|n| n.text()).unwrap_or("");
+        assert!(out.starts_with("stop reason: ") && out.contains("CR "), "{out}");
+    }
+
+    // the idm ego meets no criterion on the first: status 0, no failure in the report
+    let quiet = [
+        "run",
+        "examples/safety/crossing_negotiation.tad",
+        "--ego",
+        "idm",
+        "--seeds",
+        "0",
+        "--fail-on",
+        "collision",
+        "--junit",
+        report_arg,
+    ];
+    let out = tadslc(&quiet, "");
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    assert!(!std::fs::read_to_string(&report).unwrap().contains("<failure"));
+
+    // an unknown criterion is a usage error before anything runs
+    let out = tadslc(&["run", "examples/safety/right_turn.tad", "--fail-on", "crash"], "");
+    assert_eq!(code(&out), 2);
+    assert!(stderr(&out).contains("the criteria are collision, red_light"), "{}", stderr(&out));
+}

@@ -15,7 +15,7 @@ use crate::output::CliError;
 use crate::{Status, errln, out, outln};
 use tad_eval::record::{self, Played};
 use tad_metrics::Mode;
-use tad_runtime::Options;
+use tad_runtime::{EventKind, Options};
 
 /// What `run` prints.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -59,6 +59,22 @@ pub struct RunArgs {
     /// --shard), for `tadslc merge`
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
+    /// Exit with status 1 when an episode meets one of these: `collision`, `red_light`,
+    /// `stop_sign`, `lane_invasion`, `off_road` (comma-separated or repeated)
+    #[arg(long, value_name = "CRITERIA", value_delimiter = ',', value_parser = parse_criterion)]
+    pub fail_on: Vec<EventKind>,
+    /// Write a JUnit XML report: a test suite per scenario, a test case per ego and seed,
+    /// failed when it meets a `--fail-on` criterion
+    #[arg(long, value_name = "FILE")]
+    pub junit: Option<PathBuf>,
+}
+
+/// A `--fail-on` criterion: an event of the runtime's criteria.
+fn parse_criterion(text: &str) -> Result<EventKind, String> {
+    EventKind::parse(text).ok_or_else(|| {
+        let names: Vec<&str> = EventKind::ALL.iter().map(|k| k.as_str()).collect();
+        format!("`{text}` is not a criterion (the criteria are {})", names.join(", "))
+    })
 }
 
 /// `A..B` (B excluded, as in Rust), `A..=B` (B included) or a single seed `A`.
@@ -155,6 +171,7 @@ pub fn run(args: &RunArgs, color: bool) -> Result<Status, CliError> {
             out!("{}", record::table(&scenarios, &names, &done, mode))?;
         }
     }
+    status = status.max(gate(args, &scenes, &names, &done, step_length(&scenes))?);
     if let (Some(path), Some(first)) = (&args.render, done.first()) {
         let loaded = &scenes[first.scenario];
         let gif = path.extension().is_some_and(|x| x.eq_ignore_ascii_case("gif"));
@@ -172,6 +189,41 @@ pub fn run(args: &RunArgs, color: bool) -> Result<Status, CliError> {
         }
     }
     Ok(status)
+}
+
+/// The step length of the scenes' episodes (the same for every scene).
+fn step_length(scenes: &[crate::scenes::Loaded]) -> f64 {
+    scenes.first().map_or(0.1, |l| l.scene.limits.dt)
+}
+
+/// The CI gate: the JUnit report, and status 1 when an episode met a `--fail-on` criterion
+/// (how many, by criterion, on standard error).
+fn gate(
+    args: &RunArgs,
+    scenes: &[crate::scenes::Loaded],
+    egos: &[String],
+    done: &[Played],
+    dt: f64,
+) -> Result<Status, CliError> {
+    if let Some(path) = &args.junit {
+        let names: Vec<&str> = scenes.iter().map(|s| s.name.as_str()).collect();
+        let xml = record::junit(&names, egos, done, &args.fail_on, dt);
+        std::fs::write(path, xml).map_err(|e| CliError::usage(format!("cannot write `{}`: {e}", path.display())))?;
+    }
+    let mut met: Vec<(&str, usize)> = Vec::new();
+    for event in done.iter().filter_map(|p| record::failed(&p.episode, &args.fail_on)) {
+        match met.iter_mut().find(|(k, _)| *k == event.kind.as_str()) {
+            Some((_, n)) => *n += 1,
+            None => met.push((event.kind.as_str(), 1)),
+        }
+    }
+    if met.is_empty() {
+        return Ok(Status::Ok);
+    }
+    let failing: usize = met.iter().map(|(_, n)| n).sum();
+    let by: Vec<String> = met.iter().map(|(k, n)| format!("{k} {n}")).collect();
+    errln!("--fail-on: {failing} of {} episodes failed ({})", done.len(), by.join(", "))?;
+    Ok(Status::Failed)
 }
 
 #[cfg(test)]
