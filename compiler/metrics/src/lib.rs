@@ -217,10 +217,13 @@ pub enum StopReason {
     Timeout,
     /// The scenario program ended.
     ProgramEnd,
+    /// The ego's driver failed: an external process broke the protocol, fell silent or
+    /// ended (`tad_policy`'s external ego).
+    EgoFailed,
 }
 
 impl StopReason {
-    pub const ALL: [StopReason; 7] = [
+    pub const ALL: [StopReason; 8] = [
         StopReason::Collision,
         StopReason::OffRoad,
         StopReason::RouteComplete,
@@ -228,6 +231,7 @@ impl StopReason {
         StopReason::MaxDistance,
         StopReason::Timeout,
         StopReason::ProgramEnd,
+        StopReason::EgoFailed,
     ];
 
     /// The stable snake_case name (as serialised).
@@ -240,6 +244,7 @@ impl StopReason {
             StopReason::MaxDistance => "max_distance",
             StopReason::Timeout => "timeout",
             StopReason::ProgramEnd => "program_end",
+            StopReason::EgoFailed => "ego_failed",
         }
     }
 }

@@ -300,7 +300,16 @@ fn names_round_trip() {
     let names: Vec<&str> = StopReason::ALL.iter().map(|r| r.as_str()).collect();
     assert_eq!(
         names,
-        ["collision", "off_road", "route_complete", "max_steps", "max_distance", "timeout", "program_end"]
+        [
+            "collision",
+            "off_road",
+            "route_complete",
+            "max_steps",
+            "max_distance",
+            "timeout",
+            "program_end",
+            "ego_failed"
+        ]
     );
     assert!(StopReason::Collision < StopReason::ProgramEnd);
     let err = "crash".parse::<StopReason>().unwrap_err();

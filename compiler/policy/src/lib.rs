@@ -3,9 +3,10 @@
 //! Every policy sees an [`EgoView`] each step (SafeBench's four-feature observation and,
 //! for rule-based drivers, the full state the runtime knows) and answers an [`Action`]:
 //! an acceleration and a normalised steer the runtime applies to its kinematic bicycle.
-//! Three drivers: [`Idm`] (lane keeping and IDM car following that obeys lights and stop
-//! signs), [`Naive`] (constant speed along the route, blind to everything else) and
-//! [`Learned`] (SafeBench's SAC actor from a safetensors file). [`parse_policy`] names them.
+//! Four drivers: [`Idm`] (lane keeping and IDM car following that obeys lights and stop
+//! signs), [`Naive`] (constant speed along the route, blind to everything else),
+//! [`Learned`] (SafeBench's SAC actor from a safetensors file) and [`External`] (any
+//! process, over JSON lines). [`parse_policy`] names them.
 //!
 //! # Frames and signs
 //!
@@ -52,9 +53,11 @@
 //! SafeBench computes the observation after each tick, from the state the action led to;
 //! the first one at reset.
 
+pub mod external;
 mod idm;
 mod learned;
 
+pub use external::External;
 pub use idm::{Idm, IdmParams, Naive};
 pub use learned::Learned;
 
@@ -112,6 +115,11 @@ pub trait EgoPolicy: Send {
     /// Called before each episode.
     fn reset(&mut self) {}
     fn act(&mut self, view: &EgoView) -> Action;
+    /// Why the policy cannot drive any more (an external process that broke the protocol);
+    /// the runtime ends the episode when it says.
+    fn failure(&self) -> Option<&str> {
+        None
+    }
 }
 
 /// Pure pursuit towards `target` (ego frame, m) for a car of `wheelbase` m: the arc through
@@ -175,6 +183,8 @@ pub enum PolicyError {
     UnknownPolicy { spec: String },
     /// `learned` without `:PATH`.
     MissingPath,
+    /// `external` without `:CMD`.
+    MissingCommand,
     /// The file could not be read or written.
     Io { path: String, message: String },
     /// The bytes are not a safetensors file (or hold a type candle cannot read).
@@ -195,10 +205,13 @@ impl fmt::Display for PolicyError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             PolicyError::UnknownPolicy { spec } => {
-                write!(f, "unknown policy `{spec}` (expected `idm`, `naive` or `learned:PATH`)")
+                write!(f, "unknown policy `{spec}` (expected `idm`, `naive`, `learned:PATH` or `external:CMD`)")
             }
             PolicyError::MissingPath => {
                 f.write_str("the learned policy needs a checkpoint: `learned:PATH` (a safetensors file)")
+            }
+            PolicyError::MissingCommand => {
+                f.write_str("the external policy needs a command: `external:CMD` (it answers JSON lines)")
             }
             PolicyError::Io { path, message } => write!(f, "{path}: {message}"),
             PolicyError::NotSafetensors { path, message } => write!(f, "{path}: not a safetensors file: {message}"),
@@ -227,6 +240,8 @@ pub enum EgoSpec {
     Idm,
     Naive,
     Learned(Learned),
+    /// A command started for each episode ([`External`]).
+    External(String),
 }
 
 impl EgoSpec {
@@ -237,6 +252,8 @@ impl EgoSpec {
             None if spec == "learned" => Err(PolicyError::MissingPath),
             Some(("learned", "")) => Err(PolicyError::MissingPath),
             Some(("learned", path)) => Ok(EgoSpec::Learned(Learned::load(path)?)),
+            Some(("external", command)) if !command.trim().is_empty() => Ok(EgoSpec::External(command.to_string())),
+            Some(("external", _)) => Err(PolicyError::MissingCommand),
             _ => Err(PolicyError::UnknownPolicy { spec: spec.to_string() }),
         }
     }
@@ -247,11 +264,29 @@ impl EgoSpec {
             EgoSpec::Idm => Box::new(Idm::default()),
             EgoSpec::Naive => Box::new(Naive::default()),
             EgoSpec::Learned(actor) => Box::new(actor.clone()),
+            EgoSpec::External(command) => Box::new(External::new(command, external::TIMEOUT)),
         }
     }
 }
 
-/// A policy by its command-line name: `idm`, `naive` or `learned:PATH`.
+/// The ego specs of a comma-separated list (`idm,naive,learned:a.safetensors`); an
+/// `external:CMD` takes the rest of the list, commas and all, as its command.
+pub fn split_specs(list: &str) -> Vec<String> {
+    let mut specs = Vec::new();
+    let mut rest = list;
+    while !rest.is_empty() {
+        if rest.starts_with("external:") {
+            specs.push(rest.to_string());
+            break;
+        }
+        let (spec, tail) = rest.split_once(',').unwrap_or((rest, ""));
+        specs.push(spec.to_string());
+        rest = tail;
+    }
+    specs
+}
+
+/// A policy by its command-line name: `idm`, `naive`, `learned:PATH` or `external:CMD`.
 pub fn parse_policy(spec: &str) -> Result<Box<dyn EgoPolicy>, PolicyError> {
     EgoSpec::parse(spec).map(|ego| ego.make())
 }

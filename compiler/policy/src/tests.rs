@@ -297,9 +297,18 @@ fn policies_by_name() {
     assert_eq!(parse_policy("naive").unwrap().name(), "naive");
     for bad in ["IDM", "mobil", "", "idm:x"] {
         let err = parse_policy(bad).err().unwrap();
-        assert_eq!(err.to_string(), format!("unknown policy `{bad}` (expected `idm`, `naive` or `learned:PATH`)"));
+        assert_eq!(
+            err.to_string(),
+            format!("unknown policy `{bad}` (expected `idm`, `naive`, `learned:PATH` or `external:CMD`)")
+        );
     }
     assert_eq!(parse_policy("learned").err(), Some(PolicyError::MissingPath));
+    assert_eq!(parse_policy("external: ").err(), Some(PolicyError::MissingCommand));
+    assert_eq!(parse_policy("external:./drive --fast").unwrap().name(), "external:./drive --fast");
+    assert_eq!(
+        crate::split_specs("idm,learned:a.st,external:drive --lanes 1,2"),
+        ["idm", "learned:a.st", "external:drive --lanes 1,2"]
+    );
     assert_eq!(parse_policy("learned:").err(), Some(PolicyError::MissingPath));
     assert!(matches!(parse_policy("learned:/no/such/file").err(), Some(PolicyError::Io { .. })));
 }

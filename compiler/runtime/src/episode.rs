@@ -94,6 +94,8 @@ pub struct Episode {
     pub events: Vec<Event>,
     /// Step 0 (the start) then one per step, when asked for.
     pub frames: Vec<Frame>,
+    /// Why the ego's driver failed, when the episode stopped for it (`ego_failed`).
+    pub failure: Option<String>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -174,7 +176,11 @@ pub fn run(scene: &Scene, seed: Option<u64>, params: Vec<f64>, policy: &mut dyn 
             break;
         }
     }
-    runner.finish(seed, stop_reason)
+    let mut episode = runner.finish(seed, stop_reason);
+    if stop_reason == StopReason::EgoFailed {
+        episode.failure = policy.failure().map(String::from);
+    }
+    episode
 }
 
 /// An episode under way: what its steps share.
@@ -286,6 +292,10 @@ impl<'a> Runner<'a> {
         self.contacts();
         let reading = self.criteria(t);
         self.record(t, &reading);
+        // a driver that failed (an external process) ends the episode after its step
+        if policy.failure().is_some() {
+            return Some(StopReason::EgoFailed);
+        }
         self.stop_rule(t, &reading)
     }
 
@@ -481,6 +491,7 @@ impl<'a> Runner<'a> {
             records: self.records,
             events: self.events,
             frames: self.frames,
+            failure: None,
         }
     }
 }

@@ -200,3 +200,43 @@ fn the_ci_gate_fails_on_a_criterion_and_writes_a_junit_report() {
     assert_eq!(code(&out), 2);
     assert!(stderr(&out).contains("the criteria are collision, red_light"), "{}", stderr(&out));
 }
+
+/// An ego from any process: `external:CMD` drives over JSON lines (its commas kept in a
+/// comma-separated list); one that answers nonsense fails its episode (`ego_failed`) with
+/// the reason, status 2, and the run goes on with the next.
+#[test]
+fn an_external_process_drives_and_a_misbehaving_one_fails_its_episode_only() {
+    let steady = "external:while read view; do echo '[0.5, 0.0]'; done";
+    let egos = format!("idm,{steady}");
+    let out =
+        tadslc(&["run", "examples/safety/right_turn.tad", "--ego", &egos, "--seeds", "0", "--format", "json"], "");
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    let lines = json_lines(&out);
+    assert_eq!(lines[1]["ego"], steady.to_string(), "the command with its comma is one ego");
+    assert_ne!(lines[1]["stop_reason"], "ego_failed");
+    assert!(lines[1]["steps"].as_u64().is_some_and(|s| s > 5), "{}", lines[1]);
+
+    let broken = "external:read view; echo oops";
+    let out = tadslc(
+        &[
+            "run",
+            "examples/safety/right_turn.tad",
+            "--ego",
+            broken,
+            "--ego",
+            "idm",
+            "--seeds",
+            "0..2",
+            "--format",
+            "json",
+        ],
+        "",
+    );
+    assert_eq!(code(&out), 2, "{}", stderr(&out));
+    assert!(stderr(&out).contains("seed 1: the answer `oops` is not JSON"), "{}", stderr(&out));
+    let lines = json_lines(&out);
+    assert_eq!(lines.len(), 6, "four episodes and two aggregates: the run went on");
+    assert_eq!(lines[0]["stop_reason"], "ego_failed");
+    assert_eq!(lines[2]["ego"], "idm");
+    assert_ne!(lines[2]["stop_reason"], "ego_failed");
+}

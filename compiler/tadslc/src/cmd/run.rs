@@ -32,8 +32,9 @@ pub struct RunArgs {
     #[arg(required = true)]
     pub paths: Vec<PathBuf>,
     /// The ego policies, comma-separated or repeated: `idm`, `naive`, `learned:PATH`
-    /// (a SafeBench SAC actor in safetensors)
-    #[arg(long = "ego", value_delimiter = ',', default_values_t = ["idm".to_string(), "naive".to_string()])]
+    /// (a SafeBench SAC actor in safetensors), `external:CMD` (a process answering JSON
+    /// lines, `spec/runtime.md`)
+    #[arg(long = "ego", default_value = "idm,naive")]
     pub egos: Vec<String>,
     /// Seeds `A..B` (B excluded, as in Rust), `A..=B` (B included) or one seed `A`
     #[arg(long, default_value = "0..3", value_parser = parse_seeds)]
@@ -98,7 +99,9 @@ pub fn parse_seeds(text: &str) -> Result<Range<u64>, String> {
 
 pub fn run(args: &RunArgs, color: bool) -> Result<Status, CliError> {
     let mut policies = Vec::new();
-    for spec in &args.egos {
+    // comma-separated or repeated; an `external:CMD` keeps its commas
+    let egos: Vec<String> = args.egos.iter().flat_map(|list| tad_policy::split_specs(list)).collect();
+    for spec in &egos {
         policies.push(tad_policy::parse_policy(spec).map_err(|e| CliError::usage(format!("--ego {spec}: {e}")))?);
     }
     // raised by inputs that do not load, and by output that cannot be written
@@ -124,6 +127,11 @@ pub fn run(args: &RunArgs, color: bool) -> Result<Status, CliError> {
             for seed in args.seeds.clone() {
                 let params = tad_runtime::sample::sample(&loaded.scene.program.params, Some(seed));
                 let episode = tad_runtime::run(&loaded.scene, Some(seed), params, policy.as_mut(), &opts);
+                if let Some(why) = &episode.failure {
+                    // the run goes on with the next episode
+                    status = Status::Usage;
+                    errln!("error: {}: ego {}, seed {seed}: {why}", loaded.name, policy.name())?;
+                }
                 let Ok(score) = tad_metrics::score_episode(&episode.records, mode) else { continue };
                 if let Some(w) = trace.as_mut()
                     && let Err(err) = record::write_trace(w, &loaded.name, policy.name(), &loaded.scene, &episode)
@@ -152,7 +160,7 @@ pub fn run(args: &RunArgs, color: bool) -> Result<Status, CliError> {
     let names: Vec<String> = policies.iter().map(|p| p.name().to_string()).collect();
     if let Some(dir) = &args.out {
         let files: Vec<&str> = scenes.iter().map(|s| s.name.as_str()).collect();
-        if let Err(e) = record::results(&files, &args.egos, args.seeds.clone(), args.shard, &done).write(dir) {
+        if let Err(e) = record::results(&files, &egos, args.seeds.clone(), args.shard, &done).write(dir) {
             status = Status::Usage;
             errln!("error: cannot write the results to `{}`: {e}", dir.display())?;
         }
