@@ -123,6 +123,20 @@ pub fn read(path: &Path) -> Result<Input, String> {
     Ok(Input { name, path, text, invalid_utf8 })
 }
 
+/// Every input `paths` name (see [`collect`]), in order, and why the paths that could not
+/// be found or read were not (the search's errors first, then each file's).
+pub fn load(paths: &[PathBuf], search: Search) -> (Vec<Input>, Vec<String>) {
+    let (files, mut errors) = collect(paths, search);
+    let mut inputs = Vec::with_capacity(files.len());
+    for path in &files {
+        match read(path) {
+            Ok(input) => inputs.push(input),
+            Err(e) => errors.push(e),
+        }
+    }
+    (inputs, errors)
+}
+
 /// Every file under `dir` whose extension is `ext`, sorted (hidden directories, `target`
 /// and `node_modules` skipped); an unreadable directory gives none.
 pub fn with_extension(dir: &Path, ext: &str) -> Vec<PathBuf> {

@@ -116,16 +116,11 @@ pub fn name_of(path: &Path) -> String {
 /// not be read were not.
 pub fn read(paths: &[PathBuf]) -> (Corpus, Vec<String>) {
     let name = paths.first().map(|p| name_of(p)).unwrap_or_default();
-    let (files, mut errors) = tad_db::host::collect(paths, tad_db::host::Search::Scenarios);
-    let mut sources = Vec::with_capacity(files.len());
-    for path in &files {
-        match tad_db::host::read(path) {
-            Ok(input) => {
-                sources.push(Source { path: input.path.unwrap_or_else(|| PathBuf::from(input.name)), text: input.text })
-            }
-            Err(e) => errors.push(e),
-        }
-    }
+    let (inputs, errors) = tad_db::host::load(paths, tad_db::host::Search::Scenarios);
+    let sources = inputs
+        .into_iter()
+        .map(|input| Source { path: input.path.unwrap_or_else(|| PathBuf::from(input.name)), text: input.text })
+        .collect();
     (Corpus::new(name, sources), errors)
 }
 

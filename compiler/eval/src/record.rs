@@ -254,14 +254,16 @@ fn escape(text: &str) -> String {
     out
 }
 
-/// The JUnit XML report: one `<testsuite>` per scenario (`scenarios`, as `played` indexes
-/// them), one `<testcase>` per ego and seed, named `EGO seed N`, with its simulated time;
-/// a `<failure>` for an episode that met one of `criteria` (its type the criterion, its
-/// message the step and time); the stop reason and the ten metrics in `<system-out>`.
-pub fn junit(scenarios: &[&str], egos: &[String], played: &[Played], criteria: &[EventKind], dt: f64) -> String {
+/// The JUnit XML report: one `<testsuite>` per scenario (`scenarios`: its name and step
+/// length, as `played` indexes them), one `<testcase>` per ego and seed, named `EGO seed N`,
+/// with its simulated time; a `<failure>` for an episode that met one of `criteria` (its
+/// type the criterion, its message the step and time); the stop reason and the ten metrics
+/// in `<system-out>`.
+pub fn junit(scenarios: &[(&str, f64)], egos: &[String], played: &[Played], criteria: &[EventKind]) -> String {
     use std::fmt::Write;
     let fails = |p: &Played| failed(&p.episode, criteria).is_some();
-    let seconds = |p: &Played| p.episode.steps as f64 * dt;
+    let dt = |p: &Played| scenarios.get(p.scenario).map_or(0.0, |(_, dt)| *dt);
+    let seconds = |p: &Played| p.episode.steps as f64 * dt(p);
     let mut xml = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
     let (all, failures) = (played.len(), played.iter().filter(|p| fails(p)).count());
     let total: f64 = played.iter().map(seconds).sum();
@@ -269,7 +271,7 @@ pub fn junit(scenarios: &[&str], egos: &[String], played: &[Played], criteria: &
         xml,
         "<testsuites name=\"tadslc run\" tests=\"{all}\" failures=\"{failures}\" errors=\"0\" time=\"{total:.3}\">"
     );
-    for (k, scenario) in scenarios.iter().enumerate() {
+    for (k, (scenario, _)) in scenarios.iter().enumerate() {
         let cases: Vec<&Played> = played.iter().filter(|p| p.scenario == k).collect();
         let failing = cases.iter().filter(|p| fails(p)).count();
         let time: f64 = cases.iter().map(|p| seconds(p)).sum();
@@ -289,7 +291,7 @@ pub fn junit(scenarios: &[&str], egos: &[String], played: &[Played], criteria: &
             );
             if let Some(event) = failed(&p.episode, criteria) {
                 let kind = event.kind.as_str();
-                let at = event.step as f64 * dt;
+                let at = event.step as f64 * dt(p);
                 let _ = writeln!(
                     xml,
                     "      <failure type=\"{kind}\" message=\"{kind} at step {} ({at:.1} s)\">{kind} at step {} ({at:.1} s), at ({:.1}, {:.1}) m</failure>",

@@ -149,26 +149,10 @@ fn scenic(args: &BuildArgs, color: bool) -> Result<Status, CliError> {
                 out!("{}", emitted.text)?;
             }
             Some(dir) => {
-                let stem = input
-                    .path
-                    .as_deref()
-                    .and_then(Path::file_stem)
-                    .map_or_else(|| "stdin".to_string(), |s| s.to_string_lossy().into_owned());
-                let target = dir.join(format!("{stem}.scenic"));
-                if written.contains(&target) {
+                let Some(target) = write_into(dir, input, "scenic", emitted.text.as_bytes(), &mut written)? else {
                     status = status.max(Status::Usage);
-                    errln!(
-                        "error: {} would overwrite `{}`, written for an earlier file",
-                        input.name,
-                        target.display()
-                    )?;
                     continue;
-                }
-                if let Err(e) = std::fs::write(&target, &emitted.text) {
-                    status = status.max(Status::Usage);
-                    errln!("error: cannot write `{}`: {e}", target.display())?;
-                    continue;
-                }
+                };
                 errln!(
                     "{}: wrote {} ({}, {}, {})",
                     input.name,
@@ -182,7 +166,6 @@ fn scenic(args: &BuildArgs, color: bool) -> Result<Status, CliError> {
                 )?;
                 let map_file = map_dir.as_deref().unwrap_or(dir).join(&map_file);
                 note_missing(&mut missing, map_file, &target.display().to_string());
-                written.push(target);
             }
         }
     }
@@ -218,22 +201,10 @@ fn bytecode(args: &BuildArgs, color: bool) -> Result<Status, CliError> {
             continue;
         };
         let bytes = tad_bytecode::encode(&program);
-        let stem = input
-            .path
-            .as_deref()
-            .and_then(Path::file_stem)
-            .map_or_else(|| "stdin".to_string(), |s| s.to_string_lossy().into_owned());
-        let target = dir.join(format!("{stem}.tadc"));
-        if written.contains(&target) {
+        let Some(target) = write_into(dir, input, "tadc", &bytes, &mut written)? else {
             status = status.max(Status::Usage);
-            errln!("error: {} would overwrite `{}`, written for an earlier file", input.name, target.display())?;
             continue;
-        }
-        if let Err(e) = std::fs::write(&target, &bytes) {
-            status = status.max(Status::Usage);
-            errln!("error: cannot write `{}`: {e}", target.display())?;
-            continue;
-        }
+        };
         let actors = program.code.iter().filter(|i| matches!(i, tad_bytecode::Instr::Spawn { .. })).count();
         errln!(
             "{}: wrote {} ({}, {}, {} bytes)",
@@ -243,9 +214,36 @@ fn bytecode(args: &BuildArgs, color: bool) -> Result<Status, CliError> {
             plural(program.code.len(), "instruction"),
             bytes.len()
         )?;
-        written.push(target);
     }
     Ok(status)
+}
+
+/// Writes `bytes` for `input` as `DIR/STEM.EXT` (`stdin` without a path) and adds it to
+/// `written`; `None` when it would overwrite what an earlier input wrote or cannot be
+/// written (said on standard error; the caller's status is 2).
+fn write_into(
+    dir: &Path,
+    input: &files::Input,
+    ext: &str,
+    bytes: &[u8],
+    written: &mut Vec<PathBuf>,
+) -> Result<Option<PathBuf>, Closed> {
+    let stem = input
+        .path
+        .as_deref()
+        .and_then(Path::file_stem)
+        .map_or_else(|| "stdin".to_string(), |s| s.to_string_lossy().into_owned());
+    let target = dir.join(format!("{stem}.{ext}"));
+    if written.contains(&target) {
+        errln!("error: {} would overwrite `{}`, written for an earlier file", input.name, target.display())?;
+        return Ok(None);
+    }
+    if let Err(e) = std::fs::write(&target, bytes) {
+        errln!("error: cannot write `{}`: {e}", target.display())?;
+        return Ok(None);
+    }
+    written.push(target.clone());
+    Ok(Some(target))
 }
 
 /// Remember that `program` loads `file`, if `file` does not exist.

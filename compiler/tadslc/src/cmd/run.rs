@@ -179,7 +179,7 @@ pub fn run(args: &RunArgs, color: bool) -> Result<Status, CliError> {
             out!("{}", record::table(&scenarios, &names, &done, mode))?;
         }
     }
-    status = status.max(gate(args, &scenes, &names, &done, step_length(&scenes))?);
+    status = status.max(gate(args, &scenes, &names, &done)?);
     if let (Some(path), Some(first)) = (&args.render, done.first()) {
         let loaded = &scenes[first.scenario];
         let gif = path.extension().is_some_and(|x| x.eq_ignore_ascii_case("gif"));
@@ -199,11 +199,6 @@ pub fn run(args: &RunArgs, color: bool) -> Result<Status, CliError> {
     Ok(status)
 }
 
-/// The step length of the scenes' episodes (the same for every scene).
-fn step_length(scenes: &[crate::scenes::Loaded]) -> f64 {
-    scenes.first().map_or(0.1, |l| l.scene.limits.dt)
-}
-
 /// The CI gate: the JUnit report, and status 1 when an episode met a `--fail-on` criterion
 /// (how many, by criterion, on standard error).
 fn gate(
@@ -211,11 +206,10 @@ fn gate(
     scenes: &[crate::scenes::Loaded],
     egos: &[String],
     done: &[Played],
-    dt: f64,
 ) -> Result<Status, CliError> {
     if let Some(path) = &args.junit {
-        let names: Vec<&str> = scenes.iter().map(|s| s.name.as_str()).collect();
-        let xml = record::junit(&names, egos, done, &args.fail_on, dt);
+        let suites: Vec<(&str, f64)> = scenes.iter().map(|s| (s.name.as_str(), s.scene.limits.dt)).collect();
+        let xml = record::junit(&suites, egos, done, &args.fail_on);
         std::fs::write(path, xml).map_err(|e| CliError::usage(format!("cannot write `{}`: {e}", path.display())))?;
     }
     let mut met: Vec<(&str, usize)> = Vec::new();
