@@ -14,12 +14,13 @@
 //! `null` where the route is straight) and answers one line, the action: `[accel, steer]`
 //! (Gymnasium's two-number action) or `{"accel": A, "steer": S}`, accel in m/s², steer in
 //! `[-1, 1]`, positive to the right. Everything it writes is untrusted: a line that is not
-//! JSON, an action of another size or a number that is not finite, no answer within the
-//! timeout (5 s by default), or the process ending, fails the policy with a clear reason
+//! JSON or longer than 64 KiB, an action of another size or a number that is not finite, no
+//! answer within the timeout (5 s by default), or the process ending, fails the policy with
+//! a clear reason
 //! ([`EgoPolicy::failure`]); the runtime then ends the episode (`ego_failed`), and the run
 //! goes on. The process is killed when the episode ends.
 
-use std::io::{BufRead, BufReader, Write};
+use std::io::{BufRead, BufReader, Read, Write};
 use std::process::{Child, ChildStdin, Command, Stdio};
 use std::sync::mpsc::{Receiver, RecvTimeoutError};
 use std::time::Duration;
@@ -28,6 +29,9 @@ use crate::{Action, EgoPolicy, EgoView};
 
 /// How long the process may take to answer a step, unless the spec says otherwise.
 pub const TIMEOUT: Duration = Duration::from_secs(5);
+
+/// The longest answer read, bytes.
+const LINE: usize = 64 * 1024;
 
 /// An ego driven by a process over JSON lines (see the module's header).
 pub struct External {
@@ -42,7 +46,7 @@ pub struct External {
 struct Running {
     child: Child,
     input: ChildStdin,
-    lines: Receiver<String>,
+    lines: Receiver<Result<String, String>>,
 }
 
 impl External {
@@ -69,11 +73,24 @@ impl External {
             (Some(i), Some(o)) => (i, o),
             _ => return Err("the process has no standard input or output".into()),
         };
-        let (send, lines) = std::sync::mpsc::channel();
+        // one line waits at most, of at most `LINE` bytes: a process that floods its output
+        // holds no more memory than that
+        let (send, lines) = std::sync::mpsc::sync_channel(1);
         std::thread::spawn(move || {
-            for line in BufReader::new(output).lines() {
-                let Ok(line) = line else { break };
-                if send.send(line).is_err() {
+            let mut reader = BufReader::new(output);
+            loop {
+                let mut line = Vec::new();
+                match (&mut reader).take(LINE as u64 + 1).read_until(b'\n', &mut line) {
+                    Ok(0) | Err(_) => break,
+                    Ok(_) => {}
+                }
+                let answer = if line.len() > LINE && !line.ends_with(b"\n") {
+                    Err(format!("an answer longer than {LINE} bytes"))
+                } else {
+                    Ok(String::from_utf8_lossy(&line).trim_end().to_string())
+                };
+                let overlong = answer.is_err();
+                if send.send(answer).is_err() || overlong {
                     break;
                 }
             }
@@ -103,7 +120,8 @@ impl External {
             .and_then(|()| running.input.flush())
             .map_err(|e| format!("cannot write to the process: {e}"))?;
         match running.lines.recv_timeout(timeout) {
-            Ok(answer) => action(&answer),
+            Ok(Ok(answer)) => action(&answer),
+            Ok(Err(why)) => Err(why),
             Err(RecvTimeoutError::Timeout) => Err(format!("no action within {:.1} s", timeout.as_secs_f64())),
             Err(RecvTimeoutError::Disconnected) => {
                 let status = running.child.wait().map(|s| s.to_string()).unwrap_or_else(|e| e.to_string());
@@ -243,6 +261,7 @@ mod tests {
             ("sleep 10", "no action within 0.5 s"),
             ("read line; exit 3", "the process ended"),
             ("/nonexistent/driver", "the process"),
+            ("read line; yes 1 | tr -d '\\n'", "an answer longer than 65536 bytes"),
         ];
         for (command, reason) in cases {
             let started = std::time::Instant::now();
