@@ -16,9 +16,8 @@
 //! `[-1, 1]`, positive to the right. Everything it writes is untrusted: a line that is not
 //! JSON or longer than 64 KiB, an action of another size or a number that is not finite, no
 //! answer within the timeout (5 s by default), or the process ending, fails the policy with
-//! a clear reason
-//! ([`EgoPolicy::failure`]); the runtime then ends the episode (`ego_failed`), and the run
-//! goes on. The process is killed when the episode ends.
+//! a clear reason ([`EgoPolicy::failure`]); the runtime then ends the episode (`ego_failed`),
+//! and the run goes on. The process is killed when the episode ends.
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::process::{Child, ChildStdin, Command, Stdio};
