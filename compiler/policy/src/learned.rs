@@ -1,5 +1,6 @@
-//! SafeBench's SAC actor (`safebench/agent/rl/sac.py::Actor`): candle reads and writes the
-//! safetensors file; the forward pass is plain `f32` arithmetic.
+//! A learned ego: SafeBench's SAC actor (`safebench/agent/rl/sac.py::Actor`) or a
+//! Stable-Baselines3 MLP policy (PPO, SAC, TD3) exported to safetensors. candle reads and
+//! writes the file; the forward pass is plain `f32` arithmetic.
 //!
 //! The actor is an MLP: `x = relu(fcK(… relu(fc1(obs))))`, `mu = tanh(fc_mu(x))`, and a
 //! std head `fc_std` that deterministic evaluation ignores (SafeBench's
@@ -10,7 +11,23 @@
 //! environment does: `accel = 3·acc` m/s² (`continuous_accel_range`), `steer = 0.3·steer`
 //! (`continuous_steer_range`, CARLA's sign), so the actor never brakes harder than 3 m/s².
 //!
-//! A checkpoint converts from PyTorch with
+//! # Stable-Baselines3's policies
+//!
+//! `safetensors.torch.save_file(model.policy.state_dict(), 'policy.safetensors')` keeps
+//! SB3's names; the layout tells the algorithm (`torch.nn.Sequential` numbers its linear
+//! layers 0, 2, 4, … between activations):
+//! - PPO (`ActorCriticPolicy`): `mlp_extractor.policy_net.{0,2,…}` with tanh (SB3's
+//!   default `activation_fn`), then `action_net`: the Gaussian's mean, clipped to `[−1, 1]`
+//!   as `predict` clips it to the action space;
+//! - SAC: `actor.latent_pi.{0,2,…}` with ReLU, then `tanh(actor.mu)`;
+//! - TD3: `actor.mu.{0,2,…}` with ReLU between, `tanh` after the last.
+//!
+//! The file's metadata key `activation` (`relu` or `tanh`) overrides the hidden layers'
+//! default. The first layer's width tells the observation: 4, SafeBench's; 13,
+//! [`crate::STATE_DIM`]'s `state` (what `tadsl`'s Gymnasium environment calls
+//! `observation="state"`). The environment's action space is `[−1, 1]²`, scaled as above.
+//!
+//! A SafeBench checkpoint converts from PyTorch with
 //! `safetensors.torch.save_file(torch.load(f)['policy_net'], 'actor.safetensors')`; names
 //! prefixed `policy_net.` (a whole checkpoint flattened) are accepted too. Weights of any
 //! float type are computed in `f32`, as PyTorch does.
@@ -20,7 +37,7 @@
 //! step against a few µs for the 17 k multiply-adds themselves. The tests check this
 //! forward pass against candle's.
 
-use crate::{Action, EgoPolicy, EgoView, PolicyError};
+use crate::{Action, EgoPolicy, EgoView, PolicyError, STATE_DIM};
 use candle_core::{DType, Device, Tensor};
 use std::collections::HashMap;
 use std::path::Path;
@@ -30,21 +47,68 @@ use tad_ir::{Rng, SplitMix64};
 const OBS_DIM: usize = 4;
 /// The action's length (`ego_action_dim`).
 const ACTION_DIM: usize = 2;
-/// SafeBench's scaling of the actor's `[−1, 1]` outputs: m/s², normalised steer.
-const ACCEL_RANGE: f64 = 3.0;
-const STEER_RANGE: f64 = 0.3;
 
 /// Where the actor's tensors may live in a file.
 const PREFIXES: [&str; 2] = ["", "policy_net."];
 
-/// A learned ego: SafeBench's SAC actor, deterministic.
+/// A learned ego: SafeBench's SAC actor or an SB3 policy, deterministic.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Learned {
     name: String,
+    format: Format,
     hidden: Vec<Dense>,
+    activation: Activation,
     mu: Dense,
     /// The std head, kept only to be saved again.
     std: Option<Dense>,
+}
+
+/// Whose layout a file has (the module's header).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    SafeBench,
+    Sb3Ppo,
+    Sb3Sac,
+    Sb3Td3,
+}
+
+impl Format {
+    fn of(tensors: &HashMap<String, Tensor>) -> Format {
+        let has = |name: &str| tensors.contains_key(name);
+        if has("action_net.weight") {
+            Format::Sb3Ppo
+        } else if has("actor.latent_pi.0.weight") || has("actor.mu.weight") {
+            Format::Sb3Sac
+        } else if has("actor.mu.0.weight") {
+            Format::Sb3Td3
+        } else {
+            Format::SafeBench
+        }
+    }
+
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Format::SafeBench => "SafeBench SAC",
+            Format::Sb3Ppo => "SB3 PPO",
+            Format::Sb3Sac => "SB3 SAC",
+            Format::Sb3Td3 => "SB3 TD3",
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Activation {
+    Relu,
+    Tanh,
+}
+
+impl Activation {
+    fn apply(self, v: f32) -> f32 {
+        match self {
+            Activation::Relu => v.max(0.0),
+            Activation::Tanh => v.tanh(),
+        }
+    }
 }
 
 /// One `nn.Linear`: `weight` row-major `[outputs, inputs]`.
@@ -77,69 +141,80 @@ impl Learned {
         let path = path.as_ref();
         let shown = path.display().to_string();
         let bytes = std::fs::read(path).map_err(|e| PolicyError::Io { path: shown.clone(), message: e.to_string() })?;
-        let tensors = candle_core::safetensors::load_buffer(&bytes, &Device::Cpu)
-            .map_err(|e| PolicyError::NotSafetensors { path: shown.clone(), message: e.to_string() })?;
+        let not_safetensors = |e: String| PolicyError::NotSafetensors { path: shown.clone(), message: e };
+        let tensors =
+            candle_core::safetensors::load_buffer(&bytes, &Device::Cpu).map_err(|e| not_safetensors(e.to_string()))?;
+        let (_, metadata) =
+            safetensors::SafeTensors::read_metadata(&bytes).map_err(|e| not_safetensors(e.to_string()))?;
         let mut actor = Learned::from_tensors(&tensors, &shown)?;
+        match metadata.metadata().as_ref().and_then(|m| m.get("activation")).map(String::as_str) {
+            None => {}
+            Some("relu") => actor.activation = Activation::Relu,
+            Some("tanh") => actor.activation = Activation::Tanh,
+            Some(other) => {
+                return Err(not_safetensors(format!("metadata `activation` is `{other}`, not `relu` or `tanh`")));
+            }
+        }
         actor.name = format!("learned:{shown}");
         Ok(actor)
     }
 
     /// The actor in `tensors`; `path` names their source in errors.
     pub fn from_tensors(tensors: &HashMap<String, Tensor>, path: &str) -> Result<Learned, PolicyError> {
-        let prefix = PREFIXES.iter().find(|p| tensors.contains_key(&format!("{p}fc1.weight"))).copied().unwrap_or("");
-        // The values of `name`, which must be `[rows, cols]` (`rows` 0: any but 0) or
-        // `[rows]` (`cols` None).
-        let get = |name: &str, rows: usize, cols: Option<usize>| -> Result<Vec<f32>, PolicyError> {
-            let full = format!("{prefix}{name}");
-            let Some(t) = tensors.get(&full) else {
-                let mut found: Vec<String> = tensors.keys().cloned().collect();
-                found.sort();
-                found.truncate(8);
-                return Err(PolicyError::MissingTensor { path: path.to_string(), name: full, found });
-            };
-            let dims = t.dims();
-            let fits = match cols {
-                Some(c) => dims.len() == 2 && dims[1] == c && dims[0] > 0 && (rows == 0 || dims[0] == rows),
-                None => dims == [rows],
-            };
-            if !fits {
-                let expected = match (cols, rows) {
-                    (Some(c), 0) => format!("[n, {c}] with n ≥ 1"),
-                    (Some(c), r) => format!("[{r}, {c}]"),
-                    (None, r) => format!("[{r}]"),
-                };
-                return Err(PolicyError::WrongShape {
-                    path: path.to_string(),
-                    name: full,
-                    expected,
-                    found: dims.to_vec(),
-                });
+        let format = Format::of(tensors);
+        let prefix = match format {
+            Format::SafeBench => {
+                PREFIXES.iter().find(|p| tensors.contains_key(&format!("{p}fc1.weight"))).copied().unwrap_or("")
             }
-            let values =
-                t.to_dtype(DType::F32).and_then(|t| t.flatten_all()?.to_vec1::<f32>()).map_err(tensor_error)?;
-            if values.iter().any(|v| !v.is_finite()) {
-                return Err(PolicyError::NonFinite { path: path.to_string(), name: full });
-            }
-            Ok(values)
+            _ => "",
         };
-        let layer = |name: &str, outputs: usize, inputs: usize| -> Result<Dense, PolicyError> {
-            let weight = get(&format!("{name}.weight"), outputs, Some(inputs))?;
-            let outputs = weight.len() / inputs;
-            Ok(Dense { inputs, weight, bias: get(&format!("{name}.bias"), outputs, None)? })
+        let read = Reader { tensors, path, prefix };
+        // SB3 stacks: `base.0`, `base.2`, … while they exist
+        let stack = |base: &str| -> Vec<String> {
+            (0..).step_by(2).map(|k| format!("{base}.{k}")).take_while(|n| read.has(&format!("{n}.weight"))).collect()
         };
-        let mut hidden: Vec<Dense> = Vec::new();
-        for k in 1.. {
-            let name = format!("fc{k}");
-            if k > 1 && !tensors.contains_key(&format!("{prefix}{name}.weight")) {
-                break;
+        let (hidden_names, mu_name, activation) = match format {
+            Format::SafeBench => {
+                let names: Vec<String> = (1..)
+                    .map(|k| format!("fc{k}"))
+                    .enumerate()
+                    .take_while(|(k, n)| *k == 0 || read.has(&format!("{n}.weight")))
+                    .map(|(_, n)| n)
+                    .collect();
+                (names, "fc_mu".to_string(), Activation::Relu)
             }
-            let inputs = hidden.last().map_or(OBS_DIM, Dense::outputs);
-            hidden.push(layer(&name, 0, inputs)?);
+            Format::Sb3Ppo => (stack("mlp_extractor.policy_net"), "action_net".to_string(), Activation::Tanh),
+            Format::Sb3Sac => (stack("actor.latent_pi"), "actor.mu".to_string(), Activation::Relu),
+            Format::Sb3Td3 => {
+                let mut names = stack("actor.mu");
+                let last = names.pop().unwrap_or_else(|| "actor.mu.0".to_string());
+                (names, last, Activation::Relu)
+            }
+        };
+        let first = hidden_names.first().unwrap_or(&mu_name);
+        let mut width = read.inputs(first)?;
+        let mut hidden = Vec::new();
+        for name in &hidden_names {
+            let layer = read.layer(name, 0, width)?;
+            width = layer.outputs();
+            hidden.push(layer);
         }
-        let width = hidden.last().map_or(OBS_DIM, Dense::outputs);
-        let mu = layer("fc_mu", ACTION_DIM, width)?;
-        let std = layer("fc_std", ACTION_DIM, width).ok();
-        Ok(Learned { name: "learned".to_string(), hidden, mu, std })
+        let mu = read.layer(&mu_name, ACTION_DIM, width)?;
+        let std = match format {
+            Format::SafeBench => read.layer("fc_std", ACTION_DIM, width).ok(),
+            _ => None,
+        };
+        Ok(Learned { name: "learned".to_string(), format, hidden, activation, mu, std })
+    }
+
+    /// Whose layout the actor was read from.
+    pub fn format(&self) -> Format {
+        self.format
+    }
+
+    /// The observation's length it reads: [`OBS_DIM`] or [`STATE_DIM`].
+    pub fn inputs(&self) -> usize {
+        self.hidden.first().unwrap_or(&self.mu).inputs
     }
 
     /// A fresh actor with these hidden widths, its weights and biases drawn uniformly from
@@ -163,11 +238,23 @@ impl Learned {
         }
         let mu = layer(ACTION_DIM, width);
         let std = layer(ACTION_DIM, width);
-        Ok(Learned { name: "learned".to_string(), hidden: layers, mu, std: Some(std) })
+        Ok(Learned {
+            name: "learned".to_string(),
+            format: Format::SafeBench,
+            hidden: layers,
+            activation: Activation::Relu,
+            mu,
+            std: Some(std),
+        })
     }
 
-    /// The actor's tensors under SafeBench's names (unprefixed, `f32`).
+    /// The actor's tensors under SafeBench's names (unprefixed, `f32`); only a SafeBench
+    /// actor is written (an SB3 policy's activation and head have no SafeBench names).
     pub fn tensors(&self) -> Result<HashMap<String, Tensor>, PolicyError> {
+        if self.format != Format::SafeBench {
+            let message = format!("an {} policy is not written as a SafeBench actor", self.format.as_str());
+            return Err(PolicyError::Tensor { message });
+        }
         let named = self.hidden.iter().enumerate().map(|(k, l)| (format!("fc{}", k + 1), l));
         let named =
             named.chain([("fc_mu".to_string(), &self.mu)]).chain(self.std.iter().map(|s| ("fc_std".to_string(), s)));
@@ -192,14 +279,93 @@ impl Learned {
         self.hidden.iter().map(Dense::outputs).collect()
     }
 
-    /// The actor's `mu = tanh(fc_mu(…))` for an observation, in `[−1, 1]²`.
-    pub fn mu(&self, obs: [f64; OBS_DIM]) -> [f32; ACTION_DIM] {
+    /// The actor's deterministic action for an observation of [`Learned::inputs`] values,
+    /// in `[−1, 1]²`: `tanh(mu(…))`, or for SB3's PPO the mean clipped.
+    pub fn mu(&self, obs: &[f64]) -> [f32; ACTION_DIM] {
         let mut x: Vec<f32> = obs.iter().map(|&v| v as f32).collect();
         for layer in &self.hidden {
-            x = layer.forward(&x).into_iter().map(|v| v.max(0.0)).collect();
+            x = layer.forward(&x).into_iter().map(|v| self.activation.apply(v)).collect();
         }
         let mu = self.mu.forward(&x);
-        [mu[0].tanh(), mu[1].tanh()]
+        match self.format {
+            Format::Sb3Ppo => [mu[0].clamp(-1.0, 1.0), mu[1].clamp(-1.0, 1.0)],
+            _ => [mu[0].tanh(), mu[1].tanh()],
+        }
+    }
+}
+
+/// Reads named tensors, checking shapes and values.
+struct Reader<'t> {
+    tensors: &'t HashMap<String, Tensor>,
+    path: &'t str,
+    prefix: &'t str,
+}
+
+impl Reader<'_> {
+    fn has(&self, name: &str) -> bool {
+        self.tensors.contains_key(&format!("{}{name}", self.prefix))
+    }
+
+    /// The observation a first layer `name` reads: its weight's columns, which must be
+    /// [`OBS_DIM`] or [`STATE_DIM`].
+    fn inputs(&self, name: &str) -> Result<usize, PolicyError> {
+        let full = format!("{}{name}.weight", self.prefix);
+        let dims = self.tensor(&full)?.dims().to_vec();
+        match dims.as_slice() {
+            [rows, cols] if *rows > 0 && (*cols == OBS_DIM || *cols == STATE_DIM) => Ok(*cols),
+            _ => Err(PolicyError::WrongShape {
+                path: self.path.to_string(),
+                name: full,
+                expected: format!("[n, {OBS_DIM}] or [n, {STATE_DIM}] (the observation's length)"),
+                found: dims,
+            }),
+        }
+    }
+
+    fn tensor(&self, full: &str) -> Result<&Tensor, PolicyError> {
+        self.tensors.get(full).ok_or_else(|| {
+            let mut found: Vec<String> = self.tensors.keys().cloned().collect();
+            found.sort();
+            found.truncate(8);
+            PolicyError::MissingTensor { path: self.path.to_string(), name: full.to_string(), found }
+        })
+    }
+
+    /// The values of `name`, which must be `[rows, cols]` (`rows` 0: any but 0) or `[rows]`
+    /// (`cols` None).
+    fn values(&self, name: &str, rows: usize, cols: Option<usize>) -> Result<Vec<f32>, PolicyError> {
+        let full = format!("{}{name}", self.prefix);
+        let t = self.tensor(&full)?;
+        let dims = t.dims();
+        let fits = match cols {
+            Some(c) => dims.len() == 2 && dims[1] == c && dims[0] > 0 && (rows == 0 || dims[0] == rows),
+            None => dims == [rows],
+        };
+        if !fits {
+            let expected = match (cols, rows) {
+                (Some(c), 0) => format!("[n, {c}] with n ≥ 1"),
+                (Some(c), r) => format!("[{r}, {c}]"),
+                (None, r) => format!("[{r}]"),
+            };
+            return Err(PolicyError::WrongShape {
+                path: self.path.to_string(),
+                name: full,
+                expected,
+                found: dims.to_vec(),
+            });
+        }
+        let values = t.to_dtype(DType::F32).and_then(|t| t.flatten_all()?.to_vec1::<f32>()).map_err(tensor_error)?;
+        if values.iter().any(|v| !v.is_finite()) {
+            return Err(PolicyError::NonFinite { path: self.path.to_string(), name: full });
+        }
+        Ok(values)
+    }
+
+    /// One `nn.Linear` named `name` (`outputs` 0: any).
+    fn layer(&self, name: &str, outputs: usize, inputs: usize) -> Result<Dense, PolicyError> {
+        let weight = self.values(&format!("{name}.weight"), outputs, Some(inputs))?;
+        let outputs = weight.len() / inputs;
+        Ok(Dense { inputs, weight, bias: self.values(&format!("{name}.bias"), outputs, None)? })
     }
 }
 
@@ -209,10 +375,9 @@ impl EgoPolicy for Learned {
     }
 
     fn act(&mut self, view: &EgoView) -> Action {
-        let [acc, steer] = self.mu(view.obs);
-        Action {
-            accel: (f64::from(acc) * ACCEL_RANGE).clamp(-ACCEL_RANGE, ACCEL_RANGE),
-            steer: (f64::from(steer) * STEER_RANGE).clamp(-STEER_RANGE, STEER_RANGE),
+        match self.inputs() {
+            STATE_DIM => Action::from_unit(self.mu(&view.state())),
+            _ => Action::from_unit(self.mu(&view.obs)),
         }
     }
 }

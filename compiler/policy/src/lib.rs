@@ -59,7 +59,7 @@ mod learned;
 
 pub use external::External;
 pub use idm::{Idm, IdmParams, Naive};
-pub use learned::Learned;
+pub use learned::{Format, Learned};
 
 use std::fmt;
 
@@ -107,6 +107,52 @@ pub struct EgoView {
 pub struct Action {
     pub accel: f64,
     pub steer: f64,
+}
+
+/// The `state` observation's length ([`EgoView::state`]).
+pub const STATE_DIM: usize = 13;
+/// What the `state` observation shows for "none" or "unbounded", m and m/s.
+pub const STATE_FAR: f64 = 100.0;
+
+impl EgoView {
+    /// The `state` observation: SafeBench's four features, then what the rule-based
+    /// drivers see, as numbers a network takes (nothing infinite, presence as 0/1):
+    ///
+    /// | index | value |
+    /// |---|---|
+    /// | 0–3 | [`EgoView::obs`] |
+    /// | 4 | desired speed, m/s |
+    /// | 5, 6 | the route's point [`EgoView::lookahead`] ahead, ego frame, m |
+    /// | 7, 8, 9 | a leader: 1/0, its gap (m, [`STATE_FAR`] at most), its speed (m/s, 0 without) |
+    /// | 10, 11 | a place to stop: 1/0, its distance (m, [`STATE_FAR`] at most) |
+    /// | 12 | the route's curve speed, m/s, [`STATE_FAR`] at most |
+    pub fn state(&self) -> [f64; STATE_DIM] {
+        let (leader, gap, leader_speed) = match self.leader {
+            Some((gap, speed)) => (1.0, gap.min(STATE_FAR), speed),
+            None => (0.0, STATE_FAR, 0.0),
+        };
+        let (stop, stop_at) = self.stop.map_or((0.0, STATE_FAR), |d| (1.0, d.min(STATE_FAR)));
+        let [a, b, c, d] = self.obs;
+        let [x, y] = self.target;
+        let curve = self.curve_speed.min(STATE_FAR);
+        [a, b, c, d, self.desired_speed, x, y, leader, gap, leader_speed, stop, stop_at, curve]
+    }
+}
+
+/// SafeBench's scaling of a learned actor's `[−1, 1]` outputs: `accel = 3·a` m/s²
+/// (`continuous_accel_range`), `steer = 0.3·s` (`continuous_steer_range`, CARLA's sign).
+pub const ACCEL_RANGE: f64 = 3.0;
+pub const STEER_RANGE: f64 = 0.3;
+
+impl Action {
+    /// An actor's `[acc, steer]` in `[−1, 1]` as SafeBench's environment applies it
+    /// ([`ACCEL_RANGE`], [`STEER_RANGE`]); values outside are clamped.
+    pub fn from_unit([acc, steer]: [f32; 2]) -> Action {
+        Action {
+            accel: (f64::from(acc) * ACCEL_RANGE).clamp(-ACCEL_RANGE, ACCEL_RANGE),
+            steer: (f64::from(steer) * STEER_RANGE).clamp(-STEER_RANGE, STEER_RANGE),
+        }
+    }
 }
 
 pub trait EgoPolicy: Send {
@@ -216,7 +262,10 @@ impl fmt::Display for PolicyError {
             PolicyError::Io { path, message } => write!(f, "{path}: {message}"),
             PolicyError::NotSafetensors { path, message } => write!(f, "{path}: not a safetensors file: {message}"),
             PolicyError::MissingTensor { path, name, found } => {
-                write!(f, "{path}: no tensor `{name}` (an actor needs `fc1` … `fcN` and `fc_mu`; found ")?;
+                write!(
+                    f,
+                    "{path}: no tensor `{name}` (an actor needs SafeBench's `fc1` … `fcN` and `fc_mu`, or an SB3 policy's; found "
+                )?;
                 if found.is_empty() { f.write_str("none)") } else { write!(f, "{})", found.join(", ")) }
             }
             PolicyError::WrongShape { path, name, expected, found } => {

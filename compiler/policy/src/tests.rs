@@ -6,6 +6,7 @@ use super::*;
 use candle_core::{Device, Tensor};
 use std::collections::HashMap;
 use std::path::PathBuf;
+use tad_ir::{Rng, SplitMix64};
 
 fn view(speed: f64, desired_speed: f64) -> EgoView {
     EgoView {
@@ -237,7 +238,7 @@ fn learned_random_round_trip() {
     Learned::random(&[64, 256], 7).unwrap().save(&again).unwrap();
     assert_eq!(std::fs::read(&path).unwrap(), std::fs::read(&again).unwrap());
     let other = Learned::random(&[64, 256], 8).unwrap();
-    assert_ne!(other.mu([1.0, 0.5, 5.0, 0.0]), actor.mu([1.0, 0.5, 5.0, 0.0]));
+    assert_ne!(other.mu(&[1.0, 0.5, 5.0, 0.0]), actor.mu(&[1.0, 0.5, 5.0, 0.0]));
     assert!(matches!(Learned::random(&[], 1), Err(PolicyError::BadHidden { .. })));
     assert!(matches!(Learned::random(&[4, 0], 1), Err(PolicyError::BadHidden { .. })));
 }
@@ -273,7 +274,10 @@ fn learned_bad_files_are_errors() {
     let mut t = tiny();
     t.insert("fc1.weight".to_string(), tensor(&[0.0; 15], &[3, 5]));
     let err = Learned::from_tensors(&t, "x").unwrap_err();
-    assert_eq!(err.to_string(), "x: tensor `fc1.weight` has shape [3, 5], expected [n, 4] with n ≥ 1");
+    assert_eq!(
+        err.to_string(),
+        "x: tensor `fc1.weight` has shape [3, 5], expected [n, 4] or [n, 13] (the observation's length)"
+    );
 
     let mut t = tiny();
     t.insert("fc_mu.weight".to_string(), tensor(&[0.0; 8], &[2, 4]));
@@ -287,7 +291,7 @@ fn learned_bad_files_are_errors() {
     let err = Learned::from_tensors(&other, "x").unwrap_err();
     assert_eq!(
         err.to_string(),
-        "x: no tensor `fc1.weight` (an actor needs `fc1` … `fcN` and `fc_mu`; found net.0.weight)"
+        "x: no tensor `fc1.weight` (an actor needs SafeBench's `fc1` … `fcN` and `fc_mu`, or an SB3 policy's; found net.0.weight)"
     );
 }
 
@@ -328,7 +332,123 @@ fn learned_forward_agrees_with_candle() {
             x = linear(name).forward(&x).unwrap().relu().unwrap();
         }
         let mu = linear("fc_mu").forward(&x).unwrap().tanh().unwrap().flatten_all().unwrap().to_vec1::<f32>().unwrap();
-        let ours = actor.mu(obs);
+        let ours = actor.mu(&obs);
         assert!((ours[0] - mu[0]).abs() < 1e-5 && (ours[1] - mu[1]).abs() < 1e-5, "{ours:?} vs {mu:?}");
     }
+}
+
+/// Seeded values in ±0.5 of `shape`.
+fn seeded(shape: &[usize], seed: u64) -> Tensor {
+    let mut rng = SplitMix64::new(seed);
+    let n = shape.iter().product();
+    let values: Vec<f32> = (0..n).map(|_| (rng.unit() - 0.5) as f32).collect();
+    Tensor::from_vec(values, shape, &Device::Cpu).unwrap()
+}
+
+/// An SB3 `nn.Sequential` of linear layers `widths[0] → widths[1] → …` at `base.0`,
+/// `base.2`, …, into `t`.
+fn stack(t: &mut HashMap<String, Tensor>, base: &str, widths: &[usize], seed: u64) {
+    for (k, w) in widths.windows(2).enumerate() {
+        t.insert(format!("{base}.{}.weight", 2 * k), seeded(&[w[1], w[0]], seed + 2 * k as u64));
+        t.insert(format!("{base}.{}.bias", 2 * k), seeded(&[w[1]], seed + 2 * k as u64 + 1));
+    }
+}
+
+/// `x` through the linear layers `names` of `t` (candle-nn), `act` between them.
+fn candle_forward(t: &HashMap<String, Tensor>, names: &[String], x: &[f64], act: fn(&Tensor) -> Tensor) -> Vec<f32> {
+    use candle_nn::{Linear, Module};
+    let input: Vec<f32> = x.iter().map(|&v| v as f32).collect();
+    let mut x = Tensor::from_vec(input.clone(), (1, input.len()), &Device::Cpu).unwrap();
+    for (k, name) in names.iter().enumerate() {
+        let linear = Linear::new(t[&format!("{name}.weight")].clone(), Some(t[&format!("{name}.bias")].clone()));
+        x = linear.forward(&x).unwrap();
+        if k + 1 < names.len() {
+            x = act(&x);
+        }
+    }
+    x.flatten_all().unwrap().to_vec1::<f32>().unwrap()
+}
+
+#[test]
+fn sb3_policies_load_and_agree_with_candle() {
+    use crate::{Format, STATE_DIM};
+    let relu = |x: &Tensor| x.relu().unwrap();
+    let tanh = |x: &Tensor| x.tanh().unwrap();
+    let obs4 = [0.4, -0.3, 7.5, 1.0];
+    let state: Vec<f64> = (0..STATE_DIM).map(|k| k as f64 * 0.37 - 2.0).collect();
+    let names = |base: &str, n: usize| -> Vec<String> { (0..n).map(|k| format!("{base}.{}", 2 * k)).collect() };
+
+    // PPO on the `state` observation: tanh hidden layers, the mean clipped (big weights
+    // make it leave [−1, 1])
+    let mut t = HashMap::new();
+    stack(&mut t, "mlp_extractor.policy_net", &[STATE_DIM, 64, 64], 1);
+    stack(&mut t, "mlp_extractor.value_net", &[STATE_DIM, 64, 64], 9);
+    t.insert("action_net.weight".into(), (seeded(&[2, 64], 20) * 8.0).unwrap());
+    t.insert("action_net.bias".into(), seeded(&[2], 21));
+    t.insert("log_std".into(), seeded(&[2], 22));
+    let ppo = Learned::from_tensors(&t, "ppo").unwrap();
+    assert_eq!((ppo.format(), ppo.inputs(), ppo.hidden()), (Format::Sb3Ppo, STATE_DIM, vec![64, 64]));
+    let mut layers = names("mlp_extractor.policy_net", 2);
+    layers.push("action_net".into());
+    let mut want = candle_forward(&t, &layers, &state, tanh);
+    // the last hidden layer's tanh: candle_forward applies `act` between layers only
+    assert_eq!(want.len(), 2);
+    want.iter_mut().for_each(|v| *v = v.clamp(-1.0, 1.0));
+    let ours = ppo.mu(&state);
+    assert!(ours.iter().zip(&want).all(|(a, b)| (a - b).abs() < 1e-5), "{ours:?} vs {want:?}");
+    assert!(ours.iter().any(|v| v.abs() == 1.0), "the test's mean should need clipping: {ours:?}");
+
+    // SAC: ReLU hidden layers, tanh(mu)
+    let mut t = HashMap::new();
+    stack(&mut t, "actor.latent_pi", &[4, 32, 32], 30);
+    t.insert("actor.mu.weight".into(), seeded(&[2, 32], 40));
+    t.insert("actor.mu.bias".into(), seeded(&[2], 41));
+    t.insert("actor.log_std.weight".into(), seeded(&[2, 32], 42));
+    t.insert("actor.log_std.bias".into(), seeded(&[2], 43));
+    let sac = Learned::from_tensors(&t, "sac").unwrap();
+    assert_eq!((sac.format(), sac.inputs()), (Format::Sb3Sac, 4));
+    let mut layers = names("actor.latent_pi", 2);
+    layers.push("actor.mu".into());
+    let want: Vec<f32> = candle_forward(&t, &layers, &obs4, relu).iter().map(|v| v.tanh()).collect();
+    let ours = sac.mu(&obs4);
+    assert!(ours.iter().zip(&want).all(|(a, b)| (a - b).abs() < 1e-5), "{ours:?} vs {want:?}");
+
+    // TD3: one stack, tanh after the last layer
+    let mut t = HashMap::new();
+    stack(&mut t, "actor.mu", &[4, 16, 16, 2], 50);
+    stack(&mut t, "actor_target.mu", &[4, 16, 16, 2], 60);
+    let td3 = Learned::from_tensors(&t, "td3").unwrap();
+    assert_eq!((td3.format(), td3.hidden()), (Format::Sb3Td3, vec![16, 16]));
+    let want: Vec<f32> = candle_forward(&t, &names("actor.mu", 3), &obs4, relu).iter().map(|v| v.tanh()).collect();
+    let ours = td3.mu(&obs4);
+    assert!(ours.iter().zip(&want).all(|(a, b)| (a - b).abs() < 1e-5), "{ours:?} vs {want:?}");
+    // an SB3 policy is not written back under SafeBench's names
+    assert!(td3.tensors().is_err());
+
+    // a file's metadata may name the activation; an unknown one is an error
+    let path = temp("td3.safetensors");
+    let write = |activation: &str| {
+        let meta = HashMap::from([("activation".to_string(), activation.to_string())]);
+        let views: Vec<(String, Tensor)> = t.iter().map(|(k, v)| (k.clone(), v.clone())).collect();
+        let data: Vec<(String, Vec<u8>, Vec<usize>)> = views
+            .iter()
+            .map(|(k, v)| {
+                let bytes =
+                    v.flatten_all().unwrap().to_vec1::<f32>().unwrap().iter().flat_map(|f| f.to_le_bytes()).collect();
+                (k.clone(), bytes, v.dims().to_vec())
+            })
+            .collect();
+        let tensors = data.iter().map(|(k, b, s)| {
+            (k.clone(), safetensors::tensor::TensorView::new(safetensors::Dtype::F32, s.clone(), b).unwrap())
+        });
+        safetensors::serialize_to_file(tensors, Some(meta), &path).unwrap();
+    };
+    write("tanh");
+    let loaded = Learned::load(&path).unwrap();
+    let want: Vec<f32> = candle_forward(&t, &names("actor.mu", 3), &obs4, tanh).iter().map(|v| v.tanh()).collect();
+    let ours = loaded.mu(&obs4);
+    assert!(ours.iter().zip(&want).all(|(a, b)| (a - b).abs() < 1e-5), "{ours:?} vs {want:?}");
+    write("gelu");
+    let err = Learned::load(&path).unwrap_err().to_string();
+    assert!(err.contains("metadata `activation` is `gelu`"), "{err}");
 }

@@ -19,6 +19,8 @@ use tad_road::geom::{Footprint, Path, Pose, Vec2, wrap};
 use tad_road::road::Station;
 use tad_road::{Arm, Body, Turn};
 
+use std::ops::Deref;
+
 /// How an episode runs.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Options {
@@ -166,27 +168,117 @@ impl Seen {
     }
 }
 
-/// Run one episode of `scene` with parameters `params` (see [`crate::sample`]).
+/// Run one episode of `scene` with parameters `params` (see [`crate::sample`]), `policy`
+/// driving the ego: [`Sim`]'s steps, the policy asked at each.
 pub fn run(scene: &Scene, seed: Option<u64>, params: Vec<f64>, policy: &mut dyn EgoPolicy, opts: &Options) -> Episode {
-    let mut runner = Runner::start(scene, params, policy, opts);
-    let mut stop_reason = StopReason::MaxSteps;
-    while runner.step < scene.limits.max_steps {
-        if let Some(reason) = runner.advance(policy) {
-            stop_reason = reason;
-            break;
+    policy.reset();
+    let mut sim = Sim::start(scene, seed, params, *opts);
+    while let Some(view) = sim.view() {
+        let action = policy.act(view);
+        sim.act(action);
+        // a driver that failed (an external process) ends the episode after its step
+        if let Some(why) = policy.failure() {
+            sim.fail(why.to_string());
         }
     }
-    let mut episode = runner.finish(seed, stop_reason);
-    if stop_reason == StopReason::EgoFailed {
-        episode.failure = policy.failure().map(String::from);
+    sim.finish()
+}
+
+/// An episode stepped from outside, as Gymnasium's `reset`/`step` do: [`Sim::start`] begins
+/// the first step and shows the ego's view; each [`Sim::act`] ends the step under way with
+/// the ego's action and begins the next. [`run`] is this loop with a policy, so an episode
+/// stepped here with the same actions has the same records.
+///
+/// `S` is how the scene is held: `&Scene` for a run, `Arc<Scene>` for an environment that
+/// keeps its scenes.
+pub struct Sim<S: Deref<Target = Scene>> {
+    runner: Runner<S>,
+    seed: Option<u64>,
+    /// What the ego sees at the step under way; `None` once the episode has stopped.
+    view: Option<EgoView>,
+    stop_reason: Option<StopReason>,
+    failure: Option<String>,
+}
+
+impl<S: Deref<Target = Scene>> Sim<S> {
+    /// The episode of `scene` with parameters `params`, at its start.
+    pub fn start(scene: S, seed: Option<u64>, params: Vec<f64>, opts: Options) -> Sim<S> {
+        let runner = Runner::start(scene, params, opts);
+        Sim { runner, seed, view: None, stop_reason: None, failure: None }
     }
-    episode
+
+    /// What the ego sees at the step under way (beginning it: the scripts run); `None`
+    /// once the episode has stopped.
+    pub fn view(&mut self) -> Option<&EgoView> {
+        if self.view.is_none() && self.stop_reason.is_none() {
+            if self.runner.step >= self.runner.scene.limits.max_steps {
+                self.stop_reason = Some(StopReason::MaxSteps);
+            } else {
+                self.view = Some(self.runner.begin());
+            }
+        }
+        self.view.as_ref()
+    }
+
+    /// End the step under way with the ego's `action`: everyone moves, the criteria read
+    /// the new state, the step is recorded. Why the episode stopped, if it did (the step
+    /// limit included); after the stop nothing moves.
+    pub fn act(&mut self, action: Action) -> Option<StopReason> {
+        if self.view().is_none() {
+            return self.stop_reason;
+        }
+        self.view = None;
+        self.stop_reason = self.runner.end(action);
+        if self.stop_reason.is_none() && self.runner.step >= self.runner.scene.limits.max_steps {
+            self.stop_reason = Some(StopReason::MaxSteps);
+        }
+        self.stop_reason
+    }
+
+    /// The ego's driver failed (`why`): the episode stops here, `ego_failed`.
+    pub fn fail(&mut self, why: String) {
+        self.view = None;
+        self.stop_reason = Some(StopReason::EgoFailed);
+        self.failure = Some(why);
+    }
+
+    /// Why the episode stopped; `None` while it runs.
+    pub fn stop_reason(&self) -> Option<StopReason> {
+        self.stop_reason
+    }
+
+    /// The steps recorded so far.
+    pub fn records(&self) -> &[StepRecord] {
+        &self.runner.records
+    }
+
+    /// What the criteria noticed so far.
+    pub fn events(&self) -> &[Event] {
+        &self.runner.events
+    }
+
+    pub fn scene(&self) -> &Scene {
+        &self.runner.scene
+    }
+
+    /// The speed the scenario states for the ego, m/s.
+    pub fn desired_speed(&self) -> f64 {
+        self.runner.desired
+    }
+
+    /// The episode as [`run`] returns it.
+    pub fn finish(self) -> Episode {
+        let stop_reason = self.stop_reason.unwrap_or(StopReason::MaxSteps);
+        let mut episode = self.runner.finish(self.seed, stop_reason);
+        episode.failure = self.failure;
+        episode
+    }
 }
 
 /// An episode under way: what its steps share.
-struct Runner<'a> {
-    scene: &'a Scene,
-    opts: &'a Options,
+struct Runner<S: Deref<Target = Scene>> {
+    scene: S,
+    opts: Options,
     params: Vec<f64>,
     /// The ego's desired speed, m/s.
     desired: f64,
@@ -219,9 +311,10 @@ struct Runner<'a> {
     frames: Vec<Frame>,
 }
 
-impl<'a> Runner<'a> {
+impl<S: Deref<Target = Scene>> Runner<S> {
     /// The ego and every actor at their start, physics seeing them there.
-    fn start(scene: &'a Scene, params: Vec<f64>, policy: &mut dyn EgoPolicy, opts: &'a Options) -> Runner<'a> {
+    fn start(held: S, params: Vec<f64>, opts: Options) -> Runner<S> {
+        let scene = &*held;
         let route = &scene.ego.route;
         let ego_size = scene.ego.size;
         let desired = scene.ego.speed.eval(&params).max(0.0);
@@ -242,12 +335,13 @@ impl<'a> Runner<'a> {
             height: a.size.height,
         }));
         let physics = Physics::new(&shapes);
-        policy.reset();
+        let route_bend = models::bend(route);
+        let max_steps = scene.limits.max_steps as usize;
         let mut runner = Runner {
-            scene,
+            scene: held,
             opts,
             desired,
-            route_bend: models::bend(route),
+            route_bend,
             ego,
             ego_s,
             ego_stop,
@@ -264,7 +358,7 @@ impl<'a> Runner<'a> {
             velocity: Vec2::from_yaw(ego.yaw) * ego.speed,
             collided: false,
             off_road_for: 0.0,
-            records: Vec::with_capacity(scene.limits.max_steps as usize),
+            records: Vec::with_capacity(max_steps),
             events: Vec::new(),
             frames: Vec::new(),
             params,
@@ -279,49 +373,55 @@ impl<'a> Runner<'a> {
         runner
     }
 
-    /// One step, as the module's header lists them; the reason the episode stops after it,
-    /// if it does.
-    fn advance(&mut self, policy: &mut dyn EgoPolicy) -> Option<StopReason> {
+    /// Begin a step, as the module's header lists its parts: the scripts advance; what the
+    /// ego sees.
+    fn begin(&mut self) -> EgoView {
         self.step += 1;
-        let t = f64::from(self.step) * self.scene.limits.dt;
+        let t = self.time();
         self.before.clear();
         self.before.extend(self.actors.iter().map(|a| Seen::new(&a.kin, a.length, a.width)));
         self.scripts(t);
-        self.drive_ego(policy, t);
+        self.ego_view(t)
+    }
+
+    /// End the step with the ego's action: everyone moves, contacts and criteria, the
+    /// record; the reason the episode stops after it, if it does.
+    fn end(&mut self, action: Action) -> Option<StopReason> {
+        let t = self.time();
+        self.drive_ego(action);
         self.move_others(t);
         self.contacts();
         let reading = self.criteria(t);
         self.record(t, &reading);
-        // a driver that failed (an external process) ends the episode after its step
-        if policy.failure().is_some() {
-            return Some(StopReason::EgoFailed);
-        }
         self.stop_rule(t, &reading)
+    }
+
+    /// The step under way's time, s.
+    fn time(&self) -> f64 {
+        f64::from(self.step) * self.scene.limits.dt
     }
 
     /// Scripts advance, on the previous state.
     fn scripts(&mut self, t: f64) {
         for (setup, actor) in self.scene.actors.iter().zip(self.actors.iter_mut()) {
-            run_script(self.scene, &setup.script, actor, &self.params, t, self.ego.position);
+            run_script(&self.scene, &setup.script, actor, &self.params, t, self.ego.position);
         }
     }
 
-    /// The ego's policy acts on what it sees (its arc on the route is the last criteria's:
-    /// it has not moved), and the ego moves.
-    fn drive_ego(&mut self, policy: &mut dyn EgoPolicy, t: f64) {
-        let view = self.ego_view(t);
-        let action: Action = policy.act(&view);
+    /// The ego moves by its driver's action (what it saw was the step's view: its arc on
+    /// the route is the last criteria's).
+    fn drive_ego(&mut self, action: Action) {
         let accel = if action.accel.is_finite() { action.accel.clamp(ACCEL_MIN, ACCEL_MAX) } else { 0.0 };
         let steer = if action.steer.is_finite() { action.steer.clamp(-1.0, 1.0) } else { 0.0 };
         let old = self.ego.position;
-        let scene = self.scene;
+        let scene = &*self.scene;
         self.ego.bicycle(WHEELBASE * scene.ego.size.length, -steer * MAX_WHEEL_ANGLE, accel, scene.limits.dt);
         self.driven += old.distance(self.ego.position);
     }
 
     /// Everyone else moves.
     fn move_others(&mut self, t: f64) {
-        let scene = self.scene;
+        let scene = &*self.scene;
         let ego_seen = Seen::new(&self.ego, scene.ego.size.length, scene.ego.size.width);
         for k in 0..self.actors.len() {
             move_actor(scene, &mut self.actors, k, &self.before, ego_seen, t, scene.limits.dt);
@@ -353,7 +453,7 @@ impl<'a> Runner<'a> {
 
     /// The criteria read the new state; what they notice is an event.
     fn criteria(&mut self, t: f64) -> Reading {
-        let scene = self.scene;
+        let scene = &*self.scene;
         let route = &scene.ego.route;
         let (s_now, off_route) = route.locate(self.ego.position, self.ego_s, 10.0);
         self.ego_s = s_now;
@@ -404,7 +504,7 @@ impl<'a> Runner<'a> {
 
     /// The stop rules: why the episode ends after this step, if it does.
     fn stop_rule(&self, t: f64, reading: &Reading) -> Option<StopReason> {
-        let (opts, limits) = (self.opts, &self.scene.limits);
+        let (opts, limits) = (&self.opts, &self.scene.limits);
         if self.collided {
             Some(StopReason::Collision)
         } else if reading.route_complete >= 100.0 {
@@ -434,7 +534,7 @@ impl<'a> Runner<'a> {
 
     /// What the ego's driver sees: SafeBench's observation and the full state.
     fn ego_view(&mut self, t: f64) -> EgoView {
-        let scene = self.scene;
+        let scene = &*self.scene;
         let (ego, s, actors, before) = (&self.ego, self.ego_s, &self.actors, &self.before);
         let route = &scene.ego.route;
         let size = scene.ego.size;

@@ -19,6 +19,6 @@ pub mod sample;
 pub mod scene;
 pub mod world;
 
-pub use episode::{Episode, Event, EventKind, Frame, Options, run};
+pub use episode::{Episode, Event, EventKind, Frame, Options, Sim, run};
 pub use scene::{Scene, SetupError};
 pub use tad_metrics::{Mode, StopReason};

@@ -101,3 +101,26 @@ fn the_same_seed_gives_the_same_bytes() {
         assert_eq!(one.frames, two.frames);
     }
 }
+
+#[test]
+fn an_episode_stepped_from_outside_is_the_run() {
+    // Sim stepped with the idm's answers, view by view, records what `run` records; after
+    // the stop nothing moves
+    for path in safety().into_iter().take(3) {
+        let scene = scene(&path);
+        let ran = episode(&scene, "idm", 4);
+        let mut idm = tad_policy::parse_policy("idm").unwrap();
+        let opts = Options { keep_frames: true, ..Options::default() };
+        let mut sim = tad_runtime::Sim::start(&scene, Some(4), sample(&scene.program.params, Some(4)), opts);
+        let mut stop = None;
+        while let Some(view) = sim.view() {
+            let action = idm.act(&view.clone());
+            stop = sim.act(action);
+        }
+        assert_eq!(stop, Some(ran.stop_reason), "{}", path.display());
+        assert_eq!(sim.act(tad_policy::Action::default()), stop, "nothing moves after the stop");
+        let stepped = sim.finish();
+        assert_eq!(stepped.records, ran.records, "{}", path.display());
+        assert_eq!((stepped.steps, &stepped.frames), (ran.steps, &ran.frames), "{}", path.display());
+    }
+}

@@ -53,7 +53,7 @@ fn rust_files() -> Vec<PathBuf> {
     }
     let root = repo();
     let mut out = Vec::new();
-    for top in ["compiler", "lsp", "editors"] {
+    for top in ["compiler", "lsp", "editors", "python"] {
         walk(&root.join(top), &mut out);
     }
     out.sort();

@@ -94,9 +94,6 @@ use tad_runtime::{Options, Scene};
 use nets::{ACT, Adam, Net, OBS, PlainActor, normal_pair, normals, q_values, sample_actions, tensor_error};
 pub use reward::{Reward, Rewarder};
 
-/// SafeBench's scaling of the actor's `[−1, 1]` outputs (as `Learned` applies it).
-const ACCEL_RANGE: f64 = 3.0;
-const STEER_RANGE: f64 = 0.3;
 /// A stored transition's width: obs, action, reward, next obs, done.
 const WIDTH: usize = OBS + ACT + 1 + OBS + 1;
 const FORMAT: &str = "tad-train checkpoint 1";
@@ -301,16 +298,8 @@ impl EgoPolicy for Driver<'_> {
         };
         self.obs.push(view.obs);
         self.actions.push(a);
-        Action { accel: scaled_accel(a[0]), steer: scaled_steer(a[1]) }
+        Action::from_unit(a)
     }
-}
-
-fn scaled_accel(a: f32) -> f64 {
-    (f64::from(a) * ACCEL_RANGE).clamp(-ACCEL_RANGE, ACCEL_RANGE)
-}
-
-fn scaled_steer(a: f32) -> f64 {
-    (f64::from(a) * STEER_RANGE).clamp(-STEER_RANGE, STEER_RANGE)
 }
 
 /// Records the steer any policy applies, for its reward.
@@ -520,7 +509,7 @@ impl Trainer {
         let mut stored = 0;
         for k in 0..n {
             let a = actions[k];
-            let r = rewarder.step(&episode.records[k], scaled_steer(a[1])).total();
+            let r = rewarder.step(&episode.records[k], Action::from_unit(a).steer).total();
             episode_return += r;
             let (next, done) = match obs.get(k + 1) {
                 Some(next) if k + 1 < n => (*next, 0.0),

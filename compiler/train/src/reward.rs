@@ -1,6 +1,7 @@
 //! SafeBench's reward (`gym_carla/envs/carla_env.py::_get_reward`), step by step from the
 //! runtime's records.
 
+use std::ops::Deref;
 use tad_layout::geom::Vec2;
 use tad_metrics::StepRecord;
 use tad_runtime::Scene;
@@ -34,16 +35,18 @@ impl Reward {
 
 /// Follows the ego along its route through an episode's records, so each step's arc is
 /// found near the last one.
-pub struct Rewarder<'a> {
-    scene: &'a Scene,
+/// `S` is how the scene is held (`&Scene`, or `Arc<Scene>` for an environment).
+pub struct Rewarder<S: Deref<Target = Scene>> {
+    scene: S,
     desired: f64,
     arc: f64,
 }
 
-impl<'a> Rewarder<'a> {
+impl<S: Deref<Target = Scene>> Rewarder<S> {
     /// For an episode of `scene` whose ego wants `desired` m/s.
-    pub fn new(scene: &'a Scene, desired: f64) -> Rewarder<'a> {
-        Rewarder { scene, desired, arc: scene.ego.start }
+    pub fn new(scene: S, desired: f64) -> Rewarder<S> {
+        let arc = scene.ego.start;
+        Rewarder { scene, desired, arc }
     }
 
     /// The reward of the step that led to `record` with the applied normalised `steer`.

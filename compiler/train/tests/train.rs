@@ -229,7 +229,7 @@ fn the_saved_actor_loads_as_learned_and_acts_the_same() {
     // and the checkpoint's actor file is the same actor
     trainer.save_checkpoint(dir.join("ckpt")).expect("saved");
     let from_checkpoint = Learned::load(dir.join("ckpt/actor.safetensors")).expect("loads");
-    assert_eq!(from_checkpoint.mu([0.3, -0.1, 7.0, 1.0]), trainer.actor().expect("actor").mu([0.3, -0.1, 7.0, 1.0]));
+    assert_eq!(from_checkpoint.mu(&[0.3, -0.1, 7.0, 1.0]), trainer.actor().expect("actor").mu(&[0.3, -0.1, 7.0, 1.0]));
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -239,12 +239,12 @@ fn an_existing_actor_is_fine_tuned() {
     let mut trainer =
         Trainer::new(Config { start_training: 20, batch: 16, updates_per_episode: 1, ..small(1) }).expect("a trainer");
     trainer.init_actor(&start).expect("takes the actor");
-    assert_eq!(trainer.actor().expect("actor").mu([0.0, 0.0, 8.0, 0.0]), start.mu([0.0, 0.0, 8.0, 0.0]));
+    assert_eq!(trainer.actor().expect("actor").mu(&[0.0, 0.0, 8.0, 0.0]), start.mu(&[0.0, 0.0, 8.0, 0.0]));
     assert_eq!(trainer.actor().expect("actor").hidden(), vec![16, 24]);
     let scenes = [scene(30, false)];
     train(&mut trainer, &scenes, 2);
     assert!(trainer.updates() > 0);
-    assert_ne!(trainer.actor().expect("actor").mu([0.0, 0.0, 8.0, 0.0]), start.mu([0.0, 0.0, 8.0, 0.0]));
+    assert_ne!(trainer.actor().expect("actor").mu(&[0.0, 0.0, 8.0, 0.0]), start.mu(&[0.0, 0.0, 8.0, 0.0]));
 }
 
 #[test]
