@@ -127,3 +127,20 @@ fn wrong_input_is_an_error() {
     assert!(reports.iter().any(|r| r.contains("bad.tadc: not loaded")), "{reports:#?}");
     assert!(matches!(load(&[]), Err(GymError::NoScenario)));
 }
+
+#[test]
+fn the_specs_end_table_is_the_code() {
+    // spec/gym.md §3: each stop reason in one row, terminated or truncated as `terminates`
+    let spec = std::fs::read_to_string(tad_test_support::repo().join("spec/gym.md")).unwrap();
+    let mut said = std::collections::HashMap::new();
+    for line in spec.lines().filter(|l| l.ends_with("| `terminated` |") || l.ends_with("| `truncated` |")) {
+        let terminated = line.ends_with("| `terminated` |");
+        for name in line.split('`').skip(1).step_by(2).filter(|n| !["terminated", "truncated"].contains(n)) {
+            assert!(said.insert(name.to_string(), terminated).is_none(), "{name} is listed twice");
+        }
+    }
+    for reason in StopReason::ALL {
+        assert_eq!(said.remove(reason.as_str()), Some(terminates(reason)), "{}", reason.as_str());
+    }
+    assert!(said.is_empty(), "the spec lists stop reasons the runtime does not have: {said:?}");
+}
