@@ -30,6 +30,12 @@ def _paths(scenarios: Scenarios) -> list[str]:
     return paths
 
 
+def _no_render(render_mode: Optional[str]) -> None:
+    # libraries ask for "rgb_array" by default (SB3's make_vec_env); drawing is tadslc's job
+    if render_mode is not None:
+        gymnasium.logger.warn(f"render_mode {render_mode!r} is ignored: draw episodes with `tadslc run --render`")
+
+
 def _spaces(obs_len: int) -> tuple[spaces.Box, spaces.Box]:
     observation = spaces.Box(-np.inf, np.inf, shape=(obs_len,), dtype=np.float32)
     action = spaces.Box(-1.0, 1.0, shape=(2,), dtype=np.float32)
@@ -48,8 +54,7 @@ class ScenarioEnv(gymnasium.Env):
 
     def __init__(self, scenarios: Scenarios, observation: str = "safebench", seed: Optional[int] = None,
                  render_mode: Optional[str] = None):
-        if render_mode is not None:
-            raise ValueError(f"render_mode {render_mode!r} is not supported: use `tadslc run --render`")
+        _no_render(render_mode)
         self._core = _tadsl.Env(_paths(scenarios), observation)
         self.observation_space, self.action_space = _spaces(self._core.obs_len)
         self.scenario_names = list(self._core.scenarios)
@@ -89,8 +94,7 @@ class ScenarioVectorEnv(VectorEnv):
 
     def __init__(self, scenarios: Scenarios, num_envs: int = 8, observation: str = "safebench",
                  seed: Optional[int] = None, render_mode: Optional[str] = None):
-        if render_mode is not None:
-            raise ValueError(f"render_mode {render_mode!r} is not supported: use `tadslc run --render`")
+        _no_render(render_mode)
         self._core = _tadsl.VecEnv(_paths(scenarios), observation, num_envs)
         self.num_envs = num_envs
         self.single_observation_space, self.single_action_space = _spaces(self._core.obs_len)
