@@ -5,6 +5,9 @@
 //!   [`ATTEMPTS`] draws);
 //! - [`Generator::Baseline`]: the region-agnostic [`baseline`](crate::baseline) generator,
 //!   each region drawing its own sample;
+//! - [`Generator::ChatScene`]: ChatScene's eight safety-critical categories as templates
+//!   with its parameter ranges ([`chatscene`](crate::chatscene)), the paper's strongest
+//!   baseline;
 //! - [`Generator::Llm`]: a language model through `tadslc gen`'s check-and-repair loop (the
 //!   host runs it: it needs a server or the local model), with one of three prompts;
 //! - [`Generator::Directory`]: scenarios written elsewhere.
@@ -27,6 +30,7 @@ pub const ATTEMPTS: usize = 50;
 pub enum Generator {
     Fitted,
     Baseline,
+    ChatScene,
     Llm(Prompt),
     Directory(PathBuf),
 }
@@ -48,6 +52,7 @@ impl Generator {
         match text {
             "fitted" => Generator::Fitted,
             "baseline" => Generator::Baseline,
+            "chatscene" => Generator::ChatScene,
             "llm" => Generator::Llm(Prompt::Aligned),
             "llm-baseline" => Generator::Llm(Prompt::Unaligned),
             "llm-tuned" => Generator::Llm(Prompt::Tuned),
@@ -57,7 +62,7 @@ impl Generator {
 
     /// The names [`parse`](Generator::parse) knows, in words.
     pub const NAMES: &'static str =
-        "`fitted`, `baseline`, `llm`, `llm-baseline`, `llm-tuned` or a directory of scenarios";
+        "`chatscene`, `fitted`, `baseline`, `llm`, `llm-baseline`, `llm-tuned` or a directory of scenarios";
 }
 
 impl fmt::Display for Generator {
@@ -65,6 +70,7 @@ impl fmt::Display for Generator {
         match self {
             Generator::Fitted => f.write_str("fitted"),
             Generator::Baseline => f.write_str("baseline"),
+            Generator::ChatScene => f.write_str("chatscene"),
             Generator::Llm(Prompt::Aligned) => f.write_str("llm"),
             Generator::Llm(Prompt::Unaligned) => f.write_str("llm-baseline"),
             Generator::Llm(Prompt::Tuned) => f.write_str("llm-tuned"),
@@ -187,6 +193,11 @@ pub fn baseline(db: &mut Database, region: &str, n: usize, seed: u64) -> Vec<(St
     crate::baseline::sample(db, n, crate::baseline::region_seed(seed, region), |i| {
         format!("{region}_baseline_{:03}", i + 1)
     })
+}
+
+/// `n` scenarios of the ChatScene-style generator for `region`: (name, TAD).
+pub fn chatscene(db: &mut Database, region: &str, n: usize, seed: u64) -> Vec<(String, String)> {
+    crate::chatscene::sample(db, region, n, crate::baseline::region_seed(seed, region))
 }
 
 /// Where a language-model generator writes region `region`'s scenarios under `base`.

@@ -14,6 +14,7 @@
 //! files, print and choose exit statuses; nothing here writes to a terminal.
 
 pub mod baseline;
+pub mod chatscene;
 pub mod corpus;
 pub mod examples;
 pub mod finetune;

@@ -69,8 +69,8 @@ fn eval_prints_the_table_in_every_format_deterministically() {
     let out = tadslc(&[&args[..], &["--format", "json"]].concat(), "");
     assert_eq!(code(&out), 0, "{}", stderr(&out));
     let rows = lines(&stdout(&out));
-    // 2 regions × 2 generators × 2 egos
-    assert_eq!(rows.len(), 8, "{}", stdout(&out));
+    // 2 regions × 3 generators × 2 egos
+    assert_eq!(rows.len(), 12, "{}", stdout(&out));
     for row in &rows {
         for key in ["CR", "RR", "SS", "OR", "RF", "Comp", "TS", "ACC", "YV", "LI", "OS"] {
             assert!(row["metrics"].get(key).is_some(), "{key} in {row}");
@@ -81,8 +81,9 @@ fn eval_prints_the_table_in_every_format_deterministically() {
     }
     let pairs: Vec<(String, String, String)> =
         rows.iter().map(|r| (r["region"].to_string(), r["generator"].to_string(), r["ego"].to_string())).collect();
-    assert_eq!(pairs[0], ("\"los_angeles\"".into(), "\"fitted\"".into(), "\"idm\"".into()));
-    assert_eq!(pairs[7], ("\"new_york_city\"".into(), "\"baseline\"".into(), "\"naive\"".into()));
+    assert_eq!(pairs[0], ("\"los_angeles\"".into(), "\"chatscene\"".into(), "\"idm\"".into()));
+    assert_eq!(pairs[2], ("\"los_angeles\"".into(), "\"fitted\"".into(), "\"idm\"".into()));
+    assert_eq!(pairs[11], ("\"new_york_city\"".into(), "\"baseline\"".into(), "\"naive\"".into()));
     // the naive ego, blind to everything, collides at least as often as IDM overall
     let collisions = |ego: &str| -> f64 {
         rows.iter().filter(|r| r["ego"] == ego).map(|r| r["metrics"]["CR"].as_f64().unwrap()).sum()
@@ -214,7 +215,8 @@ fn eval_usage_errors() {
     let out = tadslc(&["eval", "examples", "--generators", "nowhere/"], "");
     assert_eq!(code(&out), 2);
     assert!(
-        stderr(&out).contains("is not `fitted`, `baseline`, `llm`, `llm-baseline`, `llm-tuned` or a directory"),
+        stderr(&out)
+            .contains("is not `chatscene`, `fitted`, `baseline`, `llm`, `llm-baseline`, `llm-tuned` or a directory"),
         "{}",
         stderr(&out)
     );

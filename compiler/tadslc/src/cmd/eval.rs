@@ -31,14 +31,16 @@ pub struct EvalArgs {
     /// Regions, comma-separated or repeated
     #[arg(long = "region", value_delimiter = ',')]
     pub regions: Vec<String>,
-    /// Generators: `fitted` (fitted on the region's scenarios), `baseline` (region-agnostic),
-    /// `llm`, `llm-baseline`, `llm-tuned` (a language model through `tadslc gen`'s loop:
-    /// the aligned prompt, the paper's unaligned region prompt, the fine-tuned model's
-    /// prompt with `--adapter`), or a directory of scenarios
-    #[arg(long, value_delimiter = ',', default_values_t = ["fitted".to_string(), "baseline".to_string()])]
+    /// Generators: `chatscene` (ChatScene's eight safety-critical categories with its
+    /// parameter ranges), `fitted` (fitted on the region's scenarios), `baseline`
+    /// (region-agnostic), `llm`, `llm-baseline`, `llm-tuned` (a language model through
+    /// `tadslc gen`'s loop: the aligned prompt, the paper's unaligned region prompt, the
+    /// fine-tuned model's prompt with `--adapter`), or a directory of scenarios
+    #[arg(long, value_delimiter = ',', default_value = "chatscene,fitted,baseline")]
     pub generators: Vec<String>,
-    /// The egos evaluated: `idm`, `naive`, `learned:PATH`
-    #[arg(long, value_delimiter = ',', default_values_t = ["idm".to_string(), "naive".to_string()])]
+    /// The egos evaluated, comma-separated or repeated: `idm`, `naive`, `learned:PATH`,
+    /// `external:CMD` (which takes the rest of its list, commas and all)
+    #[arg(long, default_value = "idm,naive")]
     pub egos: Vec<String>,
     /// The ego the scenes are searched against (ChatScene's surrogate)
     #[arg(long, default_value = "idm")]
@@ -83,8 +85,9 @@ pub struct EvalArgs {
 }
 
 pub fn run(args: &EvalArgs) -> Result<Status, CliError> {
+    let names: Vec<String> = args.egos.iter().flat_map(|list| tad_policy::split_specs(list)).collect();
     let mut egos = Vec::new();
-    for spec in args.egos.iter().chain(std::iter::once(&args.search_ego)) {
+    for spec in names.iter().chain(std::iter::once(&args.search_ego)) {
         egos.push(EgoSpec::parse(spec).map_err(|e| CliError::usage(format!("ego `{spec}`: {e}")))?);
     }
     let surrogate = egos.pop().expect("the search ego was pushed last");
@@ -114,7 +117,7 @@ pub fn run(args: &EvalArgs) -> Result<Status, CliError> {
         setup: Setup {
             regions: regions.clone(),
             generators: args.generators.clone(),
-            egos: args.egos.clone(),
+            egos: names.clone(),
             search_ego: args.search_ego.clone(),
             n: args.n,
             samples: args.samples,
@@ -186,7 +189,7 @@ pub fn run(args: &EvalArgs) -> Result<Status, CliError> {
         "evaluated {} ({} of {}) in {:.1} s on {}",
         plural(mine.len(), "scenario"),
         plural(results.rows.len(), "episode"),
-        plural(args.egos.len(), "ego"),
+        plural(names.len(), "ego"),
         started.elapsed().as_secs_f64(),
         plural(rayon::current_num_threads(), "thread")
     )?;
@@ -214,6 +217,7 @@ fn scenarios(
         }
         Generator::Fitted => return Ok((generator::fitted(db, own, region, n, seed), Status::Ok)),
         Generator::Baseline => return Ok((generator::baseline(db, region, n, seed), Status::Ok)),
+        Generator::ChatScene => return Ok((generator::chatscene(db, region, n, seed), Status::Ok)),
         Generator::Llm(prompt) => {
             // through `tadslc gen`'s loop, into the results directory or a temporary one
             let base = args
