@@ -1,3 +1,7 @@
+//! The environment against the runtime: a rollout records what `run` records, episodes are
+//! numbered from the seed, a batch does not depend on the thread count, wrong input is an
+//! error, and spec/gym.md's end table is the code.
+
 use super::*;
 use tad_policy::{EgoPolicy, EgoView};
 
