@@ -116,6 +116,9 @@ pub fn wrap(angle: f64) -> f64 {
 pub struct Path {
     points: Vec<Vec2>,
     arcs: Vec<f64>,
+    /// Each segment's heading, rad, as [`Path::pose`] gives it (computed once: poses are
+    /// asked for many times a step).
+    yaws: Vec<f64>,
     /// The bounding box `[min x, min y, max x, max y]` of each run of [`CHUNK`] segments.
     boxes: Vec<[f64; 4]>,
     /// Segments per metre, on average.
@@ -174,6 +177,7 @@ impl Path {
             }
         }
         let segments = path.points.len().saturating_sub(1);
+        path.yaws = (0..segments).map(|i| path.direction(i).yaw()).collect();
         path.boxes = (0..segments.div_ceil(CHUNK))
             .map(|c| {
                 let run = &path.points[c * CHUNK..=((c + 1) * CHUNK).min(segments)];
@@ -233,11 +237,15 @@ impl Path {
             1 => Pose { position: self.points[0], yaw: 0.0 },
             _ => {
                 let i = self.segment(s);
-                let (a, b) = (self.points[i], self.points[i + 1]);
-                let along = (b - a) * (1.0 / (self.arcs[i + 1] - self.arcs[i]));
-                Pose { position: a + along * (s - self.arcs[i]), yaw: along.yaw() }
+                let along = self.direction(i);
+                Pose { position: self.points[i] + along * (s - self.arcs[i]), yaw: self.yaws[i] }
             }
         }
+    }
+
+    /// Segment `i`'s unit direction.
+    fn direction(&self, i: usize) -> Vec2 {
+        (self.points[i + 1] - self.points[i]) * (1.0 / (self.arcs[i + 1] - self.arcs[i]))
     }
 
     /// The path moved `left` metres to the left of its direction (negative: to the right),
