@@ -102,7 +102,10 @@ fn eval_prints_the_table_in_every_format_deterministically() {
         ),
         "{table}"
     );
-    assert_eq!(table.lines().filter(|l| l.starts_with("| los_angeles") || l.starts_with("| new_york_city")).count(), 12);
+    assert_eq!(
+        table.lines().filter(|l| l.starts_with("| los_angeles") || l.starts_with("| new_york_city")).count(),
+        12
+    );
     let svg = std::fs::read_to_string(&plot).unwrap();
     assert!(svg.starts_with("<svg") && svg.contains("los_angeles · fitted") && svg.contains("naive"), "{svg}");
     let csv = stdout(&tadslc(&[&args[..], &["--format", "csv"]].concat(), ""));
