@@ -150,7 +150,9 @@ pub fn picture(scene: &Scene, ego: &str, e: &Episode, gif: bool) -> Vec<u8> {
 pub fn table(scenarios: &[&str], egos: &[String], played: &[Played], mode: Mode) -> String {
     use std::fmt::Write;
     let width = scenarios.iter().map(|s| s.len()).max().unwrap_or(8).clamp(8, 40);
-    let mut out = format!("{:<width$}  {:<10} {:>4}", "scenario", "ego", "runs");
+    // an ego named by its file (`learned:PATH`) widens its column rather than the rows
+    let ego_width = egos.iter().map(|e| e.chars().count()).max().unwrap_or(10).clamp(10, 60);
+    let mut out = format!("{:<width$}  {:<ego_width$} {:>4}", "scenario", "ego", "runs");
     for m in tad_metrics::METRICS.iter() {
         let _ = write!(out, " {:>6}", m.key);
     }
@@ -158,7 +160,7 @@ pub fn table(scenarios: &[&str], egos: &[String], played: &[Played], mode: Mode)
     let mut row = |label: &str, ego: &str, rows: &[&Played]| {
         let scores: Vec<EpisodeScore> = rows.iter().map(|d| d.score.clone()).collect();
         let Ok(agg) = tad_metrics::aggregate(&scores, mode) else { return };
-        let _ = write!(out, "{label:<width$}  {ego:<10} {:>4}", rows.len());
+        let _ = write!(out, "{label:<width$}  {ego:<ego_width$} {:>4}", rows.len());
         for m in tad_metrics::METRICS.iter() {
             let _ = match agg.normalised.get(m.metric) {
                 Some(v) => write!(out, " {v:>6.3}"),

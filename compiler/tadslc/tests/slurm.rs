@@ -20,7 +20,7 @@ use std::time::{Duration, Instant};
 /// The array's settings: small, the same for every run.
 const ARRAY: &[&str] = &["eval", "examples", "--region", "los_angeles,new_york_city", "-n", "4", "--samples", "10"];
 
-/// The cancelled shard's: 16 scenarios of a third of a second or more each (debug build), so it is
+/// The cancelled shard's: 24 scenarios of a third of a second or more each (debug build), so it is
 /// still running when its journal has one.
 const LONGER: &[&str] = &["eval", "examples", "--region", "los_angeles,new_york_city", "-n", "8", "--samples", "40"];
 
