@@ -57,8 +57,9 @@ def vector(n, seconds):
     return timed(step, seconds)
 
 
-def single(seconds):
-    env = gymnasium.make("tadsl/Scenario-v0", scenarios=SCENES, disable_env_checker=True)
+def episodes(env, seconds):
+    """Steps/s of one Gymnasium environment driven by a constant action, reset as its
+    episodes end."""
     env.reset(seed=0)
     action = np.array([0.3, 0.0], dtype=np.float32)
 
@@ -69,22 +70,17 @@ def single(seconds):
         return 1
 
     return timed(step, seconds)
+
+
+def single(seconds):
+    return episodes(gymnasium.make("tadsl/Scenario-v0", scenarios=SCENES, disable_env_checker=True), seconds)
 
 
 def highway(vehicles, seconds):
     import highway_env  # noqa: F401
 
     env = gymnasium.make("highway-fast-v0", config={"vehicles_count": vehicles, "action": {"type": "ContinuousAction"}})
-    env.reset(seed=0)
-    action = np.array([0.3, 0.0], dtype=np.float32)
-
-    def step():
-        _, _, term, trunc, _ = env.step(action)
-        if term or trunc:
-            env.reset()
-        return 1
-
-    return timed(step, seconds)
+    return episodes(env, seconds)
 
 
 def main():

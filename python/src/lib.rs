@@ -33,6 +33,21 @@ fn write<T: pyo3::buffer::Element + Copy>(py: Python<'_>, out: &PyBuffer<T>, val
     out.copy_from_slice(py, values)
 }
 
+/// An episode's `info` as Python sees it: `scenario`, `scenario_index`, `seed`,
+/// `stop_reason` (None while it runs), `steps`, `return`; empty before the first reset.
+fn info_dict<'py>(py: Python<'py>, info: Option<tad_gym::Info<'_>>) -> PyResult<Bound<'py, PyDict>> {
+    let dict = PyDict::new(py);
+    if let Some(info) = info {
+        dict.set_item("scenario", info.scenario)?;
+        dict.set_item("scenario_index", info.index)?;
+        dict.set_item("seed", info.seed)?;
+        dict.set_item("stop_reason", info.stop_reason.map(|r| r.as_str()))?;
+        dict.set_item("steps", info.steps)?;
+        dict.set_item("return", info.total_reward)?;
+    }
+    Ok(dict)
+}
+
 /// One environment: `Env(paths, observation)`; `reset(seed, scenario, obs)` and
 /// `step(acc, steer, obs) -> (reward, terminated, truncated)` write the observation into
 /// `obs` (float32, its length `obs_len`).
@@ -83,16 +98,7 @@ impl Env {
     /// The episode under way or just ended: `scenario`, `scenario_index`, `seed`,
     /// `stop_reason` (None while it runs), `steps`, `return`.
     fn info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let dict = PyDict::new(py);
-        if let Some(info) = self.env.info() {
-            dict.set_item("scenario", info.scenario)?;
-            dict.set_item("scenario_index", info.index)?;
-            dict.set_item("seed", info.seed)?;
-            dict.set_item("stop_reason", info.stop_reason.map(|r| r.as_str()))?;
-            dict.set_item("steps", info.steps)?;
-            dict.set_item("return", info.total_reward)?;
-        }
-        Ok(dict)
+        info_dict(py, self.env.info())
     }
 
     /// The episode's step records, as `tadslc run` keeps them: one tuple per step,
@@ -177,21 +183,13 @@ impl VecEnv {
 
     /// Environment `i`'s episode, as [`Env::info`] shows it.
     fn info<'py>(&self, py: Python<'py>, i: usize) -> PyResult<Bound<'py, PyDict>> {
-        let dict = PyDict::new(py);
         if i >= self.batch.len() {
             return Err(PyValueError::new_err(format!(
                 "environment {i} is out of range (there are {})",
                 self.batch.len()
             )));
         }
-        if let Some(info) = self.batch.env(i).info() {
-            dict.set_item("scenario", info.scenario)?;
-            dict.set_item("seed", info.seed)?;
-            dict.set_item("stop_reason", info.stop_reason.map(|r| r.as_str()))?;
-            dict.set_item("steps", info.steps)?;
-            dict.set_item("return", info.total_reward)?;
-        }
-        Ok(dict)
+        info_dict(py, self.batch.env(i).info())
     }
 }
 

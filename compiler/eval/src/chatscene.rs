@@ -34,6 +34,16 @@ struct Category {
     adversaries: [(&'static str, &'static str); 5],
 }
 
+/// The vehicles that come at the ego straight on or across, where a category's adversary
+/// is any of them.
+const ONCOMING_OR_CROSSING: [(&str, &str); 5] = [
+    ("car", "move_forward"),
+    ("suv", "move_forward"),
+    ("van", "move_forward"),
+    ("truck", "move_forward"),
+    ("motorcycle", "move_forward"),
+];
+
 /// SafeBench's eight categories, in its order.
 const CATEGORIES: [Category; 8] = [
     Category {
@@ -80,13 +90,7 @@ const CATEGORIES: [Category; 8] = [
         road: "type: straight_road\n    lanes: 1\n    direction: two_way\n    light: none",
         ego: "behavior: overtake\n    speed: 8..12 m/s\n    lane: 1",
         actors: "actor obstacle: 1 truck {\n    behavior: parked\n    speed: 0 m/s\n    position: front of ego\n    lane: 1\n    distance: 50 m\n  }\n  actor adversary: 1 {adv} {\n    behavior: {how}\n    speed: 5..15 m/s\n    position: front of ego\n    lane: -1\n    distance: 80 m\n  }",
-        adversaries: [
-            ("car", "move_forward"),
-            ("suv", "move_forward"),
-            ("van", "move_forward"),
-            ("truck", "move_forward"),
-            ("motorcycle", "move_forward"),
-        ],
+        adversaries: ONCOMING_OR_CROSSING,
     },
     Category {
         name: "red_light_running",
@@ -106,13 +110,7 @@ const CATEGORIES: [Category; 8] = [
         road: "type: intersection\n    lanes: 1\n    direction: two_way\n    light: green",
         ego: "behavior: turn_left\n    speed: 4..8 m/s\n    lane: 1",
         actors: "actor adversary: 1 {adv} {\n    behavior: {how}\n    speed: 5..15 m/s\n    position: front of ego\n    lane: -1\n  }",
-        adversaries: [
-            ("car", "move_forward"),
-            ("suv", "move_forward"),
-            ("van", "move_forward"),
-            ("truck", "move_forward"),
-            ("motorcycle", "move_forward"),
-        ],
+        adversaries: ONCOMING_OR_CROSSING,
     },
     Category {
         name: "right_turn",
@@ -132,13 +130,7 @@ const CATEGORIES: [Category; 8] = [
         road: "type: intersection\n    lanes: 1\n    direction: two_way\n    signs: [stop_sign]\n    light: none",
         ego: "behavior: move_forward\n    speed: 6..10 m/s\n    lane: 1",
         actors: "actor adversary: 1 {adv} {\n    behavior: {how}\n    speed: 5..15 m/s\n    position: right_front of ego\n    lane: 1\n  }",
-        adversaries: [
-            ("car", "move_forward"),
-            ("suv", "move_forward"),
-            ("van", "move_forward"),
-            ("truck", "move_forward"),
-            ("motorcycle", "move_forward"),
-        ],
+        adversaries: ONCOMING_OR_CROSSING,
     },
 ];
 

@@ -141,12 +141,10 @@ impl Observation {
     }
 
     fn write(self, view: &EgoView, out: &mut [f32]) {
-        let values = match self {
-            Observation::SafeBench => view.obs.to_vec(),
-            Observation::State => view.state().to_vec(),
-        };
-        for (o, v) in out.iter_mut().zip(values) {
-            *o = v as f32;
+        let fill = |out: &mut [f32], values: &[f64]| out.iter_mut().zip(values).for_each(|(o, &v)| *o = v as f32);
+        match self {
+            Observation::SafeBench => fill(out, &view.obs),
+            Observation::State => fill(out, &view.state()),
         }
     }
 }
