@@ -15,7 +15,7 @@ use pyo3::buffer::PyBuffer;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use tad_gym::{Batch, GymError, Observation, Outputs, Scenario};
+use tad_gym::{Batch, GymError, Outputs, Scenario};
 
 fn value_error(e: GymError) -> PyErr {
     match e {
@@ -61,7 +61,7 @@ struct Env {
 impl Env {
     #[new]
     fn new(paths: Vec<PathBuf>, observation: &str) -> PyResult<Env> {
-        let observation = Observation::parse(observation).map_err(value_error)?;
+        let observation = tad_gym::observation(observation).map_err(value_error)?;
         let env = tad_gym::Env::new(scenarios(paths)?, observation).map_err(value_error)?;
         Ok(Env { obs: vec![0.0; observation.width()], env })
     }
@@ -129,7 +129,7 @@ struct VecEnv {
 impl VecEnv {
     #[new]
     fn new(paths: Vec<PathBuf>, observation: &str, n: usize) -> PyResult<VecEnv> {
-        let observation = Observation::parse(observation).map_err(value_error)?;
+        let observation = tad_gym::observation(observation).map_err(value_error)?;
         let batch = Batch::new(scenarios(paths)?, observation, n).map_err(value_error)?;
         Ok(VecEnv {
             obs: vec![0.0; n * observation.width()],

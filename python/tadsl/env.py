@@ -47,7 +47,7 @@ class ScenarioEnv(gymnasium.Env):
 
     Episode ``e`` after ``reset(seed=s)`` runs scenario ``e mod N`` with seed ``s + e``
     (``options={"scenario": i}`` or a name pins the scenario). The action is ``[acc, steer]``
-    in ``[-1, 1]``, scaled as SafeBench scales its actors' (3 m/s², 0.3 of full lock).
+    in ``[-1, 1]``, scaled as SafeBench scales its actors' (3 m/s² forward, 8 m/s² braking, 0.3 of full lock).
     """
 
     metadata = {"render_modes": []}

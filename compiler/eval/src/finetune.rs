@@ -1,17 +1,31 @@
-//! The "after fine-tuning" stage of `eval --finetune`: a learned ego trained with SAC
-//! ([`crate::train`]) on 3/5 of each behaviour's kept scenes (ChatScene's split), then it,
-//! the ego it started from and the evaluation's egos on the held-out 2/5.
+//! The "after fine-tuning" stage of `eval --finetune`: each learned ego of the evaluation
+//! (the shipped `ppo`, `sac`, `td3`, or `learned:PATH`) fine-tuned from its own weights with
+//! its own algorithm (`learned:PATH` with SAC) through [`crate::train`], on 3/5 of each
+//! behaviour's kept scenes (ChatScene's split) at the paper's learning rate
+//! (`tad_train::Config::finetune`); then every ego, before and after, on the held-out 2/5,
+//! with paired bootstrap intervals of each model's change ([`crate::interval`]).
+//!
+//! With `--finetune-from` (a checkpoint or an actor file) or without any learned ego, one
+//! ego called `learned` is tuned instead, from that start or from scratch.
 
-use tad_policy::{EgoSpec, Learned};
-use tad_train::{Config, TrainError};
+use std::path::Path;
+
+use tad_policy::{EgoSpec, Learned, Observation};
+use tad_train::{Algo, Config, TrainError};
 
 use crate::harness::{Kept, Plan};
+use crate::interval::Change;
 use crate::results::{Results, Setup};
 use crate::train::{Start, TrainScene};
 
-/// The learned ego's names in the table.
+/// The one `learned` ego's name (its row before fine-tuning: `learned (before)`).
+pub const LEARNED: &str = "learned";
 pub const BEFORE: &str = "learned (before)";
-pub const AFTER: &str = "learned (fine-tuned)";
+
+/// The name of `ego`'s row after fine-tuning on `generator`'s scenes.
+pub fn tuned_name(ego: &str, generator: &str) -> String {
+    format!("{ego} (fine-tuned on {generator})")
+}
 
 /// Why fine-tuning did not finish.
 #[derive(Debug)]
@@ -24,8 +38,61 @@ pub enum FinetuneError {
     Actor(TrainError),
 }
 
-/// The trained ego, and the one it started from (none from scratch).
+/// One ego to fine-tune on one generator's scenes: its row names, where it starts and the
+/// run's settings.
+pub struct Tuning<'a> {
+    pub before: String,
+    pub after: String,
+    pub generator: String,
+    pub start: Start<'a>,
+    pub config: Config,
+}
+
+/// What to fine-tune: every learned ego of the plan from its weights, or one `learned`
+/// ego from `from` (or from scratch when the plan has no learned ego), each on every
+/// generator's scenes. `settings` turns an algorithm into the run's settings.
+pub fn tunings<'a>(plan: &Plan, from: Option<&'a Path>, settings: impl Fn(Algo) -> Config) -> Vec<Tuning<'a>> {
+    let learned: Vec<(&String, &Learned)> = plan
+        .setup
+        .egos
+        .iter()
+        .zip(&plan.egos)
+        .filter_map(|(name, ego)| match ego {
+            EgoSpec::Learned(actor) => Some((name, actor)),
+            _ => None,
+        })
+        .collect();
+    let mut out = Vec::new();
+    for generator in &plan.setup.generators {
+        if from.is_some() || learned.is_empty() {
+            out.push(Tuning {
+                before: BEFORE.into(),
+                after: tuned_name(LEARNED, generator),
+                generator: generator.clone(),
+                start: from.map_or(Start::Scratch, Start::from_path),
+                config: settings(Algo::Sac),
+            });
+            continue;
+        }
+        for (name, actor) in &learned {
+            let algo = tad_policy::pretrained::find(name).and_then(|m| Algo::parse(m.name)).unwrap_or(Algo::Sac);
+            let observation = Observation::of_inputs(actor.inputs()).unwrap_or_default();
+            out.push(Tuning {
+                before: (*name).clone(),
+                after: tuned_name(name, generator),
+                generator: generator.clone(),
+                start: Start::Learned((*actor).clone()),
+                config: Config { observation, ..settings(algo) },
+            });
+        }
+    }
+    out
+}
+
+/// A trained ego, and the one it started from (none from scratch), with their row names.
 pub struct Tuned {
+    pub before_name: String,
+    pub after_name: String,
     pub after: Learned,
     pub before: Option<Learned>,
 }
@@ -36,56 +103,73 @@ pub fn split(kept: &[Kept], seed: u64) -> (Vec<usize>, Vec<usize>) {
     tad_train::split(&keys, seed)
 }
 
-/// A learned ego from `start` trained for `config.episodes` more episodes on the kept
-/// scenes `train`, each with its kept parameters and seed; `on_episode` after each.
+/// The kept scenes of `train` that `generator` made.
+pub fn of_generator(kept: &[Kept], train: &[usize], generator: &str) -> Vec<usize> {
+    train.iter().copied().filter(|&i| kept[i].unit.generator == generator).collect()
+}
+
+/// `tuning`'s ego trained for `config.episodes` more episodes on the kept scenes `train`,
+/// each with its kept parameters and seed; `on_episode` after each.
 pub fn tune(
     kept: &[Kept],
     train: &[usize],
-    start: Start,
-    config: Config,
+    tuning: Tuning,
     mut on_episode: impl FnMut(),
 ) -> Result<Tuned, FinetuneError> {
+    let Tuning { before: before_name, after: after_name, start, config, .. } = tuning;
     let episodes = config.episodes;
     let (mut trainer, before) = start.trainer(config).map_err(FinetuneError::Start)?;
     let first = trainer.episodes() as usize;
     let scenes: Vec<TrainScene> = train
         .iter()
-        .map(|&i| TrainScene { scene: &kept[i].unit.scene, fixed: Some((kept[i].params.clone(), kept[i].seed)) })
+        .map(|&i| TrainScene { scene: &kept[i].unit.scene, fixed: Some((&kept[i].params, kept[i].seed)) })
         .collect();
-    crate::train::train(&mut trainer, first + episodes, &scenes, |_, _| -> Result<(), TrainError> {
-        on_episode();
+    crate::train::train(&mut trainer, first + episodes, &scenes, |_, stats| -> Result<(), TrainError> {
+        stats.iter().for_each(|_| on_episode());
         Ok(())
     })
     .map_err(FinetuneError::Training)?;
     let after = trainer.actor().map_err(FinetuneError::Actor)?;
-    Ok(Tuned { after, before })
+    Ok(Tuned { before_name, after_name, after, before })
 }
 
-/// The held-out table: every driver on the scenes `test`, and the learned ego's collision
-/// rate before and after (before: `None` when it started from scratch).
+/// The held-out table, and each tuned ego's change (with a start to change from).
 pub struct HeldOut {
     pub results: Results,
-    pub collision_rates: Option<(f64, f64)>,
+    pub changes: Vec<Change>,
 }
 
-/// The tuned ego, the one it started from and the plan's egos on the held-out scenes.
-pub fn held_out(plan: &Plan, kept: &[Kept], test: &[usize], tuned: Tuned) -> HeldOut {
+/// The tuned egos, the ones they started from and the plan's egos on the held-out scenes:
+/// each plan ego followed by its tuned self; a `learned` ego's pair first.
+pub fn held_out(plan: &Plan, kept: &[Kept], test: &[usize], tuned: Vec<Tuned>, seed: u64) -> HeldOut {
     let mut drivers: Vec<(String, EgoSpec)> = Vec::new();
-    let had_before = tuned.before.is_some();
-    if let Some(actor) = tuned.before {
-        drivers.push((BEFORE.into(), EgoSpec::Learned(actor)));
+    let mut pairs = Vec::new();
+    let planned = |name: &str| plan.setup.egos.iter().any(|e| e == name);
+    let (mut own, standalone): (Vec<Tuned>, Vec<Tuned>) = tuned.into_iter().partition(|t| planned(&t.before_name));
+    for t in standalone {
+        if let Some(actor) = t.before {
+            if !drivers.iter().any(|(n, _)| *n == t.before_name) {
+                drivers.push((t.before_name.clone(), EgoSpec::Learned(actor)));
+            }
+            pairs.push((t.before_name.clone(), t.after_name.clone()));
+        }
+        drivers.push((t.after_name, EgoSpec::Learned(t.after)));
     }
-    drivers.push((AFTER.into(), EgoSpec::Learned(tuned.after)));
-    drivers.extend(plan.setup.egos.iter().cloned().zip(plan.egos.iter().cloned()));
+    for (name, ego) in plan.setup.egos.iter().zip(&plan.egos) {
+        drivers.push((name.clone(), ego.clone()));
+        for t in own.extract_if(.., |t| &t.before_name == name) {
+            pairs.push((t.before_name, t.after_name.clone()));
+            drivers.push((t.after_name, EgoSpec::Learned(t.after)));
+        }
+    }
     let rows = crate::harness::held_out(kept, test, &drivers);
+    let changes = pairs.iter().filter_map(|(b, a)| crate::interval::change(&rows, b, a, seed)).collect();
     let setup = Setup {
         regions: vec!["held-out".into()],
         generators: vec!["searched".into()],
         egos: drivers.iter().map(|(n, _)| n.clone()).collect(),
         ..plan.setup.clone()
     };
-    let collision_rates = had_before
-        .then(|| (crate::harness::collision_rate(&rows, BEFORE), crate::harness::collision_rate(&rows, AFTER)));
     let scenarios = [("held-out/searched".to_string(), test.len())].into_iter().collect();
-    HeldOut { results: Results::new(setup, tad_base::Shard::ALL, scenarios, rows), collision_rates }
+    HeldOut { results: Results::new(setup, tad_base::Shard::ALL, scenarios, rows), changes }
 }

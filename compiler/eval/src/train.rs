@@ -1,21 +1,22 @@
-//! The one driver of SAC training on the runtime's scenes, for `tadslc train-ego` and the
+//! The one driver of training (PPO, SAC, TD3) on the runtime's scenes, for `tadslc train-ego` and the
 //! fine-tuning stage of `tadslc eval`.
 //!
 //! A trainer starts from scratch, from an actor alone (its critics fresh), or from a
 //! `train-ego` checkpoint (actor, critics, optimisers and replay: as ChatScene goes on from
-//! SafeBench's). Episode `n` runs scene `task(n)` of the list, with the scene's fixed
+//! SafeBench's). Episode `n` runs scene `task_at(n)` of the list, with the scene's fixed
 //! parameters and seed, or parameters sampled from the task's seed; so a run is a function
 //! of its seed and scenes, and resuming a checkpoint gives the unbroken run.
 
 use std::path::Path;
 
 use tad_policy::Learned;
-use tad_runtime::Scene;
 use tad_train::{Config, EpisodeStats, TrainError, Trainer};
 
 /// Where training starts.
 pub enum Start<'a> {
     Scratch,
+    /// An actor already read (a shipped model), with fresh critics.
+    Learned(Learned),
     /// An actor (safetensors, as `learned:PATH` reads), with fresh critics.
     Actor(&'a Path),
     /// A `train-ego` checkpoint directory.
@@ -33,6 +34,11 @@ impl<'a> Start<'a> {
     pub fn trainer(&self, config: Config) -> Result<(Trainer, Option<Learned>), TrainError> {
         match self {
             Start::Scratch => Ok((Trainer::new(config)?, None)),
+            Start::Learned(actor) => {
+                let mut trainer = Trainer::new(config)?;
+                trainer.init_actor(actor)?;
+                Ok((trainer, Some(actor.clone())))
+            }
             Start::Actor(path) => {
                 let actor = Learned::load(path)?;
                 let mut trainer = Trainer::new(config)?;
@@ -48,32 +54,24 @@ impl<'a> Start<'a> {
     }
 }
 
-/// A scene to train on: fixed parameters and seed (a searched scene), or none (sampled
-/// from each episode's task seed).
-pub struct TrainScene<'a> {
-    pub scene: &'a Scene,
-    pub fixed: Option<(Vec<f64>, u64)>,
-}
+pub use tad_train::TrainScene;
 
-/// Train until the trainer has run `until` episodes in all, calling `after` with each
-/// episode's statistics; stops at the first error, the trainer's or `after`'s.
+/// Train until the trainer has run `until` episodes in all, a round of `envs` episodes at
+/// a time (fewer at the end), calling `after` with each round's statistics; stops at the
+/// first error, the trainer's or `after`'s.
 pub fn train<E: From<TrainError>>(
     trainer: &mut Trainer,
     until: usize,
     scenes: &[TrainScene],
-    mut after: impl FnMut(&Trainer, &EpisodeStats) -> Result<(), E>,
+    mut after: impl FnMut(&Trainer, &[EpisodeStats]) -> Result<(), E>,
 ) -> Result<(), E> {
     if scenes.is_empty() {
         return Err(TrainError::Config("no scene to train on".into()).into());
     }
     while (trainer.episodes() as usize) < until {
-        let task = trainer.task(scenes.len());
-        let scene = &scenes[task.scenario];
-        let (params, seed) = match &scene.fixed {
-            Some((params, seed)) => (params.clone(), *seed),
-            None => (tad_runtime::sample::sample(&scene.scene.program.params, Some(task.seed)), task.seed),
-        };
-        let stats = trainer.step(scene.scene, params, seed)?;
+        let count = trainer.config().envs.min(until - trainer.episodes() as usize);
+        let jobs = trainer.jobs(scenes, count);
+        let stats = trainer.round(&jobs)?;
         after(trainer, &stats)?;
     }
     Ok(())

@@ -114,38 +114,19 @@ pub fn load(paths: &[PathBuf]) -> Result<Vec<Scenario>, GymError> {
     }
 }
 
-/// What the environment shows the agent.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Observation {
-    /// SafeBench's `[lateral_dis, −delta_yaw, speed, vehicle_front]`.
-    SafeBench,
-    /// [`tad_policy::EgoView::state`].
-    State,
+pub use tad_policy::Observation;
+
+/// The observation a name means, or why not.
+pub fn observation(name: &str) -> Result<Observation, GymError> {
+    Observation::parse(name).ok_or_else(|| GymError::Observation(name.to_string()))
 }
 
-impl Observation {
-    pub fn parse(name: &str) -> Result<Observation, GymError> {
-        match name {
-            "safebench" => Ok(Observation::SafeBench),
-            "state" => Ok(Observation::State),
-            other => Err(GymError::Observation(other.to_string())),
-        }
-    }
-
-    /// How many values it holds.
-    pub fn width(self) -> usize {
-        match self {
-            Observation::SafeBench => 4,
-            Observation::State => tad_policy::STATE_DIM,
-        }
-    }
-
-    fn write(self, view: &EgoView, out: &mut [f32]) {
-        let fill = |out: &mut [f32], values: &[f64]| out.iter_mut().zip(values).for_each(|(o, &v)| *o = v as f32);
-        match self {
-            Observation::SafeBench => fill(out, &view.obs),
-            Observation::State => fill(out, &view.state()),
-        }
+/// `observation` of `view` into `out`, without allocating.
+fn write(observation: Observation, view: &EgoView, out: &mut [f32]) {
+    let fill = |out: &mut [f32], values: &[f64]| out.iter_mut().zip(values).for_each(|(o, &v)| *o = v as f32);
+    match observation {
+        Observation::SafeBench => fill(out, &view.obs),
+        Observation::State => fill(out, &view.state()),
     }
 }
 
@@ -228,7 +209,7 @@ impl Env {
         let rewarder = Rewarder::new(scene, sim.desired_speed());
         let mut last = vec![0.0; self.observation.width()];
         if let Some(view) = sim.view() {
-            self.observation.write(view, &mut last);
+            write(self.observation, view, &mut last);
         }
         obs.copy_from_slice(&last);
         self.current = Some(Current { scenario: index, seed: episode_seed, sim, rewarder, last, total: 0.0 });
@@ -250,7 +231,7 @@ impl Env {
         };
         current.total += reward;
         if let Some(view) = current.sim.view().filter(|_| stop.is_none()) {
-            observation.write(view, &mut current.last);
+            write(observation, view, &mut current.last);
         }
         obs.copy_from_slice(&current.last);
         let ended = current.sim.stop_reason();

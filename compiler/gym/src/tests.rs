@@ -106,7 +106,7 @@ fn wrong_input_is_an_error() {
     // not finite: no action
     assert!(env.step([f32::NAN, f32::INFINITY], &mut obs).is_ok());
     assert_eq!(
-        Observation::parse("pixels").unwrap_err().to_string(),
+        observation("pixels").unwrap_err().to_string(),
         "unknown observation `pixels` (expected `safebench` or `state`)"
     );
 

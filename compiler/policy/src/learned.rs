@@ -7,9 +7,9 @@
 //! `get_action(deterministic=True)` returns `mu`). SafeBench's sizes are 4 → 64 → 256 → 2;
 //! here the hidden layers are read off the tensors: `fc1`, `fc2`, … as long as they exist,
 //! each `weight` `[out, in]` and `bias` `[out]` (PyTorch's `nn.Linear`), `fc1` taking the 4
-//! observation features and `fc_mu` giving 2. `mu = [acc, steer]` is scaled as SafeBench's
-//! environment does: `accel = 3·acc` m/s² (`continuous_accel_range`), `steer = 0.3·steer`
-//! (`continuous_steer_range`, CARLA's sign), so the actor never brakes harder than 3 m/s².
+//! observation features and `fc_mu` giving 2. `mu = [acc, steer]` is applied by
+//! [`crate::Action::from_unit`]: 3 m/s² forward and 0.3 of the steer as SafeBench, and
+//! the negative half onto the full brake (8 m/s², SafeBench's brake normaliser).
 //!
 //! # Stable-Baselines3's policies
 //!
@@ -37,14 +37,13 @@
 //! step against a few µs for the 17 k multiply-adds themselves. The tests check this
 //! forward pass against candle's.
 
-use crate::{Action, EgoPolicy, EgoView, PolicyError, STATE_DIM};
+use crate::{Action, EgoPolicy, EgoView, OBS_DIM, Observation, PolicyError, STATE_DIM};
 use candle_core::{DType, Device, Tensor};
 use std::collections::HashMap;
 use std::path::Path;
 use tad_ir::{Rng, SplitMix64};
 
 /// The observation's length (SafeBench's `ego_state_dim`).
-const OBS_DIM: usize = 4;
 /// The action's length (`ego_action_dim`).
 const ACTION_DIM: usize = 2;
 
@@ -141,12 +140,20 @@ impl Learned {
         let path = path.as_ref();
         let shown = path.display().to_string();
         let bytes = std::fs::read(path).map_err(|e| PolicyError::Io { path: shown.clone(), message: e.to_string() })?;
-        let not_safetensors = |e: String| PolicyError::NotSafetensors { path: shown.clone(), message: e };
+        let mut actor = Learned::from_bytes(&bytes, &shown)?;
+        actor.name = format!("learned:{shown}");
+        Ok(actor)
+    }
+
+    /// An actor from a safetensors file's bytes; `source` names them in errors and is the
+    /// driver's name.
+    pub fn from_bytes(bytes: &[u8], source: &str) -> Result<Learned, PolicyError> {
+        let not_safetensors = |e: String| PolicyError::NotSafetensors { path: source.to_string(), message: e };
         let tensors =
-            candle_core::safetensors::load_buffer(&bytes, &Device::Cpu).map_err(|e| not_safetensors(e.to_string()))?;
+            candle_core::safetensors::load_buffer(bytes, &Device::Cpu).map_err(|e| not_safetensors(e.to_string()))?;
         let (_, metadata) =
-            safetensors::SafeTensors::read_metadata(&bytes).map_err(|e| not_safetensors(e.to_string()))?;
-        let mut actor = Learned::from_tensors(&tensors, &shown)?;
+            safetensors::SafeTensors::read_metadata(bytes).map_err(|e| not_safetensors(e.to_string()))?;
+        let mut actor = Learned::from_tensors(&tensors, source)?;
         match metadata.metadata().as_ref().and_then(|m| m.get("activation")).map(String::as_str) {
             None => {}
             Some("relu") => actor.activation = Activation::Relu,
@@ -155,7 +162,7 @@ impl Learned {
                 return Err(not_safetensors(format!("metadata `activation` is `{other}`, not `relu` or `tanh`")));
             }
         }
-        actor.name = format!("learned:{shown}");
+        actor.name = source.to_string();
         Ok(actor)
     }
 
@@ -375,10 +382,8 @@ impl EgoPolicy for Learned {
     }
 
     fn act(&mut self, view: &EgoView) -> Action {
-        match self.inputs() {
-            STATE_DIM => Action::from_unit(self.mu(&view.state())),
-            _ => Action::from_unit(self.mu(&view.obs)),
-        }
+        let observation = Observation::of_inputs(self.inputs()).unwrap_or_default();
+        Action::from_unit(self.mu(&observation.of(view)))
     }
 }
 

@@ -194,7 +194,7 @@ fn tiny() -> HashMap<String, Tensor> {
 fn learned_matches_a_hand_computed_forward_pass() {
     // obs [0.5, −1, 4, 1]: fc1 = [0.5, −1 + 0.5, 0.5·4 − 1] = [0.5, −0.5, 1], relu [0.5, 0, 1];
     // fc_mu = [0.5 + 0 − 1 + 0.1, 0.25 + 0 + 0.25 − 0.2] = [−0.4, 0.3];
-    // accel = 3·tanh(−0.4) = −1.139846, steer = 0.3·tanh(0.3) = 0.087394.
+    // braking: accel = 8·tanh(−0.4) = −3.039592, steer = 0.3·tanh(0.3) = 0.087394.
     let path = temp("tiny.safetensors");
     candle_core::safetensors::save(&tiny(), &path).unwrap();
     let mut actor = Learned::load(&path).unwrap();
@@ -203,9 +203,9 @@ fn learned_matches_a_hand_computed_forward_pass() {
     let mut s = view(4.0, 8.0);
     s.obs = [0.5, -1.0, 4.0, 1.0];
     let a = actor.act(&s);
-    assert!((a.accel - 3.0 * (-0.4f64).tanh()).abs() < 1e-5, "{a:?}");
+    assert!((a.accel - 8.0 * (-0.4f64).tanh()).abs() < 1e-5, "{a:?}");
     assert!((a.steer - 0.3 * 0.3f64.tanh()).abs() < 1e-5, "{a:?}");
-    assert!((a.accel + 1.139846).abs() < 1e-5 && (a.steer - 0.087394).abs() < 1e-5);
+    assert!((a.accel + 3.039592).abs() < 1e-5 && (a.steer - 0.087394).abs() < 1e-5);
     // Named as a whole checkpoint flattened, in f64, without the std head: the same.
     let prefixed: HashMap<String, Tensor> = tiny()
         .into_iter()
@@ -231,7 +231,7 @@ fn learned_random_round_trip() {
         let a = loaded.act(&s);
         assert_eq!(a, loaded.act(&s), "deterministic");
         assert_eq!(a, original.act(&s), "the file holds the actor");
-        assert!(a.accel.abs() <= 3.0 && a.steer.abs() <= 0.3, "{a:?}");
+        assert!((-8.0..=3.0).contains(&a.accel) && a.steer.abs() <= 0.3, "{a:?}");
     }
     // The seed decides the weights.
     let again = temp("again.safetensors");
@@ -299,11 +299,16 @@ fn learned_bad_files_are_errors() {
 fn policies_by_name() {
     assert_eq!(parse_policy("idm").unwrap().name(), "idm");
     assert_eq!(parse_policy("naive").unwrap().name(), "naive");
+    for model in ["ppo", "sac", "td3"] {
+        assert_eq!(parse_policy(model).unwrap().name(), model);
+    }
     for bad in ["IDM", "mobil", "", "idm:x"] {
         let err = parse_policy(bad).err().unwrap();
         assert_eq!(
             err.to_string(),
-            format!("unknown policy `{bad}` (expected `idm`, `naive`, `learned:PATH` or `external:CMD`)")
+            format!(
+                "unknown policy `{bad}` (expected `idm`, `naive`, `ppo`, `sac`, `td3`, `learned:PATH` or `external:CMD`)"
+            )
         );
     }
     assert_eq!(parse_policy("learned").err(), Some(PolicyError::MissingPath));
@@ -451,4 +456,46 @@ fn sb3_policies_load_and_agree_with_candle() {
     write("gelu");
     let err = Learned::load(&path).unwrap_err().to_string();
     assert!(err.contains("metadata `activation` is `gelu`"), "{err}");
+}
+
+#[test]
+fn unit_actions_round_trip_through_the_ranges() {
+    for unit in [[1.0f32, 1.0], [-1.0, -1.0], [0.5, -0.25], [-0.375, 0.0], [0.0, 0.0]] {
+        let action = Action::from_unit(unit);
+        let back = action.to_unit();
+        assert!(
+            (back[0] - unit[0]).abs() < 1e-6 && (back[1] - unit[1]).abs() < 1e-6,
+            "{unit:?} → {action:?} → {back:?}"
+        );
+    }
+    assert_eq!(Action::from_unit([-1.0, 0.0]).accel, -BRAKE_RANGE);
+    assert_eq!(Action::from_unit([1.0, 0.0]).accel, ACCEL_RANGE);
+    // beyond the ranges: clamped; not finite: nothing
+    assert_eq!(Action { accel: -20.0, steer: 2.0 }.to_unit(), [-1.0, 1.0]);
+    assert_eq!(Action { accel: f64::NAN, steer: f64::INFINITY }.to_unit(), [0.0, 0.0]);
+}
+
+#[test]
+fn observations_by_name_and_width() {
+    for (name, observation) in Observation::ALL {
+        assert_eq!(Observation::parse(name), Some(observation));
+        assert_eq!(observation.name(), name);
+        assert_eq!(Observation::of_inputs(observation.width()), Some(observation));
+        assert_eq!(observation.of(&view(4.0, 8.0)).len(), observation.width());
+    }
+    assert_eq!(Observation::parse("pixels"), None);
+    // the state is scaled to about 1: nothing beyond the caps, "none" at the cap
+    let state = view(4.0, 8.0).state();
+    assert_eq!((state[7], state[8], state[10], state[11]), (0.0, 1.0, 0.0, 1.0));
+    assert!(state.iter().all(|v| v.is_finite() && v.abs() <= 10.0), "{state:?}");
+}
+
+#[test]
+fn the_shipped_models_load_by_name() {
+    for model in pretrained::ALL {
+        let actor = model.load().unwrap();
+        assert_eq!(actor.name(), model.name);
+        assert_eq!(actor.inputs(), STATE_DIM, "{} reads the state", model.name);
+    }
+    assert!(pretrained::find("ddpg").is_none());
 }

@@ -69,8 +69,8 @@ fn eval_prints_the_table_in_every_format_deterministically() {
     let out = tadslc(&[&args[..], &["--format", "json"]].concat(), "");
     assert_eq!(code(&out), 0, "{}", stderr(&out));
     let rows = lines(&stdout(&out));
-    // 2 regions × 3 generators × 2 egos
-    assert_eq!(rows.len(), 12, "{}", stdout(&out));
+    // 2 regions × 3 generators × 5 egos (the shipped ppo, sac, td3, then idm and naive)
+    assert_eq!(rows.len(), 30, "{}", stdout(&out));
     for row in &rows {
         for key in ["CR", "RR", "SS", "OR", "RF", "Comp", "TS", "ACC", "YV", "LI", "OS"] {
             assert!(row["metrics"].get(key).is_some(), "{key} in {row}");
@@ -81,9 +81,10 @@ fn eval_prints_the_table_in_every_format_deterministically() {
     }
     let pairs: Vec<(String, String, String)> =
         rows.iter().map(|r| (r["region"].to_string(), r["generator"].to_string(), r["ego"].to_string())).collect();
-    assert_eq!(pairs[0], ("\"los_angeles\"".into(), "\"chatscene\"".into(), "\"idm\"".into()));
-    assert_eq!(pairs[2], ("\"los_angeles\"".into(), "\"fitted\"".into(), "\"idm\"".into()));
-    assert_eq!(pairs[11], ("\"new_york_city\"".into(), "\"baseline\"".into(), "\"naive\"".into()));
+    assert_eq!(pairs[0], ("\"los_angeles\"".into(), "\"chatscene\"".into(), "\"ppo\"".into()));
+    assert_eq!(pairs[3], ("\"los_angeles\"".into(), "\"chatscene\"".into(), "\"idm\"".into()));
+    assert_eq!(pairs[5], ("\"los_angeles\"".into(), "\"fitted\"".into(), "\"ppo\"".into()));
+    assert_eq!(pairs[29], ("\"new_york_city\"".into(), "\"baseline\"".into(), "\"naive\"".into()));
     // the naive ego, blind to everything, collides at least as often as IDM overall
     let collisions = |ego: &str| -> f64 {
         rows.iter().filter(|r| r["ego"] == ego).map(|r| r["metrics"]["CR"].as_f64().unwrap()).sum()
@@ -104,13 +105,13 @@ fn eval_prints_the_table_in_every_format_deterministically() {
     );
     assert_eq!(
         table.lines().filter(|l| l.starts_with("| los_angeles") || l.starts_with("| new_york_city")).count(),
-        12
+        30
     );
     let svg = std::fs::read_to_string(&plot).unwrap();
     assert!(svg.starts_with("<svg") && svg.contains("los_angeles · fitted") && svg.contains("naive"), "{svg}");
     let csv = stdout(&tadslc(&[&args[..], &["--format", "csv"]].concat(), ""));
     assert_eq!(csv.lines().next(), Some("region,generator,ego,scenarios,episodes,CR,RR,SS,OR,RF,Comp,TS,ACC,YV,LI,OS"));
-    assert_eq!(csv.lines().count(), 13);
+    assert_eq!(csv.lines().count(), 31);
 }
 
 #[test]
@@ -302,7 +303,16 @@ fn eval_adds_the_after_fine_tuning_table_when_asked() {
     let rows = lines(&stdout(&out));
     let held: Vec<&Value> = rows.iter().filter(|r| r["region"] == "held-out").collect();
     let egos: Vec<&str> = held.iter().map(|r| r["ego"].as_str().unwrap()).collect();
-    assert_eq!(egos, ["learned (fine-tuned)", "idm", "naive"], "{}", stdout(&out));
+    // each shipped model, then itself fine-tuned on each generator's scenes; idm and naive
+    let mut expected = Vec::new();
+    for model in ["ppo", "sac", "td3"] {
+        expected.push(model.to_string());
+        for generator in ["chatscene", "fitted", "baseline"] {
+            expected.push(format!("{model} (fine-tuned on {generator})"));
+        }
+    }
+    expected.extend(["idm".to_string(), "naive".to_string()]);
+    assert_eq!(egos, expected, "{}", stdout(&out));
     // the held-out scenes are 2/5 of the kept ones, the same for every ego
     let kept: u64 = rows
         .iter()
@@ -312,13 +322,30 @@ fn eval_adds_the_after_fine_tuning_table_when_asked() {
     let test = held[0]["episodes"].as_u64().unwrap();
     assert!(held.iter().all(|r| r["episodes"] == test));
     assert!(test * 5 >= kept && test * 5 <= kept * 3, "{test} held out of {kept}");
-    let actor = dir.join("finetuned.safetensors");
-    let again = tadslc(
+    // each model's change, with intervals that hold the value
+    let changes: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("finetune-changes.json")).unwrap()).unwrap();
+    let changes = changes.as_array().unwrap();
+    assert_eq!(changes.len(), 9, "{changes:?}");
+    for c in changes {
+        for key in ["cr_before", "cr_after", "os_before", "os_after", "cr_points"] {
+            let (v, lo, hi) =
+                (c[key]["value"].as_f64().unwrap(), c[key]["low"].as_f64().unwrap(), c[key]["high"].as_f64().unwrap());
+            assert!(lo <= v + 1e-9 && v <= hi + 1e-9, "{key}: {c}");
+        }
+        assert_eq!(c["scenes"].as_u64(), Some(test));
+    }
+    assert!(stderr(&out).contains("held-out collision rate of ppo"), "{}", stderr(&out));
+    // seeded: the same tables again
+    let again = tadslc(&args[..args.len() - 2], "");
+    assert_eq!(stdout(&out), stdout(&again), "the fine-tuning table is deterministic");
+    let actor = dir.join("finetuned").join("td3-fine-tuned-on-fitted.safetensors");
+    let driven = tadslc(
         &["run", "examples/safety/right_turn.tad", "--ego", &format!("learned:{}", path(&actor)), "--seeds", "0"],
         "",
     );
-    assert_eq!(code(&again), 0, "{}", stderr(&again));
-    // from a train-ego checkpoint: the ego it was is in the table too
+    assert_eq!(code(&driven), 0, "{}", stderr(&driven));
+    // from a train-ego checkpoint: one `learned` ego, before and after
     let pre = dir.join("pre.safetensors");
     let trained = tadslc(
         &["train-ego", "examples/safety", "-o", path(&pre), "--episodes", "2", "--hidden", "16,16", "--batch", "32"],
@@ -335,6 +362,12 @@ fn eval_adds_the_after_fine_tuning_table_when_asked() {
         "3",
         "--samples",
         "5",
+        "--generators",
+        "fitted",
+        "--egos",
+        "idm,naive",
+        "--search-ego",
+        "idm",
         "--finetune",
         "2",
         "--format",
@@ -347,8 +380,8 @@ fn eval_adds_the_after_fine_tuning_table_when_asked() {
     let rows = lines(&stdout(&out));
     let egos: Vec<&str> =
         rows.iter().filter(|r| r["region"] == "held-out").map(|r| r["ego"].as_str().unwrap()).collect();
-    assert_eq!(egos, ["learned (before)", "learned (fine-tuned)", "idm", "naive"], "{}", stdout(&out));
-    assert!(stderr(&out).contains("held-out collision rate of the learned ego"), "{}", stderr(&out));
+    assert_eq!(egos, ["learned (before)", "learned (fine-tuned on fitted)", "idm", "naive"], "{}", stdout(&out));
+    assert!(stderr(&out).contains("held-out collision rate of learned (before)"), "{}", stderr(&out));
     let sharded = tadslc(&["eval", "examples", "--finetune", "5", "--shard", "0/2"], "");
     assert_eq!(code(&sharded), 2);
     assert!(stderr(&sharded).contains("without --shard"), "{}", stderr(&sharded));

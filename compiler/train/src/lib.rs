@@ -1,191 +1,102 @@
-//! SAC training of the learned ego (SafeBench's and ChatScene's agent) in candle, on the
-//! CPU, against the runtime's episodes. The actor comes out in exactly the safetensors form
-//! `tad_policy::Learned` reads, so `--ego learned:PATH` drives with it.
+//! PPO, SAC and TD3 for the learned ego, in candle on the CPU, against the runtime's
+//! episodes: SafeBench's observation, action and reward, SafeBench's settings per algorithm
+//! and ChatScene's SAC. Every actor comes out in the safetensors form `tad_policy::Learned`
+//! reads, so `--ego learned:PATH` drives with it.
 //!
 //! ```text
-//! Scene + params(seed) ──tad_runtime::run(explorer)──▶ Episode (one record per act)
-//!      explorer: tanh(mu + σ·ε) per step, the observation and squashed action kept
-//!      ──▶ rewards from the records (SafeBench's) ──▶ transitions ──▶ replay (ring)
-//! after each episode, `updates_per_episode` times once the replay holds `start_training`:
-//!      batch (with replacement) ─▶ twin-critic loss ─▶ Adam ─▶ actor loss ─▶ Adam ─▶ polyak
+//! jobs (scene, params, seed) ──rayon: one explorer per episode, its own noise──▶ episodes
+//!      ──▶ SafeBench's rewards from the records ──▶ transitions, in the jobs' order
+//!   SAC, TD3: replay (ring) ─▶ `updates_per_episode` learning steps per episode
+//!   PPO: rollout ─▶ once it holds `rollout` transitions: GAE, `epochs` passes of minibatches
 //! checkpoint: every tensor, both optimizers' moments, the replay, the generator, the counters
 //! ```
 //!
-//! # Networks
+//! # Algorithms
 //!
-//! Spinning Up's SAC, as ChatScene's `adv_scenic.yaml` sets it: an actor `4 → hidden →`
-//! two heads, `fc_mu` and `fc_std` (a clamped log standard deviation in `[−20, 2]`), its
-//! action `tanh(mu + σ·ε)`, log-density `Σ log N(u; mu, σ) − Σ 2(log 2 − u − softplus(−2u))`
-//! (the tanh change of variables, written stably); two critics `Q(obs, action)`,
-//! `6 → hidden → 1`, each with a target copy moved by polyak averaging. The layers are
-//! PyTorch's `nn.Linear` (`weight [out, in]`, `bias [out]`) initialised as PyTorch does
-//! (uniform `±1/√fan_in`); the actor's are named `fc1 … fcN`, `fc_mu`, `fc_std`, which is
-//! `Learned`'s file. The deterministic actor (evaluation, the saved file) is `tanh(fc_mu(x))`
-//! scaled to `accel = 3·a0` m/s², `steer = 0.3·a1`, exactly as `Learned` acts; exploration
-//! applies the same scaling to the sampled action. Per step the actor runs as plain `f32`
-//! sums (the same as `Learned::mu`), not through candle: a candle matmul on the CPU costs
-//! more in overhead than the 66 k multiply-adds of a 256 × 256 actor.
+//! All three share the actor's body (`obs → hidden → fc_mu`, ReLU, PyTorch's `nn.Linear`
+//! and its initialisation, layers named `fc1 … fcN`, `fc_mu`) and its deterministic action
+//! `tanh(fc_mu(x))`, scaled by `tad_policy::Action::from_unit` (3 m/s² forward and 0.3 of the steer as SafeBench; the full brake of 8 m/s²):
+//!
+//! - **SAC** (Spinning Up's, as ChatScene runs it): a second head `fc_std`, a clamped log
+//!   standard deviation in `[−20, 2]`; exploration `tanh(mu + σ·ε)`; twin critics
+//!   `Q(obs, action)` with polyak-averaged targets; a fixed entropy weight `alpha`.
+//! - **TD3** (Fujimoto et al. 2018): no `fc_std`; exploration `clip(tanh(mu) + N(0, s))`;
+//!   twin critics against a target actor whose action is smoothed by clipped noise; the
+//!   actor (`−Q1`) and every target move each `policy_delay` critic steps.
+//! - **PPO** (clipped, Schulman et al. 2017): the `fc_std` head gives a Gaussian over the
+//!   pre-tanh action `u`; the rollout keeps `u`, and the ratio is that Gaussian's (the tanh
+//!   correction depends on `u` alone and cancels); a value network `obs → hidden → v`;
+//!   advantages by GAE(γ, λ), normalised per update; `epochs` passes in shuffled minibatches.
+//!
+//! [`Config::safebench`] holds SafeBench's settings per algorithm
+//! (`agent/config/{sac,td3,ppo}.yaml`): SAC lr 5e-4, τ .005, batch 32, buffer 10 k,
+//! 3 updates per episode; TD3 lr 3e-4, τ .005, policy delay 2, target noise .2 clipped at
+//! .5, exploration .1; PPO lr 1e-4, clip .2, 20 passes, minibatch 64; γ .99 for all. What
+//! SafeBench leaves unsaid is Spinning Up's or SB3's default (PPO's λ .95 and rollout
+//! 2048). [`Config::default`] is ChatScene's SAC (`adv_scenic.yaml`: lr 1e-4, α .01,
+//! polyak .995, batch 512, buffer 30 k, learning from 1000 transitions, 600 episodes).
 //!
 //! # Reward
 //!
 //! SafeBench's (`carla_env.py::_get_reward`), computed from each step's record, the state
 //! the action led to: `r = −1·collision + lspeed_lon + 10·r_fast + r_out + 5·(−steer²) +
-//! 0.2·(−|steer|·lspeed_lon²)`, with `lspeed_lon` the speed along the route where the ego
-//! is, `r_fast = −1` above the desired speed, `r_out = −1` beyond 4 m from the route, and
-//! `steer` the applied normalised control. The desired speed is the scenario's own ego
-//! speed (`EgoView::desired_speed`) unless [`Config::desired_speed`] fixes one
-//! (SafeBench's 8 m/s): a fixed 8 m/s would punish every highway scenario's stated speed.
+//! 0.2·(−|steer|·lspeed_lon²)` ([`Rewarder`]). The desired speed is the scenario's own ego
+//! speed unless [`Config::desired_speed`] fixes one (SafeBench's 8 m/s).
 //!
 //! # Transitions
 //!
-//! The runtime asks the policy once per step, before the step's record: step `k`'s
-//! observation `o_k` and action `a_k` lead to record `k`, which gives `r_k`; the next
-//! observation is `o_{k+1}`, the one the next `act` sees. The last step has no next
-//! observation: after a collision or going off the road it is terminal (`done`, nothing
-//! bootstrapped); after a time, distance or route-complete stop it is a truncation, and the
-//! transition is left out rather than stored as a false terminal. Its reward still counts
-//! in the episode's return.
+//! Step `k`'s observation `o_k` and action `a_k` lead to record `k`, which gives `r_k`; the
+//! next observation is `o_{k+1}`. After a collision or going off the road the last step is
+//! terminal (`done`). After a time, distance or route-complete stop it is a truncation: the
+//! off-policy replay leaves it out rather than store a false terminal; PPO keeps it and
+//! bootstraps from the value of its own observation. Each row also marks the episode's end,
+//! where GAE's sum stops.
 //!
-//! # Update schedule
+//! # Parallel rollouts, determinism
 //!
-//! ChatScene: one learning step (batch 512) per finished episode once 1000 transitions
-//! are stored, 600 episodes. [`Config::updates_per_episode`] is that 1 by default; more
-//! learns faster from the same episodes (the tests use it). Each step: the critics'
-//! squared error against `r + γ(1 − d)(min Q_targ(o', ã') − α log π(ã'|o'))`, one Adam
-//! step on both critics; then the actor's `α log π(ã|o) − min Q(o, ã)`, one Adam step on
-//! the actor; then the targets. Adam is PyTorch's (β 0.9, 0.999, ε 1e-8), written here so
-//! its moments can be checkpointed.
+//! [`Trainer::round`] runs [`Config::envs`] episodes with the same actor on rayon, each
+//! drawing its exploration noise from a generator seeded by the run's seed and the
+//! episode's number, and stores them in the jobs' order; so the result does not depend on
+//! the thread count. Every other random choice (initialisation, batches, the update's
+//! noise) draws from one `tad_ir::SplitMix64` seeded by [`Config::seed`]. The `n`-th
+//! episode's scenario and seed ([`Trainer::task_at`]) are a function of the seed and `n`.
+//! Same seed, scenes and settings ⇒ the same file bytes on the same machine (candle's CPU
+//! matmul splits work by output block, so its sums do not depend on the thread count).
 //!
-//! # Checkpoints
+//! # Warm start
 //!
-//! A directory, written whole or not at all (a `.part` sibling renamed over it):
-//! `state.json` (format, config, the actor's widths, counters, the generator's state, the
-//! replay's write position, the caller's note), `actor.safetensors` (`Learned`'s file:
-//! loadable by `learned:DIR/actor.safetensors`), `critics.safetensors` (layer names under
-//! `q1.`, `q2.`, `q1_target.`, `q2_target.`), `optimizer.safetensors` (each parameter's
-//! `.m` and `.v` under `actor.` or `critic.`; the step counts are in the state) and
-//! `replay.safetensors` (`transitions`, `[n, 12]`: obs 4, action 2, reward, next obs 4,
-//! done). Everything the next step reads is in it, so N episodes, a stop and a resume to
-//! 2N give the same bytes as 2N at once.
-//!
-//! # Determinism
-//!
-//! Every random choice draws from one `tad_ir::SplitMix64` seeded by [`Config::seed`]:
-//! initialisation, exploration noise (Box–Muller), replay batches, the update's noise. The
-//! scenario and parameter seed of the `n`-th episode ([`Trainer::task`]) are a function of
-//! the seed and `n` only. Same seed, scenarios and settings ⇒ the same file bytes on the
-//! same machine (candle's CPU matmul splits work by output block, so the sums' order does
-//! not depend on the thread count, but a different CPU's kernels may round differently).
+//! [`Trainer::imitate`] clones a teacher (the idm driver) into the actor by DAgger: the
+//! teacher drives the first round, the actor the later ones, and the teacher labels every
+//! state seen; the actor's `tanh(fc_mu)` is fitted to the labels by mean squared error.
+//! [`Config::critic_warmup`] then lets fresh critics learn the cloned driver's values
+//! before the actor moves, and [`Config::bc_weight`] keeps the labelled states as
+//! demonstrations in the actor's loss (TD3+BC's form), so the algorithm improves on the
+//! clone instead of forgetting it.
 
+mod checkpoint;
+mod config;
+mod imitate;
 mod nets;
 pub mod reward;
+mod rollout;
+mod update;
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::BTreeMap;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-use candle_core::{DType, Device, Tensor};
-use serde::{Deserialize, Serialize};
+use rayon::prelude::*;
 use tad_ir::{Rng, SplitMix64};
-use tad_metrics::{Mode, StopReason};
-use tad_policy::{Action, EgoPolicy, EgoView, Learned, PolicyError};
-use tad_runtime::{Options, Scene};
+use tad_metrics::StopReason;
+use tad_policy::{EgoPolicy, Learned, PolicyError};
+use tad_runtime::Scene;
 
-use nets::{ACT, Adam, Net, OBS, PlainActor, normal_pair, normals, q_values, sample_actions, tensor_error};
+pub use config::{Algo, Config, MAX_BUFFER, MAX_WIDTH};
+pub use imitate::{Imitation, ImitationRound};
 pub use reward::{Reward, Rewarder};
+pub use rollout::evaluate;
 
-/// A stored transition's width: obs, action, reward, next obs, done.
-const WIDTH: usize = OBS + ACT + 1 + OBS + 1;
-const FORMAT: &str = "tad-train checkpoint 1";
-
-/// The training run's settings; the defaults are ChatScene's (`adv_scenic.yaml`).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Config {
-    /// Hidden widths of the actor and of each critic.
-    pub hidden: Vec<usize>,
-    pub actor_lr: f64,
-    pub critic_lr: f64,
-    /// The entropy weight (fixed).
-    pub alpha: f64,
-    pub gamma: f64,
-    /// Target networks keep this much of themselves per update.
-    pub polyak: f64,
-    pub batch: usize,
-    /// The replay's capacity, transitions (oldest overwritten).
-    pub buffer: usize,
-    /// No update before the replay holds this many transitions.
-    pub start_training: usize,
-    /// Episodes in all (for callers' loops; the trainer itself counts).
-    pub episodes: usize,
-    /// Learning steps after each episode (ChatScene: 1).
-    pub updates_per_episode: usize,
-    /// The reward's desired speed, m/s; `None`: the scenario's ego speed.
-    pub desired_speed: Option<f64>,
-    /// SafeBench's quirks (off-road never ends an episode) instead of the fixed rules.
-    pub compat: bool,
-    pub seed: u64,
-}
-
-impl Default for Config {
-    fn default() -> Config {
-        Config {
-            hidden: vec![256, 256],
-            actor_lr: 1e-4,
-            critic_lr: 1e-4,
-            alpha: 0.01,
-            gamma: 0.99,
-            polyak: 0.995,
-            batch: 512,
-            buffer: 30_000,
-            start_training: 1000,
-            episodes: 600,
-            updates_per_episode: 1,
-            desired_speed: None,
-            compat: false,
-            seed: 0,
-        }
-    }
-}
-
-impl Config {
-    /// Why these settings cannot train, if they cannot.
-    pub fn check(&self) -> Result<(), TrainError> {
-        let bad = |m: String| Err(TrainError::Config(m));
-        if self.hidden.is_empty() || self.hidden.contains(&0) {
-            return bad(format!(
-                "the hidden widths must be at least one layer of at least one unit (got {:?})",
-                self.hidden
-            ));
-        }
-        for (name, v) in [("actor learning rate", self.actor_lr), ("critic learning rate", self.critic_lr)] {
-            if !(v.is_finite() && v > 0.0) {
-                return bad(format!("the {name} must be a positive number (got {v})"));
-            }
-        }
-        if !(self.alpha.is_finite() && self.alpha >= 0.0) {
-            return bad(format!("alpha must be a number ≥ 0 (got {})", self.alpha));
-        }
-        for (name, v) in [("gamma", self.gamma), ("polyak", self.polyak)] {
-            if !(0.0..=1.0).contains(&v) {
-                return bad(format!("{name} must be within 0..=1 (got {v})"));
-            }
-        }
-        if self.batch == 0 || self.buffer == 0 {
-            return bad("the batch and the replay's capacity must not be zero".into());
-        }
-        if let Some(v) = self.desired_speed
-            && !(v.is_finite() && v >= 0.0)
-        {
-            return bad(format!("the desired speed must be a number ≥ 0 (got {v})"));
-        }
-        Ok(())
-    }
-
-    fn options(&self) -> Options {
-        Options { mode: if self.compat { Mode::Compat } else { Mode::Fixed }, ..Options::default() }
-    }
-}
+use nets::{ACT, Adam, Net, PlainActor, tensor_error};
 
 /// Why training could not go on.
 #[derive(Clone, Debug, PartialEq)]
@@ -225,10 +136,11 @@ impl From<PolicyError> for TrainError {
 /// One learning step's losses.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Losses {
-    /// Both critics' mean squared errors, summed.
+    /// The critics' (PPO: the value network's) mean squared errors, summed.
     pub critic: f32,
+    /// The actor's loss (0 when only the critics moved).
     pub actor: f32,
-    /// The batch's mean `−log π`, nats.
+    /// SAC: the batch's mean `−log π`, nats; PPO: the Gaussian's; TD3: 0.
     pub entropy: f32,
 }
 
@@ -240,7 +152,9 @@ pub struct EpisodeStats {
     pub steps: u32,
     pub collision: bool,
     pub stop_reason: StopReason,
-    /// Transitions stored in the replay (0 when evaluating).
+    /// The route completed at the end, 0..=1.
+    pub route_complete: f64,
+    /// Transitions stored (0 when evaluating).
     pub stored: usize,
     /// The last learning step's losses after it, when one ran.
     pub losses: Option<Losses>,
@@ -253,207 +167,208 @@ pub struct Task {
     pub seed: u64,
 }
 
-/// The replay: a ring of transitions.
-#[derive(Clone, Debug, Default)]
-struct Replay {
-    data: Vec<[f32; WIDTH]>,
-    next: usize,
+/// A scene to train on: fixed parameters and seed (a searched scene), or none (sampled
+/// from each episode's task seed).
+#[derive(Clone, Copy)]
+pub struct TrainScene<'a> {
+    pub scene: &'a Scene,
+    pub fixed: Option<(&'a [f64], u64)>,
 }
 
-impl Replay {
-    fn push(&mut self, capacity: usize, t: [f32; WIDTH]) {
-        if self.data.len() < capacity {
-            self.data.push(t);
-            self.next = self.data.len() % capacity;
-        } else {
-            self.data[self.next] = t;
-            self.next = (self.next + 1) % capacity;
+/// One episode to run: a scene, its parameters and its seed.
+#[derive(Clone)]
+pub struct Job<'a> {
+    pub scene: &'a Scene,
+    pub params: Vec<f64>,
+    pub seed: u64,
+}
+
+impl<'a> TrainScene<'a> {
+    /// The episode this scene gives for a task's seed.
+    pub fn job(&self, seed: u64) -> Job<'a> {
+        match self.fixed {
+            Some((params, seed)) => Job { scene: self.scene, params: params.to_vec(), seed },
+            None => Job {
+                scene: self.scene,
+                params: tad_runtime::sample::sample(&self.scene.program.params, Some(seed)),
+                seed,
+            },
         }
     }
 }
 
-/// The explorer or the evaluator: acts with the actor, keeps what it saw and did.
-struct Driver<'a> {
-    actor: &'a PlainActor,
-    /// `None`: deterministic (`tanh(mu)`).
-    noise: Option<&'a mut SplitMix64>,
-    obs: Vec<[f64; OBS]>,
-    actions: Vec<[f32; ACT]>,
+/// The replay (SAC, TD3: a ring of `buffer` rows) or the rollout (PPO: emptied by each
+/// update). A row: obs, action (PPO: pre-tanh), reward, next obs, done, episode end.
+#[derive(Clone, Debug, Default)]
+struct Replay {
+    width: usize,
+    data: Vec<f32>,
+    next: usize,
 }
 
-impl EgoPolicy for Driver<'_> {
-    fn name(&self) -> &str {
-        "learned"
+impl Replay {
+    fn new(obs: usize) -> Replay {
+        Replay { width: row_width(obs), data: Vec::new(), next: 0 }
     }
 
-    fn act(&mut self, view: &EgoView) -> Action {
-        let (mu, log_std) = self.actor.heads(view.obs);
-        let a = match self.noise.as_deref_mut() {
-            Some(rng) => {
-                let eps = normal_pair(rng);
-                let u = |k: usize| mu[k] + log_std[k].exp() * eps[k] as f32;
-                [u(0).tanh(), u(1).tanh()]
+    fn len(&self) -> usize {
+        self.data.len() / self.width
+    }
+
+    fn row(&self, i: usize) -> &[f32] {
+        &self.data[i * self.width..(i + 1) * self.width]
+    }
+
+    /// Append, or overwrite the oldest once `capacity` rows are held.
+    fn push(&mut self, capacity: usize, row: &[f32]) {
+        if self.len() < capacity {
+            self.data.extend_from_slice(row);
+            self.next = self.len() % capacity;
+        } else {
+            let w = self.width;
+            self.data[self.next * w..(self.next + 1) * w].copy_from_slice(row);
+            self.next = (self.next + 1) % capacity;
+        }
+    }
+
+    fn clear(&mut self) {
+        self.data.clear();
+        self.next = 0;
+    }
+}
+
+/// A row's width for observations of `obs` values.
+fn row_width(obs: usize) -> usize {
+    obs + ACT + 1 + obs + 2
+}
+
+/// The critics of each algorithm, by name (their order is the checkpoint's).
+struct Critics {
+    nets: Vec<(&'static str, Net)>,
+}
+
+impl Critics {
+    fn new(config: &Config, obs: usize, actor: &Net, rng: &mut SplitMix64) -> Result<Critics, TrainError> {
+        let mut nets = Vec::new();
+        match config.algo {
+            Algo::Sac | Algo::Td3 => {
+                let q = |rng: &mut SplitMix64| Net::random(obs + ACT, &config.hidden, &[("fc_q", 1)], rng);
+                let (q1, q2) = (q(rng)?, q(rng)?);
+                let (t1, t2) = (q1.copy()?, q2.copy()?);
+                nets.extend([("q1", q1), ("q2", q2), ("q1_target", t1), ("q2_target", t2)]);
+                if config.algo == Algo::Td3 {
+                    nets.push(("actor_target", actor.copy()?));
+                }
             }
-            None => [mu[0].tanh(), mu[1].tanh()],
-        };
-        self.obs.push(view.obs);
-        self.actions.push(a);
-        Action::from_unit(a)
+            Algo::Ppo => nets.push(("v", Net::random(obs, &config.hidden, &[("fc_v", 1)], rng)?)),
+        }
+        Ok(Critics { nets })
+    }
+
+    fn get(&self, name: &str) -> &Net {
+        // every name asked for is one `new` made for the algorithm
+        &self.nets.iter().find(|(n, _)| *n == name).expect("a critic of the algorithm").1
+    }
+
+    /// The networks the critic optimizer moves (not the targets).
+    fn trained(&self) -> Vec<(String, candle_core::Var)> {
+        let trained = self.nets.iter().filter(|(n, _)| !n.ends_with("_target"));
+        trained.flat_map(|(n, net)| net.vars().into_iter().map(move |(v, var)| (format!("{n}.{v}"), var))).collect()
     }
 }
 
-/// Records the steer any policy applies, for its reward.
-struct Recording<'a> {
-    policy: &'a mut dyn EgoPolicy,
-    steers: Vec<f64>,
-}
+/// The standard deviation of the pre-tanh action a stochastic head starts with where none
+/// is learnt yet (PPO's fresh actor; an actor without `fc_std`): SB3's `log_std_init` 0 is
+/// σ 1, which through tanh makes every action near ±1, and a noisy steer makes slow
+/// driving the best under SafeBench's steer penalty.
+pub const INITIAL_STD: f64 = 0.2;
 
-impl EgoPolicy for Recording<'_> {
-    fn name(&self) -> &str {
-        self.policy.name()
-    }
-
-    fn reset(&mut self) {
-        self.policy.reset();
-    }
-
-    fn act(&mut self, view: &EgoView) -> Action {
-        let action = self.policy.act(view);
-        // as the runtime applies it
-        let steer = if action.steer.is_finite() { action.steer.clamp(-1.0, 1.0) } else { 0.0 };
-        self.steers.push(steer);
-        action
-    }
-}
-
-/// The desired speed of the reward for an episode of `scene` with `params`.
-fn desired_speed(config: &Config, scene: &Scene, params: &[f64]) -> f64 {
-    config.desired_speed.unwrap_or_else(|| scene.ego.speed.eval(params).max(0.0))
-}
-
-/// Any policy's episode scored with the training reward (the settings' desired speed and
-/// rules): how to compare egos on held-out scenarios.
-pub fn evaluate(
-    scene: &Scene,
-    params: Vec<f64>,
-    seed: u64,
-    policy: &mut dyn EgoPolicy,
-    config: &Config,
-) -> EpisodeStats {
-    let desired = desired_speed(config, scene, &params);
-    let mut recording = Recording { policy, steers: Vec::new() };
-    recording.reset();
-    let episode = tad_runtime::run(scene, Some(seed), params, &mut recording, &config.options());
-    let mut rewarder = Rewarder::new(scene, desired);
-    let episode_return = episode
-        .records
-        .iter()
-        .zip(&recording.steers)
-        .map(|(record, &steer)| rewarder.step(record, steer).total())
-        .sum();
-    EpisodeStats {
-        episode_return,
-        steps: episode.steps,
-        collision: episode.records.iter().any(|r| r.collision),
-        stop_reason: episode.stop_reason,
-        stored: 0,
-        losses: None,
-    }
-}
-
-/// SAC's state: the networks, their optimizers, the replay, the generator, the counters.
+/// A run's state: the networks, their optimizers, the replay, the generator, the counters.
 pub struct Trainer {
     config: Config,
     actor: Net,
-    q1: Net,
-    q2: Net,
-    q1_target: Net,
-    q2_target: Net,
-    actor_opt: Adam,
-    critic_opt: Adam,
     plain: PlainActor,
+    actor_opt: Adam,
+    critics: Critics,
+    critic_opt: Adam,
     replay: Replay,
+    /// The warm start's labelled states: rows of obs and the teacher's action.
+    demos: Vec<f32>,
     rng: SplitMix64,
     episodes: u64,
     updates: u64,
     note: String,
 }
 
-/// What `state.json` holds.
-#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
-#[serde(deny_unknown_fields)]
-struct State {
-    format: String,
-    config: Config,
-    actor_hidden: Vec<usize>,
-    episodes: u64,
-    updates: u64,
-    actor_steps: u64,
-    critic_steps: u64,
-    rng: u64,
-    replay_len: usize,
-    replay_next: usize,
-    note: String,
-}
-
-const STATE_FILE: &str = "state.json";
-const ACTOR_FILE: &str = "actor.safetensors";
-const CRITICS_FILE: &str = "critics.safetensors";
-const OPTIMIZER_FILE: &str = "optimizer.safetensors";
-const REPLAY_FILE: &str = "replay.safetensors";
-
-fn actor_net(hidden: &[usize], rng: &mut SplitMix64) -> Result<Net, TrainError> {
-    Net::random(OBS, hidden, &[("fc_mu", ACT), ("fc_std", ACT)], rng)
+fn actor_net(config: &Config, obs: usize, hidden: &[usize], rng: &mut SplitMix64) -> Result<Net, TrainError> {
+    match config.algo {
+        Algo::Td3 => Net::random(obs, hidden, &[("fc_mu", ACT)], rng),
+        Algo::Sac | Algo::Ppo => Net::random(obs, hidden, &[("fc_mu", ACT), ("fc_std", ACT)], rng),
+    }
 }
 
 impl Trainer {
     /// A fresh run: networks initialised from the seed.
     pub fn new(config: Config) -> Result<Trainer, TrainError> {
         config.check()?;
+        let obs = config.observation.width();
         let mut rng = SplitMix64::new(config.seed);
-        let actor = actor_net(&config.hidden, &mut rng)?;
-        let critic = |rng: &mut SplitMix64| Net::random(OBS + ACT, &config.hidden, &[("fc_q", 1)], rng);
-        let q1 = critic(&mut rng)?;
-        let q2 = critic(&mut rng)?;
-        let (q1_target, q2_target) = (q1.copy()?, q2.copy()?);
+        let actor = actor_net(&config, obs, &config.hidden, &mut rng)?;
+        if config.algo == Algo::Ppo {
+            actor.constant_std(INITIAL_STD)?;
+        }
+        let critics = Critics::new(&config, obs, &actor, &mut rng)?;
         let actor_opt = Adam::new(actor.vars(), config.actor_lr)?;
-        let critic_vars = q1.vars().into_iter().map(|(n, v)| (format!("q1.{n}"), v));
-        let critic_vars = critic_vars.chain(q2.vars().into_iter().map(|(n, v)| (format!("q2.{n}"), v))).collect();
-        let critic_opt = Adam::new(critic_vars, config.critic_lr)?;
+        let critic_opt = Adam::new(critics.trained(), config.critic_lr)?;
         let plain = PlainActor::of(&actor)?;
         Ok(Trainer {
-            config,
             actor,
-            q1,
-            q2,
-            q1_target,
-            q2_target,
-            actor_opt,
-            critic_opt,
             plain,
-            replay: Replay::default(),
+            actor_opt,
+            critics,
+            critic_opt,
+            replay: Replay::new(obs),
+            demos: Vec::new(),
             rng,
             episodes: 0,
             updates: 0,
             note: String::new(),
+            config,
         })
     }
 
     /// Start the actor from an existing one (the paper fine-tunes SafeBench's checkpoint):
-    /// its widths and weights; a missing `fc_std` head keeps a fresh one. The actor's
-    /// optimizer starts over.
+    /// its widths and weights; a missing `fc_std` head gives [`INITIAL_STD`], and TD3 drops
+    /// it. The actor's optimizer starts over; TD3's target actor is the new actor.
     pub fn init_actor(&mut self, learned: &Learned) -> Result<(), TrainError> {
-        let actor = actor_net(&learned.hidden(), &mut self.rng)?;
+        let obs = self.config.observation.width();
+        if learned.inputs() != obs {
+            return Err(TrainError::Config(format!(
+                "the actor reads {} values, but the run's observation `{}` has {obs}",
+                learned.inputs(),
+                self.config.observation.name()
+            )));
+        }
+        let actor = actor_net(&self.config, obs, &learned.hidden(), &mut self.rng)?;
+        actor.constant_std(INITIAL_STD)?;
         let mut tensors = learned.tensors()?;
+        let fresh = actor.tensors("");
         for name in ["fc_std.weight", "fc_std.bias"] {
-            if !tensors.contains_key(name) {
-                let fresh = actor.tensors("");
-                tensors.insert(name.to_string(), fresh[name].clone());
+            if let Some(t) = fresh.get(name) {
+                tensors.entry(name.to_string()).or_insert_with(|| t.clone());
             }
         }
         actor.set(&tensors, "", "the initial actor")?;
+        self.set_actor(actor)
+    }
+
+    /// `actor` as the run's, its optimizer fresh and TD3's target a copy.
+    fn set_actor(&mut self, actor: Net) -> Result<(), TrainError> {
         self.actor_opt = Adam::new(actor.vars(), self.config.actor_lr)?;
         self.plain = PlainActor::of(&actor)?;
+        if let Some(slot) = self.critics.nets.iter_mut().find(|(n, _)| *n == "actor_target") {
+            slot.1 = actor.copy()?;
+        }
         self.actor = actor;
         Ok(())
     }
@@ -472,9 +387,14 @@ impl Trainer {
         self.updates
     }
 
-    /// Transitions in the replay.
+    /// Transitions in the replay (PPO: in the rollout not yet learned from).
     pub fn replay_len(&self) -> usize {
-        self.replay.data.len()
+        self.replay.len()
+    }
+
+    /// Labelled states kept from the warm start (the demonstrations of [`Config::bc_weight`]).
+    pub fn demos(&self) -> usize {
+        self.demos.len() / (self.config.observation.width() + ACT)
     }
 
     /// The caller's record kept in checkpoints (the command line keeps its scenarios').
@@ -486,135 +406,107 @@ impl Trainer {
         self.note = note.into();
     }
 
-    /// The next episode's scenario among `scenarios` and its seed: a function of the
-    /// seed and the episodes run only, so a resumed run goes on as an unbroken one.
+    /// The next episode's scenario among `scenarios` and its seed.
     pub fn task(&self, scenarios: usize) -> Task {
+        self.task_at(self.episodes, scenarios)
+    }
+
+    /// Episode `n`'s scenario among `scenarios` and its seed: a function of the seed and
+    /// `n` only, so a resumed run goes on as an unbroken one.
+    pub fn task_at(&self, n: u64, scenarios: usize) -> Task {
         let mut rng = SplitMix64::new(self.config.seed ^ 0xA076_1D64_78BD_642F);
-        rng.0 = rng.0.wrapping_add(self.episodes.wrapping_mul(0xD1B5_4A32_D192_ED03));
+        rng.0 = rng.0.wrapping_add(n.wrapping_mul(0xD1B5_4A32_D192_ED03));
         let scenario = rng.below(scenarios);
         Task { scenario, seed: rng.next_u64() }
     }
 
-    /// One exploring episode: stochastic actions, its transitions stored.
-    pub fn episode(&mut self, scene: &Scene, params: Vec<f64>, seed: u64) -> EpisodeStats {
-        let desired = desired_speed(&self.config, scene, &params);
-        let mut driver =
-            Driver { actor: &self.plain, noise: Some(&mut self.rng), obs: Vec::new(), actions: Vec::new() };
-        let episode = tad_runtime::run(scene, Some(seed), params, &mut driver, &self.config.options());
-        let Driver { obs, actions, .. } = driver;
-        let n = episode.records.len().min(obs.len());
-        let terminal = matches!(episode.stop_reason, StopReason::Collision | StopReason::OffRoad);
-        let mut rewarder = Rewarder::new(scene, desired);
-        let mut episode_return = 0.0;
-        let mut stored = 0;
-        for k in 0..n {
-            let a = actions[k];
-            let r = rewarder.step(&episode.records[k], Action::from_unit(a).steer).total();
-            episode_return += r;
-            let (next, done) = match obs.get(k + 1) {
-                Some(next) if k + 1 < n => (*next, 0.0),
-                _ if terminal => (obs[k], 1.0),
-                _ => continue,
-            };
-            let mut t = [0f32; WIDTH];
-            for i in 0..OBS {
-                t[i] = obs[k][i] as f32;
-                t[OBS + ACT + 1 + i] = next[i] as f32;
+    /// The next `count` episodes' jobs on `scenes`.
+    pub fn jobs<'a>(&self, scenes: &[TrainScene<'a>], count: usize) -> Vec<Job<'a>> {
+        (0..count as u64)
+            .map(|k| {
+                let task = self.task_at(self.episodes + k, scenes.len());
+                scenes[task.scenario].job(task.seed)
+            })
+            .collect()
+    }
+
+    /// Episode `n`'s exploration noise seed.
+    fn noise_seed(&self, n: u64) -> u64 {
+        SplitMix64::new(self.config.seed ^ 0x9E37_79B9_7F4A_7C15 ^ n.wrapping_mul(0xBF58_476D_1CE4_E5B9)).next_u64()
+    }
+
+    /// Exploring episodes of `jobs` with the current actor, in parallel; their
+    /// transitions stored in order; then the algorithm's learning steps.
+    pub fn round(&mut self, jobs: &[Job]) -> Result<Vec<EpisodeStats>, TrainError> {
+        let first = self.episodes;
+        let seeds: Vec<u64> = (0..jobs.len() as u64).map(|k| self.noise_seed(first + k)).collect();
+        let (plain, config) = (&self.plain, &self.config);
+        let collected: Vec<rollout::Collected> = jobs
+            .par_iter()
+            .zip(&seeds)
+            .map(|(job, &seed)| rollout::explore(plain, config, job, SplitMix64::new(seed)))
+            .collect();
+        let mut all = Vec::with_capacity(collected.len());
+        for c in collected {
+            for row in c.rows.chunks_exact(self.replay.width) {
+                let capacity = if self.config.algo == Algo::Ppo { usize::MAX } else { self.config.buffer };
+                self.replay.push(capacity, row);
             }
-            t[OBS..OBS + ACT].copy_from_slice(&a);
-            t[OBS + ACT] = r as f32;
-            t[WIDTH - 1] = done;
-            self.replay.push(self.config.buffer, t);
-            stored += 1;
+            self.episodes += 1;
+            all.push(c.stats);
         }
-        self.episodes += 1;
-        EpisodeStats {
-            episode_return,
-            steps: episode.steps,
-            collision: episode.records.iter().any(|r| r.collision),
-            stop_reason: episode.stop_reason,
-            stored,
-            losses: None,
+        let losses = self.learn(jobs.len())?;
+        if let Some(last) = all.last_mut() {
+            last.losses = losses;
+        }
+        Ok(all)
+    }
+
+    /// An exploring episode, then the learning steps it brings.
+    pub fn step(&mut self, scene: &Scene, params: Vec<f64>, seed: u64) -> Result<EpisodeStats, TrainError> {
+        let mut stats = self.round(&[Job { scene, params, seed }])?;
+        Ok(stats.remove(0))
+    }
+
+    /// The learning steps after `episodes` finished episodes; the last one's losses.
+    fn learn(&mut self, episodes: usize) -> Result<Option<Losses>, TrainError> {
+        match self.config.algo {
+            Algo::Sac | Algo::Td3 => {
+                let mut last = None;
+                for _ in 0..self.config.updates_per_episode * episodes {
+                    if let Some(losses) = self.update()? {
+                        last = Some(losses);
+                    }
+                }
+                Ok(last)
+            }
+            Algo::Ppo if self.replay.len() >= self.config.rollout => {
+                let losses = self.ppo_update().map_err(tensor_error)?;
+                self.replay.clear();
+                Ok(Some(losses))
+            }
+            Algo::Ppo => Ok(None),
         }
     }
 
-    /// One learning step on a batch from the replay; `None` while it holds fewer than
-    /// `start_training` transitions.
+    /// One off-policy learning step on a batch from the replay; `None` while it holds
+    /// fewer than `start_training` transitions, and always for PPO (see [`Trainer::round`]).
     pub fn update(&mut self) -> Result<Option<Losses>, TrainError> {
-        let len = self.replay.data.len();
+        let len = self.replay.len();
         if len == 0 || len < self.config.start_training {
             return Ok(None);
         }
-        self.learn().map(Some).map_err(tensor_error)
-    }
-
-    fn learn(&mut self) -> candle_core::Result<Losses> {
-        let b = self.config.batch;
-        let (mut obs, mut act, mut rew, mut next, mut done) = (
-            Vec::with_capacity(b * OBS),
-            Vec::with_capacity(b * ACT),
-            Vec::with_capacity(b),
-            Vec::with_capacity(b * OBS),
-            Vec::with_capacity(b),
-        );
-        for _ in 0..b {
-            let t = &self.replay.data[self.rng.below(self.replay.data.len())];
-            obs.extend_from_slice(&t[..OBS]);
-            act.extend_from_slice(&t[OBS..OBS + ACT]);
-            rew.push(t[OBS + ACT]);
-            next.extend_from_slice(&t[OBS + ACT + 1..WIDTH - 1]);
-            done.push(t[WIDTH - 1]);
-        }
-        let cpu = &Device::Cpu;
-        let obs = Tensor::from_vec(obs, (b, OBS), cpu)?;
-        let act = Tensor::from_vec(act, (b, ACT), cpu)?;
-        let rew = Tensor::from_vec(rew, (b, 1), cpu)?;
-        let next = Tensor::from_vec(next, (b, OBS), cpu)?;
-        let done = Tensor::from_vec(done, (b, 1), cpu)?;
-        let eps_next = Tensor::from_vec(normals(&mut self.rng, b * ACT), (b, ACT), cpu)?;
-        let eps_now = Tensor::from_vec(normals(&mut self.rng, b * ACT), (b, ACT), cpu)?;
-        let (gamma, alpha) = (self.config.gamma, self.config.alpha);
-
-        // critics: r + γ(1 − d)(min Q_targ(o', ã') − α log π(ã'|o')), held fixed
-        let (a2, logp2) = sample_actions(&self.actor, &next, &eps_next)?;
-        let (t1, t2) = q_values(&self.q1_target, &self.q2_target, &next, &a2)?;
-        let soft = (t1.minimum(&t2)? - logp2.affine(alpha, 0.0)?)?;
-        let backup = (rew + (done.affine(-gamma, gamma)? * soft)?)?.detach();
-        let (c1, c2) = q_values(&self.q1, &self.q2, &obs, &act)?;
-        let critic_loss = ((c1 - &backup)?.sqr()?.mean_all()? + (c2 - &backup)?.sqr()?.mean_all()?)?;
-        self.critic_opt.minimise(&critic_loss)?;
-
-        // actor: α log π(ã|o) − min Q(o, ã), on the critics just updated
-        let (a, logp) = sample_actions(&self.actor, &obs, &eps_now)?;
-        let (p1, p2) = q_values(&self.q1, &self.q2, &obs, &a)?;
-        let actor_loss = (logp.affine(alpha, 0.0)? - p1.minimum(&p2)?)?.mean_all()?;
-        self.actor_opt.minimise(&actor_loss)?;
-
-        self.q1_target.polyak_from(&self.q1, self.config.polyak)?;
-        self.q2_target.polyak_from(&self.q2, self.config.polyak)?;
-        self.plain = PlainActor::of(&self.actor).map_err(|e| candle_core::Error::Msg(e.to_string()))?;
-        self.updates += 1;
-        Ok(Losses {
-            critic: critic_loss.to_scalar::<f32>()?,
-            actor: actor_loss.to_scalar::<f32>()?,
-            entropy: -logp.mean_all()?.to_scalar::<f32>()?,
-        })
-    }
-
-    /// An exploring episode, then `updates_per_episode` learning steps.
-    pub fn step(&mut self, scene: &Scene, params: Vec<f64>, seed: u64) -> Result<EpisodeStats, TrainError> {
-        let mut stats = self.episode(scene, params, seed);
-        for _ in 0..self.config.updates_per_episode {
-            if let Some(losses) = self.update()? {
-                stats.losses = Some(losses);
-            }
-        }
-        Ok(stats)
+        let losses = match self.config.algo {
+            Algo::Sac => self.sac_update(),
+            Algo::Td3 => self.td3_update(),
+            Algo::Ppo => return Ok(None),
+        };
+        losses.map(Some).map_err(tensor_error)
     }
 
     /// The deterministic actor's episode (nothing stored, no noise drawn).
     pub fn evaluate(&self, scene: &Scene, params: Vec<f64>, seed: u64) -> EpisodeStats {
-        let mut driver = Driver { actor: &self.plain, noise: None, obs: Vec::new(), actions: Vec::new() };
+        let mut driver = rollout::Driver::deterministic(&self.plain, &self.config);
         evaluate(scene, params, seed, &mut driver, &self.config)
     }
 
@@ -627,140 +519,10 @@ impl Trainer {
     pub fn save_actor(&self, path: impl AsRef<Path>) -> Result<(), TrainError> {
         Ok(self.actor()?.save(path)?)
     }
-
-    /// Write a checkpoint into `dir` (see the crate's header), whole or not at all.
-    pub fn save_checkpoint(&self, dir: impl AsRef<Path>) -> Result<(), TrainError> {
-        let dir = dir.as_ref();
-        let io = |path: &Path, e: &dyn fmt::Display| TrainError::Io {
-            path: path.display().to_string(),
-            message: format!("cannot write it: {e}"),
-        };
-        let mut name = dir.file_name().map(|n| n.to_os_string()).unwrap_or_else(|| "checkpoint".into());
-        name.push(".part");
-        let partial = dir.with_file_name(name);
-        if partial.exists() {
-            std::fs::remove_dir_all(&partial).map_err(|e| io(&partial, &e))?;
-        }
-        std::fs::create_dir_all(&partial).map_err(|e| io(&partial, &e))?;
-
-        let save = |file: &str, tensors: &HashMap<String, Tensor>| {
-            let path = partial.join(file);
-            candle_core::safetensors::save(tensors, &path).map_err(|e| io(&path, &e))
-        };
-        self.save_actor(partial.join(ACTOR_FILE))?;
-        let mut critics = self.q1.tensors("q1.");
-        critics.extend(self.q2.tensors("q2."));
-        critics.extend(self.q1_target.tensors("q1_target."));
-        critics.extend(self.q2_target.tensors("q2_target."));
-        save(CRITICS_FILE, &critics)?;
-        let mut moments = HashMap::new();
-        self.actor_opt.tensors("actor.", &mut moments);
-        self.critic_opt.tensors("critic.", &mut moments);
-        save(OPTIMIZER_FILE, &moments)?;
-        let rows = self.replay.data.len();
-        let flat: Vec<f32> = self.replay.data.iter().flatten().copied().collect();
-        let transitions = Tensor::from_vec(flat, (rows, WIDTH), &Device::Cpu).map_err(tensor_error)?;
-        save(REPLAY_FILE, &HashMap::from([("transitions".to_string(), transitions)]))?;
-        let state = State {
-            format: FORMAT.to_string(),
-            config: self.config.clone(),
-            actor_hidden: self.actor.widths(),
-            episodes: self.episodes,
-            updates: self.updates,
-            actor_steps: self.actor_opt.step,
-            critic_steps: self.critic_opt.step,
-            rng: self.rng.0,
-            replay_len: rows,
-            replay_next: self.replay.next,
-            note: self.note.clone(),
-        };
-        let text = serde_json::to_string_pretty(&state).map_err(|e| io(&partial.join(STATE_FILE), &e))?;
-        let state_path = partial.join(STATE_FILE);
-        std::fs::write(&state_path, text + "\n").map_err(|e| io(&state_path, &e))?;
-        if dir.exists() {
-            std::fs::remove_dir_all(dir).map_err(|e| io(dir, &e))?;
-        }
-        std::fs::rename(&partial, dir).map_err(|e| io(dir, &e))
-    }
-
-    /// The run a checkpoint directory holds, to go on with.
-    pub fn load_checkpoint(dir: impl AsRef<Path>) -> Result<Trainer, TrainError> {
-        let dir = dir.as_ref();
-        let shown = |p: &Path| p.display().to_string();
-        let broken = |path: &Path, message: String| TrainError::Checkpoint { path: shown(path), message };
-        let state_path = dir.join(STATE_FILE);
-        let text = std::fs::read_to_string(&state_path)
-            .map_err(|e| TrainError::Io { path: shown(&state_path), message: format!("cannot read it: {e}") })?;
-        let state: State = serde_json::from_str(&text).map_err(|e| broken(&state_path, e.to_string()))?;
-        if state.format != FORMAT {
-            return Err(broken(&state_path, format!("format `{}`, expected `{FORMAT}`", state.format)));
-        }
-        state.config.check().map_err(|e| broken(&state_path, e.to_string()))?;
-        let mut trainer = Trainer::new(state.config.clone())?;
-        let read = |file: &str| -> Result<HashMap<String, Tensor>, TrainError> {
-            let path = dir.join(file);
-            let bytes = std::fs::read(&path)
-                .map_err(|e| TrainError::Io { path: shown(&path), message: format!("cannot read it: {e}") })?;
-            candle_core::safetensors::load_buffer(&bytes, &Device::Cpu).map_err(|e| broken(&path, e.to_string()))
-        };
-
-        let actor_path = dir.join(ACTOR_FILE);
-        let actor_tensors = read(ACTOR_FILE)?;
-        trainer.actor =
-            actor_net(&state.actor_hidden, &mut SplitMix64::new(0)).map_err(|e| broken(&state_path, e.to_string()))?;
-        trainer.actor.set(&actor_tensors, "", &shown(&actor_path))?;
-        trainer.actor_opt = Adam::new(trainer.actor.vars(), trainer.config.actor_lr)?;
-
-        let critics_path = shown(&dir.join(CRITICS_FILE));
-        let critics = read(CRITICS_FILE)?;
-        for (net, prefix) in [
-            (&trainer.q1, "q1."),
-            (&trainer.q2, "q2."),
-            (&trainer.q1_target, "q1_target."),
-            (&trainer.q2_target, "q2_target."),
-        ] {
-            net.set(&critics, prefix, &critics_path)?;
-        }
-
-        let optimizer_path = shown(&dir.join(OPTIMIZER_FILE));
-        let moments = read(OPTIMIZER_FILE)?;
-        trainer.actor_opt.set(&moments, "actor.", &optimizer_path)?;
-        trainer.critic_opt.set(&moments, "critic.", &optimizer_path)?;
-        trainer.actor_opt.step = state.actor_steps;
-        trainer.critic_opt.step = state.critic_steps;
-
-        let replay_path = dir.join(REPLAY_FILE);
-        let replay = read(REPLAY_FILE)?;
-        let transitions =
-            replay.get("transitions").filter(|t| t.dims() == [state.replay_len, WIDTH]).ok_or_else(|| {
-                broken(&replay_path, format!("no `transitions` of shape [{}, {WIDTH}]", state.replay_len))
-            })?;
-        let flat = transitions
-            .to_dtype(DType::F32)
-            .and_then(|t| t.flatten_all()?.to_vec1::<f32>())
-            .map_err(|e| broken(&replay_path, e.to_string()))?;
-        // filling, the next write appends; full, it overwrites the oldest
-        let valid = match state.replay_len.cmp(&state.config.buffer) {
-            std::cmp::Ordering::Less => state.replay_next == state.replay_len,
-            std::cmp::Ordering::Equal => state.replay_next < state.replay_len,
-            std::cmp::Ordering::Greater => false,
-        };
-        if !valid {
-            return Err(broken(&state_path, "the replay's length or position does not fit its capacity".into()));
-        }
-        trainer.replay = Replay {
-            data: flat.chunks_exact(WIDTH).map(|c| c.try_into().unwrap_or([0.0; WIDTH])).collect(),
-            next: state.replay_next,
-        };
-
-        trainer.plain = PlainActor::of(&trainer.actor)?;
-        trainer.rng = SplitMix64::new(state.rng);
-        trainer.episodes = state.episodes;
-        trainer.updates = state.updates;
-        trainer.note = state.note;
-        Ok(trainer)
-    }
 }
+
+/// Any policy, boxed for a thread of its own.
+pub type PolicyMaker<'a> = &'a (dyn Fn() -> Box<dyn EgoPolicy> + Sync);
 
 /// The held-out split of the paper: for each key (a behaviour), 3/5 of its items for
 /// training (rounded to the nearest, at least one and, with two or more, at most all but

@@ -9,8 +9,7 @@ use tad_ir::{Rng, SplitMix64};
 
 use crate::TrainError;
 
-/// The observation's length (SafeBench's `ego_state_dim`) and the action's.
-pub(crate) const OBS: usize = 4;
+/// The action's length (SafeBench's `ego_action_dim`).
 pub(crate) const ACT: usize = 2;
 /// Spinning Up's (and ChatScene's) bounds on the actor's log standard deviation.
 pub(crate) const LOG_STD_MIN: f32 = -20.0;
@@ -147,6 +146,16 @@ impl Net {
     }
 
     /// `self ← polyak·self + (1 − polyak)·source`, parameter by parameter.
+    /// The stochastic head (`fc_std`, the second) set to give `std` everywhere: weights
+    /// 0, biases `ln std`. Nothing without one.
+    pub fn constant_std(&self, std: f64) -> Result<(), TrainError> {
+        let Some(head) = self.heads.get(1) else { return Ok(()) };
+        let zeros = head.weight.zeros_like().map_err(tensor_error)?;
+        head.weight.set(&zeros).map_err(tensor_error)?;
+        let bias = (head.bias.ones_like().map_err(tensor_error)? * std.max(1e-6).ln()).map_err(tensor_error)?;
+        head.bias.set(&bias).map_err(tensor_error)
+    }
+
     pub fn polyak_from(&self, source: &Net, polyak: f64) -> candle_core::Result<()> {
         for ((_, target), (_, var)) in self.vars().iter().zip(source.vars()) {
             let next = (target.as_tensor().affine(polyak, 0.0)? + var.as_tensor().affine(1.0 - polyak, 0.0)?)?;
@@ -186,7 +195,8 @@ impl Dense {
 pub(crate) struct PlainActor {
     hidden: Vec<Dense>,
     mu: Dense,
-    log_std: Dense,
+    /// SAC's and PPO's `fc_std`; TD3's actor has none.
+    log_std: Option<Dense>,
 }
 
 impl PlainActor {
@@ -195,12 +205,13 @@ impl PlainActor {
         Ok(PlainActor {
             hidden: actor.hidden.iter().map(dense).collect::<Result<_, _>>()?,
             mu: dense(&actor.heads[0])?,
-            log_std: dense(&actor.heads[1])?,
+            log_std: actor.heads.get(1).map(dense).transpose()?,
         })
     }
 
     /// `(mu, log_std)` before squashing (log_std clamped).
-    pub fn heads(&self, obs: [f64; OBS]) -> ([f32; ACT], [f32; ACT]) {
+    /// `mu` and the clamped log standard deviation (0 without an `fc_std` head).
+    pub fn heads(&self, obs: &[f64]) -> ([f32; ACT], [f32; ACT]) {
         let mut x: Vec<f32> = obs.iter().map(|&v| v as f32).collect();
         let mut y = Vec::new();
         for layer in &self.hidden {
@@ -210,7 +221,8 @@ impl PlainActor {
         }
         self.mu.forward(&x, &mut y);
         let mu = [y[0], y[1]];
-        self.log_std.forward(&x, &mut y);
+        let Some(log_std) = &self.log_std else { return (mu, [0.0; ACT]) };
+        log_std.forward(&x, &mut y);
         let ls = [y[0].clamp(LOG_STD_MIN, LOG_STD_MAX), y[1].clamp(LOG_STD_MIN, LOG_STD_MAX)];
         (mu, ls)
     }
@@ -256,6 +268,21 @@ pub(crate) fn sample_actions(actor: &Net, obs: &Tensor, eps: &Tensor) -> candle_
 }
 
 /// The smaller of two critics' values of `(obs, action)`, and each, `[B, 1]`.
+/// The Gaussian log-density of pre-tanh samples `u` under the actor at `obs`, summed over
+/// the action (PPO's ratio: the tanh correction depends on `u` alone and cancels).
+pub(crate) fn gaussian_log_prob(actor: &Net, obs: &Tensor, u: &Tensor) -> candle_core::Result<Tensor> {
+    let heads = actor.forward(obs)?;
+    let (mu, log_std) = (&heads[0], heads[1].clamp(LOG_STD_MIN, LOG_STD_MAX)?);
+    let z = ((u - mu)? / log_std.exp()?)?;
+    let half_log_2pi = 0.5 * (2.0 * std::f64::consts::PI).ln();
+    (z.sqr()?.affine(-0.5, -half_log_2pi)? - log_std)?.sum_keepdim(D::Minus1)
+}
+
+/// The deterministic action `tanh(mu(obs))`.
+pub(crate) fn deterministic(actor: &Net, obs: &Tensor) -> candle_core::Result<Tensor> {
+    actor.forward(obs)?[0].tanh()
+}
+
 pub(crate) fn q_values(q1: &Net, q2: &Net, obs: &Tensor, action: &Tensor) -> candle_core::Result<(Tensor, Tensor)> {
     let x = Tensor::cat(&[obs, action], 1)?;
     let a = q1.forward(&x)?.remove(0);

@@ -13,7 +13,6 @@ use tad_base::Shard;
 use tad_db::Database;
 use tad_eval::finetune::{self, FinetuneError};
 use tad_eval::generator::{self, Generator};
-use tad_eval::train::Start;
 use tad_eval::{Item, Journal, Kept, Plan, Results, Setup, Unit};
 use tad_policy::EgoSpec;
 use tad_train::Config;
@@ -38,12 +37,12 @@ pub struct EvalArgs {
     /// fine-tuned model's prompt with `--adapter`), or a directory of scenarios
     #[arg(long, value_delimiter = ',', default_value = "chatscene,fitted,baseline")]
     pub generators: Vec<String>,
-    /// The egos evaluated, comma-separated or repeated: `idm`, `naive`, `learned:PATH`,
+    /// The egos evaluated, comma-separated or repeated: the shipped `ppo`, `sac`, `td3`, `idm`, `naive`, `learned:PATH`,
     /// `external:CMD` (which takes the rest of its list, commas and all)
-    #[arg(long, default_value = "idm,naive")]
+    #[arg(long, default_value = "ppo,sac,td3,idm,naive")]
     pub egos: Vec<String>,
-    /// The ego the scenes are searched against (ChatScene's surrogate)
-    #[arg(long, default_value = "idm")]
+    /// The ego the scenes are searched against (ChatScene's surrogate: the pretrained SAC)
+    #[arg(long, default_value = "sac")]
     pub search_ego: String,
     /// Scenarios per region and generator
     #[arg(short, default_value_t = 10)]
@@ -68,13 +67,14 @@ pub struct EvalArgs {
     /// Evaluate every N-th scenario from I (a job array's index I of N jobs, from 0)
     #[arg(long, value_name = "I/N", default_value = "0/1")]
     pub shard: tad_base::Shard,
-    /// Also the "after fine-tuning" table: a learned ego trained with SAC for this many
-    /// episodes on 3/5 of each behaviour's kept scenes, every ego on the other 2/5
+    /// Also the "after fine-tuning" table: each learned ego (`ppo`, `sac`, `td3`,
+    /// `learned:PATH`) fine-tuned for this many episodes with its algorithm on 3/5 of each
+    /// behaviour's kept scenes of each generator (the paper: 500), every ego on the other 2/5
     #[arg(long, value_name = "EPISODES", default_value_t = 0)]
     pub finetune: usize,
-    /// Learning steps per fine-tuning episode (ChatScene: 1)
-    #[arg(long, value_name = "N", default_value_t = tad_train::Config::default().updates_per_episode)]
-    pub finetune_updates: usize,
+    /// Off-policy learning steps per fine-tuning episode (default: the algorithm's; ChatScene's SAC: 1)
+    #[arg(long, value_name = "N")]
+    pub finetune_updates: Option<usize>,
     /// Where fine-tuning starts: a `train-ego` checkpoint directory (actor, critics, replay),
     /// or an actor alone (a safetensors file, as `learned:PATH` reads)
     #[arg(long, value_name = "FILE")]
@@ -260,53 +260,141 @@ fn scenarios(
     Ok((corpus.items.into_iter().map(|i| (i.name, i.tad)).collect(), read))
 }
 
-/// The "after fine-tuning" table of `eval --finetune` (`tad_eval::finetune`).
+/// The "after fine-tuning" table of `eval --finetune` (`tad_eval::finetune`): every learned
+/// ego fine-tuned on each generator's kept scenes, all on the held-out composite set, and
+/// each model's change with its interval.
 pub fn finetune(args: &EvalArgs, plan: &Plan, kept: &[Kept]) -> Result<Status, CliError> {
-    let (train, test) = finetune::split(kept, args.llm.seed);
+    let seed = args.llm.seed;
+    let (train, test) = finetune::split(kept, seed);
     if train.is_empty() || test.is_empty() {
         errln!("warning: no fine-tuning: {} kept scenes are too few to hold some out", kept.len())?;
         return Ok(Status::Failed);
     }
-    let config = Config {
-        episodes: args.finetune,
-        updates_per_episode: args.finetune_updates,
-        seed: args.llm.seed,
-        ..Config::default()
+    let settings = |algo| {
+        let base = Config::finetune(algo);
+        Config {
+            episodes: args.finetune,
+            updates_per_episode: args.finetune_updates.unwrap_or(base.updates_per_episode),
+            envs: FINETUNE_ENVS,
+            seed,
+            ..base
+        }
     };
-    let start = args.finetune_from.as_deref().map_or(Start::Scratch, Start::from_path);
+    let tunings = finetune::tunings(plan, args.finetune_from.as_deref(), settings);
     errln!(
-        "fine-tuning a learned ego on {} ({} held out), {}",
-        plural(train.len(), "scene"),
+        "fine-tuning {} on each generator's kept scenes ({} in all; {} held out), {} each",
+        plural(tunings.len() / plan.setup.generators.len().max(1), "learned ego"),
+        train.len(),
         test.len(),
         plural(args.finetune, "episode")
     )?;
-    let progress = crate::output::progress(args.finetune, "episodes");
-    let tuned = finetune::tune(kept, &train, start, config, || progress.inc(1));
-    progress.finish_and_clear();
-    let tuned = tuned.map_err(|e| match e {
-        FinetuneError::Start(e) => CliError::usage(format!("--finetune-from: {e}")),
-        FinetuneError::Training(e) => CliError::failed(format!("fine-tuning stopped: {e}")),
-        FinetuneError::Actor(e) => CliError::failed(e),
-    })?;
-    if let Some(dir) = &args.out {
-        let path = dir.join("finetuned.safetensors");
-        tuned.after.save(&path).map_err(CliError::usage)?;
-        errln!("the fine-tuned ego in {}", path.display())?;
+    let progress = crate::output::progress(args.finetune * tunings.len(), "episodes");
+    let mut tuned = Vec::new();
+    for tuning in tunings {
+        let subset = finetune::of_generator(kept, &train, &tuning.generator);
+        if subset.is_empty() {
+            progress.inc(args.finetune as u64);
+            errln!("warning: `{}` kept no scene to train on: no `{}` row", tuning.generator, tuning.after)?;
+            continue;
+        }
+        let after = tuning.after.clone();
+        let t = finetune::tune(kept, &subset, tuning, || progress.inc(1)).map_err(|e| match e {
+            FinetuneError::Start(e) => CliError::usage(format!("--finetune-from: {e}")),
+            FinetuneError::Training(e) => CliError::failed(format!("fine-tuning `{after}` stopped: {e}")),
+            FinetuneError::Actor(e) => CliError::failed(e),
+        })?;
+        if let Some(dir) = &args.out {
+            let path = dir.join("finetuned").join(format!("{}.safetensors", file_name(&after)));
+            std::fs::create_dir_all(dir.join("finetuned"))
+                .and_then(|_| t.after.save(&path).map_err(std::io::Error::other))
+                .map_err(|e| CliError::usage(format!("cannot write `{}`: {e}", path.display())))?;
+        }
+        tuned.push(t);
     }
-    let held_out = finetune::held_out(plan, kept, &test, tuned);
+    progress.finish_and_clear();
+    if let Some(dir) = &args.out {
+        errln!("the fine-tuned egos in {}", dir.join("finetuned").display())?;
+    }
+    let held_out = finetune::held_out(plan, kept, &test, tuned, seed);
     if args.format == EvalFormat::Markdown {
         outln!()?;
         outln!(
-            "After fine-tuning: the learned ego trained on {} kept scenes (3/5 of each behaviour's), all egos on the {} held out:",
-            train.len(),
+            "After fine-tuning: each learned ego trained on 3/5 of each behaviour's kept scenes of one generator, every ego on the {} held out:",
             test.len()
         )?;
         outln!()?;
     }
     let status = super::merge::print(&[held_out.results], args.format, None)?;
-    if let Some((was, now)) = held_out.collision_rates {
-        let change = if was > 0.0 { format!("{:+.0} %", 100.0 * (now - was) / was) } else { "–".into() };
-        errln!("held-out collision rate of the learned ego: {was:.3} before, {now:.3} after fine-tuning ({change})")?;
+    print_changes(&held_out.changes, args.format)?;
+    if let Some(dir) = &args.out {
+        let path = dir.join("finetune-changes.json");
+        let text = serde_json::to_string_pretty(&held_out.changes).unwrap_or_default() + "\n";
+        std::fs::write(&path, text).map_err(|e| CliError::usage(format!("cannot write `{}`: {e}", path.display())))?;
     }
     Ok(status)
+}
+
+/// Episodes rolled out at once while fine-tuning (a setting, so results do not depend on
+/// the machine).
+const FINETUNE_ENVS: usize = 4;
+
+/// A row name as a file name: `ppo (fine-tuned on fitted)` → `ppo-fine-tuned-on-fitted`.
+fn file_name(name: &str) -> String {
+    let mut out = String::new();
+    for c in name.chars() {
+        if c.is_ascii_alphanumeric() || c == '_' {
+            out.push(c);
+        } else if !out.ends_with('-') {
+            out.push('-');
+        }
+    }
+    out.trim_matches('-').to_string()
+}
+
+/// Each model's change: a table after the held-out one (Markdown), else on stderr.
+fn print_changes(changes: &[tad_eval::interval::Change], format: EvalFormat) -> Result<(), CliError> {
+    if changes.is_empty() {
+        return Ok(());
+    }
+    let rows: Vec<String> = changes
+        .iter()
+        .map(|c| {
+            format!(
+                "| {} | {} | {} | {} | {} | {:.1} | {:.1} | {} | {} |",
+                c.before,
+                c.after,
+                c.scenes,
+                c.cr_before,
+                c.cr_after,
+                c.cr_points,
+                c.cr_relative,
+                c.os_before,
+                c.os_after
+            )
+        })
+        .collect();
+    let header = "| model | after | scenes | CR before | CR after | ΔCR (pp) | ΔCR (%) | OS before | OS after |";
+    if format == EvalFormat::Markdown {
+        outln!()?;
+        outln!("Change after fine-tuning (95 % paired bootstrap intervals over the held-out scenes):")?;
+        outln!()?;
+        outln!("{header}")?;
+        outln!("|---|---|---|---|---|---|---|---|---|")?;
+        for row in rows {
+            outln!("{row}")?;
+        }
+    } else {
+        for c in changes {
+            errln!(
+                "held-out collision rate of {}: {:.3} before, {:.3} after ({}, {:+.1} pp, {:+.0} %)",
+                c.before,
+                c.cr_before.value,
+                c.cr_after.value,
+                c.after,
+                c.cr_points.value,
+                c.cr_relative.value
+            )?;
+        }
+    }
+    Ok(())
 }

@@ -1,4 +1,4 @@
-//! `tadslc train-ego` and the fine-tuning stage of `tadslc eval`: SAC training of a learned
+//! `tadslc train-ego` and the fine-tuning stage of `tadslc eval`: PPO, SAC or TD3 training of a learned
 //! ego through `tad-eval`'s one driver (`tad_eval::train`), with checkpoints, resume,
 //! progress with returns, and the paper's held-out split.
 //!
@@ -9,39 +9,74 @@
 use std::path::PathBuf;
 
 use tad_eval::train::{Start, TrainScene};
-use tad_train::{Config, TrainError, Trainer};
+use tad_policy::{EgoSpec, Observation};
+use tad_train::{Algo, Config, Imitation, TrainError, Trainer};
 
 use crate::output::{CliError, Closed};
 use crate::scenes::Loaded;
 use crate::{Status, errln, outln, plural};
 
-/// Train a learned ego with SAC on scenarios
+/// Train a learned ego with PPO, SAC or TD3 on scenarios
 #[derive(clap::Args, Debug, Clone)]
 pub struct TrainEgoArgs {
     /// Scenario files or directories (e.g. the scenes `tadslc search` kept), or `.tadc` files
-    #[arg(required = true)]
+    #[arg(required_unless_present = "pretrained")]
     pub paths: Vec<PathBuf>,
+    /// Reproduce a shipped model (`ppo`, `sac`, `td3`): its corpus, warm start and settings
+    /// (`tad_eval::pretrain`); every other training flag is ignored
+    #[arg(long, value_name = "ALGO", value_parser = ["ppo", "sac", "td3"], conflicts_with = "paths")]
+    pub pretrained: Option<String>,
     /// The trained actor (safetensors; `--ego learned:PATH` drives with it)
     #[arg(short, long, value_name = "FILE")]
     pub out: PathBuf,
-    /// Training episodes in all (ChatScene: 600)
-    #[arg(long, value_name = "N", default_value_t = Config::default().episodes)]
-    pub episodes: usize,
-    /// Learning steps after each episode (ChatScene: 1)
-    #[arg(long, value_name = "N", default_value_t = Config::default().updates_per_episode)]
-    pub updates_per_episode: usize,
+    /// The algorithm; its settings are SafeBench's, or with `--chatscene` ChatScene's SAC
+    #[arg(long, value_parser = ["ppo", "sac", "td3"], default_value = "sac")]
+    pub algo: String,
+    /// ChatScene's SAC settings (`adv_scenic.yaml`) instead of SafeBench's
+    #[arg(long)]
+    pub chatscene: bool,
+    /// What the actor sees: SafeBench's 4 values or the 13-value `state`
+    #[arg(long, value_parser = ["safebench", "state"], default_value = "safebench")]
+    pub observation: String,
+    /// Training episodes in all (SafeBench: 2000; ChatScene: 600)
+    #[arg(long, value_name = "N")]
+    pub episodes: Option<usize>,
+    /// Off-policy learning steps after each episode (SafeBench: 3; ChatScene: 1)
+    #[arg(long, value_name = "N")]
+    pub updates_per_episode: Option<usize>,
     /// Hidden widths of the actor and the critics
-    #[arg(long, value_delimiter = ',', default_value = "256,256")]
-    pub hidden: Vec<usize>,
+    #[arg(long, value_delimiter = ',')]
+    pub hidden: Option<Vec<usize>>,
     /// Learning rate of the actor and the critics
-    #[arg(long, default_value_t = Config::default().actor_lr)]
-    pub lr: f64,
-    /// Transitions per learning step
-    #[arg(long, value_name = "N", default_value_t = Config::default().batch)]
-    pub batch: usize,
+    #[arg(long)]
+    pub lr: Option<f64>,
+    /// Transitions per learning step (PPO: per minibatch)
+    #[arg(long, value_name = "N")]
+    pub batch: Option<usize>,
     /// No learning before the replay holds this many transitions
-    #[arg(long, value_name = "N", default_value_t = Config::default().start_training)]
-    pub start_training: usize,
+    #[arg(long, value_name = "N")]
+    pub start_training: Option<usize>,
+    /// Episodes rolled out at once over the cores (results do not depend on the thread count)
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub envs: usize,
+    /// Train under SafeBench's episode rules (off road does not end an episode), so that
+    /// leaving the road is never an escape from the steps' penalties
+    #[arg(long)]
+    pub compat: bool,
+    /// Learning steps at the start that train the critics only
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub critic_warmup: usize,
+    /// The weight of the warm start's demonstrations in the actor's loss (TD3+BC's form; 0: pure RL)
+    #[arg(long, value_name = "W", default_value_t = 0.0)]
+    pub bc_weight: f64,
+    /// Warm-start the actor by imitating this driver (DAgger), e.g. `idm`
+    #[arg(long, value_name = "EGO")]
+    pub imitate: Option<String>,
+    /// DAgger rounds and episodes per round for `--imitate`
+    #[arg(long, value_name = "N", default_value_t = Imitation::default().rounds)]
+    pub imitate_rounds: usize,
+    #[arg(long, value_name = "N", default_value_t = Imitation::default().episodes)]
+    pub imitate_episodes: usize,
     /// Start the actor from a trained one (a safetensors actor, as `learned:PATH` reads)
     #[arg(long, value_name = "FILE")]
     pub init: Option<PathBuf>,
@@ -62,18 +97,32 @@ pub struct TrainEgoArgs {
 }
 
 impl TrainEgoArgs {
-    fn config(&self) -> Config {
-        Config {
-            hidden: self.hidden.clone(),
-            actor_lr: self.lr,
-            critic_lr: self.lr,
-            batch: self.batch,
-            start_training: self.start_training,
-            episodes: self.episodes,
-            updates_per_episode: self.updates_per_episode,
-            seed: self.seed,
-            ..Config::default()
+    fn config(&self) -> Result<Config, CliError> {
+        if let Some(algo) = self.pretrained.as_deref().and_then(Algo::parse) {
+            return Ok(tad_eval::pretrain::config(algo));
         }
+        let algo = Algo::parse(&self.algo).unwrap_or_default();
+        let base = match (self.chatscene, algo) {
+            (true, Algo::Sac) => Config::default(),
+            (true, _) => return Err(CliError::usage("--chatscene is ChatScene's SAC: use it with --algo sac")),
+            (false, algo) => Config::safebench(algo),
+        };
+        Ok(Config {
+            observation: Observation::parse(&self.observation).unwrap_or_default(),
+            hidden: self.hidden.clone().unwrap_or(base.hidden.clone()),
+            actor_lr: self.lr.unwrap_or(base.actor_lr),
+            critic_lr: self.lr.unwrap_or(base.critic_lr),
+            batch: self.batch.unwrap_or(base.batch),
+            start_training: self.start_training.unwrap_or(base.start_training),
+            episodes: self.episodes.unwrap_or(base.episodes),
+            updates_per_episode: self.updates_per_episode.unwrap_or(base.updates_per_episode),
+            envs: self.envs,
+            critic_warmup: self.critic_warmup,
+            bc_weight: self.bc_weight,
+            compat: self.compat || base.compat,
+            seed: self.seed,
+            ..base
+        })
     }
 }
 
@@ -83,10 +132,18 @@ fn behaviour_key(loaded: &Loaded) -> String {
 }
 
 pub fn run(args: &TrainEgoArgs, color: bool) -> Result<Status, CliError> {
-    let config = args.config();
+    let config = args.config()?;
     config.check().map_err(CliError::usage)?;
+    let teacher = match args.pretrained {
+        Some(_) => Some(tad_eval::pretrain::TEACHER),
+        None => args.imitate.as_deref(),
+    };
+    let teacher = teacher.map(EgoSpec::parse).transpose().map_err(CliError::usage)?;
     // raised by inputs that do not load
-    let (scenes, status) = crate::scenes::load(&args.paths, color)?;
+    let (scenes, status) = match args.pretrained {
+        Some(_) => (pretraining_corpus()?, Status::Ok),
+        None => crate::scenes::load(&args.paths, color)?,
+    };
     let scenes: &[Loaded] = &scenes;
     if scenes.is_empty() {
         return Err(CliError::usage("no scenario to train on"));
@@ -97,21 +154,28 @@ pub fn run(args: &TrainEgoArgs, color: bool) -> Result<Status, CliError> {
     }
     let (train, test) = split(args, scenes)?;
     let checkpoint = args.checkpoint.clone().unwrap_or_else(|| tad_train::default_checkpoint_dir(&args.out));
+    let config_episodes = config.episodes;
     let mut trainer = trainer(args, config, &checkpoint)?;
-    let total = args.episodes;
+    let total = config_episodes;
+    let train_scenes: Vec<TrainScene> =
+        train.iter().map(|&i| TrainScene { scene: &scenes[i].scene, fixed: None }).collect();
+    if let Some(teacher) = teacher.filter(|_| trainer.episodes() == 0) {
+        imitate(&mut trainer, &train_scenes, &teacher, args)?;
+    }
     let start = trainer.episodes() as usize;
     let progress = crate::output::progress(total.saturating_sub(start), "episodes");
     let window = 25;
     let (mut returns, mut collisions) = (Vec::new(), Vec::new());
     let started = std::time::Instant::now();
-    let train_scenes: Vec<TrainScene> =
-        train.iter().map(|&i| TrainScene { scene: &scenes[i].scene, fixed: None }).collect();
-    let trained = tad_eval::train::train(&mut trainer, total, &train_scenes, |trainer, stats| -> Result<(), Stop> {
-        returns.push(stats.episode_return);
-        collisions.push(stats.collision);
-        progress.inc(1);
+    let trained = tad_eval::train::train(&mut trainer, total, &train_scenes, |trainer, round| -> Result<(), Stop> {
         let n = trainer.episodes() as usize;
-        if n.is_multiple_of(window) || n == total {
+        let before = n - round.len();
+        returns.extend(round.iter().map(|s| s.episode_return));
+        collisions.extend(round.iter().map(|s| s.collision));
+        progress.inc(round.len() as u64);
+        // a multiple of N crossed by this round
+        let crossed = |every: usize| every > 0 && n / every > before / every;
+        if crossed(window) || n == total {
             let k = returns.len().min(window);
             let mean = returns[returns.len() - k..].iter().sum::<f64>() / k as f64;
             let hits = collisions[collisions.len() - k..].iter().filter(|c| **c).count();
@@ -122,7 +186,7 @@ pub fn run(args: &TrainEgoArgs, color: bool) -> Result<Status, CliError> {
             )
             .map_err(Stop::Closed)?;
         }
-        if args.every > 0 && n.is_multiple_of(args.every) && n < total {
+        if crossed(args.every) && n < total {
             trainer.save_checkpoint(&checkpoint).map_err(Stop::Checkpoint)?;
         }
         Ok(())
@@ -192,14 +256,67 @@ fn trainer(args: &TrainEgoArgs, config: Config, checkpoint: &std::path::Path) ->
         return start.trainer(config).map(|(t, _)| t).map_err(CliError::usage);
     }
     let t = Trainer::load_checkpoint(checkpoint).map_err(CliError::usage)?;
-    if t.config().seed != config.seed || t.config().hidden != config.hidden {
+    let had = t.config();
+    if (had.seed, &had.hidden, had.algo, had.observation)
+        != (config.seed, &config.hidden, config.algo, config.observation)
+    {
         return Err(CliError::usage(format!(
-            "{} was trained with another seed or other widths: resume with the same --seed and --hidden",
+            "{} was trained with another seed, widths, algorithm or observation: resume with the same --seed, --hidden, --algo and --observation",
             checkpoint.display()
         )));
     }
     errln!("resumed from {} after {}", checkpoint.display(), plural(t.episodes() as usize, "episode"))?;
     Ok(t)
+}
+
+/// The shipped models' corpus (`tad_eval::pretrain::corpus`) from the embedded examples.
+fn pretraining_corpus() -> Result<Vec<Loaded>, CliError> {
+    let examples = crate::corpus::counted(tad_eval::examples::corpus("examples", "examples/"))?;
+    let (units, notes) = tad_eval::pretrain::corpus(&examples);
+    for note in notes {
+        errln!("note: {note}")?;
+    }
+    errln!("the shipped models' corpus: {} (fitted and baseline over every region)", plural(units.len(), "scene"))?;
+    Ok(units
+        .into_iter()
+        .map(|u| Loaded { name: format!("{}/{}", u.generator, u.name), scene: u.scene, source: None, key: Some(u.key) })
+        .collect())
+}
+
+/// The DAgger warm start from `teacher`, its rounds reported.
+fn imitate(
+    trainer: &mut Trainer,
+    scenes: &[TrainScene],
+    teacher: &EgoSpec,
+    args: &TrainEgoArgs,
+) -> Result<(), CliError> {
+    let settings = match args.pretrained {
+        Some(_) => tad_eval::pretrain::imitation(),
+        None => Imitation { rounds: args.imitate_rounds, episodes: args.imitate_episodes, ..Imitation::default() },
+    };
+    let make = || teacher.make();
+    let mut closed = None;
+    trainer
+        .imitate(scenes, &make, &settings, |r| {
+            let line = errln!(
+                "imitation round {}/{} ({} drove): {} collided, route {:.0} %, {} labelled states, loss {:.4}",
+                r.round + 1,
+                settings.rounds,
+                r.driver,
+                plural(r.collisions, "episode"),
+                100.0 * r.route_complete,
+                r.samples,
+                r.loss
+            );
+            if let Err(e) = line {
+                closed.get_or_insert(e);
+            }
+        })
+        .map_err(CliError::usage)?;
+    match closed {
+        Some(e) => Err(e.into()),
+        None => Ok(()),
+    }
 }
 
 /// Why a training loop stopped early.

@@ -1,0 +1,51 @@
+//! The shipped driving models drive: on held-out ordinary scenes (`tad_eval::pretrain`'s
+//! generators, another seed) each completes its routes about as far as the idm driver and
+//! collides at most 1.5 times as often.
+
+use rayon::prelude::*;
+use tad_eval::pretrain::{HELD_OUT_SEED, scenes};
+use tad_policy::EgoSpec;
+use tad_runtime::Options;
+
+/// An ego's collision rate and mean route completion over `units` × `seeds`.
+fn drive(units: &[tad_eval::Unit], ego: &EgoSpec, seeds: u64) -> (f64, f64) {
+    let runs: Vec<(bool, f64)> = units
+        .par_iter()
+        .flat_map_iter(|u| (0..seeds).map(move |seed| (u, seed)))
+        .map(|(u, seed)| {
+            let params = tad_runtime::sample::sample(&u.scene.program.params, Some(seed));
+            let mut policy = ego.make();
+            let episode = tad_runtime::run(&u.scene, Some(seed), params, policy.as_mut(), &Options::default());
+            let collided = episode.records.iter().any(|r| r.collision);
+            (collided, episode.records.last().map_or(0.0, |r| r.route_complete / 100.0))
+        })
+        .collect();
+    let n = runs.len().max(1) as f64;
+    (runs.iter().filter(|r| r.0).count() as f64 / n, runs.iter().map(|r| r.1).sum::<f64>() / n)
+}
+
+fn bar(per_region: usize, seeds: u64) {
+    let examples = tad_eval::examples::corpus("examples", "examples/");
+    let (units, _) = scenes(&examples, per_region, HELD_OUT_SEED);
+    assert!(units.len() >= 10 * per_region, "{} held-out scenes", units.len());
+    let (idm_cr, idm_rc) = drive(&units, &EgoSpec::parse("idm").unwrap(), seeds);
+    eprintln!("{} scenes × {seeds} seeds: idm CR {idm_cr:.3}, route {idm_rc:.3}", units.len());
+    for model in ["ppo", "sac", "td3"] {
+        let (cr, rc) = drive(&units, &EgoSpec::parse(model).unwrap(), seeds);
+        eprintln!("{model}: CR {cr:.3} ({:.2} × idm), route {rc:.3} ({:.2} × idm)", cr / idm_cr, rc / idm_rc);
+        assert!(cr <= 1.5 * idm_cr, "{model} collides in {cr:.3} of the episodes, idm in {idm_cr:.3}");
+        assert!(rc >= 0.9 * idm_rc, "{model} completes {rc:.3} of its routes, idm {idm_rc:.3}");
+    }
+}
+
+#[test]
+fn the_shipped_models_drive_as_well_as_idm_on_held_out_scenes() {
+    bar(4, 2);
+}
+
+/// The figures for the record: `cargo test -p tad-eval --release --test pretrained -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn the_driving_bar_on_more_scenes() {
+    bar(30, 3);
+}
