@@ -16,6 +16,7 @@
 pub mod align;
 pub mod llm;
 pub mod lsp;
+pub mod rl;
 pub mod runtime;
 
 use std::hint::black_box;

@@ -13,9 +13,13 @@
 //!    stop line: a driver on them cannot meet the idm bar), SafeBench's episode rules
 //!    (`compat`: leaving the road is no escape from the penalties), critics warmed up
 //!    before the actor moves, and the demonstrations kept in the actor's loss.
+//! 4. **Selection**, as the paper reports its models: the clone and the actor every
+//!    [`VALIDATE_EVERY`] episodes are judged on validation scenes ([`VALIDATION_SEED`]),
+//!    and the best ([`Judged::better_than`]) is the shipped file.
 
+use rayon::prelude::*;
 use tad_db::Database;
-use tad_policy::Observation;
+use tad_policy::{EgoPolicy, Observation};
 use tad_train::{Algo, Config, Imitation};
 
 use crate::corpus::Corpus;
@@ -32,6 +36,12 @@ pub const SEED: u64 = 0;
 
 /// The seed of the held-out scenes the shipped models are judged on.
 pub const HELD_OUT_SEED: u64 = 2000;
+/// The seed of the validation scenes that choose among a run's actors, how many per region
+/// and generator, the episode seeds each, and how often an actor is judged (episodes).
+pub const VALIDATION_SEED: u64 = 3000;
+pub const VALIDATION_PER_REGION: usize = 4;
+pub const VALIDATION_SEEDS: u64 = 2;
+pub const VALIDATE_EVERY: usize = 50;
 
 /// The corpus's scenes (see the module's header), and notes on scenarios that did not build.
 pub fn corpus(examples: &Corpus) -> (Vec<Unit>, Vec<String>) {
@@ -80,5 +90,41 @@ pub fn config(algo: Algo) -> Config {
             Algo::Ppo => Config { critic_warmup: 2, ..base },
             Algo::Sac | Algo::Td3 => off_policy,
         }
+    }
+}
+
+/// How a driver did on some scenes: its collision rate and mean route completion (0..=1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Judged {
+    pub collision_rate: f64,
+    pub route_complete: f64,
+}
+
+impl Judged {
+    /// Fewer collisions first, then further along the routes.
+    pub fn better_than(&self, other: &Judged) -> bool {
+        (self.collision_rate, -self.route_complete) < (other.collision_rate, -other.route_complete)
+    }
+}
+
+/// A driver on `units` × seeds `0..seeds` (parameters sampled per seed), in parallel; the
+/// result does not depend on the thread count.
+pub fn judge(units: &[Unit], seeds: u64, make: &(dyn Fn() -> Box<dyn EgoPolicy> + Sync)) -> Judged {
+    let runs: Vec<(bool, f64)> = units
+        .par_iter()
+        .flat_map_iter(|u| (0..seeds).map(move |seed| (u, seed)))
+        .map(|(u, seed)| {
+            let params = tad_runtime::sample::sample(&u.scene.program.params, Some(seed));
+            let mut policy = make();
+            let options = tad_runtime::Options::default();
+            let episode = tad_runtime::run(&u.scene, Some(seed), params, policy.as_mut(), &options);
+            let collided = episode.records.iter().any(|r| r.collision);
+            (collided, episode.records.last().map_or(0.0, |r| r.route_complete / 100.0))
+        })
+        .collect();
+    let n = runs.len().max(1) as f64;
+    Judged {
+        collision_rate: runs.iter().filter(|r| r.0).count() as f64 / n,
+        route_complete: runs.iter().map(|r| r.1).sum::<f64>() / n,
     }
 }

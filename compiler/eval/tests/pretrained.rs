@@ -2,26 +2,13 @@
 //! generators, another seed) each completes its routes about as far as the idm driver and
 //! collides at most 1.5 times as often.
 
-use rayon::prelude::*;
-use tad_eval::pretrain::{HELD_OUT_SEED, scenes};
+use tad_eval::pretrain::{HELD_OUT_SEED, judge, scenes};
 use tad_policy::EgoSpec;
-use tad_runtime::Options;
 
 /// An ego's collision rate and mean route completion over `units` × `seeds`.
 fn drive(units: &[tad_eval::Unit], ego: &EgoSpec, seeds: u64) -> (f64, f64) {
-    let runs: Vec<(bool, f64)> = units
-        .par_iter()
-        .flat_map_iter(|u| (0..seeds).map(move |seed| (u, seed)))
-        .map(|(u, seed)| {
-            let params = tad_runtime::sample::sample(&u.scene.program.params, Some(seed));
-            let mut policy = ego.make();
-            let episode = tad_runtime::run(&u.scene, Some(seed), params, policy.as_mut(), &Options::default());
-            let collided = episode.records.iter().any(|r| r.collision);
-            (collided, episode.records.last().map_or(0.0, |r| r.route_complete / 100.0))
-        })
-        .collect();
-    let n = runs.len().max(1) as f64;
-    (runs.iter().filter(|r| r.0).count() as f64 / n, runs.iter().map(|r| r.1).sum::<f64>() / n)
+    let judged = judge(units, seeds, &|| ego.make());
+    (judged.collision_rate, judged.route_complete)
 }
 
 fn bar(per_region: usize, seeds: u64) {

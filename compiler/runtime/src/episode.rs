@@ -753,11 +753,14 @@ fn move_actor(scene: &Scene, actors: &mut [Actor], k: usize, before: &[Seen], eg
             a.kin = Kinematics { position: pose.position, yaw: if keep_yaw { a.kin.yaw } else { pose.yaw }, speed };
         }
         Motion::Drive => {
+            let mut leader = leader_of(scene, actors, k, before, ego, t);
             if actors[k].mobil && t >= actors[k].next_mobil {
                 actors[k].next_mobil = t + 1.0;
-                mobil(scene, actors, k, before, ego, t);
+                // a new lane has another leader
+                if mobil(scene, actors, k, before, ego, leader) {
+                    leader = leader_of(scene, actors, k, before, ego, t);
+                }
             }
-            let leader = leader_of(scene, actors, k, before, ego, t);
             let a = &mut actors[k];
             let Some(track) = &a.track else { return };
             let (s, _) = track.locate(a.kin.position, a.s, 8.0);
@@ -849,55 +852,91 @@ fn ahead_on(
 ) -> Option<(f64, f64)> {
     let Kinematics { position, yaw, speed } = kin;
     let heading = Vec2::from_yaw(yaw);
-    let mut best: Option<(f64, f64)> = None;
-    let mut keep = |gap: f64, along: f64| {
-        if best.is_none_or(|(g, _)| gap < g) {
-            best = Some((gap, along));
-        }
-    };
-    for Seen { position: p, yaw: other_yaw, heading: other_heading, speed: v, length: l, width: w } in others {
-        let d = p - position;
-        if beyond(d, LOOK) {
-            continue;
-        }
-        let crossing = v > 0.3 && other_heading.dot(heading).abs() < 0.7;
-        if !crossing {
-            if d.dot(heading) <= 0.0 {
+    NEAR.with_borrow_mut(|(ahead, crossing)| {
+        ahead.clear();
+        crossing.clear();
+        for (i, o) in others.enumerate() {
+            let d = o.position - position;
+            if beyond(d, LOOK) {
                 continue;
+            }
+            if o.speed > 0.3 && o.heading.dot(heading).abs() < 0.7 {
+                crossing.push((i, o));
+            } else if d.dot(heading) > 0.0 {
+                ahead.push((d.dot(d), i, o));
+            }
+        }
+        // the nearest first, so that most of the rest fall to the bound below; the best
+        // is the least (gap, index), the one taking them in order would keep
+        ahead.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        // how far the vehicle stands from its own track at `s`
+        let off_track = corridor.track.pose(corridor.s).position.distance(position);
+        let mut best: Option<(f64, f64, usize)> = None;
+        let keep = |best: &mut Option<(f64, f64, usize)>, gap: f64, along: f64, i: usize| {
+            if best.is_none_or(|(g, _, j)| gap < g || (gap == g && i < j)) {
+                *best = Some((gap, along, i));
+            }
+        };
+        for &(squared, i, seen) in ahead.iter() {
+            let Seen { position: p, yaw: other_yaw, speed: v, length: l, width: w, .. } = seen;
+            // A bound on what it could keep: the arc to it is at least the chord between
+            // the two points on the track, which is at least the distance less both
+            // offsets from the track (its offset is within `in_corridor`'s reach); an
+            // oncoming one is kept scaled by at least `speed / (speed + v)`.
+            if let Some((g, _, _)) = best {
+                let reach = corridor.width / 2.0 + l / 2.0 + w / 2.0 + 0.3;
+                let bound = squared.sqrt() - reach - off_track - corridor.length / 2.0 - (l / 2.0 + w / 2.0);
+                let scale = speed.max(1.0) / (speed.max(1.0) + v.max(0.0));
+                if bound > 0.0 && bound * scale > g + BOUND_MARGIN {
+                    continue;
+                }
             }
             let other = Footprint { pose: Pose { position: p, yaw: other_yaw }, length: l, width: w };
-            if let Some((gap, rel)) = in_corridor(&corridor, &other, d.dot(heading)) {
+            if let Some((gap, rel)) = in_corridor(&corridor, &other, (p - position).dot(heading)) {
                 let along = v * rel.cos();
                 if along >= 0.0 {
-                    keep(gap, along);
+                    keep(&mut best, gap, along, i);
                 } else {
                     // oncoming: a standing obstacle where the two would meet
-                    keep(gap * speed.max(1.0) / (speed.max(1.0) - along), 0.0);
-                }
-            }
-            continue;
-        }
-        let velocity = other_heading * v;
-        let samples = if yields { CROSS_SAMPLES } else { 0 };
-        for k in 0..=samples {
-            let tau = CROSS_HORIZON * k as f64 / CROSS_SAMPLES as f64;
-            let q = p + velocity * tau;
-            let ahead = (q - position).dot(heading);
-            if ahead <= 0.0 {
-                continue;
-            }
-            let other = Footprint { pose: Pose { position: q, yaw: other_yaw }, length: l, width: w };
-            if let Some((gap, _)) = in_corridor(&corridor, &other, ahead) {
-                let arrive = gap.max(0.0) / speed.max(1.0);
-                if (arrive - tau).abs() <= CROSS_MARGIN || (k == 0 && gap < 3.0) {
-                    keep(gap, 0.0);
-                    break;
+                    keep(&mut best, gap * speed.max(1.0) / (speed.max(1.0) - along), 0.0, i);
                 }
             }
         }
-    }
-    best
+        for &(i, seen) in crossing.iter() {
+            let Seen { position: p, yaw: other_yaw, heading: other_heading, speed: v, length: l, width: w } = seen;
+            let velocity = other_heading * v;
+            let samples = if yields { CROSS_SAMPLES } else { 0 };
+            for k in 0..=samples {
+                let tau = CROSS_HORIZON * k as f64 / CROSS_SAMPLES as f64;
+                let q = p + velocity * tau;
+                let ahead = (q - position).dot(heading);
+                if ahead <= 0.0 {
+                    continue;
+                }
+                let other = Footprint { pose: Pose { position: q, yaw: other_yaw }, length: l, width: w };
+                if let Some((gap, _)) = in_corridor(&corridor, &other, ahead) {
+                    let arrive = gap.max(0.0) / speed.max(1.0);
+                    if (arrive - tau).abs() <= CROSS_MARGIN || (k == 0 && gap < 3.0) {
+                        keep(&mut best, gap, 0.0, i);
+                        break;
+                    }
+                }
+            }
+        }
+        best.map(|(gap, along, _)| (gap, along))
+    })
 }
+
+/// [`ahead_on`]'s lists, kept between calls: what is ahead (squared distance, index,
+/// what it is) and what moves across (index, what it is).
+type Near = (Vec<(f64, usize, Seen)>, Vec<(usize, Seen)>);
+thread_local! {
+    static NEAR: std::cell::RefCell<Near> = const { std::cell::RefCell::new((Vec::new(), Vec::new())) };
+}
+
+/// What the bound must exceed the best gap by before a candidate is passed over, m: the
+/// rounding of the bound's sums, many times over.
+const BOUND_MARGIN: f64 = 1e-6;
 
 /// Whether `d` is longer than `limit`, its exact length taken only when the bounds
 /// `max(|x|, |y|) ≤ length ≤ |x| + |y|` do not tell.
@@ -936,12 +975,20 @@ fn in_corridor(corridor: &Corridor, other: &Footprint, ahead: f64) -> Option<(f6
 
 /// MOBIL (Kesting, Treiber and Helbing 2007) with politeness 0: change to a neighbouring lane
 /// when it gains more than 0.2 m/s² and its new follower need not brake harder than 4 m/s².
-fn mobil(scene: &Scene, actors: &mut [Actor], k: usize, before: &[Seen], ego: Seen, t: f64) {
+/// `leader` is the vehicle's leader in its lane ([`leader_of`]); whether it changed lanes.
+fn mobil(
+    scene: &Scene,
+    actors: &mut [Actor],
+    k: usize,
+    before: &[Seen],
+    ego: Seen,
+    leader: Option<(f64, f64)>,
+) -> bool {
     const GAIN: f64 = 0.2;
     const SAFE: f64 = 4.0;
     let now = {
         let me = &actors[k];
-        IdmParams::default().accel(me.kin.speed, me.target, leader_of(scene, actors, k, before, ego, t))
+        IdmParams::default().accel(me.kin.speed, me.target, leader)
     };
     let mut choice: Option<(i64, f64)> = None;
     for dir in [-1, 1] {
@@ -966,7 +1013,7 @@ fn mobil(scene: &Scene, actors: &mut [Actor], k: usize, before: &[Seen], ego: Se
             choice = Some((dir, then - now));
         }
     }
-    if let Some((dir, _)) = choice {
-        change_lane(scene, &mut actors[k], dir);
-    }
+    let Some((dir, _)) = choice else { return false };
+    change_lane(scene, &mut actors[k], dir);
+    true
 }

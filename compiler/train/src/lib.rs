@@ -504,6 +504,21 @@ impl Trainer {
         losses.map(Some).map_err(tensor_error)
     }
 
+    /// One learning step now: SAC's or TD3's on a replay batch (as [`Trainer::update`]), or
+    /// PPO's on the rollout held so far, whatever its length (then emptied). For
+    /// benchmarks and callers with their own schedule.
+    pub fn learn_now(&mut self) -> Result<Option<Losses>, TrainError> {
+        match self.config.algo {
+            Algo::Ppo if self.replay.len() > 0 => {
+                let losses = self.ppo_update().map_err(tensor_error)?;
+                self.replay.clear();
+                Ok(Some(losses))
+            }
+            Algo::Ppo => Ok(None),
+            Algo::Sac | Algo::Td3 => self.update(),
+        }
+    }
+
     /// The deterministic actor's episode (nothing stored, no noise drawn).
     pub fn evaluate(&self, scene: &Scene, params: Vec<f64>, seed: u64) -> EpisodeStats {
         let mut driver = rollout::Driver::deterministic(&self.plain, &self.config);

@@ -124,7 +124,8 @@ impl Net {
                     message: format!("tensor `{full}` has shape {:?}, expected {:?}", t.dims(), var.dims()),
                 });
             }
-            let t = t.to_dtype(DType::F32).map_err(tensor_error)?;
+            // a copy: the source may be this very variable's tensor
+            let t = t.to_dtype(DType::F32).and_then(|t| t.copy()).map_err(tensor_error)?;
             var.set(&t).map_err(tensor_error)?;
         }
         Ok(())

@@ -73,6 +73,26 @@ pub struct Args {
     /// Steps per episode (fewer for tests)
     #[arg(long, default_value_t = 300, requires = "runtime", hide = true)]
     pub steps: u32,
+    /// Measure reinforcement learning instead: environment steps and gradient updates per
+    /// second for PPO, SAC and TD3, against Stable-Baselines3 with the same networks,
+    /// batches and threads
+    #[arg(long, conflicts_with_all = ["runtime", "lsp", "llm", "align"])]
+    pub rl: bool,
+    /// The Python with stable-baselines3 and torch for `--rl`'s peer (default `python3`)
+    #[arg(long, value_name = "PATH", requires = "rl")]
+    pub python: Option<PathBuf>,
+    /// Skip the Stable-Baselines3 peer
+    #[arg(long, requires = "rl", conflicts_with = "python")]
+    pub no_sb3: bool,
+    /// Learning steps timed per measurement (`--rl`)
+    #[arg(long, value_name = "N", default_value_t = 200, requires = "rl")]
+    pub updates: usize,
+    /// Exploring episodes timed per measurement (`--rl`)
+    #[arg(long = "rl-episodes", value_name = "N", default_value_t = 32, requires = "rl")]
+    pub rl_episodes: usize,
+    /// Thread counts measured (`--rl`)
+    #[arg(long = "rl-threads", value_name = "N,...", value_delimiter = ',', default_value = "1,2", requires = "rl")]
+    pub rl_threads: Vec<usize>,
     /// Run the alignment recovery experiment instead: labelled synthetic regions, the
     /// fitted generator against the unaligned baseline on held-out samples
     #[arg(long, conflicts_with_all = ["runtime", "lsp", "llm"])]
@@ -116,6 +136,15 @@ pub fn run(args: &Args) -> Result<Status, CliError> {
             descriptions: args.descriptions.clone(),
         };
         return streamed("bench --llm: ", |progress| tad_bench::llm::run(&llm, progress));
+    }
+    if args.rl {
+        let rl = tad_bench::rl::RlArgs {
+            python: (!args.no_sb3).then(|| args.python.clone().unwrap_or_else(|| "python3".into())),
+            updates: args.updates,
+            episodes: args.rl_episodes,
+            threads: args.rl_threads.clone(),
+        };
+        return streamed("bench --rl: ", |progress| tad_bench::rl::run(&rl, progress));
     }
     if args.runtime {
         let runtime = tad_bench::runtime::RuntimeArgs {

@@ -298,8 +298,11 @@ pub fn finetune(args: &EvalArgs, plan: &Plan, kept: &[Kept]) -> Result<Status, C
             continue;
         }
         let after = tuning.after.clone();
+        let from_flag =
+            matches!(tuning.start, tad_eval::train::Start::Checkpoint(_) | tad_eval::train::Start::Actor(_));
         let t = finetune::tune(kept, &subset, tuning, || progress.inc(1)).map_err(|e| match e {
-            FinetuneError::Start(e) => CliError::usage(format!("--finetune-from: {e}")),
+            FinetuneError::Start(e) if from_flag => CliError::usage(format!("--finetune-from: {e}")),
+            FinetuneError::Start(e) => CliError::failed(format!("cannot start fine-tuning `{after}`: {e}")),
             FinetuneError::Training(e) => CliError::failed(format!("fine-tuning `{after}` stopped: {e}")),
             FinetuneError::Actor(e) => CliError::failed(e),
         })?;

@@ -8,6 +8,7 @@
 
 use std::path::PathBuf;
 
+use tad_eval::pretrain::Judged;
 use tad_eval::train::{Start, TrainScene};
 use tad_policy::{EgoSpec, Observation};
 use tad_train::{Algo, Config, Imitation, TrainError, Trainer};
@@ -162,6 +163,17 @@ pub fn run(args: &TrainEgoArgs, color: bool) -> Result<Status, CliError> {
     if let Some(teacher) = teacher.filter(|_| trainer.episodes() == 0) {
         imitate(&mut trainer, &train_scenes, &teacher, args)?;
     }
+    // the recipe's selection: the clone and every VALIDATE_EVERY episodes, the best kept
+    let mut selection = match args.pretrained {
+        Some(_) => Some(Selection::new()?),
+        None => None,
+    };
+    if let Some(selection) = &mut selection {
+        selection.judge(&trainer).map_err(|e| match e {
+            Stop::Closed(c) => c.into(),
+            Stop::Checkpoint(e) | Stop::Train(e) => CliError::failed(e),
+        })?;
+    }
     let start = trainer.episodes() as usize;
     let progress = crate::output::progress(total.saturating_sub(start), "episodes");
     let window = 25;
@@ -189,6 +201,11 @@ pub fn run(args: &TrainEgoArgs, color: bool) -> Result<Status, CliError> {
         if crossed(args.every) && n < total {
             trainer.save_checkpoint(&checkpoint).map_err(Stop::Checkpoint)?;
         }
+        if let Some(selection) = &mut selection
+            && (crossed(tad_eval::pretrain::VALIDATE_EVERY) || n == total)
+        {
+            selection.judge(trainer)?;
+        }
         Ok(())
     });
     progress.finish_and_clear();
@@ -201,7 +218,18 @@ pub fn run(args: &TrainEgoArgs, color: bool) -> Result<Status, CliError> {
             return Err(CliError::failed(format!("training stopped at episode {}: {e}", trainer.episodes())));
         }
     }
-    trainer.save_checkpoint(&checkpoint).and_then(|_| trainer.save_actor(&args.out)).map_err(CliError::usage)?;
+    trainer.save_checkpoint(&checkpoint).map_err(CliError::usage)?;
+    match selection.and_then(|s| s.best) {
+        Some((episode, judged, actor)) => {
+            actor.save(&args.out).map_err(CliError::usage)?;
+            errln!(
+                "kept the actor of episode {episode}: validation collision rate {:.3}, route {:.3}",
+                judged.collision_rate,
+                judged.route_complete
+            )?;
+        }
+        None => trainer.save_actor(&args.out).map_err(CliError::usage)?,
+    }
     // the deterministic actor on the held-out scenarios (or the training ones)
     let judged = if test.is_empty() { &train } else { &test };
     let mut hits = 0;
@@ -316,6 +344,50 @@ fn imitate(
     match closed {
         Some(e) => Err(e.into()),
         None => Ok(()),
+    }
+}
+
+/// The recipe's choice among a run's actors: each judged on the validation scenes
+/// (`tad_eval::pretrain`), the best kept with its episode.
+struct Selection {
+    units: Vec<tad_eval::Unit>,
+    best: Option<(u64, Judged, tad_policy::Learned)>,
+}
+
+impl Selection {
+    fn new() -> Result<Selection, CliError> {
+        use tad_eval::pretrain::{VALIDATION_PER_REGION, VALIDATION_SEED, scenes};
+        let examples = crate::corpus::counted(tad_eval::examples::corpus("examples", "examples/"))?;
+        let (units, _) = scenes(&examples, VALIDATION_PER_REGION, VALIDATION_SEED);
+        // the teacher on the same scenes, for scale
+        let idm = tad_eval::pretrain::judge(&units, tad_eval::pretrain::VALIDATION_SEEDS, &|| {
+            Box::new(tad_policy::Idm::default())
+        });
+        errln!(
+            "validation: {} scenes; idm's collision rate {:.3}, route {:.3}",
+            units.len(),
+            idm.collision_rate,
+            idm.route_complete
+        )?;
+        Ok(Selection { units, best: None })
+    }
+
+    fn judge(&mut self, trainer: &Trainer) -> Result<(), Stop> {
+        let actor = trainer.actor().map_err(Stop::Train)?;
+        let judged =
+            tad_eval::pretrain::judge(&self.units, tad_eval::pretrain::VALIDATION_SEEDS, &|| Box::new(actor.clone()));
+        let episode = trainer.episodes();
+        errln!(
+            "validation at episode {episode}: collision rate {:.3}, route {:.3} ({} scenes)",
+            judged.collision_rate,
+            judged.route_complete,
+            self.units.len()
+        )
+        .map_err(Stop::Closed)?;
+        if self.best.as_ref().is_none_or(|(_, b, _)| judged.better_than(b)) {
+            self.best = Some((episode, judged, actor));
+        }
+        Ok(())
     }
 }
 
