@@ -87,7 +87,8 @@ enum Command {
     ///
     /// `--runtime` times 300-step episodes with 1, 14 and 50 actors against Scenic's
     /// Newtonian simulator on the same scenarios, and ChatScene's parameter search over the
-    /// safety examples; on one core.
+    /// safety examples; on one core. `--rl` times PPO's, SAC's and TD3's environment steps
+    /// and learning steps against Stable-Baselines3.
     Bench(cmd::bench::Args),
     /// Translate a description into a TAD program with a language model, the compiler in
     /// the loop
@@ -161,6 +162,10 @@ enum Color {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // the commands that train small networks: before any thread is started
+    if matches!(cli.command, Command::TrainEgo(_) | Command::Eval(_) | Command::Bench(_)) {
+        tad_train::prefer_one_thread();
+    }
     let color = match cli.color {
         Color::Always => true,
         Color::Never => false,

@@ -536,6 +536,20 @@ impl Trainer {
     }
 }
 
+/// Tensor operations on the calling thread only, unless `CANDLE_NUM_THREADS` says
+/// otherwise. candle's CPU pool keeps its workers spinning between operations; on these
+/// networks (256 × 256, batches of 64 to 512) that made learning steps 5× slower than one
+/// thread (measured by `bench --rl`), and it competes with the parallel rollouts. Call it
+/// at the start of a process, before other threads run: it sets an environment variable
+/// that candle reads once.
+pub fn prefer_one_thread() {
+    if std::env::var_os("CANDLE_NUM_THREADS").is_none() {
+        // SAFETY: called at the start of the process, before any other thread reads the
+        // environment
+        unsafe { std::env::set_var("CANDLE_NUM_THREADS", "1") };
+    }
+}
+
 /// Any policy, boxed for a thread of its own.
 pub type PolicyMaker<'a> = &'a (dyn Fn() -> Box<dyn EgoPolicy> + Sync);
 
