@@ -93,6 +93,8 @@ pub fn tunings<'a>(plan: &Plan, from: Option<&'a Path>, settings: impl Fn(Algo) 
 pub struct Tuned {
     pub before_name: String,
     pub after_name: String,
+    /// Learning steps taken (0: the run was too short to learn anything).
+    pub updates: u64,
     pub after: Learned,
     pub before: Option<Learned>,
 }
@@ -130,7 +132,7 @@ pub fn tune(
     })
     .map_err(FinetuneError::Training)?;
     let after = trainer.actor().map_err(FinetuneError::Actor)?;
-    Ok(Tuned { before_name, after_name, after, before })
+    Ok(Tuned { before_name, after_name, updates: trainer.updates(), after, before })
 }
 
 /// The held-out table, and each tuned ego's change (with a start to change from).

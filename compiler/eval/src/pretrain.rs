@@ -13,9 +13,10 @@
 //!    stop line: a driver on them cannot meet the idm bar), SafeBench's episode rules
 //!    (`compat`: leaving the road is no escape from the penalties), critics warmed up
 //!    before the actor moves, and the demonstrations kept in the actor's loss.
-//! 4. **Selection**, as the paper reports its models: the clone and the actor every
-//!    [`VALIDATE_EVERY`] episodes are judged on validation scenes ([`VALIDATION_SEED`]),
-//!    and the best ([`Judged::better_than`]) is the shipped file.
+//! 4. **Selection**, as the paper reports its models: the actor every
+//!    [`VALIDATE_EVERY`] episodes is judged on validation scenes ([`VALIDATION_SEED`]),
+//!    and the best ([`Judged::better_than`]) is the shipped file. The clone is judged
+//!    too, for the record, but not chosen: each shipped model is its algorithm's.
 
 use rayon::prelude::*;
 use tad_db::Database;
@@ -39,8 +40,8 @@ pub const HELD_OUT_SEED: u64 = 2000;
 /// The seed of the validation scenes that choose among a run's actors, how many per region
 /// and generator, the episode seeds each, and how often an actor is judged (episodes).
 pub const VALIDATION_SEED: u64 = 3000;
-pub const VALIDATION_PER_REGION: usize = 4;
-pub const VALIDATION_SEEDS: u64 = 2;
+pub const VALIDATION_PER_REGION: usize = 8;
+pub const VALIDATION_SEEDS: u64 = 3;
 pub const VALIDATE_EVERY: usize = 50;
 
 /// The corpus's scenes (see the module's header), and notes on scenarios that did not build.

@@ -1,6 +1,7 @@
 //! The shipped driving models drive: on held-out ordinary scenes (`tad_eval::pretrain`'s
 //! generators, another seed) each completes its routes about as far as the idm driver and
-//! collides at most 1.5 times as often.
+//! collides at most 1.5 times as often (`cargo test -p tad-eval --test pretrained -- --nocapture`
+//! prints the figures).
 
 use tad_eval::pretrain::{HELD_OUT_SEED, judge, scenes};
 use tad_policy::EgoSpec;
@@ -25,14 +26,9 @@ fn bar(per_region: usize, seeds: u64) {
     }
 }
 
+/// 30 scenarios per region and generator, 3 seeds each: about 1,000 episodes per driver
+/// (on 100 episodes, one driver's collision rate moved by a factor of two with the seed).
 #[test]
 fn the_shipped_models_drive_as_well_as_idm_on_held_out_scenes() {
-    bar(4, 2);
-}
-
-/// The figures for the record: `cargo test -p tad-eval --release --test pretrained -- --ignored --nocapture`.
-#[test]
-#[ignore]
-fn the_driving_bar_on_more_scenes() {
     bar(30, 3);
 }

@@ -272,6 +272,83 @@ pub fn scatter(title: &str, sets: &[(&str, Vec<[f64; 2]>)]) -> String {
     out
 }
 
+/// Line charts stacked over one x axis: each panel a y label and named series of (x, y)
+/// points, each panel scaled to its own range (training curves: return and collision rate
+/// over episodes).
+pub fn curves(title: &str, x_label: &str, panels: &[(&str, Vec<(&str, Vec<[f64; 2]>)>)]) -> String {
+    let (plot_w, plot_h, margin, legend_w, gap) = (560.0, 200.0, 56.0, 190.0, 44.0);
+    let width = plot_w + 2.0 * margin + legend_w;
+    let height = margin + panels.len() as f64 * (plot_h + gap) + 20.0;
+    let all = panels.iter().flat_map(|(_, series)| series.iter().flat_map(|(_, p)| p.iter()));
+    let (x0, x1) = all.fold((f64::MAX, f64::MIN), |(a, b), [x, _]| (a.min(*x), b.max(*x)));
+    let (x0, x1) = if x0 > x1 { (0.0, 1.0) } else { (x0, x1) };
+    let sx = (x1 - x0).max(1e-9);
+    let mut out = format!(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{width}\" height=\"{height}\" viewBox=\"0 0 {width} {height}\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
+    );
+    let _ = writeln!(out, "<text x=\"{margin}\" y=\"24\" font-size=\"16\" {FONT}>{}</text>", escape(title));
+    for (k, (label, series)) in panels.iter().enumerate() {
+        let top = margin + k as f64 * (plot_h + gap);
+        let ys = series.iter().flat_map(|(_, p)| p.iter().map(|[_, y]| *y)).filter(|y| y.is_finite());
+        let (y0, y1) = ys.fold((f64::MAX, f64::MIN), |(a, b), y| (a.min(y), b.max(y)));
+        let (y0, y1) = if y0 > y1 {
+            (0.0, 1.0)
+        } else if y0 == y1 {
+            (y0 - 0.5, y1 + 0.5)
+        } else {
+            (y0, y1)
+        };
+        let sy = y1 - y0;
+        let _ = writeln!(
+            out,
+            "<rect x=\"{margin}\" y=\"{top}\" width=\"{plot_w}\" height=\"{plot_h}\" fill=\"none\" stroke=\"#999\"/>"
+        );
+        for (value, y) in [(y1, top + 4.0), (y0, top + plot_h)] {
+            let _ = writeln!(
+                out,
+                "<text x=\"{}\" y=\"{y}\" font-size=\"10\" text-anchor=\"end\" {FONT}>{value:.3}</text>",
+                margin - 4.0
+            );
+        }
+        let _ = writeln!(
+            out,
+            "<text x=\"{}\" y=\"{}\" font-size=\"12\" {FONT}>{}</text>",
+            margin,
+            top - 6.0,
+            escape(label)
+        );
+        for (c, (name, points)) in series.iter().enumerate() {
+            let path: Vec<String> = points
+                .iter()
+                .filter(|[_, y]| y.is_finite())
+                .map(|[x, y]| {
+                    let px = margin + plot_w * (x - x0) / sx;
+                    let py = top + plot_h * (1.0 - (y - y0) / sy);
+                    format!("{px:.1},{py:.1}")
+                })
+                .collect();
+            let _ = writeln!(
+                out,
+                "<polyline fill=\"none\" stroke=\"{}\" stroke-width=\"1.5\" points=\"{}\"><title>{}</title></polyline>",
+                COLOURS[c % COLOURS.len()],
+                path.join(" "),
+                escape(name)
+            );
+        }
+        let names: Vec<&str> = series.iter().map(|(n, _)| *n).collect();
+        legend(&mut out, &names, margin + plot_w + 16.0, top + 12.0);
+    }
+    let _ = writeln!(
+        out,
+        "<text x=\"{}\" y=\"{}\" font-size=\"11\" text-anchor=\"middle\" {FONT}>{} ({x0:.0} to {x1:.0})</text>",
+        margin + plot_w / 2.0,
+        height - 8.0,
+        escape(x_label)
+    );
+    out.push_str("</svg>\n");
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -296,6 +373,9 @@ mod tests {
         assert!(svg.contains("a&lt;b") && svg.contains("x &amp; y"));
         assert_eq!(svg.matches("<svg").count(), 1);
         assert!(svg.trim_end().ends_with("</svg>"));
+        let c = curves("r & c", "episode", &[("return", vec![("a<", vec![[0.0, 1.0], [10.0, 2.0]])]), ("CR", vec![])]);
+        assert!(c.contains("a&lt;") && c.contains("r &amp; c") && c.matches("<polyline").count() == 1);
+        assert!(c.trim_end().ends_with("</svg>"));
         let s = scatter("t", &[("a", vec![[0.0, 0.0], [1.0, 2.0]]), ("b", vec![])]);
         assert_eq!(s.matches("<circle").count(), 2);
     }

@@ -306,6 +306,11 @@ pub fn finetune(args: &EvalArgs, plan: &Plan, kept: &[Kept]) -> Result<Status, C
             FinetuneError::Training(e) => CliError::failed(format!("fine-tuning `{after}` stopped: {e}")),
             FinetuneError::Actor(e) => CliError::failed(e),
         })?;
+        if t.updates == 0 {
+            errln!(
+                "warning: `{after}` took no learning step: its episodes stored too few transitions to start learning"
+            )?;
+        }
         if let Some(dir) = &args.out {
             let path = dir.join("finetuned").join(format!("{}.safetensors", file_name(&after)));
             std::fs::create_dir_all(dir.join("finetuned"))

@@ -93,6 +93,10 @@ pub struct TrainEgoArgs {
     /// Continue from the checkpoint
     #[arg(long)]
     pub resume: bool,
+    /// Draw the training curves as SVG: the return and the collision rate over episodes
+    /// (means of the last 25), and with `--pretrained` the validation's collision rate
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<PathBuf>,
     #[arg(long, default_value_t = Config::default().seed)]
     pub seed: u64,
 }
@@ -169,7 +173,7 @@ pub fn run(args: &TrainEgoArgs, color: bool) -> Result<Status, CliError> {
         None => None,
     };
     if let Some(selection) = &mut selection {
-        selection.judge(&trainer).map_err(|e| match e {
+        selection.judge(&trainer, false).map_err(|e| match e {
             Stop::Closed(c) => c.into(),
             Stop::Checkpoint(e) | Stop::Train(e) => CliError::failed(e),
         })?;
@@ -204,7 +208,7 @@ pub fn run(args: &TrainEgoArgs, color: bool) -> Result<Status, CliError> {
         if let Some(selection) = &mut selection
             && (crossed(tad_eval::pretrain::VALIDATE_EVERY) || n == total)
         {
-            selection.judge(trainer)?;
+            selection.judge(trainer, true)?;
         }
         Ok(())
     });
@@ -219,6 +223,19 @@ pub fn run(args: &TrainEgoArgs, color: bool) -> Result<Status, CliError> {
         }
     }
     trainer.save_checkpoint(&checkpoint).map_err(CliError::usage)?;
+    if trainer.updates() == 0 && trainer.episodes() > 0 {
+        let c = trainer.config();
+        let needed = if c.algo == Algo::Ppo { c.rollout } else { c.start_training };
+        errln!(
+            "warning: no learning step was taken: {} transitions are stored and learning needs {needed} (more --episodes)",
+            trainer.replay_len()
+        )?;
+    }
+    if let Some(path) = &args.plot {
+        let validation = selection.as_ref().map(|s| s.history.clone()).unwrap_or_default();
+        let svg = curves(&config_name(args), start, &returns, &collisions, &validation, window);
+        std::fs::write(path, svg).map_err(|e| CliError::usage(format!("cannot write `{}`: {e}", path.display())))?;
+    }
     match selection.and_then(|s| s.best) {
         Some((episode, judged, actor)) => {
             actor.save(&args.out).map_err(CliError::usage)?;
@@ -347,11 +364,52 @@ fn imitate(
     }
 }
 
+/// The run's name on its plot.
+fn config_name(args: &TrainEgoArgs) -> String {
+    match &args.pretrained {
+        Some(algo) => format!("{algo}: the shipped model's training"),
+        None => format!("{} training", args.algo),
+    }
+}
+
+/// The training curves: the means of the last `window` episodes' returns and collisions
+/// after each episode from `start`, and the validation's collision rates.
+fn curves(
+    title: &str,
+    start: usize,
+    returns: &[f64],
+    collisions: &[bool],
+    validation: &[[f64; 2]],
+    window: usize,
+) -> String {
+    let mean_of = |values: &[f64]| -> Vec<[f64; 2]> {
+        (0..values.len())
+            .map(|i| {
+                let from = (i + 1).saturating_sub(window);
+                let part = &values[from..=i];
+                [(start + i + 1) as f64, part.iter().sum::<f64>() / part.len() as f64]
+            })
+            .collect()
+    };
+    let hits: Vec<f64> = collisions.iter().map(|&c| f64::from(u8::from(c))).collect();
+    let mut rates = vec![("training (last 25 episodes)", mean_of(&hits))];
+    if !validation.is_empty() {
+        rates.push(("validation", validation.to_vec()));
+    }
+    tad_stats::plot::curves(
+        title,
+        "episode",
+        &[("return (mean of the last 25 episodes)", vec![("training", mean_of(returns))]), ("collision rate", rates)],
+    )
+}
+
 /// The recipe's choice among a run's actors: each judged on the validation scenes
 /// (`tad_eval::pretrain`), the best kept with its episode.
 struct Selection {
     units: Vec<tad_eval::Unit>,
     best: Option<(u64, Judged, tad_policy::Learned)>,
+    /// Each judged episode and its collision rate.
+    history: Vec<[f64; 2]>,
 }
 
 impl Selection {
@@ -369,10 +427,11 @@ impl Selection {
             idm.collision_rate,
             idm.route_complete
         )?;
-        Ok(Selection { units, best: None })
+        Ok(Selection { units, best: None, history: Vec::new() })
     }
 
-    fn judge(&mut self, trainer: &Trainer) -> Result<(), Stop> {
+    /// Judge the trainer's actor; keep it if `eligible` and the best so far.
+    fn judge(&mut self, trainer: &Trainer, eligible: bool) -> Result<(), Stop> {
         let actor = trainer.actor().map_err(Stop::Train)?;
         let judged =
             tad_eval::pretrain::judge(&self.units, tad_eval::pretrain::VALIDATION_SEEDS, &|| Box::new(actor.clone()));
@@ -384,7 +443,8 @@ impl Selection {
             self.units.len()
         )
         .map_err(Stop::Closed)?;
-        if self.best.as_ref().is_none_or(|(_, b, _)| judged.better_than(b)) {
+        self.history.push([episode as f64, judged.collision_rate]);
+        if eligible && self.best.as_ref().is_none_or(|(_, b, _)| judged.better_than(b)) {
             self.best = Some((episode, judged, actor));
         }
         Ok(())
