@@ -379,6 +379,8 @@ fn eval_generates_with_the_model_and_tables_its_scenarios() {
         "los_angeles",
         "--generators",
         "llm,llm-baseline,fitted",
+        "--egos",
+        "idm,naive",
         "-n",
         "2",
         "--samples",
