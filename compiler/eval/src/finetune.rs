@@ -11,7 +11,7 @@
 use std::path::Path;
 
 use tad_policy::{EgoSpec, Learned, Observation};
-use tad_train::{Algo, Config, TrainError};
+use tad_train::{Algo, Config, Imitation, TrainError};
 
 use crate::harness::{Kept, Plan};
 use crate::interval::Change;
@@ -105,6 +105,9 @@ pub fn split(kept: &[Kept], seed: u64) -> (Vec<usize>, Vec<usize>) {
     tad_train::split(&keys, seed)
 }
 
+/// Episodes of the model before fine-tuning whose states and actions anchor it.
+const ANCHOR_EPISODES: usize = 64;
+
 /// The kept scenes of `train` that `generator` made.
 pub fn of_generator(kept: &[Kept], train: &[usize], generator: &str) -> Vec<usize> {
     train.iter().copied().filter(|&i| kept[i].unit.generator == generator).collect()
@@ -126,6 +129,12 @@ pub fn tune(
         .iter()
         .map(|&i| TrainScene { scene: &kept[i].unit.scene, fixed: Some((&kept[i].params, kept[i].seed)) })
         .collect();
+    // the model's own actions on the training scenes: what the demonstrations' term keeps
+    if let Some(model) = before.as_ref().filter(|_| trainer.config().bc_weight > 0.0 && trainer.demos() == 0) {
+        let anchor = Imitation { rounds: 1, episodes: ANCHOR_EPISODES, epochs: 0, ..Imitation::default() };
+        let drive = || -> Box<dyn tad_policy::EgoPolicy> { Box::new(model.clone()) };
+        trainer.imitate(&scenes, &drive, &anchor, |_| {}).map_err(FinetuneError::Training)?;
+    }
     crate::train::train(&mut trainer, first + episodes, &scenes, |_, stats| -> Result<(), TrainError> {
         stats.iter().for_each(|_| on_episode());
         Ok(())

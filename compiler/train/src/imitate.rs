@@ -21,7 +21,8 @@ pub struct Imitation {
     pub rounds: usize,
     /// Episodes per round.
     pub episodes: usize,
-    /// Passes over the data after each round.
+    /// Passes over the data after each round; 0 keeps the actor and only collects the
+    /// teacher's labelled states as demonstrations ([`crate::Config::bc_weight`]).
     pub epochs: usize,
     pub lr: f64,
     pub batch: usize,
@@ -150,6 +151,10 @@ impl Trainer {
             .zip(labels.chunks_exact(ACT))
             .flat_map(|(o, a)| o.iter().chain(a).copied())
             .collect();
+        // no pass over the data: only the demonstrations were wanted
+        if settings.epochs == 0 {
+            return Ok(());
+        }
         self.settle(settings.std)
     }
 
