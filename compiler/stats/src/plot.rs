@@ -272,10 +272,13 @@ pub fn scatter(title: &str, sets: &[(&str, Vec<[f64; 2]>)]) -> String {
     out
 }
 
+/// A panel of [`curves`]: its y label and its named series of (x, y) points.
+pub type Panel<'a> = (&'a str, Vec<(&'a str, Vec<[f64; 2]>)>);
+
 /// Line charts stacked over one x axis: each panel a y label and named series of (x, y)
 /// points, each panel scaled to its own range (training curves: return and collision rate
 /// over episodes).
-pub fn curves(title: &str, x_label: &str, panels: &[(&str, Vec<(&str, Vec<[f64; 2]>)>)]) -> String {
+pub fn curves(title: &str, x_label: &str, panels: &[Panel]) -> String {
     let (plot_w, plot_h, margin, legend_w, gap) = (560.0, 200.0, 56.0, 190.0, 44.0);
     let width = plot_w + 2.0 * margin + legend_w;
     let height = margin + panels.len() as f64 * (plot_h + gap) + 20.0;

@@ -2,14 +2,9 @@
 //! actor, damaged checkpoints. Small networks and short episodes so a debug build runs
 //! them in about a minute; the settings' defaults are checked separately.
 
-use std::path::PathBuf;
 use std::time::Instant;
 
-use tad_bytecode::{Instr, ParamSlot, Polyline, Program, Size, Value};
-use tad_layout::road::LANE_WIDTH;
-use tad_layout::{Arm, Body, Facing, Place, Road, Shape, Turn};
 use tad_policy::{EgoPolicy, EgoView, Learned};
-use tad_runtime::Scene;
 use tad_train::{Config, Trainer, split};
 
 mod common;
