@@ -37,7 +37,9 @@ def test_a_rollout_is_what_tadslc_run_records(repo, tadslc, tmp_path):
     physical, done = [], False
     while not done:
         acc, steer = rng.integers(-8, 9, size=2) / 8
-        physical.append([3.0 * float(np.float32(acc)), 0.3 * float(np.float32(steer))])
+        # tad_policy::Action::from_unit: 3 m/s² forward, the full brake (8 m/s²) backward
+        scale = 3.0 if acc >= 0 else 8.0
+        physical.append([scale * float(np.float32(acc)), 0.3 * float(np.float32(steer))])
         _, _, terminated, truncated, info = env.step(np.array([acc, steer], dtype=np.float32))
         done = terminated or truncated
     records = env.records()
