@@ -57,7 +57,8 @@ def test_a_rollout_is_what_tadslc_run_records(repo, tadslc, tmp_path):
     poses = [json.loads(line)["actors"][0] for line in trace.read_text().splitlines()][1:]
     assert len(poses) == len(records)
     for pose, (_, x, y, yaw_deg, speed, _, _) in zip(poses, records):
-        assert (pose["x"], pose["y"], pose["v"]) == (round(x, 3), round(y, 3), round(speed, 3))
+        # the trace rounds to mm and mm/s; a value at a rounding boundary may round either way
+        assert [pose["x"], pose["y"], pose["v"]] == pytest.approx([x, y, speed], abs=5.01e-4)
         assert pose["yaw"] == pytest.approx(np.radians(-yaw_deg), abs=2e-3)
 
 
