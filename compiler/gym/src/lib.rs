@@ -123,11 +123,7 @@ pub fn observation(name: &str) -> Result<Observation, GymError> {
 
 /// `observation` of `view` into `out`, without allocating.
 fn write(observation: Observation, view: &EgoView, out: &mut [f32]) {
-    let fill = |out: &mut [f32], values: &[f64]| out.iter_mut().zip(values).for_each(|(o, &v)| *o = v as f32);
-    match observation {
-        Observation::SafeBench => fill(out, &view.obs),
-        Observation::State => fill(out, &view.state()),
-    }
+    observation.with(view, |values| out.iter_mut().zip(values).for_each(|(o, &v)| *o = v as f32));
 }
 
 /// What a step returns besides the observation.

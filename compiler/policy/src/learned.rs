@@ -43,7 +43,6 @@ use std::collections::HashMap;
 use std::path::Path;
 use tad_ir::{Rng, SplitMix64};
 
-/// The observation's length (SafeBench's `ego_state_dim`).
 /// The action's length (`ego_action_dim`).
 const ACTION_DIM: usize = 2;
 

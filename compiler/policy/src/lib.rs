@@ -179,12 +179,17 @@ impl Observation {
         }
     }
 
+    /// `f` of the observation of `view`, [`Observation::width`] values, without allocating.
+    pub fn with<R>(self, view: &EgoView, f: impl FnOnce(&[f64]) -> R) -> R {
+        match self {
+            Observation::SafeBench => f(&view.obs),
+            Observation::State => f(&view.state()),
+        }
+    }
+
     /// The observation of `view`, [`Observation::width`] values.
     pub fn of(self, view: &EgoView) -> Vec<f64> {
-        match self {
-            Observation::SafeBench => view.obs.to_vec(),
-            Observation::State => view.state().to_vec(),
-        }
+        self.with(view, <[f64]>::to_vec)
     }
 
     /// The observation a learned actor with `inputs` inputs reads.

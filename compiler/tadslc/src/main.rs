@@ -163,7 +163,12 @@ enum Color {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     // the commands that train small networks: before any thread is started
-    if matches!(cli.command, Command::TrainEgo(_) | Command::Eval(_) | Command::Bench(_)) {
+    let trains = match &cli.command {
+        Command::TrainEgo(_) | Command::Eval(_) => true,
+        Command::Bench(args) => args.rl,
+        _ => false,
+    };
+    if trains {
         tad_train::prefer_one_thread();
     }
     let color = match cli.color {

@@ -173,7 +173,7 @@ impl Trainer {
             .map_err(|e| broken(&replay_path, e.to_string()))?;
         // filling, the next write appends; full, it overwrites the oldest (PPO's rollout
         // only fills)
-        let capacity = if trainer.config.algo == crate::Algo::Ppo { usize::MAX } else { state.config.buffer };
+        let capacity = state.config.replay_capacity();
         let valid = match state.replay_len.cmp(&capacity) {
             std::cmp::Ordering::Less => state.replay_next == state.replay_len % capacity,
             std::cmp::Ordering::Equal => state.replay_next < state.replay_len,

@@ -238,6 +238,12 @@ impl Config {
         Ok(())
     }
 
+    /// How many transitions the replay holds before overwriting the oldest: `buffer`, and
+    /// for PPO's rollout, emptied by each update instead, no bound.
+    pub(crate) fn replay_capacity(&self) -> usize {
+        if self.algo == Algo::Ppo { usize::MAX } else { self.buffer }
+    }
+
     pub(crate) fn options(&self) -> Options {
         Options { mode: if self.compat { Mode::Compat } else { Mode::Fixed }, ..Options::default() }
     }

@@ -15,7 +15,8 @@
 //!
 //! All three share the actor's body (`obs → hidden → fc_mu`, ReLU, PyTorch's `nn.Linear`
 //! and its initialisation, layers named `fc1 … fcN`, `fc_mu`) and its deterministic action
-//! `tanh(fc_mu(x))`, scaled by `tad_policy::Action::from_unit` (3 m/s² forward and 0.3 of the steer as SafeBench; the full brake of 8 m/s²):
+//! `tanh(fc_mu(x))`, applied by `tad_policy::Action::from_unit` (3 m/s² forward and 0.3
+//! of the steer as SafeBench; the full brake of 8 m/s²):
 //!
 //! - **SAC** (Spinning Up's, as ChatScene runs it): a second head `fc_std`, a clamped log
 //!   standard deviation in `[−20, 2]`; exploration `tanh(mu + σ·ε)`; twin critics
@@ -447,9 +448,9 @@ impl Trainer {
             .map(|(job, &seed)| rollout::explore(plain, config, job, SplitMix64::new(seed)))
             .collect();
         let mut all = Vec::with_capacity(collected.len());
+        let capacity = self.config.replay_capacity();
         for c in collected {
             for row in c.rows.chunks_exact(self.replay.width) {
-                let capacity = if self.config.algo == Algo::Ppo { usize::MAX } else { self.config.buffer };
                 self.replay.push(capacity, row);
             }
             self.episodes += 1;
