@@ -108,10 +108,12 @@ pub fn wrap(angle: f64) -> f64 {
 ///
 /// Projections onto a path are the runtime's hottest code (every vehicle projects the
 /// others onto its path each step), so they visit the segments from the hint outwards and
-/// rule out runs of [`CHUNK`] segments by their bounding box and single segments by their
-/// squared distance before taking a square root, each with a margin far above rounding:
-/// the result is the one a forward scan with exact distances gives (the nearest segment,
-/// ties to the first). A segment is found from the mean spacing, then walked to.
+/// rule out runs of [`CHUNK`] segments ([`Chunk`]: a bounding box, and a strip along the
+/// run's chord, which follows a diagonal or gently curved road closely) and single
+/// segments by their squared distance before taking a square root, each with a margin far
+/// above rounding: the result is the one a forward scan with exact distances gives (the
+/// nearest segment, ties to the first). A segment is found from the mean spacing, then
+/// walked to.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Path {
     points: Vec<Vec2>,
@@ -119,14 +121,106 @@ pub struct Path {
     /// Each segment's heading, rad, as [`Path::pose`] gives it (computed once: poses are
     /// asked for many times a step).
     yaws: Vec<f64>,
-    /// The bounding box `[min x, min y, max x, max y]` of each run of [`CHUNK`] segments.
-    boxes: Vec<[f64; 4]>,
+    /// Each run of [`CHUNK`] segments, bounded.
+    chunks: Vec<Chunk>,
     /// Segments per metre, on average.
     density: f64,
 }
 
-/// Segments per bounding box.
-const CHUNK: usize = 16;
+/// A stretch of a [`Path`] around an arc (its hint): its first and last segments, the
+/// segment of the hint, and that segment's unit direction.
+#[derive(Clone, Copy, Debug)]
+pub struct Window {
+    first: usize,
+    last: usize,
+    start: usize,
+    pub heading: Vec2,
+}
+
+/// Segments per [`Chunk`].
+const CHUNK: usize = 8;
+
+/// What bounds a run of segments: its box `[min x, min y, max x, max y]`; the line from its
+/// first point (`origin`) along its chord (`along`, unit), how far its points stray from
+/// that line (`slack`, infinite for a closed run) and the least and most of their
+/// distances along it (`span`); its first segment's heading and how far any of its
+/// segments' headings turns from it (`turn`, rad, at most π).
+#[derive(Clone, Debug, Default, PartialEq)]
+struct Chunk {
+    bounds: [f64; 4],
+    origin: Vec2,
+    along: Vec2,
+    slack: f64,
+    span: [f64; 2],
+    yaw: f64,
+    turn: f64,
+}
+
+impl Chunk {
+    /// The chunk of `points` (a run's points, at least two) whose segments head `yaws`.
+    fn new(points: &[Vec2], yaws: &[f64]) -> Chunk {
+        let bounds =
+            points.iter().fold([f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY], |b, q| {
+                [b[0].min(q.x), b[1].min(q.y), b[2].max(q.x), b[3].max(q.y)]
+            });
+        let origin = points[0];
+        let chord = points[points.len() - 1] - origin;
+        let (along, slack) = if chord.length() > 1e-9 {
+            let along = chord * (1.0 / chord.length());
+            (along, points.iter().map(|&q| along.cross(q - origin).abs()).fold(0.0, f64::max))
+        } else {
+            (Vec2::new(1.0, 0.0), f64::INFINITY)
+        };
+        let span = points.iter().fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], &q| {
+            let t = along.dot(q - origin);
+            [lo.min(t), hi.max(t)]
+        });
+        let yaw = yaws[0];
+        let turn = yaws.iter().map(|&y| angle_between(y, yaw)).fold(0.0, f64::max);
+        Chunk { bounds, origin, along, slack, span, yaw, turn }
+    }
+
+    /// The corners of the rectangle along its chord that holds its points.
+    fn corners(&self) -> [Vec2; 4] {
+        let [lo, hi] = self.span;
+        let side = self.along.left() * self.slack;
+        let (a, b) = (self.origin + self.along * lo, self.origin + self.along * hi);
+        [a + side, a - side, b + side, b - side]
+    }
+}
+
+/// The angle between headings `a` and `b` on the circle, in `[0, π]`, for headings in
+/// `(-π, π]` (as `wrap(a - b).abs()`, without its remainder).
+fn angle_between(a: f64, b: f64) -> f64 {
+    let d = (a - b).abs();
+    d.min(std::f64::consts::TAU - d)
+}
+
+/// A straight line a stretch of a path keeps near ([`Path::strip`]): every point of its
+/// segments is within `slack` of the line through `origin` along `along` (unit), and every
+/// segment heads within `turn` rad of `along`. Nothing is known of a stretch whose slack is
+/// infinite.
+#[derive(Clone, Copy, Debug)]
+pub struct Strip {
+    pub origin: Vec2,
+    pub along: Vec2,
+    pub slack: f64,
+    pub turn: f64,
+}
+
+impl Strip {
+    const UNKNOWN: Strip = Strip {
+        origin: Vec2::new(0.0, 0.0),
+        along: Vec2::new(1.0, 0.0),
+        slack: f64::INFINITY,
+        turn: std::f64::consts::PI,
+    };
+
+    /// At least how far `p` is from every point of the stretch (up to rounding).
+    pub fn distance_from(&self, p: Vec2) -> f64 {
+        self.along.cross(p - self.origin).abs() - self.slack
+    }
+}
 
 /// A projection under way: the best segment so far (index, parameter on it, distance), the
 /// distance beyond which nothing matters (the best's, at first the caller's reach), and the
@@ -148,12 +242,14 @@ impl Scan {
         if limit >= 1e-100 { limit * limit * (1.0 + 1e-9) } else { f64::INFINITY }
     }
 
-    /// Whether every point of `box` is surely farther from `p` than the limit.
-    fn rules_out(&self, [x0, y0, x1, y1]: [f64; 4], p: Vec2) -> bool {
+    /// Whether every point of `chunk` is surely farther from `p` than the limit: beyond its
+    /// box, or farther from its chord's line than its points stray.
+    fn rules_out(&self, chunk: &Chunk, p: Vec2) -> bool {
+        let [x0, y0, x1, y1] = chunk.bounds;
         let dx = (x0 - p.x).max(p.x - x1).max(0.0);
         let dy = (y0 - p.y).max(p.y - y1).max(0.0);
         let m = self.limit + 1e-6;
-        dx * dx + dy * dy > m * m
+        dx * dx + dy * dy > m * m || chunk.along.cross(p - chunk.origin).abs() - chunk.slack > m
     }
 }
 
@@ -178,12 +274,10 @@ impl Path {
         }
         let segments = path.points.len().saturating_sub(1);
         path.yaws = (0..segments).map(|i| path.direction(i).yaw()).collect();
-        path.boxes = (0..segments.div_ceil(CHUNK))
+        path.chunks = (0..segments.div_ceil(CHUNK))
             .map(|c| {
-                let run = &path.points[c * CHUNK..=((c + 1) * CHUNK).min(segments)];
-                run.iter().fold([f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY], |b, q| {
-                    [b[0].min(q.x), b[1].min(q.y), b[2].max(q.x), b[3].max(q.y)]
-                })
+                let end = ((c + 1) * CHUNK).min(segments);
+                Chunk::new(&path.points[c * CHUNK..=end], &path.yaws[c * CHUNK..end])
             })
             .collect();
         // (paths compare equal by value: no NaN for a path of fewer than two points)
@@ -292,14 +386,71 @@ impl Path {
     /// [`Path::locate`]'s result when its distance is at most `reach`; otherwise `None`, or
     /// a result farther than `reach` (the caller compares).
     pub fn nearest(&self, p: Vec2, hint: f64, window: f64, reach: f64) -> Option<(f64, f64)> {
+        self.nearest_in(&self.window(hint, window), p, reach)
+    }
+
+    /// [`Path::nearest`] in a window taken before.
+    pub fn nearest_in(&self, window: &Window, p: Vec2, reach: f64) -> Option<(f64, f64)> {
         if self.points.len() < 2 {
             return Some((0.0, self.points.first().map_or(f64::INFINITY, |q| q.distance(p))));
         }
-        let (first, last) = (self.segment(hint - window), self.segment(hint + window));
-        let start = self.segment(hint).clamp(first, last);
+        let Window { first, last, start, .. } = *window;
         let (i, t, d) = self.scan(p, first, last, start, reach, true)?;
         let (a, b) = (self.points[i], self.points[i + 1]);
         Some((self.arc(i, t), if (b - a).cross(p - a) < 0.0 { -d } else { d }))
+    }
+
+    /// The stretch of the path within `window` metres of arc `hint`, where
+    /// [`Path::nearest_in`] looks.
+    pub fn window(&self, hint: f64, window: f64) -> Window {
+        if self.points.len() < 2 {
+            return Window { first: 0, last: 0, start: 0, heading: Vec2::new(1.0, 0.0) };
+        }
+        let (first, last, start) = (self.segment(hint - window), self.segment(hint + window), self.segment(hint));
+        Window { first, last, start, heading: self.direction(start) }
+    }
+
+    /// At most how far, rad, the heading [`Path::pose`] gives at any arc of `window` (or
+    /// one segment beyond either side) turns from the window's [`Window::heading`]; at
+    /// most π.
+    pub fn turn_within(&self, window: &Window) -> f64 {
+        if self.points.len() < 2 {
+            return 0.0;
+        }
+        let (first, last) = (window.first.saturating_sub(1), (window.last + 1).min(self.points.len() - 2));
+        let yaw = self.yaws[window.start];
+        let turn = self.chunks[first / CHUNK..=last / CHUNK]
+            .iter()
+            .map(|c| angle_between(c.yaw, yaw) + c.turn)
+            .fold(0.0, f64::max);
+        turn.min(std::f64::consts::PI)
+    }
+
+    /// The [`Strip`] of the stretch from arc `from` to arc `to`: it holds every point
+    /// [`Path::nearest`] may find with its window within the stretch, and the heading
+    /// [`Path::pose`] gives there. Built from whole chunks, so it is a bound, not the
+    /// tightest; unknown where the stretch reaches an end segment (the path goes on
+    /// straight beyond it).
+    pub fn strip(&self, from: f64, to: f64) -> Strip {
+        if self.points.len() < 3 {
+            return Strip::UNKNOWN;
+        }
+        let last = self.points.len() - 2;
+        let (first, end) = (self.segment(from), self.segment(to) + 1);
+        if first == 0 || end >= last {
+            return Strip::UNKNOWN;
+        }
+        let chunks = &self.chunks[first / CHUNK..=end / CHUNK];
+        let origin = self.points[first / CHUNK * CHUNK];
+        let chord = self.points[((end / CHUNK + 1) * CHUNK).min(last + 1)] - origin;
+        if chord.length() < 1e-9 || chunks.iter().any(|c| c.slack.is_infinite()) {
+            return Strip::UNKNOWN;
+        }
+        let along = chord * (1.0 / chord.length());
+        let slack = chunks.iter().flat_map(|c| c.corners()).map(|q| along.cross(q - origin).abs()).fold(0.0, f64::max);
+        let yaw = along.yaw();
+        let turn = chunks.iter().map(|c| angle_between(c.yaw, yaw) + c.turn).fold(0.0, f64::max);
+        Strip { origin, along, slack, turn: turn.min(std::f64::consts::PI) }
     }
 
     fn arc(&self, i: usize, t: f64) -> f64 {
@@ -326,7 +477,7 @@ impl Path {
             let to = (c * CHUNK + CHUNK - 1).min(last);
             // extended end segments reach beyond their box
             let boxed = !extend || (from > 0 && to < n - 2);
-            if boxed && scan.rules_out(self.boxes[c], p) {
+            if boxed && scan.rules_out(&self.chunks[c], p) {
                 continue;
             }
             if c == home {
@@ -493,9 +644,10 @@ mod tests {
                 .chain((0..=60).rev().map(|k| Vec2::new(k as f64, 6.0))),
         );
         let vee = Path::new([Vec2::new(-10.0, 10.0), Vec2::new(0.0, 0.0), Vec2::new(10.0, 10.0)]);
+        let diagonal = Path::new((0..=300).map(|k| Vec2::from_yaw(0.5) * k as f64 + Vec2::new(-100.0, -7.0)));
         let bits = |(s, d): (f64, f64)| (s.to_bits(), d.to_bits());
         let mut checked = 0;
-        for path in [&lane, &hairpin, &vee] {
+        for path in [&lane, &hairpin, &vee, &diagonal] {
             let n = path.points.len();
             for k in 0..2000 {
                 let x = (k as f64 * 0.37).sin() * 90.0 + 30.0;
@@ -522,7 +674,51 @@ mod tests {
                 }
             }
         }
-        assert_eq!(checked, 18_000);
+        assert_eq!(checked, 24_000);
+    }
+
+    #[test]
+    fn strips_and_windows_bound_their_stretch() {
+        // a lane across the axes, a circle's arc, the hairpin of the test above
+        let diagonal = Path::new((0..=300).map(|k| Vec2::from_yaw(0.5) * k as f64 + Vec2::new(3.0, -7.0)));
+        let arc = Path::new((0..=300).map(|k| Vec2::from_yaw(k as f64 / 40.0) * 40.0));
+        let hairpin = Path::new(
+            (0..=60)
+                .map(|k| Vec2::new(k as f64, 0.0))
+                .chain((1..=30).map(|k| Vec2::from_yaw(-FRAC_PI_2 + k as f64 * 0.1047) * 3.0 + Vec2::new(60.0, 3.0)))
+                .chain((0..=60).rev().map(|k| Vec2::new(k as f64, 6.0))),
+        );
+        let mut known = 0;
+        for path in [&diagonal, &arc, &hairpin] {
+            for k in 0..60 {
+                let (from, to) = (k as f64 * 2.5 - 10.0, k as f64 * 2.5 + 60.0);
+                let strip = path.strip(from, to);
+                let window = path.window((from + to) / 2.0, 30.0);
+                let turn = path.turn_within(&window);
+                let (first, last) = (path.segment(from), path.segment(to) + 1);
+                if strip.slack.is_finite() {
+                    known += 1;
+                    for i in first..=last {
+                        for u in [0.0, 0.3, 1.0] {
+                            let q = path.points[i] + (path.points[i + 1] - path.points[i]) * u;
+                            assert!(strip.distance_from(q) <= 1e-9, "{q:?} off the strip {strip:?}");
+                        }
+                        let off = wrap(path.yaws[i] - strip.along.yaw()).abs();
+                        assert!(off <= strip.turn + 1e-12, "segment {i} turns {off} > {}", strip.turn);
+                    }
+                }
+                let yaw = path.pose((from + to) / 2.0).yaw;
+                let (first, last) = (window.first.saturating_sub(1), (window.last + 1).min(path.points.len() - 2));
+                for i in first..=last {
+                    let off = wrap(path.yaws[i] - yaw).abs();
+                    assert!(off <= turn + 1e-12, "segment {i} turns {off} > {turn}");
+                }
+            }
+        }
+        // the straight lanes are known wherever the stretch stays off their ends, and thin
+        assert!(known > 100, "{known}");
+        let strip = diagonal.strip(50.0, 120.0);
+        assert!(strip.slack < 1e-9 && strip.turn < 1e-9, "{strip:?}");
     }
 
     #[test]

@@ -871,6 +871,9 @@ fn ahead_on(
         ahead.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         // how far the vehicle stands from its own track at `s`
         let off_track = corridor.track.pose(corridor.s).position.distance(position);
+        // the line its track keeps near wherever `in_corridor` may look for what is ahead,
+        // taken when first needed
+        let mut strip = None;
         let mut best: Option<(f64, f64, usize)> = None;
         let keep = |best: &mut Option<(f64, f64, usize)>, gap: f64, along: f64, i: usize| {
             if best.is_none_or(|(g, _, j)| gap < g || (gap == g && i < j)) {
@@ -878,7 +881,7 @@ fn ahead_on(
             }
         };
         for &(squared, i, seen) in ahead.iter() {
-            let Seen { position: p, yaw: other_yaw, speed: v, length: l, width: w, .. } = seen;
+            let Seen { position: p, yaw: other_yaw, heading: facing, speed: v, length: l, width: w } = seen;
             // A bound on what it could keep: the arc to it is at least the chord between
             // the two points on the track, which is at least the distance less both
             // offsets from the track (its offset is within `in_corridor`'s reach); an
@@ -892,7 +895,12 @@ fn ahead_on(
                 }
             }
             let other = Footprint { pose: Pose { position: p, yaw: other_yaw }, length: l, width: w };
-            if let Some((gap, rel)) = in_corridor(&corridor, &other, (p - position).dot(heading)) {
+            let strip =
+                strip.get_or_insert_with(|| corridor.track.strip(corridor.s - WINDOW, corridor.s + LOOK + WINDOW));
+            if strip.distance_from(p) > reach(corridor.width, &other, facing, strip.along, strip.turn) {
+                continue;
+            }
+            if let Some((gap, rel)) = in_corridor(&corridor, &other, facing, (p - position).dot(heading)) {
                 let along = v * rel.cos();
                 if along >= 0.0 {
                     keep(&mut best, gap, along, i);
@@ -914,7 +922,7 @@ fn ahead_on(
                     continue;
                 }
                 let other = Footprint { pose: Pose { position: q, yaw: other_yaw }, length: l, width: w };
-                if let Some((gap, _)) = in_corridor(&corridor, &other, ahead) {
+                if let Some((gap, _)) = in_corridor(&corridor, &other, other_heading, ahead) {
                     let arrive = gap.max(0.0) / speed.max(1.0);
                     if (arrive - tau).abs() <= CROSS_MARGIN || (k == 0 && gap < 3.0) {
                         keep(&mut best, gap, 0.0, i);
@@ -954,14 +962,30 @@ const CROSS_HORIZON: f64 = 4.0;
 const CROSS_SAMPLES: usize = 8;
 const CROSS_MARGIN: f64 = 1.5;
 
-/// Whether the box `other`, `ahead` metres in front of the vehicle along its heading, reaches
-/// into its `corridor`: the bumper gap and the box's heading relative to the track there.
-fn in_corridor(corridor: &Corridor, other: &Footprint, ahead: f64) -> Option<(f64, f64)> {
+/// How far either side of its expected arc a box is looked for on a track, m.
+const WINDOW: f64 = 8.0;
+
+/// At most how far off a track the box `other` (heading `facing`) may be and still reach
+/// into a corridor `width` wide, where the track heads within `turn` rad of `heading`:
+/// [`in_corridor`]'s test, known before the box's nearest point on the track is. Its
+/// half-extent across the track, `|sin| l/2 + |cos| w/2` of the angle between their
+/// headings, changes by at most `l/2 + w/2` per radian.
+fn reach(width: f64, other: &Footprint, facing: Vec2, heading: Vec2, turn: f64) -> f64 {
+    let (l, w) = (other.length, other.width);
+    let across = heading.cross(facing).abs() * l / 2.0 + heading.dot(facing).abs() * w / 2.0;
+    width / 2.0 + across + (l / 2.0 + w / 2.0) * turn + 0.3 + 1e-6
+}
+
+/// Whether the box `other` (heading `facing`, its yaw's unit vector), `ahead` metres in
+/// front of the vehicle along its heading, reaches into its `corridor`: the bumper gap and
+/// the box's heading relative to the track there.
+fn in_corridor(corridor: &Corridor, other: &Footprint, facing: Vec2, ahead: f64) -> Option<(f64, f64)> {
     let Corridor { track, s, length, width } = *corridor;
     let Footprint { pose: Pose { position: p, yaw }, length: l, width: w } = *other;
-    // out of reach whatever the headings: the reach below with |sin| and |cos| at 1
-    let reach = width / 2.0 + l / 2.0 + w / 2.0 + 0.3;
-    let (sj, lat) = track.nearest(p, s + ahead, 8.0, reach)?;
+    let window = track.window(s + ahead, WINDOW);
+    // anything farther is out, so the search need not find where
+    let reach = reach(width, other, facing, window.heading, track.turn_within(&window));
+    let (sj, lat) = track.nearest_in(&window, p, reach)?;
     if sj <= s || lat.abs() > reach {
         return None;
     }
