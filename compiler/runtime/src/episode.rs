@@ -560,7 +560,7 @@ impl<S: Deref<Target = Scene>> Runner<S> {
         });
         let lookahead = models::lookahead(ego.speed);
         let target = Pose { position: ego.position, yaw: ego.yaw }.local(route.pose(s + lookahead).position);
-        let corridor = Corridor { track: route, s, length: size.length, width: size.width };
+        let corridor = Corridor { track: route, s, length: size.length, width: size.width, back: false };
         let leader = ahead_on(corridor, *ego, true, before.iter().copied());
         let stop = self.ego_stop.and_then(|line| {
             let gap = line - (s + size.length / 2.0);
@@ -799,7 +799,7 @@ fn leader_of(scene: &Scene, actors: &[Actor], k: usize, before: &[Seen], ego: Se
     let track = me.track.as_ref()?;
     let others = before.iter().enumerate().filter(|(j, _)| *j != k).map(|(_, &o)| o);
     let ego_entry = me.obey.then_some(ego);
-    let corridor = Corridor { track, s: me.s, length: me.length, width: me.width };
+    let corridor = Corridor { track, s: me.s, length: me.length, width: me.width, back: false };
     let mut best = ahead_on(corridor, me.kin, me.obey, others.chain(ego_entry));
     if me.obey
         && let Some((line, arm)) = me.stop_line
@@ -827,17 +827,27 @@ fn must_stop(scene: &Scene, arm: Arm, gap: f64, speed: f64, t: f64, stopped_at_s
 }
 
 /// The strip a vehicle sweeps ahead along its track: from its arc `s` on `track`, as wide as
-/// the vehicle, its front bumper `length / 2` ahead of `s`.
+/// the vehicle, its front bumper `length / 2` ahead of `s`; or, `back`, the strip behind it
+/// down its track, from its rear bumper.
 #[derive(Clone, Copy)]
 struct Corridor<'a> {
     track: &'a Path,
     s: f64,
     length: f64,
     width: f64,
+    back: bool,
+}
+
+impl Corridor<'_> {
+    /// The arc `ahead` metres on from `s`, the corridor's way.
+    fn on(&self, ahead: f64) -> f64 {
+        if self.back { self.s - ahead } else { self.s + ahead }
+    }
 }
 
 /// The nearest of `others` ahead in a vehicle's `corridor`, the vehicle moving as `kin` says
-/// (its heading may be turned round, to look behind): `(gap, speed along)`. Something going
+/// (turned round for a corridor `back`, with `others` turned round too): `(gap, speed
+/// along)`. Something going
 /// its way (or against it) counts where it is; something moving across counts only if,
 /// going on straight at its speed, it will be in the corridor when this vehicle (at its
 /// speed, at least 1 m/s) gets there, within [`CROSS_HORIZON`] s, and then as standing where
@@ -895,8 +905,10 @@ fn ahead_on(
                 }
             }
             let other = Footprint { pose: Pose { position: p, yaw: other_yaw }, length: l, width: w };
-            let strip =
-                strip.get_or_insert_with(|| corridor.track.strip(corridor.s - WINDOW, corridor.s + LOOK + WINDOW));
+            let strip = strip.get_or_insert_with(|| {
+                let (a, b) = (corridor.on(-WINDOW), corridor.on(LOOK + WINDOW));
+                corridor.track.strip(a.min(b), a.max(b))
+            });
             if strip.distance_from(p) > reach(corridor.width, &other, facing, strip.along, strip.turn) {
                 continue;
             }
@@ -978,23 +990,24 @@ fn reach(width: f64, other: &Footprint, facing: Vec2, heading: Vec2, turn: f64) 
 
 /// Whether the box `other` (heading `facing`, its yaw's unit vector), `ahead` metres in
 /// front of the vehicle along its heading, reaches into its `corridor`: the bumper gap and
-/// the box's heading relative to the track there.
+/// the box's heading relative to the corridor's way there.
 fn in_corridor(corridor: &Corridor, other: &Footprint, facing: Vec2, ahead: f64) -> Option<(f64, f64)> {
-    let Corridor { track, s, length, width } = *corridor;
+    let Corridor { track, s, length, width, back } = *corridor;
     let Footprint { pose: Pose { position: p, yaw }, length: l, width: w } = *other;
-    let window = track.window(s + ahead, WINDOW);
+    let window = track.window(corridor.on(ahead), WINDOW);
     // anything farther is out, so the search need not find where
     let reach = reach(width, other, facing, window.heading, track.turn_within(&window));
     let (sj, lat) = track.nearest_in(&window, p, reach)?;
-    if sj <= s || lat.abs() > reach {
+    let (past, way) = if back { (s - sj, std::f64::consts::PI) } else { (sj - s, 0.0) };
+    if past <= 0.0 || lat.abs() > reach {
         return None;
     }
-    let rel = wrap(yaw - track.pose(sj).yaw);
+    let rel = wrap(yaw - track.pose(sj).yaw - way);
     let (c, sn) = (rel.cos().abs(), rel.sin().abs());
     if lat.abs() > width / 2.0 + sn * l / 2.0 + c * w / 2.0 + 0.3 {
         return None;
     }
-    Some((sj - s - length / 2.0 - (c * l / 2.0 + sn * w / 2.0), rel))
+    Some((past - length / 2.0 - (c * l / 2.0 + sn * w / 2.0), rel))
 }
 
 /// MOBIL (Kesting, Treiber and Helbing 2007) with politeness 0: change to a neighbouring lane
@@ -1024,11 +1037,11 @@ fn mobil(
         let (s, _) = track.project_from(me.kin.position, me.s);
         let entries =
             || before.iter().enumerate().filter(|(j, _)| *j != k).map(|(_, &o)| o).chain(std::iter::once(ego));
-        let corridor = Corridor { track, s, length: me.length, width: me.width };
+        let corridor = Corridor { track, s, length: me.length, width: me.width, back: false };
         let then = IdmParams::default().accel(me.kin.speed, me.target, ahead_on(corridor, me.kin, me.obey, entries()));
         // the new follower: the nearest behind in the target lane, with this vehicle ahead of it
         let back = Kinematics { yaw: me.kin.yaw + std::f64::consts::PI, ..me.kin };
-        let behind = ahead_on(corridor, back, me.obey, entries().map(Seen::reversed));
+        let behind = ahead_on(Corridor { back: true, ..corridor }, back, me.obey, entries().map(Seen::reversed));
         let safe = behind.is_none_or(|(gap, speed_back)| {
             IdmParams::default().accel(speed_back, speed_back.max(me.target), Some((gap, me.kin.speed))) >= -SAFE
                 && gap > 1.0

@@ -293,3 +293,25 @@ fn mobil_passes_a_slow_car_and_stays_put_without_it() {
     assert!(last.poses[2].0 < last.poses[1].0, "without MOBIL it follows");
     assert!((last.poses[2].1 + 1.75).abs() < 0.2);
 }
+
+#[test]
+fn mobil_does_not_cut_in_front_of_a_close_follower() {
+    // the MOBIL car (actor 1) closes on a slow car in lane 1 while a faster one (actor 2)
+    // comes up lane 2 close behind it: it changes lanes only once that one is past
+    let code = vec![
+        driving(0, 40.0, 1, 4.0),
+        driving(1, 20.0, 1, 12.0),
+        driving(2, 5.0, 2, 14.0),
+        Instr::Drive { actor: 0, speed: Value::lit(4.0), turn: Turn::Straight },
+        Instr::Drive { actor: 1, speed: Value::lit(12.0), turn: Turn::Straight },
+        Instr::Drive { actor: 2, speed: Value::lit(14.0), turn: Turn::Straight },
+        Instr::Mobil { actor: 1, on: true },
+    ];
+    let scene = Scene::new(&program(straight(), 0.0, code)).unwrap();
+    let opts = Options { keep_frames: true, ..Options::default() };
+    let e = run(&scene, None, vec![], policy("idm").as_mut(), &opts);
+    let in_lane_2 = |y: f64| (y + 5.25).abs() < 1.75;
+    let step = e.frames.iter().position(|f| in_lane_2(f.poses[2].1)).expect("it changes lanes once it may");
+    let (car, follower) = (e.frames[step].poses[2], e.frames[step].poses[3]);
+    assert!(follower.0 > car.0, "it cut in {:.1} m ahead of the follower at step {step}", car.0 - follower.0);
+}
