@@ -41,8 +41,11 @@ impl Layer {
         })
     }
 
-    fn forward(&self, x: &Tensor) -> candle_core::Result<Tensor> {
-        x.matmul(&self.weight.as_tensor().t()?)?.broadcast_add(self.bias.as_tensor())
+    /// `x Wᵀ + b`; `fixed`, the parameters as constants, so that a backward pass computes
+    /// no gradient of theirs.
+    fn forward(&self, x: &Tensor, fixed: bool) -> candle_core::Result<Tensor> {
+        let (w, b) = (self.weight.as_tensor(), self.bias.as_tensor());
+        if fixed { x.matmul(&w.detach().t()?)?.broadcast_add(&b.detach()) } else { x.matmul(&w.t()?)?.broadcast_add(b) }
     }
 
     fn outputs(&self) -> usize {
@@ -85,11 +88,21 @@ impl Net {
 
     /// Each head's output for a batch `x` `[B, inputs]`.
     pub fn forward(&self, x: &Tensor) -> candle_core::Result<Vec<Tensor>> {
+        self.forward_as(x, false)
+    }
+
+    /// [`Net::forward`] as a fixed function: gradients reach `x`, not the parameters (a
+    /// critic under the actor's loss, a target net).
+    pub fn forward_fixed(&self, x: &Tensor) -> candle_core::Result<Vec<Tensor>> {
+        self.forward_as(x, true)
+    }
+
+    fn forward_as(&self, x: &Tensor, fixed: bool) -> candle_core::Result<Vec<Tensor>> {
         let mut x = x.clone();
         for layer in &self.hidden {
-            x = layer.forward(&x)?.relu()?;
+            x = layer.forward(&x, fixed)?.relu()?;
         }
-        self.heads.iter().map(|h| h.forward(&x)).collect()
+        self.heads.iter().map(|h| h.forward(&x, fixed)).collect()
     }
 
     fn layers(&self) -> impl Iterator<Item = &Layer> {
@@ -289,6 +302,11 @@ pub(crate) fn q_values(q1: &Net, q2: &Net, obs: &Tensor, action: &Tensor) -> can
     let a = q1.forward(&x)?.remove(0);
     let b = q2.forward(&x)?.remove(0);
     Ok((a, b))
+}
+
+/// `Q(obs, action)` of a critic held fixed ([`Net::forward_fixed`]).
+pub(crate) fn q_fixed(q: &Net, obs: &Tensor, action: &Tensor) -> candle_core::Result<Tensor> {
+    Ok(q.forward_fixed(&Tensor::cat(&[obs, action], 1)?)?.remove(0))
 }
 
 /// Adam (PyTorch's, bias-corrected, no weight decay) with its moments kept by name, so a

@@ -4,7 +4,7 @@
 use candle_core::{Device, Tensor};
 use tad_ir::Rng;
 
-use crate::nets::{ACT, deterministic, gaussian_log_prob, normals, q_values, sample_actions};
+use crate::nets::{ACT, deterministic, gaussian_log_prob, normals, q_fixed, q_values, sample_actions};
 use crate::{Losses, Trainer};
 
 /// TD3+BC's α: the RL term's weight against the demonstrations' once divided by mean |Q|.
@@ -111,18 +111,18 @@ impl Trainer {
 
         // critics: r + γ(1 − d)(min Q_targ(o', ã') − α log π(ã'|o')), held fixed
         let (a2, logp2) = sample_actions(&self.actor, &next, &eps_next)?;
-        let (t1, t2) = q_values(c.get("q1_target"), c.get("q2_target"), &next, &a2)?;
+        let (t1, t2) = (q_fixed(c.get("q1_target"), &next, &a2)?, q_fixed(c.get("q2_target"), &next, &a2)?);
         let soft = (t1.minimum(&t2)? - logp2.affine(alpha, 0.0)?)?;
         let backup = (rew + (done.affine(-gamma, gamma)? * soft)?)?.detach();
         let (c1, c2) = q_values(c.get("q1"), c.get("q2"), &obs, &act)?;
         let critic_loss = ((c1 - &backup)?.sqr()?.mean_all()? + (c2 - &backup)?.sqr()?.mean_all()?)?;
         self.critic_opt.minimise(&critic_loss)?;
 
-        // actor: α log π(ã|o) − min Q(o, ã), on the critics just updated
+        // actor: α log π(ã|o) − min Q(o, ã), on the critics just updated (held fixed)
         let (a, logp) = sample_actions(&self.actor, &obs, &eps_now)?;
         let mut actor_loss = 0.0;
         if self.actor_moves() {
-            let (p1, p2) = q_values(c.get("q1"), c.get("q2"), &obs, &a)?;
+            let (p1, p2) = (q_fixed(c.get("q1"), &obs, &a)?, q_fixed(c.get("q2"), &obs, &a)?);
             let q = p1.minimum(&p2)?;
             let loss = (logp.affine(alpha, 0.0)? - &q)?.mean_all()?;
             let loss = self.with_demos(loss, &q.detach())?;
@@ -154,8 +154,8 @@ impl Trainer {
         let c = &self.critics;
 
         // critics: r + γ(1 − d) min Q_targ(o', clip(π_targ(o') + clip(ε)))
-        let a2 = (deterministic(c.get("actor_target"), &next)? + noise)?.clamp(-1f32, 1f32)?;
-        let (t1, t2) = q_values(c.get("q1_target"), c.get("q2_target"), &next, &a2)?;
+        let a2 = (c.get("actor_target").forward_fixed(&next)?[0].tanh()? + noise)?.clamp(-1f32, 1f32)?;
+        let (t1, t2) = (q_fixed(c.get("q1_target"), &next, &a2)?, q_fixed(c.get("q2_target"), &next, &a2)?);
         let backup = (rew + (done.affine(-gamma, gamma)? * t1.minimum(&t2)?)?)?.detach();
         let (c1, c2) = q_values(c.get("q1"), c.get("q2"), &obs, &act)?;
         let critic_loss = ((c1 - &backup)?.sqr()?.mean_all()? + (c2 - &backup)?.sqr()?.mean_all()?)?;
@@ -167,7 +167,8 @@ impl Trainer {
         if self.updates.is_multiple_of(self.config.policy_delay as u64) {
             if self.actor_moves() {
                 let a = deterministic(&self.actor, &obs)?;
-                let (p1, _) = q_values(c.get("q1"), c.get("q2"), &obs, &a)?;
+                // TD3's actor follows the first critic only (held fixed)
+                let p1 = q_fixed(c.get("q1"), &obs, &a)?;
                 let loss = p1.neg()?.mean_all()?;
                 let loss = self.with_demos(loss, &p1.detach())?;
                 self.actor_opt.minimise(&loss)?;
