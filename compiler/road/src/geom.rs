@@ -142,16 +142,17 @@ const CHUNK: usize = 8;
 
 /// What bounds a run of segments: its box `[min x, min y, max x, max y]`; the line from its
 /// first point (`origin`) along its chord (`along`, unit), how far its points stray from
-/// that line (`slack`, infinite for a closed run) and the least and most of their
-/// distances along it (`span`); its first segment's heading and how far any of its
-/// segments' headings turns from it (`turn`, rad, at most π).
+/// that line (`slack`, infinite for a closed run), and the rectangle along it that holds
+/// them (its `centre`, `half` its length); its first segment's heading and how far any of
+/// its segments' headings turns from it (`turn`, rad, at most π).
 #[derive(Clone, Debug, Default, PartialEq)]
 struct Chunk {
     bounds: [f64; 4],
     origin: Vec2,
     along: Vec2,
     slack: f64,
-    span: [f64; 2],
+    centre: Vec2,
+    half: f64,
     yaw: f64,
     turn: f64,
 }
@@ -171,21 +172,22 @@ impl Chunk {
         } else {
             (Vec2::new(1.0, 0.0), f64::INFINITY)
         };
-        let span = points.iter().fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], &q| {
+        let [lo, hi] = points.iter().fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], &q| {
             let t = along.dot(q - origin);
             [lo.min(t), hi.max(t)]
         });
+        let (centre, half) = (origin + along * ((lo + hi) / 2.0), (hi - lo) / 2.0);
         let yaw = yaws[0];
         let turn = yaws.iter().map(|&y| angle_between(y, yaw)).fold(0.0, f64::max);
-        Chunk { bounds, origin, along, slack, span, yaw, turn }
+        Chunk { bounds, origin, along, slack, centre, half, yaw, turn }
     }
 
-    /// The corners of the rectangle along its chord that holds its points.
-    fn corners(&self) -> [Vec2; 4] {
-        let [lo, hi] = self.span;
-        let side = self.along.left() * self.slack;
-        let (a, b) = (self.origin + self.along * lo, self.origin + self.along * hi);
-        [a + side, a - side, b + side, b - side]
+    /// The farthest its rectangle reaches from the line through `origin` along `along`
+    /// (unit): its farthest corner's distance.
+    fn reach_from(&self, origin: Vec2, along: Vec2) -> f64 {
+        along.cross(self.centre - origin).abs()
+            + self.half * along.cross(self.along).abs()
+            + self.slack * along.dot(self.along).abs()
     }
 }
 
@@ -195,6 +197,10 @@ fn angle_between(a: f64, b: f64) -> f64 {
     let d = (a - b).abs();
     d.min(std::f64::consts::TAU - d)
 }
+
+/// A run of whole chunks of a path ([`Path::stretch`]); `None` near an end.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Stretch(Option<(usize, usize)>);
 
 /// A straight line a stretch of a path keeps near ([`Path::strip`]): every point of its
 /// segments is within `slack` of the line through `origin` along `along` (unit), and every
@@ -209,7 +215,8 @@ pub struct Strip {
 }
 
 impl Strip {
-    const UNKNOWN: Strip = Strip {
+    /// A strip of nothing known.
+    pub const UNKNOWN: Strip = Strip {
         origin: Vec2::new(0.0, 0.0),
         along: Vec2::new(1.0, 0.0),
         slack: f64::INFINITY,
@@ -257,7 +264,10 @@ impl Path {
     /// A path through `points`; repeated points are dropped. At least two distinct points
     /// make a path; fewer give a degenerate one that stays at its point, facing `+x`.
     pub fn new(points: impl IntoIterator<Item = Vec2>) -> Path {
+        let points = points.into_iter();
         let mut path = Path::default();
+        path.points.reserve(points.size_hint().0);
+        path.arcs.reserve(points.size_hint().0);
         for p in points {
             match path.points.last() {
                 Some(last) if last.distance(p) < 1e-6 => {}
@@ -426,30 +436,39 @@ impl Path {
         turn.min(std::f64::consts::PI)
     }
 
-    /// The [`Strip`] of the stretch from arc `from` to arc `to`: it holds every point
-    /// [`Path::nearest`] may find with its window within the stretch, and the heading
-    /// [`Path::pose`] gives there. Built from whole chunks, so it is a bound, not the
-    /// tightest; unknown where the stretch reaches an end segment (the path goes on
-    /// straight beyond it).
-    pub fn strip(&self, from: f64, to: f64) -> Strip {
+    /// The stretch from arc `from` to arc `to`, as [`Path::strip`] bounds it: the whole
+    /// chunks holding its segments and one more either side (where [`Path::pose`] may
+    /// turn a point on their ends), or nothing where it reaches an end segment (the path
+    /// goes on straight beyond it). Equal stretches give equal strips, so a caller
+    /// moving along a path can keep its strip while the stretch stays.
+    pub fn stretch(&self, from: f64, to: f64) -> Stretch {
         if self.points.len() < 3 {
-            return Strip::UNKNOWN;
+            return Stretch(None);
         }
         let last = self.points.len() - 2;
         let (first, end) = (self.segment(from), self.segment(to) + 1);
         if first == 0 || end >= last {
-            return Strip::UNKNOWN;
+            return Stretch(None);
         }
-        let chunks = &self.chunks[first / CHUNK..=end / CHUNK];
-        let origin = self.points[first / CHUNK * CHUNK];
-        let chord = self.points[((end / CHUNK + 1) * CHUNK).min(last + 1)] - origin;
+        Stretch(Some((first / CHUNK, end / CHUNK)))
+    }
+
+    /// The [`Strip`] of a `stretch`: it holds every point [`Path::nearest`] may find with
+    /// its window within the stretch, and the heading [`Path::pose`] gives there. Built
+    /// from whole chunks, so it is a bound, not the tightest.
+    pub fn strip(&self, stretch: Stretch) -> Strip {
+        let Stretch(Some((a, b))) = stretch else { return Strip::UNKNOWN };
+        let chunks = &self.chunks[a..=b];
+        let origin = self.points[a * CHUNK];
+        let chord = self.points[((b + 1) * CHUNK).min(self.points.len() - 1)] - origin;
         if chord.length() < 1e-9 || chunks.iter().any(|c| c.slack.is_infinite()) {
             return Strip::UNKNOWN;
         }
         let along = chord * (1.0 / chord.length());
-        let slack = chunks.iter().flat_map(|c| c.corners()).map(|q| along.cross(q - origin).abs()).fold(0.0, f64::max);
         let yaw = along.yaw();
-        let turn = chunks.iter().map(|c| angle_between(c.yaw, yaw) + c.turn).fold(0.0, f64::max);
+        let (slack, turn) = chunks.iter().fold((0.0, 0.0), |(slack, turn): (f64, f64), c| {
+            (slack.max(c.reach_from(origin, along)), turn.max(angle_between(c.yaw, yaw) + c.turn))
+        });
         Strip { origin, along, slack, turn: turn.min(std::f64::consts::PI) }
     }
 
@@ -692,7 +711,7 @@ mod tests {
         for path in [&diagonal, &arc, &hairpin] {
             for k in 0..60 {
                 let (from, to) = (k as f64 * 2.5 - 10.0, k as f64 * 2.5 + 60.0);
-                let strip = path.strip(from, to);
+                let strip = path.strip(path.stretch(from, to));
                 let window = path.window((from + to) / 2.0, 30.0);
                 let turn = path.turn_within(&window);
                 let (first, last) = (path.segment(from), path.segment(to) + 1);
@@ -717,7 +736,7 @@ mod tests {
         }
         // the straight lanes are known wherever the stretch stays off their ends, and thin
         assert!(known > 100, "{known}");
-        let strip = diagonal.strip(50.0, 120.0);
+        let strip = diagonal.strip(diagonal.stretch(50.0, 120.0));
         assert!(strip.slack < 1e-9 && strip.turn < 1e-9, "{strip:?}");
     }
 

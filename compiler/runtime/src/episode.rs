@@ -15,7 +15,7 @@ use crate::world::Spot;
 use tad_bytecode::{Instr, Light, Value};
 use tad_metrics::{Mode, StepRecord, StopReason};
 use tad_policy::{ACCEL_MAX, ACCEL_MIN, Action, EgoPolicy, EgoView, IdmParams, MAX_WHEEL_ANGLE, Preview};
-use tad_road::geom::{Footprint, Path, Pose, Vec2, wrap};
+use tad_road::geom::{Footprint, Path, Pose, Stretch, Strip, Vec2, wrap};
 use tad_road::road::Station;
 use tad_road::{Arm, Body, Turn};
 
@@ -142,6 +142,9 @@ struct Actor {
     block: Block,
     /// The tracks of lanes beside its own, by lane and turn ([`beside_track`]).
     beside: Vec<(i64, Turn, Path)>,
+    /// The strip of its track its leader search looks in, kept while the stretch stays
+    /// ([`own_strip`]).
+    strip: Option<(Stretch, Strip)>,
 }
 
 /// An actor as the others see it during a step: its state at the end of the previous one,
@@ -163,8 +166,7 @@ impl Seen {
 
     /// Seen from behind: turned round.
     fn reversed(self) -> Seen {
-        let yaw = self.yaw + std::f64::consts::PI;
-        Seen { yaw, heading: Vec2::from_yaw(yaw), ..self }
+        Seen { yaw: self.yaw + std::f64::consts::PI, heading: -self.heading, ..self }
     }
 }
 
@@ -560,7 +562,7 @@ impl<S: Deref<Target = Scene>> Runner<S> {
         });
         let lookahead = models::lookahead(ego.speed);
         let target = Pose { position: ego.position, yaw: ego.yaw }.local(route.pose(s + lookahead).position);
-        let corridor = Corridor { track: route, s, length: size.length, width: size.width, back: false };
+        let corridor = Corridor::new(route, s, size.length, size.width, false);
         let leader = ahead_on(corridor, *ego, true, before.iter().copied());
         let stop = self.ego_stop.and_then(|line| {
             let gap = line - (s + size.length / 2.0);
@@ -625,6 +627,7 @@ fn spawn(scene: &Scene, a: &crate::scene::ActorSetup, params: &[f64]) -> Actor {
         pc: 0,
         block: Block::None,
         beside: Vec::new(),
+        strip: None,
     }
 }
 
@@ -662,6 +665,7 @@ fn set_track(scene: &Scene, a: &mut Actor, track: Path) {
     };
     a.bend = models::bend(&track);
     a.track = Some(track);
+    a.strip = None;
 }
 
 /// Advance an actor's script until it blocks or ends.
@@ -753,12 +757,14 @@ fn move_actor(scene: &Scene, actors: &mut [Actor], k: usize, before: &[Seen], eg
             a.kin = Kinematics { position: pose.position, yaw: if keep_yaw { a.kin.yaw } else { pose.yaw }, speed };
         }
         Motion::Drive => {
-            let mut leader = leader_of(scene, actors, k, before, ego, t);
+            let strip = own_strip(&mut actors[k]);
+            let mut leader = leader_of(scene, actors, k, strip, before, ego, t);
             if actors[k].mobil && t >= actors[k].next_mobil {
                 actors[k].next_mobil = t + 1.0;
                 // a new lane has another leader
                 if mobil(scene, actors, k, before, ego, leader) {
-                    leader = leader_of(scene, actors, k, before, ego, t);
+                    let strip = own_strip(&mut actors[k]);
+                    leader = leader_of(scene, actors, k, strip, before, ego, t);
                 }
             }
             let a = &mut actors[k];
@@ -792,14 +798,38 @@ const IDM_STOP_REACH: f64 = 6.0;
 /// How far ahead vehicles look for a leader, m.
 const LOOK: f64 = 60.0;
 
-/// The nearest thing ahead of actor `k` on its track: (bumper gap, its speed along), the
-/// ego included unless `k` runs lights (an adversary), and its stop line when it must stop.
-fn leader_of(scene: &Scene, actors: &[Actor], k: usize, before: &[Seen], ego: Seen, t: f64) -> Option<(f64, f64)> {
+/// The strip of its track an actor's leader search looks in now: kept from an earlier step
+/// while the stretch stays, as a vehicle takes many steps to leave a chunk.
+fn own_strip(a: &mut Actor) -> Strip {
+    let Some(track) = &a.track else { return Strip::UNKNOWN };
+    let stretch = Corridor::stretch_of(track, a.s, false);
+    match a.strip {
+        Some((kept, strip)) if kept == stretch => strip,
+        _ => {
+            let strip = track.strip(stretch);
+            a.strip = Some((stretch, strip));
+            strip
+        }
+    }
+}
+
+/// The nearest thing ahead of actor `k` on its track (whose [`own_strip`] is `strip`):
+/// (bumper gap, its speed along), the ego included unless `k` runs lights (an adversary),
+/// and its stop line when it must stop.
+fn leader_of(
+    scene: &Scene,
+    actors: &[Actor],
+    k: usize,
+    strip: Strip,
+    before: &[Seen],
+    ego: Seen,
+    t: f64,
+) -> Option<(f64, f64)> {
     let me = &actors[k];
     let track = me.track.as_ref()?;
     let others = before.iter().enumerate().filter(|(j, _)| *j != k).map(|(_, &o)| o);
     let ego_entry = me.obey.then_some(ego);
-    let corridor = Corridor { track, s: me.s, length: me.length, width: me.width, back: false };
+    let corridor = Corridor { track, s: me.s, length: me.length, width: me.width, back: false, strip };
     let mut best = ahead_on(corridor, me.kin, me.obey, others.chain(ego_entry));
     if me.obey
         && let Some((line, arm)) = me.stop_line
@@ -828,7 +858,8 @@ fn must_stop(scene: &Scene, arm: Arm, gap: f64, speed: f64, t: f64, stopped_at_s
 
 /// The strip a vehicle sweeps ahead along its track: from its arc `s` on `track`, as wide as
 /// the vehicle, its front bumper `length / 2` ahead of `s`; or, `back`, the strip behind it
-/// down its track, from its rear bumper.
+/// down its track, from its rear bumper. `strip` is the track's [`Strip`] of the stretch
+/// its search may look in ([`Corridor::stretch_of`]).
 #[derive(Clone, Copy)]
 struct Corridor<'a> {
     track: &'a Path,
@@ -836,9 +867,22 @@ struct Corridor<'a> {
     length: f64,
     width: f64,
     back: bool,
+    strip: Strip,
 }
 
-impl Corridor<'_> {
+impl<'a> Corridor<'a> {
+    /// The corridor on `track` from `s`, its strip taken now.
+    fn new(track: &'a Path, s: f64, length: f64, width: f64, back: bool) -> Corridor<'a> {
+        let strip = track.strip(Corridor::stretch_of(track, s, back));
+        Corridor { track, s, length, width, back, strip }
+    }
+
+    /// The stretch of `track` a search from `s` may look in: [`in_corridor`]'s window
+    /// about anything up to [`LOOK`] ahead (or, `back`, behind).
+    fn stretch_of(track: &Path, s: f64, back: bool) -> Stretch {
+        if back { track.stretch(s - LOOK - WINDOW, s + WINDOW) } else { track.stretch(s - WINDOW, s + LOOK + WINDOW) }
+    }
+
     /// The arc `ahead` metres on from `s`, the corridor's way.
     fn on(&self, ahead: f64) -> f64 {
         if self.back { self.s - ahead } else { self.s + ahead }
@@ -881,9 +925,8 @@ fn ahead_on(
         ahead.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         // how far the vehicle stands from its own track at `s`
         let off_track = corridor.track.pose(corridor.s).position.distance(position);
-        // the line its track keeps near wherever `in_corridor` may look for what is ahead,
-        // taken when first needed
-        let mut strip = None;
+        // the line its track keeps near wherever `in_corridor` may look for what is ahead
+        let strip = &corridor.strip;
         let mut best: Option<(f64, f64, usize)> = None;
         let keep = |best: &mut Option<(f64, f64, usize)>, gap: f64, along: f64, i: usize| {
             if best.is_none_or(|(g, _, j)| gap < g || (gap == g && i < j)) {
@@ -905,10 +948,6 @@ fn ahead_on(
                 }
             }
             let other = Footprint { pose: Pose { position: p, yaw: other_yaw }, length: l, width: w };
-            let strip = strip.get_or_insert_with(|| {
-                let (a, b) = (corridor.on(-WINDOW), corridor.on(LOOK + WINDOW));
-                corridor.track.strip(a.min(b), a.max(b))
-            });
             if strip.distance_from(p) > reach(corridor.width, &other, facing, strip.along, strip.turn) {
                 continue;
             }
@@ -992,7 +1031,7 @@ fn reach(width: f64, other: &Footprint, facing: Vec2, heading: Vec2, turn: f64) 
 /// front of the vehicle along its heading, reaches into its `corridor`: the bumper gap and
 /// the box's heading relative to the corridor's way there.
 fn in_corridor(corridor: &Corridor, other: &Footprint, facing: Vec2, ahead: f64) -> Option<(f64, f64)> {
-    let Corridor { track, s, length, width, back } = *corridor;
+    let Corridor { track, s, length, width, back, .. } = *corridor;
     let Footprint { pose: Pose { position: p, yaw }, length: l, width: w } = *other;
     let window = track.window(corridor.on(ahead), WINDOW);
     // anything farther is out, so the search need not find where
@@ -1037,11 +1076,12 @@ fn mobil(
         let (s, _) = track.project_from(me.kin.position, me.s);
         let entries =
             || before.iter().enumerate().filter(|(j, _)| *j != k).map(|(_, &o)| o).chain(std::iter::once(ego));
-        let corridor = Corridor { track, s, length: me.length, width: me.width, back: false };
+        let corridor = Corridor::new(track, s, me.length, me.width, false);
         let then = IdmParams::default().accel(me.kin.speed, me.target, ahead_on(corridor, me.kin, me.obey, entries()));
         // the new follower: the nearest behind in the target lane, with this vehicle ahead of it
         let back = Kinematics { yaw: me.kin.yaw + std::f64::consts::PI, ..me.kin };
-        let behind = ahead_on(Corridor { back: true, ..corridor }, back, me.obey, entries().map(Seen::reversed));
+        let corridor = Corridor::new(track, s, me.length, me.width, true);
+        let behind = ahead_on(corridor, back, me.obey, entries().map(Seen::reversed));
         let safe = behind.is_none_or(|(gap, speed_back)| {
             IdmParams::default().accel(speed_back, speed_back.max(me.target), Some((gap, me.kin.speed))) >= -SAFE
                 && gap > 1.0

@@ -31,9 +31,9 @@ pub struct RunArgs {
     /// `.tadc` bytecode files
     #[arg(required = true)]
     pub paths: Vec<PathBuf>,
-    /// The ego policies, comma-separated or repeated: `idm`, `naive`, `learned:PATH`
-    /// (a SafeBench SAC actor in safetensors), `external:CMD` (a process answering JSON
-    /// lines, `spec/runtime.md`)
+    /// The ego policies, comma-separated or repeated: `idm`, `naive`, the shipped models
+    /// `ppo`, `sac`, `td3`, `learned:PATH` (an actor in safetensors: `train-ego`'s, or
+    /// SafeBench's SAC), `external:CMD` (a process answering JSON lines, `spec/runtime.md`)
     #[arg(long = "ego", default_value = "idm,naive")]
     pub egos: Vec<String>,
     /// Seeds `A..B` (B excluded, as in Rust), `A..=B` (B included) or one seed `A`

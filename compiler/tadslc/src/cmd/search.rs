@@ -24,7 +24,8 @@ pub struct SearchArgs {
     /// Scenario files or directories (searched recursively), or `.tadc` files
     #[arg(required = true)]
     pub paths: Vec<PathBuf>,
-    /// The ego the scenes are searched against: `idm`, `naive`, `learned:PATH`
+    /// The ego the scenes are searched against: `idm`, `naive`, `ppo`, `sac`, `td3`,
+    /// `learned:PATH`
     #[arg(long, default_value = "idm")]
     pub ego: String,
     /// The directory the chosen scenes and `search.json` are written to
