@@ -889,10 +889,11 @@ impl<'a> Corridor<'a> {
     }
 }
 
-/// The nearest of `others` ahead in a vehicle's `corridor`, the vehicle moving as `kin` says
-/// (turned round for a corridor `back`, with `others` turned round too): `(gap, speed
-/// along)`. Something going
-/// its way (or against it) counts where it is; something moving across counts only if,
+/// The nearest of `others` ahead in a vehicle's `corridor`, the vehicle moving as `kin` says:
+/// `(gap, speed along)`. A corridor `back` looks behind: the vehicle and the others are
+/// turned round, so that the follower is the leader of the turned-round vehicle, and its
+/// speed along is its speed towards the vehicle. Something going its way (or against it)
+/// counts where it is; something moving across counts only if,
 /// going on straight at its speed, it will be in the corridor when this vehicle (at its
 /// speed, at least 1 m/s) gets there, within [`CROSS_HORIZON`] s, and then as standing where
 /// they meet: crossing traffic that will have gone is no obstacle, and one about to cross is
@@ -905,7 +906,9 @@ fn ahead_on(
     others: impl Iterator<Item = Seen>,
 ) -> Option<(f64, f64)> {
     let Kinematics { position, yaw, speed } = kin;
+    let yaw = if corridor.back { yaw + std::f64::consts::PI } else { yaw };
     let heading = Vec2::from_yaw(yaw);
+    let others = others.map(|o| if corridor.back { o.reversed() } else { o });
     NEAR.with_borrow_mut(|(ahead, crossing)| {
         ahead.clear();
         crossing.clear();
@@ -1079,9 +1082,8 @@ fn mobil(
         let corridor = Corridor::new(track, s, me.length, me.width, false);
         let then = IdmParams::default().accel(me.kin.speed, me.target, ahead_on(corridor, me.kin, me.obey, entries()));
         // the new follower: the nearest behind in the target lane, with this vehicle ahead of it
-        let back = Kinematics { yaw: me.kin.yaw + std::f64::consts::PI, ..me.kin };
         let corridor = Corridor::new(track, s, me.length, me.width, true);
-        let behind = ahead_on(corridor, back, me.obey, entries().map(Seen::reversed));
+        let behind = ahead_on(corridor, me.kin, me.obey, entries());
         let safe = behind.is_none_or(|(gap, speed_back)| {
             IdmParams::default().accel(speed_back, speed_back.max(me.target), Some((gap, me.kin.speed))) >= -SAFE
                 && gap > 1.0
