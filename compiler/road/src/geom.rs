@@ -198,6 +198,12 @@ fn angle_between(a: f64, b: f64) -> f64 {
     d.min(std::f64::consts::TAU - d)
 }
 
+/// At most how far, rad, any segment of `chunks` heads from `yaw`; at most π.
+fn turn_from(chunks: &[Chunk], yaw: f64) -> f64 {
+    let turn = chunks.iter().map(|c| angle_between(c.yaw, yaw) + c.turn).fold(0.0, f64::max);
+    turn.min(std::f64::consts::PI)
+}
+
 /// A run of whole chunks of a path ([`Path::stretch`]); `None` near an end.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Stretch(Option<(usize, usize)>);
@@ -428,12 +434,7 @@ impl Path {
             return 0.0;
         }
         let (first, last) = (window.first.saturating_sub(1), (window.last + 1).min(self.points.len() - 2));
-        let yaw = self.yaws[window.start];
-        let turn = self.chunks[first / CHUNK..=last / CHUNK]
-            .iter()
-            .map(|c| angle_between(c.yaw, yaw) + c.turn)
-            .fold(0.0, f64::max);
-        turn.min(std::f64::consts::PI)
+        turn_from(&self.chunks[first / CHUNK..=last / CHUNK], self.yaws[window.start])
     }
 
     /// The stretch from arc `from` to arc `to`, as [`Path::strip`] bounds it: the whole
@@ -465,11 +466,8 @@ impl Path {
             return Strip::UNKNOWN;
         }
         let along = chord * (1.0 / chord.length());
-        let yaw = along.yaw();
-        let (slack, turn) = chunks.iter().fold((0.0, 0.0), |(slack, turn): (f64, f64), c| {
-            (slack.max(c.reach_from(origin, along)), turn.max(angle_between(c.yaw, yaw) + c.turn))
-        });
-        Strip { origin, along, slack, turn: turn.min(std::f64::consts::PI) }
+        let slack = chunks.iter().map(|c| c.reach_from(origin, along)).fold(0.0, f64::max);
+        Strip { origin, along, slack, turn: turn_from(chunks, along.yaw()) }
     }
 
     fn arc(&self, i: usize, t: f64) -> f64 {
