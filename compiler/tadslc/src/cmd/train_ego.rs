@@ -180,7 +180,7 @@ pub fn run(args: &TrainEgoArgs, color: bool) -> Result<Status, CliError> {
     }
     let start = trainer.episodes() as usize;
     let progress = crate::output::progress(total.saturating_sub(start), "episodes");
-    let window = 25;
+    let window = RECENT;
     let (mut returns, mut collisions) = (Vec::new(), Vec::new());
     let started = std::time::Instant::now();
     let trained = tad_eval::train::train(&mut trainer, total, &train_scenes, |trainer, round| -> Result<(), Stop> {
@@ -364,6 +364,10 @@ fn imitate(
     }
 }
 
+/// How many of the latest episodes the progress lines and the curves average over (the
+/// `--plot` help says it too).
+const RECENT: usize = 25;
+
 /// The run's name on its plot.
 fn config_name(args: &TrainEgoArgs) -> String {
     match &args.pretrained {
@@ -392,14 +396,16 @@ fn curves(
             .collect()
     };
     let hits: Vec<f64> = collisions.iter().map(|&c| f64::from(u8::from(c))).collect();
-    let mut rates = vec![("training (last 25 episodes)", mean_of(&hits))];
+    let (recent, mean) =
+        (format!("training (last {window} episodes)"), format!("return (mean of the last {window} episodes)"));
+    let mut rates = vec![(recent.as_str(), mean_of(&hits))];
     if !validation.is_empty() {
         rates.push(("validation", validation.to_vec()));
     }
     tad_stats::plot::curves(
         title,
         "episode",
-        &[("return (mean of the last 25 episodes)", vec![("training", mean_of(returns))]), ("collision rate", rates)],
+        &[(mean.as_str(), vec![("training", mean_of(returns))]), ("collision rate", rates)],
     )
 }
 
