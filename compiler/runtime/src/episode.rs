@@ -919,7 +919,7 @@ fn ahead_on(
             }
             if o.speed > 0.3 && o.heading.dot(heading).abs() < 0.7 {
                 crossing.push((i, o));
-            } else if d.dot(heading) > 0.0 {
+            } else if d.dot(heading) > 0.0 && !off_strip(&corridor, &o) {
                 ahead.push((d.dot(d), i, o));
             }
         }
@@ -928,8 +928,6 @@ fn ahead_on(
         ahead.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         // how far the vehicle stands from its own track at `s`
         let off_track = corridor.track.pose(corridor.s).position.distance(position);
-        // the line its track keeps near wherever `in_corridor` may look for what is ahead
-        let strip = &corridor.strip;
         let mut best: Option<(f64, f64, usize)> = None;
         let keep = |best: &mut Option<(f64, f64, usize)>, gap: f64, along: f64, i: usize| {
             if best.is_none_or(|(g, _, j)| gap < g || (gap == g && i < j)) {
@@ -951,9 +949,6 @@ fn ahead_on(
                 }
             }
             let other = Footprint { pose: Pose { position: p, yaw: other_yaw }, length: l, width: w };
-            if strip.distance_from(p) > reach(corridor.width, &other, facing, strip.along, strip.turn) {
-                continue;
-            }
             if let Some((gap, rel)) = in_corridor(&corridor, &other, facing, (p - position).dot(heading)) {
                 let along = v * rel.cos();
                 if along >= 0.0 {
@@ -987,6 +982,16 @@ fn ahead_on(
         }
         best.map(|(gap, along, _)| (gap, along))
     })
+}
+
+/// Whether `seen` is surely out of `corridor` wherever [`in_corridor`] may look: farther
+/// from the strip its track keeps near than the box could reach into it. Decided before
+/// the candidates are sorted, as it does not depend on the best so far.
+fn off_strip(corridor: &Corridor, seen: &Seen) -> bool {
+    let Seen { position, yaw, heading: facing, length, width, .. } = *seen;
+    let strip = &corridor.strip;
+    let other = Footprint { pose: Pose { position, yaw }, length, width };
+    strip.distance_from(position) > reach(corridor.width, &other, facing, strip.along, strip.turn)
 }
 
 /// [`ahead_on`]'s lists, kept between calls: what is ahead (squared distance, index,
