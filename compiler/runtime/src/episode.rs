@@ -1070,6 +1070,10 @@ fn mobil(
 ) -> bool {
     const GAIN: f64 = 0.2;
     const SAFE: f64 = 4.0;
+    // with the road ahead free, no lane gains: a leader only ever lowers IDM's acceleration
+    if leader.is_none() {
+        return false;
+    }
     let now = {
         let me = &actors[k];
         IdmParams::default().accel(me.kin.speed, me.target, leader)
@@ -1086,6 +1090,11 @@ fn mobil(
             || before.iter().enumerate().filter(|(j, _)| *j != k).map(|(_, &o)| o).chain(std::iter::once(ego));
         let corridor = Corridor::new(track, s, me.length, me.width, false);
         let then = IdmParams::default().accel(me.kin.speed, me.target, ahead_on(corridor, me.kin, me.obey, entries()));
+        let gain = then - now;
+        // (the follower is looked for only where the lane gains; NaN gains nothing)
+        if !(gain > GAIN && choice.is_none_or(|(_, g)| gain > g)) {
+            continue;
+        }
         // the new follower: the nearest behind in the target lane, with this vehicle ahead of it
         let corridor = Corridor::new(track, s, me.length, me.width, true);
         let behind = ahead_on(corridor, me.kin, me.obey, entries());
@@ -1093,8 +1102,8 @@ fn mobil(
             IdmParams::default().accel(speed_back, speed_back.max(me.target), Some((gap, me.kin.speed))) >= -SAFE
                 && gap > 1.0
         });
-        if safe && then - now > GAIN && choice.is_none_or(|(_, g)| then - now > g) {
-            choice = Some((dir, then - now));
+        if safe {
+            choice = Some((dir, gain));
         }
     }
     let Some((dir, _)) = choice else { return false };
