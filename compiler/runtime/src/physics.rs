@@ -185,4 +185,22 @@ mod tests {
         physics.step(&[(6.0, 0.0, 0.0), (10.0, 0.0, 0.0), (0.0, 5.0, 0.0)], &mut hits);
         assert_eq!(hits, vec![1]);
     }
+
+    #[test]
+    fn a_parked_box_that_comes_back_is_touched_and_others_never_pair() {
+        let car = Shape { length: 4.5, width: 1.8, height: 1.5 };
+        let mut physics = Physics::new(&[car, car, car, car]);
+        let mut hits = Vec::new();
+        // box 1 far off (parked), boxes 2 and 3 overlap each other beside the ego
+        physics.step(&[(0.0, 0.0, 0.0), (200.0, 0.0, 0.0), (0.0, 4.0, 0.0), (1.0, 4.0, 0.0)], &mut hits);
+        assert!(hits.is_empty());
+        assert_eq!(physics.parked, [false, true, false, false]);
+        // box 1 drives up to the ego in one step: its real pose is back in rapier
+        physics.step(&[(0.0, 0.0, 0.0), (4.0, 0.0, 0.0), (0.0, 4.0, 0.0), (1.0, 4.0, 0.0)], &mut hits);
+        assert_eq!(hits, vec![1]);
+        assert!(physics.narrow_phase.intersection_pairs().all(|(a, b, _)| {
+            let user = |h| physics.colliders.get(h).map(|c| c.user_data);
+            user(a) == Some(0) || user(b) == Some(0)
+        }));
+    }
 }
