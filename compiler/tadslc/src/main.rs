@@ -169,7 +169,7 @@ fn main() -> ExitCode {
         _ => false,
     };
     if trains {
-        tad_train::prefer_one_thread();
+        tad_train::set_up_threads();
     }
     let color = match cli.color {
         Color::Always => true,
