@@ -169,22 +169,30 @@ pub struct Lexed {
 pub fn lex(src: &str) -> Lexed {
     let mut out = Lexed::default();
     let mut lexer = Token::lexer(src);
-    // whether the last token is an unexpected-character error that may grow
-    let mut merging = false;
+    // whether the last token is an unexpected-character error that may grow, and whether
+    // it has grown past its first character
+    let (mut merging, mut grown) = (false, false);
     while let Some(result) = lexer.next() {
         let span = lexer.span();
+        let extends = merging
+            && matches!(result, Err(LexError::UnexpectedChar))
+            && out.tokens.last().is_some_and(|t| t.2 == span.start);
+        if grown && !extends {
+            name_run(src, &mut out);
+            grown = false;
+        }
         match result {
             Ok(Token::Comment) => out.comments.push(span.into()),
             Ok(token) => {
                 merging = false;
                 out.tokens.push((span.start, token, span.end));
             }
-            Err(LexError::UnexpectedChar) if merging && out.tokens.last().is_some_and(|t| t.2 == span.start) => {
-                // A run of unexpected characters is one token and one diagnostic.
+            // A run of unexpected characters is one token and one diagnostic.
+            Err(_) if extends => {
                 if let (Some(token), Some(d)) = (out.tokens.last_mut(), out.diagnostics.last_mut()) {
                     token.2 = span.end;
                     d.primary.span.end = span.end;
-                    d.message = format!("unexpected characters `{}`", src[token.0..token.2].escape_debug());
+                    grown = true;
                 }
             }
             Err(error) => {
@@ -194,6 +202,9 @@ pub fn lex(src: &str) -> Lexed {
             }
         }
     }
+    if grown {
+        name_run(src, &mut out);
+    }
     for i in 1..out.tokens.len() {
         if out.tokens[i].1 == Token::LBrace && out.tokens[i - 1].1 == Token::Ident {
             out.tokens[i - 1].1 = Token::Head;
@@ -201,6 +212,14 @@ pub fn lex(src: &str) -> Lexed {
     }
     mark_declaration_kinds(&mut out.tokens);
     out
+}
+
+/// Names the run of unexpected characters that the last token and diagnostic hold, once
+/// it has ended: naming it at every character it grew by made a long run quadratic.
+fn name_run(src: &str, out: &mut Lexed) {
+    if let (Some(token), Some(d)) = (out.tokens.last(), out.diagnostics.last_mut()) {
+        d.message = format!("unexpected characters `{}`", src[token.0..token.2].escape_debug());
+    }
 }
 
 /// Outside braces, items are flat (`use PATH`, `scenario NAME {...}`, `KIND NAME [{...}]`):
@@ -449,6 +468,17 @@ mod tests {
         assert_eq!(lexed.tokens.iter().filter(|t| t.1 == Token::Error).count(), 1);
         let lexed = lex("é");
         assert_eq!(lexed.diagnostics[0].primary.span, Span::new(0, 2));
+        assert_eq!(lexed.diagnostics[0].message, "unexpected character `é`");
+        // the run's message names all of it, before a comment and at the end of the text
+        let lexed = lex("a $% // c\n@@");
+        let messages: Vec<&str> = lexed.diagnostics.iter().map(|d| d.message.as_str()).collect();
+        assert_eq!(messages, ["unexpected characters `$%`", "unexpected characters `@@`"]);
+        // a long run is one token and one diagnostic (naming it at every character was
+        // quadratic: 100,000 took 34 s)
+        let lexed = lex(&"@".repeat(100_000));
+        assert_eq!((lexed.tokens.len(), lexed.diagnostics.len()), (1, 1));
+        assert_eq!(lexed.diagnostics[0].primary.span, Span::new(0, 100_000));
+        assert_eq!(lexed.diagnostics[0].message.len(), "unexpected characters ``".len() + 100_000);
     }
 
     #[test]
