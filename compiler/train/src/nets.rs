@@ -225,10 +225,15 @@ impl Net {
         head.bias.set(&bias).map_err(tensor_error)
     }
 
+    /// `θ_target ← ρ·θ_target + (1 − ρ)·θ`, in one pass per parameter: the `f32` arithmetic
+    /// of the `affine`s and the `+` it replaces, as [`Adam`]'s step (`polyak_is_the_tensor_expression`).
     pub fn polyak_from(&self, source: &Net, polyak: f64) -> candle_core::Result<()> {
+        let (keep, take) = (polyak as f32, (1.0 - polyak) as f32);
         for ((_, target), (_, var)) in self.vars().iter().zip(source.vars()) {
-            let next = (target.as_tensor().affine(polyak, 0.0)? + var.as_tensor().affine(1.0 - polyak, 0.0)?)?;
-            target.set(&next)?;
+            let mut next = target.as_tensor().flatten_all()?.to_vec1::<f32>()?;
+            let from = var.as_tensor().flatten_all()?.to_vec1::<f32>()?;
+            next.iter_mut().zip(&from).for_each(|(t, s)| *t = (*t * keep + 0.0) + (s * take + 0.0));
+            target.set(&Tensor::from_vec(next, target.shape(), target.device())?)?;
         }
         Ok(())
     }
@@ -514,6 +519,22 @@ mod tests {
             (bits(&y), bits(grads.get(w.as_tensor()).unwrap()), bits(grads.get(b.as_tensor()).unwrap()))
         };
         assert_eq!(grads(true), grads(false));
+    }
+
+    #[test]
+    fn polyak_is_the_tensor_expression() {
+        let mut rng = SplitMix64::new(11);
+        let mut net = || Net::random(7, &[16, 16], &[("q", 1)], &mut rng).unwrap();
+        let (target, source) = (net(), net());
+        let before: Vec<Tensor> = target.vars().iter().map(|(_, v)| v.as_tensor().copy().unwrap()).collect();
+        target.polyak_from(&source, 0.995).unwrap();
+        for ((t, (_, s)), (name, fused)) in before.iter().zip(source.vars()).zip(target.vars()) {
+            let expected = (t.affine(0.995, 0.0).unwrap() + s.as_tensor().affine(1.0 - 0.995, 0.0).unwrap()).unwrap();
+            let bits = |t: &Tensor| -> Vec<u32> {
+                t.flatten_all().unwrap().to_vec1::<f32>().unwrap().iter().map(|v| v.to_bits()).collect()
+            };
+            assert_eq!(bits(fused.as_tensor()), bits(&expected), "{name}");
+        }
     }
 
     #[test]
