@@ -563,7 +563,7 @@ impl<S: Deref<Target = Scene>> Runner<S> {
         let lookahead = models::lookahead(ego.speed);
         let target = Pose { position: ego.position, yaw: ego.yaw }.local(route.pose(s + lookahead).position);
         let corridor = Corridor::new(route, s, size.length, size.width, false);
-        let leader = ahead_on(corridor, *ego, true, before.iter().copied());
+        let leader = ahead_on(corridor, Seen::new(ego, size.length, size.width), true, before.iter().copied());
         let stop = self.ego_stop.and_then(|line| {
             let gap = line - (s + size.length / 2.0);
             (gap > -0.5 && must_stop(scene, Arm::Ego, gap, ego.speed, t, self.detectors.stopped_at_sign()))
@@ -827,10 +827,12 @@ fn leader_of(
 ) -> Option<(f64, f64)> {
     let me = &actors[k];
     let track = me.track.as_ref()?;
+    // it has not moved yet this step: it is as the step began
+    debug_assert_eq!((before[k].position, before[k].yaw), (me.kin.position, me.kin.yaw));
     let others = before.iter().enumerate().filter(|(j, _)| *j != k).map(|(_, &o)| o);
     let ego_entry = me.obey.then_some(ego);
     let corridor = Corridor { track, s: me.s, length: me.length, width: me.width, back: false, strip };
-    let mut best = ahead_on(corridor, me.kin, me.obey, others.chain(ego_entry));
+    let mut best = ahead_on(corridor, before[k], me.obey, others.chain(ego_entry));
     if me.obey
         && let Some((line, arm)) = me.stop_line
     {
@@ -889,7 +891,7 @@ impl<'a> Corridor<'a> {
     }
 }
 
-/// The nearest of `others` ahead in a vehicle's `corridor`, the vehicle moving as `kin` says:
+/// The nearest of `others` ahead in a vehicle's `corridor`, the vehicle as `me` sees it:
 /// `(gap, speed along)`. A corridor `back` looks behind: the vehicle and the others are
 /// turned round, so that the follower is the leader of the turned-round vehicle, and its
 /// speed along is its speed towards the vehicle. Something going its way (or against it)
@@ -899,15 +901,9 @@ impl<'a> Corridor<'a> {
 /// they meet: crossing traffic that will have gone is no obstacle, and one about to cross is
 /// one before it arrives. One that does not `yield` (an adversary) only stops for crossing
 /// traffic already in front of it.
-fn ahead_on(
-    corridor: Corridor,
-    kin: Kinematics,
-    yields: bool,
-    others: impl Iterator<Item = Seen>,
-) -> Option<(f64, f64)> {
-    let Kinematics { position, yaw, speed } = kin;
-    let yaw = if corridor.back { yaw + std::f64::consts::PI } else { yaw };
-    let heading = Vec2::from_yaw(yaw);
+fn ahead_on(corridor: Corridor, me: Seen, yields: bool, others: impl Iterator<Item = Seen>) -> Option<(f64, f64)> {
+    let Seen { position, heading, speed, .. } = me;
+    let heading = if corridor.back { Vec2::from_yaw(me.yaw + std::f64::consts::PI) } else { heading };
     let others = others.map(|o| if corridor.back { o.reversed() } else { o });
     NEAR.with_borrow_mut(|(ahead, crossing)| {
         ahead.clear();
@@ -1089,7 +1085,8 @@ fn mobil(
         let entries =
             || before.iter().enumerate().filter(|(j, _)| *j != k).map(|(_, &o)| o).chain(std::iter::once(ego));
         let corridor = Corridor::new(track, s, me.length, me.width, false);
-        let then = IdmParams::default().accel(me.kin.speed, me.target, ahead_on(corridor, me.kin, me.obey, entries()));
+        let then =
+            IdmParams::default().accel(me.kin.speed, me.target, ahead_on(corridor, before[k], me.obey, entries()));
         let gain = then - now;
         // (the follower is looked for only where the lane gains; NaN gains nothing)
         if !(gain > GAIN && choice.is_none_or(|(_, g)| gain > g)) {
@@ -1097,7 +1094,7 @@ fn mobil(
         }
         // the new follower: the nearest behind in the target lane, with this vehicle ahead of it
         let corridor = Corridor::new(track, s, me.length, me.width, true);
-        let behind = ahead_on(corridor, me.kin, me.obey, entries());
+        let behind = ahead_on(corridor, before[k], me.obey, entries());
         let safe = behind.is_none_or(|(gap, speed_back)| {
             IdmParams::default().accel(speed_back, speed_back.max(me.target), Some((gap, me.kin.speed))) >= -SAFE
                 && gap > 1.0
