@@ -27,6 +27,11 @@ pub fn tuned_name(ego: &str, generator: &str) -> String {
     format!("{ego} (fine-tuned on {generator})")
 }
 
+/// The name of that row when the run took no learning step: the ego as it started.
+pub fn untuned_name(ego: &str, generator: &str) -> String {
+    format!("{ego} (no learning step on {generator})")
+}
+
 /// Why fine-tuning did not finish.
 #[derive(Debug)]
 pub enum FinetuneError {
@@ -93,7 +98,8 @@ pub fn tunings<'a>(plan: &Plan, from: Option<&'a Path>, settings: impl Fn(Algo) 
 pub struct Tuned {
     pub before_name: String,
     pub after_name: String,
-    /// Learning steps taken (0: the run was too short to learn anything).
+    /// Learning steps this fine-tuning took (0: it was too short to learn anything, and
+    /// `after_name` says so).
     pub updates: u64,
     pub after: Learned,
     pub before: Option<Learned>,
@@ -121,10 +127,11 @@ pub fn tune(
     tuning: Tuning,
     mut on_episode: impl FnMut(),
 ) -> Result<Tuned, FinetuneError> {
-    let Tuning { before: before_name, after: after_name, start, config, .. } = tuning;
+    let Tuning { before: before_name, after: after_name, generator, start, config } = tuning;
     let episodes = config.episodes;
     let (mut trainer, before) = start.trainer(config).map_err(FinetuneError::Start)?;
     let first = trainer.episodes() as usize;
+    let learned = trainer.updates();
     let scenes: Vec<TrainScene> = train
         .iter()
         .map(|&i| TrainScene { scene: &kept[i].unit.scene, fixed: Some((&kept[i].params, kept[i].seed)) })
@@ -141,7 +148,11 @@ pub fn tune(
     })
     .map_err(FinetuneError::Training)?;
     let after = trainer.actor().map_err(FinetuneError::Actor)?;
-    Ok(Tuned { before_name, after_name, updates: trainer.updates(), after, before })
+    // an actor that learned nothing here is not labelled fine-tuned
+    let updates = trainer.updates() - learned;
+    let ego = if before_name == BEFORE { LEARNED } else { before_name.as_str() };
+    let after_name = if updates == 0 { untuned_name(ego, &generator) } else { after_name };
+    Ok(Tuned { before_name, after_name, updates, after, before })
 }
 
 /// The held-out table, and each tuned ego's change (with a start to change from).

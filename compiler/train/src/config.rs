@@ -132,6 +132,12 @@ impl Default for Config {
 }
 
 impl Config {
+    /// The transitions stored before the first learning step: PPO's rollout, else
+    /// `start_training`.
+    pub fn transitions_to_learn(&self) -> usize {
+        if self.algo == Algo::Ppo { self.rollout } else { self.start_training }
+    }
+
     /// SafeBench's settings for `algo` (`agent/config/*.yaml`; see the crate's header).
     pub fn safebench(algo: Algo) -> Config {
         let base = Config { algo, episodes: 2000, ..Config::default() };

@@ -393,6 +393,23 @@ impl Trainer {
         self.replay.len()
     }
 
+    /// Why `episodes` more episodes of at most `steps` steps each cannot reach a first
+    /// learning step, if they cannot: they store one transition a step, and learning starts
+    /// at [`Config::transitions_to_learn`]. `None` once it has learned, or when they may.
+    pub fn cannot_learn_within(&self, episodes: usize, steps: usize) -> Option<String> {
+        let needed = self.config.transitions_to_learn();
+        let stored = self.replay_len();
+        let most = stored.saturating_add(episodes.saturating_mul(steps));
+        (self.updates == 0 && most < needed).then(|| {
+            let enough = (needed - stored).div_ceil(steps.max(1));
+            format!(
+                "{} of at most {steps} steps store at most {most} transitions ({stored} stored now), \
+                 and learning starts at {needed}: at least {enough} episodes are needed",
+                tad_base::plural(episodes, "episode")
+            )
+        })
+    }
+
     /// Labelled states kept from the warm start (the demonstrations of [`Config::bc_weight`]).
     pub fn demos(&self) -> usize {
         self.demos.len() / (self.config.observation.width() + ACT)

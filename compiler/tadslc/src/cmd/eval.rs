@@ -308,11 +308,13 @@ pub fn finetune(args: &EvalArgs, plan: &Plan, kept: &[Kept]) -> Result<Status, C
         })?;
         if t.updates == 0 {
             errln!(
-                "warning: `{after}` took no learning step: its episodes stored too few transitions to start learning"
+                "warning: `{after}` took no learning step (its episodes stored too few transitions to start \
+                 learning): its row is `{}`, the ego as it started",
+                t.after_name
             )?;
         }
         if let Some(dir) = &args.out {
-            let path = dir.join("finetuned").join(format!("{}.safetensors", file_name(&after)));
+            let path = dir.join("finetuned").join(format!("{}.safetensors", file_name(&t.after_name)));
             std::fs::create_dir_all(dir.join("finetuned"))
                 .and_then(|_| t.after.save(&path).map_err(std::io::Error::other))
                 .map_err(|e| CliError::usage(format!("cannot write `{}`: {e}", path.display())))?;

@@ -164,6 +164,13 @@ pub fn run(args: &TrainEgoArgs, color: bool) -> Result<Status, CliError> {
     let total = config_episodes;
     let train_scenes: Vec<TrainScene> =
         train.iter().map(|&i| TrainScene { scene: &scenes[i].scene, fixed: None }).collect();
+    // without a warm start, a run that cannot take a learning step would make nothing
+    let longest = train.iter().map(|&i| scenes[i].scene.limits.max_steps as usize).max().unwrap_or(0);
+    let to_run = total.saturating_sub(trainer.episodes() as usize);
+    if let Some(why) = trainer.cannot_learn_within(to_run, longest).filter(|_| teacher.is_none()) {
+        return Err(CliError::usage(format!("no learning step could be taken: {why} (--episodes)")));
+    }
+    let warm = teacher.is_some();
     if let Some(teacher) = teacher.filter(|_| trainer.episodes() == 0) {
         imitate(&mut trainer, &train_scenes, &teacher, args)?;
     }
@@ -224,11 +231,18 @@ pub fn run(args: &TrainEgoArgs, color: bool) -> Result<Status, CliError> {
     }
     trainer.save_checkpoint(&checkpoint).map_err(CliError::usage)?;
     if trainer.updates() == 0 && trainer.episodes() > 0 {
-        let c = trainer.config();
-        let needed = if c.algo == Algo::Ppo { c.rollout } else { c.start_training };
+        let (stored, needed) = (trainer.replay_len(), trainer.config().transitions_to_learn());
+        if !warm {
+            // the actor is the one it started with: not written as if trained
+            return Err(CliError::failed(format!(
+                "no learning step was taken: the episodes ended early and stored {stored} transitions; learning \
+                 starts at {needed}. The checkpoint is in {}: continue with --resume and more --episodes",
+                checkpoint.display()
+            )));
+        }
         errln!(
-            "warning: no learning step was taken: {} transitions are stored and learning needs {needed} (more --episodes)",
-            trainer.replay_len()
+            "warning: no learning step was taken after the warm start: {stored} transitions are stored and learning \
+             starts at {needed} (more --episodes)"
         )?;
     }
     if let Some(path) = &args.plot {
