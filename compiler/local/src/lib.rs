@@ -11,6 +11,7 @@
 
 mod adapter;
 mod engine;
+mod kquant;
 mod llama;
 mod quant;
 

@@ -18,25 +18,37 @@ use candle_core::quantized::GgmlDType;
 use candle_core::quantized::gguf_file::Content;
 
 use crate::adapter::{Adapter, Target, hf_to_gguf_rows};
+use crate::kquant::{self, Q4K, Q5_0, Q6K, SUPER};
 use crate::quant::{self, BLOCK, Heads, Kernels, Q4_1, Q8_0, Q8_1};
 
-/// A weight matrix: `rows` rows of `cols` values, row after row, in blocks.
+/// A weight matrix: `rows` rows of `cols` values, row after row, in blocks (`per_row` of
+/// them: of 32 values, or of 256 for the K formats).
 enum Matrix {
     Q4_1 { blocks: Vec<Q4_1>, rows: usize, per_row: usize },
     Q8_0 { blocks: Vec<Q8_0>, rows: usize, per_row: usize },
+    Q5_0 { blocks: Vec<Q5_0>, rows: usize, per_row: usize },
+    Q4K { blocks: Vec<Q4K>, rows: usize, per_row: usize },
+    Q6K { blocks: Vec<Q6K>, rows: usize, per_row: usize },
 }
 
 impl Matrix {
     fn rows(&self) -> usize {
         match self {
-            Matrix::Q4_1 { rows, .. } | Matrix::Q8_0 { rows, .. } => *rows,
+            Matrix::Q4_1 { rows, .. }
+            | Matrix::Q8_0 { rows, .. }
+            | Matrix::Q5_0 { rows, .. }
+            | Matrix::Q4K { rows, .. }
+            | Matrix::Q6K { rows, .. } => *rows,
         }
     }
 
     fn bytes(&self) -> usize {
         match self {
-            Matrix::Q4_1 { blocks, .. } => blocks.len() * std::mem::size_of::<Q4_1>(),
-            Matrix::Q8_0 { blocks, .. } => blocks.len() * std::mem::size_of::<Q8_0>(),
+            Matrix::Q4_1 { blocks, .. } => std::mem::size_of_val(blocks.as_slice()),
+            Matrix::Q8_0 { blocks, .. } => std::mem::size_of_val(blocks.as_slice()),
+            Matrix::Q5_0 { blocks, .. } => std::mem::size_of_val(blocks.as_slice()),
+            Matrix::Q4K { blocks, .. } => std::mem::size_of_val(blocks.as_slice()),
+            Matrix::Q6K { blocks, .. } => std::mem::size_of_val(blocks.as_slice()),
         }
     }
 
@@ -44,6 +56,38 @@ impl Matrix {
         match self {
             Matrix::Q4_1 { blocks, per_row, .. } => (k.q4_1)(&blocks[r * per_row..(r + 1) * per_row], x),
             Matrix::Q8_0 { blocks, per_row, .. } => (k.q8_0)(&blocks[r * per_row..(r + 1) * per_row], x),
+            Matrix::Q5_0 { blocks, per_row, .. } => kquant::dot_q5_0_scalar(&blocks[r * per_row..(r + 1) * per_row], x),
+            Matrix::Q4K { blocks, per_row, .. } => kquant::dot_q4_k_scalar(&blocks[r * per_row..(r + 1) * per_row], x),
+            Matrix::Q6K { blocks, per_row, .. } => kquant::dot_q6_k_scalar(&blocks[r * per_row..(r + 1) * per_row], x),
+        }
+    }
+
+    /// Row `r`'s values.
+    fn dequantize_row(&self, r: usize, out: &mut Vec<f32>) {
+        let r = r.min(self.rows().saturating_sub(1));
+        match self {
+            Matrix::Q4_1 { blocks, per_row, .. } => {
+                out.clear();
+                for block in &blocks[r * per_row..(r + 1) * per_row] {
+                    out.extend((0..16).map(|j| block.d * (block.qs[j] & 15) as f32 + block.m));
+                    out.extend((0..16).map(|j| block.d * (block.qs[j] >> 4) as f32 + block.m));
+                }
+            }
+            Matrix::Q8_0 { blocks, per_row, .. } => {
+                out.clear();
+                for block in &blocks[r * per_row..(r + 1) * per_row] {
+                    out.extend(block.qs.iter().map(|&q| block.d * q as f32));
+                }
+            }
+            Matrix::Q5_0 { blocks, per_row, .. } => {
+                kquant::dequantize_q5_0(&blocks[r * per_row..(r + 1) * per_row], out)
+            }
+            Matrix::Q4K { blocks, per_row, .. } => {
+                kquant::dequantize_q4_k(&blocks[r * per_row..(r + 1) * per_row], out)
+            }
+            Matrix::Q6K { blocks, per_row, .. } => {
+                kquant::dequantize_q6_k(&blocks[r * per_row..(r + 1) * per_row], out)
+            }
         }
     }
 
@@ -304,22 +348,9 @@ impl Model {
     }
 
     fn embed(&self, token: u32, out: &mut [f32]) {
-        if let Matrix::Q8_0 { blocks, per_row, rows } = &self.embedding {
-            let row = (token as usize).min(rows.saturating_sub(1));
-            for (b, block) in blocks[row * per_row..(row + 1) * per_row].iter().enumerate() {
-                for (j, q) in block.qs.iter().enumerate() {
-                    out[b * BLOCK + j] = block.d * *q as f32;
-                }
-            }
-        } else if let Matrix::Q4_1 { blocks, per_row, rows } = &self.embedding {
-            let row = (token as usize).min(rows.saturating_sub(1));
-            for (b, block) in blocks[row * per_row..(row + 1) * per_row].iter().enumerate() {
-                for j in 0..16 {
-                    out[b * BLOCK + j] = block.d * (block.qs[j] & 15) as f32 + block.m;
-                    out[b * BLOCK + j + 16] = block.d * (block.qs[j] >> 4) as f32 + block.m;
-                }
-            }
-        }
+        let mut row = Vec::with_capacity(out.len());
+        self.embedding.dequantize_row(token as usize, &mut row);
+        out.iter_mut().zip(&row).for_each(|(o, v)| *o = *v);
     }
 
     fn rope_upto(&mut self, positions: usize) {
@@ -491,10 +522,17 @@ fn matrix<R: Read + Seek>(
         _ => return Err(format!("tensor `{name}` is {dims:?}, not a matrix of {cols} columns fitting the model")),
     };
     let per_row = cols / BLOCK;
+    let (kper_row, whole) = (cols / SUPER, cols.is_multiple_of(SUPER));
     match dtype {
         GgmlDType::Q4_1 => Ok(Matrix::Q4_1 { blocks: quant::read_q4_1(&bytes), rows, per_row }),
         GgmlDType::Q8_0 => Ok(Matrix::Q8_0 { blocks: quant::read_q8_0(&bytes), rows, per_row }),
-        other => Err(format!("tensor `{name}` is {other:?}: only Q4_1 and Q8_0 matrices are supported")),
+        GgmlDType::Q5_0 => Ok(Matrix::Q5_0 { blocks: kquant::read_q5_0(&bytes), rows, per_row }),
+        GgmlDType::Q4K if whole => Ok(Matrix::Q4K { blocks: kquant::read_q4_k(&bytes), rows, per_row: kper_row }),
+        GgmlDType::Q6K if whole => Ok(Matrix::Q6K { blocks: kquant::read_q6_k(&bytes), rows, per_row: kper_row }),
+        other => Err(format!(
+            "tensor `{name}` is {other:?} with rows of {cols}: the matrices supported are Q4_1, Q8_0, Q5_0, and \
+             Q4_K and Q6_K with rows of a multiple of {SUPER}"
+        )),
     }
 }
 
