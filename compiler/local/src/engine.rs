@@ -82,15 +82,19 @@ impl TokenizerEnv for Env {
     }
 }
 
-/// The GGUF's tokenizer, with SmolLM2's pre-tokenizer ("smollm": digits one by one,
-/// byte-level without a prefix space).
+/// The GGUF's tokenizer as candle builds it from `tokenizer.ggml.pre` (Qwen2's split
+/// and byte level), or with SmolLM2's pre-tokenizer for its `smollm` (digits one by one,
+/// byte-level without a prefix space), which candle does not know.
 pub fn tokenizer(content: &gguf_file::Content) -> Result<Tokenizer, String> {
     let mut tokenizer = Tokenizer::from_gguf(content).map_err(|e| e.to_string())?;
-    use tokenizers::pre_tokenizers::{byte_level::ByteLevel, digits::Digits, sequence::Sequence};
-    tokenizer.with_pre_tokenizer(Some(Sequence::new(vec![
-        Digits::new(true).into(),
-        ByteLevel::new(false, true, false).into(),
-    ])));
+    let pre = content.metadata.get("tokenizer.ggml.pre").and_then(|v| v.to_string().ok()).map(String::as_str);
+    if matches!(pre, None | Some("smollm")) {
+        use tokenizers::pre_tokenizers::{byte_level::ByteLevel, digits::Digits, sequence::Sequence};
+        tokenizer.with_pre_tokenizer(Some(Sequence::new(vec![
+            Digits::new(true).into(),
+            ByteLevel::new(false, true, false).into(),
+        ])));
+    }
     Ok(tokenizer)
 }
 

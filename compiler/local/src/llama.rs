@@ -1,8 +1,13 @@
 //! A llama-architecture decoder over ggml's quantized blocks, written for CPU inference of
-//! a small model: the weights stay as they are in the GGUF file (Q4_1 layers, the Q8_0
-//! embedding that is also the output projection), activations are quantized to 8 bits a
-//! block before each product ([`crate::quant`]), and the KV cache is appended in place,
-//! each query head reading its group's key/value head directly (no copies of the cache).
+//! a small model: the weights stay as they are in the GGUF file (SmolLM2: Q4_1 layers, the
+//! Q8_0 embedding that is also the output projection; Qwen2.5-Coder: Q4_K, Q6_K, Q5_0 and
+//! Q8_0, [`crate::kquant`]), activations are quantized to 8 bits a block before each product
+//! ([`crate::quant`]), and the KV cache is appended in place, each query head reading its
+//! group's key/value head directly (no copies of the cache).
+//!
+//! `qwen2` is llama with biases on the query, key and value projections and the rotary
+//! embedding over the two halves of each head (llama's GGUF layout rotates adjacent pairs);
+//! its rope base and norm epsilon come from the file, as llama's do.
 //!
 //! A prompt is read in chunks of tokens: every weight row is loaded once per chunk and
 //! multiplied with each token's activations while it is in cache, which makes prefill
@@ -148,6 +153,8 @@ struct Layer {
     q: Matrix,
     k: Matrix,
     v: Matrix,
+    /// qwen2's biases of q, k and v.
+    bias: Option<[Vec<f32>; 3]>,
     o: Matrix,
     ffn_norm: Vec<f32>,
     gate: Matrix,
@@ -155,9 +162,17 @@ struct Layer {
     down: Matrix,
 }
 
+/// The decoder architectures read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Arch {
+    Llama,
+    Qwen2,
+}
+
 /// The shape of the model, from the GGUF metadata.
 #[derive(Clone, Copy, Debug)]
 pub struct Shape {
+    pub arch: Arch,
     pub layers: usize,
     pub dim: usize,
     pub hidden: usize,
@@ -211,24 +226,29 @@ impl Shape {
     /// The shape in a llama GGUF's metadata, checked for what the decoder needs.
     pub fn from_gguf(content: &Content) -> Result<Shape, String> {
         let meta = |k: &str| content.metadata.get(k).ok_or_else(|| format!("no `{k}` in the GGUF metadata"));
-        let int = |k: &str| meta(k).and_then(|v| v.to_u32().map_err(error)).map(|v| v as usize);
-        let float = |k: &str| meta(k).and_then(|v| v.to_f32().map_err(error));
-        let arch = meta("general.architecture")?.to_string().map_err(error)?.clone();
-        if arch != "llama" {
-            return Err(format!("a `{arch}` model: only the llama architecture is supported"));
-        }
-        let dim = int("llama.embedding_length")?;
-        let heads = int("llama.attention.head_count")?;
+        let name = meta("general.architecture")?.to_string().map_err(error)?.clone();
+        let arch = match name.as_str() {
+            "llama" => Arch::Llama,
+            "qwen2" => Arch::Qwen2,
+            _ => return Err(format!("a `{name}` model: the architectures supported are llama and qwen2")),
+        };
+        // every key is under the architecture's name
+        let key = |k: &str| format!("{name}.{k}");
+        let int = |k: &str| meta(&key(k)).and_then(|v| v.to_u32().map_err(error)).map(|v| v as usize);
+        let float = |k: &str| meta(&key(k)).and_then(|v| v.to_f32().map_err(error));
+        let dim = int("embedding_length")?;
+        let heads = int("attention.head_count")?;
         let shape = Shape {
-            layers: int("llama.block_count")?,
+            arch,
+            layers: int("block_count")?,
             dim,
-            hidden: int("llama.feed_forward_length")?,
+            hidden: int("feed_forward_length")?,
             heads,
-            kv_heads: int("llama.attention.head_count_kv").unwrap_or(heads),
+            kv_heads: int("attention.head_count_kv").unwrap_or(heads),
             head_dim: dim / heads.max(1),
-            context: int("llama.context_length").unwrap_or(2048),
-            eps: float("llama.attention.layer_norm_rms_epsilon").unwrap_or(1e-5),
-            rope_base: float("llama.rope.freq_base").unwrap_or(10_000.0),
+            context: int("context_length").unwrap_or(2048),
+            eps: float("attention.layer_norm_rms_epsilon").unwrap_or(1e-5),
+            rope_base: float("rope.freq_base").unwrap_or(10_000.0),
         };
         if heads == 0
             || shape.kv_heads == 0
@@ -284,7 +304,13 @@ impl Model {
         let mut layers = Vec::with_capacity(shape.layers);
         for i in 0..shape.layers {
             let name = |part: &str| format!("blk.{i}.{part}.weight");
+            let mut bias = |part: &str, len: usize| vector(content, file, &format!("blk.{i}.{part}.bias"), len);
+            let bias = match shape.arch {
+                Arch::Qwen2 => Some([bias("attn_q", dim)?, bias("attn_k", kv_dim)?, bias("attn_v", kv_dim)?]),
+                Arch::Llama => None,
+            };
             layers.push(Layer {
+                bias,
                 attn_norm: vector(content, file, &name("attn_norm"), dim)?,
                 ffn_norm: vector(content, file, &name("ffn_norm"), dim)?,
                 q: matrix(content, file, &name("attn_q"), Some(dim), dim)?,
@@ -414,6 +440,17 @@ impl Model {
                     pair.add(scale, &normed, out, n);
                 }
             }
+            if let Some(biases) = &layer.bias {
+                for (out, bias) in [&mut q, &mut kk, &mut vv].into_iter().zip(biases) {
+                    for row in out.chunks_exact_mut(bias.len()) {
+                        row.iter_mut().zip(bias).for_each(|(o, b)| *o += b);
+                    }
+                }
+            }
+            let rotate = match self.shape.arch {
+                Arch::Llama => rotate_pairs,
+                Arch::Qwen2 => rotate_halves,
+            };
             for t in 0..n {
                 let angles = &self.rope[(start + t) * pairs..(start + t + 1) * pairs];
                 for h in 0..heads {
@@ -555,11 +592,21 @@ fn rms_norm(x: &[f32], weight: &[f32], eps: f32, dim: usize, out: &mut [f32]) {
 }
 
 /// Rotates adjacent pairs `(x[2i], x[2i+1])` by the position's angles (GGUF's llama layout).
-fn rotate(x: &mut [f32], angles: &[(f32, f32)]) {
+fn rotate_pairs(x: &mut [f32], angles: &[(f32, f32)]) {
     for (pair, &(cos, sin)) in x.chunks_exact_mut(2).zip(angles) {
         let (a, b) = (pair[0], pair[1]);
         pair[0] = a * cos - b * sin;
         pair[1] = a * sin + b * cos;
+    }
+}
+
+/// Rotates the pairs `(x[i], x[i + d/2])` by the position's angles (qwen2's layout, GPT-NeoX's).
+fn rotate_halves(x: &mut [f32], angles: &[(f32, f32)]) {
+    let (first, second) = x.split_at_mut(x.len() / 2);
+    for ((a, b), &(cos, sin)) in first.iter_mut().zip(second.iter_mut()).zip(angles) {
+        let (x0, x1) = (*a, *b);
+        *a = x0 * cos - x1 * sin;
+        *b = x0 * sin + x1 * cos;
     }
 }
 
@@ -691,5 +738,38 @@ mod tests {
         let mine = ours.forward(&[next], &mut cache);
         assert_eq!(argmax(&mine), argmax(&theirs));
         assert!(cosine(&mine, &theirs) > 0.995, "cosine {}", cosine(&mine, &theirs));
+    }
+
+    /// qwen2 (biases, the rotary embedding over halves, Q4_K/Q6_K/Q5_0/Q8_0 weights) on the
+    /// real Qwen2.5-Coder-0.5B file, against candle's quantized qwen2.
+    #[test]
+    fn agrees_with_candles_quantized_qwen2() {
+        use candle_transformers::models::quantized_qwen2::ModelWeights as Qwen2;
+        let Some(path) = crate::for_tests("qwen2.5-coder-0.5b") else { return };
+        let mut file = std::fs::File::open(&path).unwrap();
+        let content = Content::read(&mut file).unwrap();
+        let tokenizer = crate::tokenizer(&content).unwrap();
+        let (tokens, _) = crate::chatml(&tokenizer, &[("user", "A bus drives ahead of the ego car.")]).unwrap();
+        let mut ours = Model::load(&content, &mut file, 2).unwrap();
+        assert_eq!(ours.shape.arch, Arch::Qwen2);
+        let mut file2 = std::fs::File::open(&path).unwrap();
+        let mut reference = Qwen2::from_gguf(Content::read(&mut file2).unwrap(), &mut file2, &Device::Cpu).unwrap();
+        let expected =
+            reference.forward(&Tensor::new(tokens.as_slice(), &Device::Cpu).unwrap().unsqueeze(0).unwrap(), 0).unwrap();
+        let expected: Vec<f32> = expected.squeeze(0).unwrap().to_vec1().unwrap();
+        let mut cache = ours.new_cache();
+        let logits = ours.forward(&tokens, &mut cache);
+        assert_eq!(logits.len(), expected.len());
+        assert_eq!(argmax(&logits), argmax(&expected));
+        assert!(cosine(&logits, &expected) > 0.99, "cosine {}", cosine(&logits, &expected));
+        // the next token from the cache, as candle's
+        let next = argmax(&expected) as u32;
+        let theirs = reference
+            .forward(&Tensor::new(&[next], &Device::Cpu).unwrap().unsqueeze(0).unwrap(), tokens.len())
+            .unwrap();
+        let theirs: Vec<f32> = theirs.squeeze(0).unwrap().to_vec1().unwrap();
+        let mine = ours.forward(&[next], &mut cache);
+        assert_eq!(argmax(&mine), argmax(&theirs));
+        assert!(cosine(&mine, &theirs) > 0.99, "cosine {}", cosine(&mine, &theirs));
     }
 }
