@@ -185,43 +185,133 @@ pub fn dequantize_q6_k(blocks: &[Q6K], out: &mut Vec<f32>) {
     }
 }
 
-/// The integer dot product of a block of values with an activation block.
-fn sum<T: Copy + Into<i32>>(q: &[T], x: &[i8]) -> i32 {
-    q.iter().zip(x).map(|(&a, &b)| a.into() * b as i32).sum()
+/// A weight row unpacked for dot products: its values as small integers, and for each
+/// block of 32 the factors `(f1, f2, f3)` of `dx·(f1·Σ₁ + f2·Σ₂) − f3·s`, where Σ₁ and Σ₂
+/// are the integer sums of its two 16-value halves against an activation block (`dx`,
+/// `s = dx·Σx`). One form for every format, so a row is unpacked once for all the tokens
+/// of a chunk, and the scalar and AVX2 kernels differ only in the integer sums (exact).
+#[derive(Clone, Debug, Default)]
+pub struct Unpacked {
+    pub q: Vec<i8>,
+    pub factors: Vec<[f32; 3]>,
 }
 
-/// A row of Q5_0 blocks against activations of as many blocks.
-pub fn dot_q5_0_scalar(w: &[Q5_0], x: &[Q8_1]) -> f32 {
-    w.iter().zip(x).map(|(w, x)| w.d * x.d * sum(&w.values(), &x.qs) as f32).sum()
-}
-
-/// A row of Q4_K super-blocks against activations of eight blocks each: per block,
-/// `d·sc·dx·Σq·x − dmin·m·s` (`s = dx·Σx`).
-pub fn dot_q4_k_scalar(w: &[Q4K], x: &[Q8_1]) -> f32 {
-    let mut total = 0f32;
-    for (w, x) in w.iter().zip(x.chunks_exact(SUPER / BLOCK)) {
-        let q = w.values();
-        for (sub, (chunk, x)) in q.chunks_exact(BLOCK).zip(x).enumerate() {
-            let (sc, m) = w.scale_min(sub);
-            total += w.d * sc as f32 * x.d * sum(chunk, &x.qs) as f32 - w.dmin * m as f32 * x.s;
+impl Unpacked {
+    pub fn q5_0(blocks: &[Q5_0], out: &mut Unpacked) {
+        out.clear();
+        for b in blocks {
+            out.q.extend(b.values());
+            out.factors.push([b.d, b.d, 0.0]);
         }
     }
-    total
-}
 
-/// A row of Q6_K super-blocks against activations of eight blocks each: per block, its two
-/// 16-value halves' integer sums, each times its scale, then `d·dx`.
-pub fn dot_q6_k_scalar(w: &[Q6K], x: &[Q8_1]) -> f32 {
-    let mut total = 0f32;
-    for (w, x) in w.iter().zip(x.chunks_exact(SUPER / BLOCK)) {
-        let q = w.values();
-        for (b, (chunk, x)) in q.chunks_exact(BLOCK).zip(x).enumerate() {
-            let halves = w.scales[2 * b] as i32 * sum(&chunk[..16], &x.qs[..16])
-                + w.scales[2 * b + 1] as i32 * sum(&chunk[16..], &x.qs[16..]);
-            total += w.d * x.d * halves as f32;
+    pub fn q4_k(blocks: &[Q4K], out: &mut Unpacked) {
+        out.clear();
+        for b in blocks {
+            out.q.extend(b.values().map(|v| v as i8));
+            for sub in 0..SUPER / BLOCK {
+                let (sc, m) = b.scale_min(sub);
+                let scale = b.d * sc as f32;
+                out.factors.push([scale, scale, b.dmin * m as f32]);
+            }
         }
     }
-    total
+
+    pub fn q6_k(blocks: &[Q6K], out: &mut Unpacked) {
+        out.clear();
+        for b in blocks {
+            out.q.extend(b.values());
+            for sub in 0..SUPER / BLOCK {
+                out.factors.push([b.d * b.scales[2 * sub] as f32, b.d * b.scales[2 * sub + 1] as f32, 0.0]);
+            }
+        }
+    }
+
+    fn clear(&mut self) {
+        self.q.clear();
+        self.factors.clear();
+    }
+
+    /// The row against activations `x` (as many blocks), the halves' sums from `halves`.
+    pub fn dot(&self, x: &[Q8_1], halves: Halves) -> f32 {
+        let mut total = 0f32;
+        for ((q, [f1, f2, f3]), x) in self.q.chunks_exact(BLOCK).zip(&self.factors).zip(x) {
+            let q: &[i8; BLOCK] = q.try_into().unwrap_or(&[0; BLOCK]);
+            let (s1, s2) = halves(q, &x.qs);
+            total += x.d * (f1 * s1 as f32 + f2 * s2 as f32) - f3 * x.s;
+        }
+        total
+    }
+}
+
+/// The integer dot products of the two 16-value halves of two blocks of 32.
+pub type Halves = fn(&[i8; BLOCK], &[i8; BLOCK]) -> (i32, i32);
+
+pub fn halves_scalar(a: &[i8; BLOCK], b: &[i8; BLOCK]) -> (i32, i32) {
+    let sum = |a: &[i8], b: &[i8]| a.iter().zip(b).map(|(&x, &y)| x as i32 * y as i32).sum::<i32>();
+    (sum(&a[..16], &b[..16]), sum(&a[16..], &b[16..]))
+}
+
+/// [`halves_scalar`] with AVX2, when the CPU has it (the same integers).
+pub fn halves() -> Halves {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        return avx2::halves_safe;
+    }
+    halves_scalar
+}
+
+#[cfg(target_arch = "x86_64")]
+mod avx2 {
+    use super::BLOCK;
+    use std::arch::x86_64::*;
+
+    pub fn halves_safe(a: &[i8; BLOCK], b: &[i8; BLOCK]) -> (i32, i32) {
+        // SAFETY: chosen only when the CPU has AVX2 (`super::halves`)
+        unsafe { halves(a, b) }
+    }
+
+    /// `a`'s values are small (|a| ≤ 32 in every format here), so the pairwise 16-bit
+    /// sums of `|a|·(±b)` cannot saturate.
+    #[target_feature(enable = "avx2")]
+    fn halves(a: &[i8; BLOCK], b: &[i8; BLOCK]) -> (i32, i32) {
+        // SAFETY: both arrays are 32 bytes; unaligned loads
+        let (va, vb) = unsafe {
+            (_mm256_loadu_si256(a.as_ptr().cast::<__m256i>()), _mm256_loadu_si256(b.as_ptr().cast::<__m256i>()))
+        };
+        let products = _mm256_maddubs_epi16(_mm256_sign_epi8(va, va), _mm256_sign_epi8(vb, va));
+        let sums = _mm256_madd_epi16(products, _mm256_set1_epi16(1));
+        let half = |v: __m128i| {
+            let v = _mm_add_epi32(v, _mm_shuffle_epi32(v, 0b01_00_11_10));
+            let v = _mm_add_epi32(v, _mm_shuffle_epi32(v, 0b10_11_00_01));
+            _mm_cvtsi128_si32(v)
+        };
+        (half(_mm256_castsi256_si128(sums)), half(_mm256_extracti128_si256(sums, 1)))
+    }
+}
+
+/// A row of Q5_0 blocks against activations of as many blocks (the tests' reference).
+#[cfg(test)]
+fn dot_q5_0_scalar(w: &[Q5_0], x: &[Q8_1]) -> f32 {
+    let mut row = Unpacked::default();
+    Unpacked::q5_0(w, &mut row);
+    row.dot(x, halves_scalar)
+}
+
+/// A row of Q4_K super-blocks against activations of eight blocks each.
+#[cfg(test)]
+fn dot_q4_k_scalar(w: &[Q4K], x: &[Q8_1]) -> f32 {
+    let mut row = Unpacked::default();
+    Unpacked::q4_k(w, &mut row);
+    row.dot(x, halves_scalar)
+}
+
+/// A row of Q6_K super-blocks against activations of eight blocks each.
+#[cfg(test)]
+fn dot_q6_k_scalar(w: &[Q6K], x: &[Q8_1]) -> f32 {
+    let mut row = Unpacked::default();
+    Unpacked::q6_k(w, &mut row);
+    row.dot(x, halves_scalar)
 }
 
 #[cfg(test)]
@@ -330,5 +420,17 @@ mod tests {
             seen.push((dtype, name.clone()));
         }
         assert_eq!(seen.len(), 3, "the file holds Q5_0, Q4_K and Q6_K tensors: {seen:?}");
+    }
+
+    #[test]
+    fn the_simd_halves_are_the_scalar_ones() {
+        let mut rng = SplitMix64::new(21);
+        for _ in 0..1000 {
+            let mut a = [0i8; BLOCK];
+            let mut b = [0i8; BLOCK];
+            a.iter_mut().for_each(|v| *v = rng.below(65) as i8 - 32);
+            b.iter_mut().for_each(|v| *v = (rng.below(255) as i32 - 127) as i8);
+            assert_eq!(halves()(&a, &b), halves_scalar(&a, &b), "{a:?} · {b:?}");
+        }
     }
 }

@@ -23,7 +23,12 @@ use candle_core::quantized::GgmlDType;
 use candle_core::quantized::gguf_file::Content;
 
 use crate::adapter::{Adapter, Target, hf_to_gguf_rows};
-use crate::kquant::{self, Q4K, Q5_0, Q6K, SUPER};
+use crate::kquant::{self, Q4K, Q5_0, Q6K, SUPER, Unpacked};
+
+thread_local! {
+    /// A row being multiplied, unpacked ([`Matrix::row_all`]), kept between rows.
+    static UNPACKED: std::cell::RefCell<Unpacked> = std::cell::RefCell::new(Unpacked::default());
+}
 use crate::quant::{self, BLOCK, Heads, Kernels, Q4_1, Q8_0, Q8_1};
 
 /// A weight matrix: `rows` rows of `cols` values, row after row, in blocks (`per_row` of
@@ -61,9 +66,21 @@ impl Matrix {
         match self {
             Matrix::Q4_1 { blocks, per_row, .. } => (k.q4_1)(&blocks[r * per_row..(r + 1) * per_row], x),
             Matrix::Q8_0 { blocks, per_row, .. } => (k.q8_0)(&blocks[r * per_row..(r + 1) * per_row], x),
-            Matrix::Q5_0 { blocks, per_row, .. } => kquant::dot_q5_0_scalar(&blocks[r * per_row..(r + 1) * per_row], x),
-            Matrix::Q4K { blocks, per_row, .. } => kquant::dot_q4_k_scalar(&blocks[r * per_row..(r + 1) * per_row], x),
-            Matrix::Q6K { blocks, per_row, .. } => kquant::dot_q6_k_scalar(&blocks[r * per_row..(r + 1) * per_row], x),
+            Matrix::Q5_0 { .. } | Matrix::Q4K { .. } | Matrix::Q6K { .. } => {
+                let mut row = Unpacked::default();
+                self.unpack(r, &mut row);
+                row.dot(x, k.halves)
+            }
+        }
+    }
+
+    /// Row `r` of a K-format matrix (or Q5_0) unpacked; nothing for the others.
+    fn unpack(&self, r: usize, out: &mut Unpacked) {
+        match self {
+            Matrix::Q5_0 { blocks, per_row, .. } => Unpacked::q5_0(&blocks[r * per_row..(r + 1) * per_row], out),
+            Matrix::Q4K { blocks, per_row, .. } => Unpacked::q4_k(&blocks[r * per_row..(r + 1) * per_row], out),
+            Matrix::Q6K { blocks, per_row, .. } => Unpacked::q6_k(&blocks[r * per_row..(r + 1) * per_row], out),
+            Matrix::Q4_1 { .. } | Matrix::Q8_0 { .. } => {}
         }
     }
 
@@ -106,6 +123,12 @@ impl Matrix {
                 out.extend((k.q4_1_x4)(w, [&four[0], &four[1], &four[2], &four[3]]));
             }
             out.extend(fours.remainder().iter().map(|xt| self.row(k, r, xt)));
+        } else if let Matrix::Q5_0 { .. } | Matrix::Q4K { .. } | Matrix::Q6K { .. } = self {
+            // unpacked once for the chunk's tokens
+            UNPACKED.with_borrow_mut(|row| {
+                self.unpack(r, row);
+                out.extend(x.iter().map(|xt| row.dot(xt, k.halves)));
+            });
         } else {
             out.extend(x.iter().map(|xt| self.row(k, r, xt)));
         }

@@ -116,6 +116,8 @@ pub struct Kernels {
     /// One weight row against four tokens: the row is unpacked once.
     pub q4_1_x4: fn(&[Q4_1], [&[Q8_1]; 4]) -> [f32; 4],
     pub q8_0: fn(&[Q8_0], &[Q8_1]) -> f32,
+    /// The integer sums of the K formats' unpacked rows ([`crate::kquant::Unpacked`]).
+    pub halves: crate::kquant::Halves,
     /// `out = softmax(q·kᵀ·scale)·v` over a head's positions (`scores` is scratch).
     pub attend: fn(&[f32], &Heads, f32, &mut Vec<f32>, &mut [f32]),
     pub name: &'static str,
@@ -168,6 +170,7 @@ impl Kernels {
                 q4_1: avx2::q4_1_safe,
                 q4_1_x4: avx2::q4_1_x4_safe,
                 q8_0: avx2::q8_0_safe,
+                halves: crate::kquant::halves(),
                 attend: avx2::attend_safe,
                 name: "avx2",
             };
@@ -180,6 +183,7 @@ impl Kernels {
             q4_1: dot_q4_1_scalar,
             q4_1_x4: |w, x| x.map(|x| dot_q4_1_scalar(w, x)),
             q8_0: dot_q8_0_scalar,
+            halves: crate::kquant::halves_scalar,
             attend: |q, h, scale, scores, out| attend_with(dot_scalar, axpy_scalar, q, h, scale, scores, out),
             name: "scalar",
         }
