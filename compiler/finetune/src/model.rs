@@ -15,7 +15,7 @@ use std::path::Path;
 use candle_core::quantized::gguf_file::Content;
 use candle_core::{D, DType, Device, Tensor, Var};
 use candle_nn::VarMap;
-use tad_local::{Adapter, Lora, Shape, Target, gguf_to_hf_rows, hf_to_gguf_rows, tensor_name};
+use tad_local::{Adapter, Arch, Lora, Shape, Target, gguf_to_hf_rows, hf_to_gguf_rows, tensor_name};
 
 pub(crate) fn err(e: impl std::fmt::Display) -> String {
     e.to_string()
@@ -51,6 +51,9 @@ impl Weights {
     /// Dequantizes the GGUF's tensors (the llama.cpp names), each checked against the shape.
     pub fn from_gguf(content: &Content, file: &mut std::fs::File) -> Result<Weights, String> {
         let shape = Shape::from_gguf(content)?;
+        if shape.arch != Arch::Llama {
+            return Err(format!("a {:?} model: LoRA fine-tuning reads the llama architecture only", shape.arch));
+        }
         let device = Device::Cpu;
         let mut load = |name: &str, dims: &[usize]| -> Result<Tensor, String> {
             let q = content.tensor(file, name, &device).map_err(|e| format!("tensor `{name}`: {e}"))?;

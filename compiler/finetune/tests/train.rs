@@ -10,10 +10,11 @@ use std::path::{Path, PathBuf};
 use tad_finetune::{
     Adapter, Config, Example, FinetuneError, LoraSet, Message, Progress, Rng, Sample, Target, Weights, uniform,
 };
-use tad_local::{Lora, Shape};
+use tad_local::{Arch, Lora, Shape};
 
 fn tiny_shape() -> Shape {
     Shape {
+        arch: Arch::Llama,
         layers: 2,
         dim: 32,
         hidden: 64,

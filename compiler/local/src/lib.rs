@@ -21,7 +21,7 @@ use tad_llm::{Chat, ChatFuture, Error, ErrorKind, OnText, Request};
 
 pub use adapter::{Adapter, BASE_MODEL, Lora, Target, gguf_to_hf_rows, hf_to_gguf_rows, tensor_name};
 pub use engine::{Engine, Timing, chatml, tokenizer};
-pub use llama::Shape;
+pub use llama::{Arch, Shape};
 pub use tokenizers::Tokenizer;
 
 // The table of models and their fetching live in `tad-models`, shared with `tad-embed`.

@@ -365,6 +365,13 @@ impl Model {
     /// Applies `adapter` from now on (in f32, beside the quantized products); checked
     /// against the model's shape first.
     pub fn attach(&mut self, adapter: &Adapter) -> Result<(), String> {
+        // the query and key rows are reordered for llama's rotary layout, not qwen2's
+        if self.shape.arch != Arch::Llama {
+            return Err(format!(
+                "a {:?} model: LoRA adapters are applied to the llama architecture only",
+                self.shape.arch
+            ));
+        }
         adapter.check(&self.shape)?;
         let mut layers: Vec<[Option<LoraPair>; 7]> = (0..self.shape.layers).map(|_| Default::default()).collect();
         for (&(layer, target), lora) in &adapter.layers {
