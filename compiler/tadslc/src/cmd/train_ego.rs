@@ -6,7 +6,7 @@
 //! the task's seed, so the whole run is a function of the seed and the inputs. The split
 //! keys each scenario by its behaviour (`tad_eval::corpus::behaviour`).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use tad_eval::pretrain::Judged;
 use tad_eval::train::{Start, TrainScene};
@@ -131,6 +131,42 @@ impl TrainEgoArgs {
     }
 }
 
+/// Without a warm start, a run whose episodes cannot store the transitions learning starts
+/// at, even at the longest training scenario's step limit, would make nothing: refused
+/// before it runs.
+fn refuse_what_cannot_learn(
+    trainer: &Trainer,
+    scenes: &[Loaded],
+    train: &[usize],
+    total: usize,
+    warm: bool,
+) -> Result<(), CliError> {
+    let longest = train.iter().map(|&i| scenes[i].scene.limits.max_steps as usize).max().unwrap_or(0);
+    let to_run = total.saturating_sub(trainer.episodes() as usize);
+    match trainer.cannot_learn_within(to_run, longest).filter(|_| !warm) {
+        Some(why) => Err(CliError::usage(format!("no learning step could be taken: {why} (--episodes)"))),
+        None => Ok(()),
+    }
+}
+
+/// A run that took no learning step: an error without a warm start (its actor is the one it
+/// started with, so it is not written as if trained; the checkpoint is), else a warning.
+fn no_learning_step(trainer: &Trainer, warm: bool, checkpoint: &Path) -> Result<(), CliError> {
+    let (stored, needed) = (trainer.replay_len(), trainer.config().transitions_to_learn());
+    if !warm {
+        return Err(CliError::failed(format!(
+            "no learning step was taken: the episodes ended early and stored {stored} transitions; learning starts \
+             at {needed}. The checkpoint is in {}: continue with --resume and more --episodes",
+            checkpoint.display()
+        )));
+    }
+    errln!(
+        "warning: no learning step was taken after the warm start: {stored} transitions are stored and learning \
+         starts at {needed} (more --episodes)"
+    )?;
+    Ok(())
+}
+
 /// A scenario's behaviour for the split (`none` for a `.tadc` file, which has no source).
 fn behaviour_key(loaded: &Loaded) -> String {
     loaded.key.clone().unwrap_or_else(|| "none".into())
@@ -164,13 +200,8 @@ pub fn run(args: &TrainEgoArgs, color: bool) -> Result<Status, CliError> {
     let total = config_episodes;
     let train_scenes: Vec<TrainScene> =
         train.iter().map(|&i| TrainScene { scene: &scenes[i].scene, fixed: None }).collect();
-    // without a warm start, a run that cannot take a learning step would make nothing
-    let longest = train.iter().map(|&i| scenes[i].scene.limits.max_steps as usize).max().unwrap_or(0);
-    let to_run = total.saturating_sub(trainer.episodes() as usize);
-    if let Some(why) = trainer.cannot_learn_within(to_run, longest).filter(|_| teacher.is_none()) {
-        return Err(CliError::usage(format!("no learning step could be taken: {why} (--episodes)")));
-    }
     let warm = teacher.is_some();
+    refuse_what_cannot_learn(&trainer, scenes, &train, total, warm)?;
     if let Some(teacher) = teacher.filter(|_| trainer.episodes() == 0) {
         imitate(&mut trainer, &train_scenes, &teacher, args)?;
     }
@@ -231,19 +262,7 @@ pub fn run(args: &TrainEgoArgs, color: bool) -> Result<Status, CliError> {
     }
     trainer.save_checkpoint(&checkpoint).map_err(CliError::usage)?;
     if trainer.updates() == 0 && trainer.episodes() > 0 {
-        let (stored, needed) = (trainer.replay_len(), trainer.config().transitions_to_learn());
-        if !warm {
-            // the actor is the one it started with: not written as if trained
-            return Err(CliError::failed(format!(
-                "no learning step was taken: the episodes ended early and stored {stored} transitions; learning \
-                 starts at {needed}. The checkpoint is in {}: continue with --resume and more --episodes",
-                checkpoint.display()
-            )));
-        }
-        errln!(
-            "warning: no learning step was taken after the warm start: {stored} transitions are stored and learning \
-             starts at {needed} (more --episodes)"
-        )?;
+        no_learning_step(&trainer, warm, &checkpoint)?;
     }
     if let Some(path) = &args.plot {
         let validation = selection.as_ref().map(|s| s.history.clone()).unwrap_or_default();
