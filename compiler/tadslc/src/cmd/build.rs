@@ -285,11 +285,28 @@ mod tests {
     use super::*;
     use crate::output::finish;
 
-    fn scratch(name: &str) -> PathBuf {
+    /// A fresh directory under the system's temporary one, removed when the test ends
+    /// (passed or not).
+    struct Scratch(PathBuf);
+
+    impl Drop for Scratch {
+        fn drop(&mut self) {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
+
+    impl std::ops::Deref for Scratch {
+        type Target = Path;
+        fn deref(&self) -> &Path {
+            &self.0
+        }
+    }
+
+    fn scratch(name: &str) -> Scratch {
         let dir = std::env::temp_dir().join(format!("tadslc-build-{name}-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap();
-        dir
+        Scratch(dir)
     }
 
     fn build(paths: &[PathBuf], output: Option<&Path>, map_dir: Option<&str>, simulator: SimulatorArg) -> BuildArgs {
@@ -312,7 +329,7 @@ mod tests {
         let out = scratch("ok");
         let inputs =
             [example("examples/safety/right_turn.tad"), example("examples/regions/yosemite_deer_on_curve.tad")];
-        let args = build(&inputs, Some(&out), Some("maps"), SimulatorArg::Newtonian);
+        let args = build(&inputs, Some(&*out), Some("maps"), SimulatorArg::Newtonian);
         let status = finish(run(&args, false));
         assert_eq!(status, Status::Ok);
         let text = std::fs::read_to_string(out.join("right_turn.scenic")).unwrap();
@@ -328,7 +345,7 @@ mod tests {
         let bad = dir.join("bad.tad");
         std::fs::write(&bad, "scenario bad {\n  environment {\n    weather: sunnyy\n  }\n}\n").unwrap();
         assert_eq!(
-            finish(run(&build(std::slice::from_ref(&bad), Some(&dir), None, SimulatorArg::Carla), false)),
+            finish(run(&build(std::slice::from_ref(&bad), Some(&*dir), None, SimulatorArg::Carla), false)),
             Status::Failed
         );
         assert!(!dir.join("bad.scenic").exists());
@@ -348,13 +365,13 @@ mod tests {
             finish(run(&args, false))
         };
         let disasm = |path: PathBuf| finish(crate::cmd::disasm::run(&crate::cmd::disasm::Args { path }));
-        assert_eq!(bytecode(Some(&out), None), Status::Ok);
+        assert_eq!(bytecode(Some(&*out), None), Status::Ok);
         let bytes = std::fs::read(out.join("right_turn.tadc")).unwrap();
         let program = tad_bytecode::decode(&bytes).unwrap();
         assert_eq!(program.name, "right_turn");
         assert_eq!(disasm(out.join("right_turn.tadc")), Status::Ok);
         assert_eq!(bytecode(None, None), Status::Usage);
-        assert_eq!(bytecode(Some(&out), Some("maps")), Status::Usage);
+        assert_eq!(bytecode(Some(&*out), Some("maps")), Status::Usage);
         std::fs::write(out.join("bad.tadc"), b"TADC\x09\x00").unwrap();
         assert_eq!(disasm(out.join("bad.tadc")), Status::Failed);
         assert_eq!(disasm(out.join("missing.tadc")), Status::Usage);
