@@ -290,30 +290,6 @@ mod avx2 {
     }
 }
 
-/// A row of Q5_0 blocks against activations of as many blocks (the tests' reference).
-#[cfg(test)]
-fn dot_q5_0_scalar(w: &[Q5_0], x: &[Q8_1]) -> f32 {
-    let mut row = Unpacked::default();
-    Unpacked::q5_0(w, &mut row);
-    row.dot(x, halves_scalar)
-}
-
-/// A row of Q4_K super-blocks against activations of eight blocks each.
-#[cfg(test)]
-fn dot_q4_k_scalar(w: &[Q4K], x: &[Q8_1]) -> f32 {
-    let mut row = Unpacked::default();
-    Unpacked::q4_k(w, &mut row);
-    row.dot(x, halves_scalar)
-}
-
-/// A row of Q6_K super-blocks against activations of eight blocks each.
-#[cfg(test)]
-fn dot_q6_k_scalar(w: &[Q6K], x: &[Q8_1]) -> f32 {
-    let mut row = Unpacked::default();
-    Unpacked::q6_k(w, &mut row);
-    row.dot(x, halves_scalar)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -352,6 +328,13 @@ mod tests {
         tensor.dequantize(&Device::Cpu).unwrap().to_vec1::<f32>().unwrap()
     }
 
+    /// A row of blocks unpacked by `unpack`.
+    fn unpacked<B>(unpack: fn(&[B], &mut Unpacked), blocks: &[B]) -> Unpacked {
+        let mut row = Unpacked::default();
+        unpack(blocks, &mut row);
+        row
+    }
+
     fn ours(dtype: GgmlDType, bytes: &[u8]) -> Vec<f32> {
         let mut out = Vec::new();
         match dtype {
@@ -387,10 +370,11 @@ mod tests {
             let w = ours(dtype, &bytes);
             let want: f64 = w.iter().zip(&xd).map(|(a, b)| f64::from(*a) * f64::from(*b)).sum();
             let got = match dtype {
-                GgmlDType::Q5_0 => dot_q5_0_scalar(&read_q5_0(&bytes), &xq),
-                GgmlDType::Q4K => dot_q4_k_scalar(&read_q4_k(&bytes), &xq),
-                _ => dot_q6_k_scalar(&read_q6_k(&bytes), &xq),
-            };
+                GgmlDType::Q5_0 => unpacked(Unpacked::q5_0, &read_q5_0(&bytes)),
+                GgmlDType::Q4K => unpacked(Unpacked::q4_k, &read_q4_k(&bytes)),
+                _ => unpacked(Unpacked::q6_k, &read_q6_k(&bytes)),
+            }
+            .dot(&xq, halves_scalar);
             let size: f64 = w.iter().zip(&xd).map(|(a, b)| (f64::from(*a) * f64::from(*b)).abs()).sum();
             assert!((f64::from(got) - want).abs() <= 1e-5 * size, "{dtype:?}: {got} against {want}");
         }

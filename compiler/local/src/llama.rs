@@ -66,11 +66,10 @@ impl Matrix {
         match self {
             Matrix::Q4_1 { blocks, per_row, .. } => (k.q4_1)(&blocks[r * per_row..(r + 1) * per_row], x),
             Matrix::Q8_0 { blocks, per_row, .. } => (k.q8_0)(&blocks[r * per_row..(r + 1) * per_row], x),
-            Matrix::Q5_0 { .. } | Matrix::Q4K { .. } | Matrix::Q6K { .. } => {
-                let mut row = Unpacked::default();
-                self.unpack(r, &mut row);
+            Matrix::Q5_0 { .. } | Matrix::Q4K { .. } | Matrix::Q6K { .. } => UNPACKED.with_borrow_mut(|row| {
+                self.unpack(r, row);
                 row.dot(x, k.halves)
-            }
+            }),
         }
     }
 
@@ -713,6 +712,16 @@ mod tests {
         assert!(error.contains("blk.0.attn_q.weight"), "{error}");
     }
 
+    /// `tokens` as a batch of one for candle's models.
+    fn batch(tokens: &[u32]) -> Tensor {
+        Tensor::new(tokens, &Device::Cpu).unwrap().unsqueeze(0).unwrap()
+    }
+
+    /// The logits a candle model returned for a batch of one.
+    fn candles(forward: candle_core::Result<Tensor>) -> Vec<f32> {
+        forward.unwrap().squeeze(0).unwrap().to_vec1().unwrap()
+    }
+
     #[test]
     fn agrees_with_candles_quantized_llama() {
         let Some(path) = gguf() else { return };
@@ -725,9 +734,7 @@ mod tests {
         // "<|im_start|>user\nA bus drives ahead of the ego car.<|im_end|>\n<|im_start|>assistant\n"
         let tokens: Vec<u32> =
             vec![1, 4093, 198, 49, 1615, 16520, 4245, 282, 260, 23346, 1345, 30, 2, 198, 1, 520, 9531, 198];
-        let expected =
-            reference.forward(&Tensor::new(tokens.as_slice(), &Device::Cpu).unwrap().unsqueeze(0).unwrap(), 0).unwrap();
-        let expected: Vec<f32> = expected.squeeze(0).unwrap().to_vec1().unwrap();
+        let expected = candles(reference.forward(&batch(&tokens), 0));
 
         let mut cache = ours.new_cache();
         let chunked = ours.forward(&tokens, &mut cache);
@@ -761,10 +768,7 @@ mod tests {
 
         // the next token, continuing from the cache, as candle continues from its own
         let next = argmax(&expected) as u32;
-        let theirs = reference
-            .forward(&Tensor::new(&[next], &Device::Cpu).unwrap().unsqueeze(0).unwrap(), tokens.len())
-            .unwrap();
-        let theirs: Vec<f32> = theirs.squeeze(0).unwrap().to_vec1().unwrap();
+        let theirs = candles(reference.forward(&batch(&[next]), tokens.len()));
         let mine = ours.forward(&[next], &mut cache);
         assert_eq!(argmax(&mine), argmax(&theirs));
         assert!(cosine(&mine, &theirs) > 0.995, "cosine {}", cosine(&mine, &theirs));
@@ -784,9 +788,7 @@ mod tests {
         assert_eq!(ours.shape.arch, Arch::Qwen2);
         let mut file2 = std::fs::File::open(&path).unwrap();
         let mut reference = Qwen2::from_gguf(Content::read(&mut file2).unwrap(), &mut file2, &Device::Cpu).unwrap();
-        let expected =
-            reference.forward(&Tensor::new(tokens.as_slice(), &Device::Cpu).unwrap().unsqueeze(0).unwrap(), 0).unwrap();
-        let expected: Vec<f32> = expected.squeeze(0).unwrap().to_vec1().unwrap();
+        let expected = candles(reference.forward(&batch(&tokens), 0));
         let mut cache = ours.new_cache();
         let logits = ours.forward(&tokens, &mut cache);
         assert_eq!(logits.len(), expected.len());
@@ -794,10 +796,7 @@ mod tests {
         assert!(cosine(&logits, &expected) > 0.99, "cosine {}", cosine(&logits, &expected));
         // the next token from the cache, as candle's
         let next = argmax(&expected) as u32;
-        let theirs = reference
-            .forward(&Tensor::new(&[next], &Device::Cpu).unwrap().unsqueeze(0).unwrap(), tokens.len())
-            .unwrap();
-        let theirs: Vec<f32> = theirs.squeeze(0).unwrap().to_vec1().unwrap();
+        let theirs = candles(reference.forward(&batch(&[next]), tokens.len()));
         let mine = ours.forward(&[next], &mut cache);
         assert_eq!(argmax(&mine), argmax(&theirs));
         assert!(cosine(&mine, &theirs) > 0.99, "cosine {}", cosine(&mine, &theirs));
