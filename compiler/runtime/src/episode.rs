@@ -902,9 +902,9 @@ impl<'a> Corridor<'a> {
 /// one before it arrives. One that does not `yield` (an adversary) only stops for crossing
 /// traffic already in front of it.
 fn ahead_on(corridor: Corridor, me: Seen, yields: bool, others: impl Iterator<Item = Seen>) -> Option<(f64, f64)> {
-    let Seen { position, heading, speed, .. } = me;
-    let heading = if corridor.back { Vec2::from_yaw(me.yaw + std::f64::consts::PI) } else { heading };
-    let others = others.map(|o| if corridor.back { o.reversed() } else { o });
+    let turn = |o: Seen| if corridor.back { o.reversed() } else { o };
+    let Seen { position, heading, speed, .. } = turn(me);
+    let others = others.map(turn);
     NEAR.with_borrow_mut(|(ahead, crossing)| {
         ahead.clear();
         crossing.clear();
