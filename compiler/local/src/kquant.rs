@@ -6,8 +6,9 @@
 //! Their dot products take the same activations as the other kernels: blocks of 32 values
 //! quantized to 8 bits with their sum ([`Q8_1`]), eight to a super-block. Each block's
 //! integer sum is scaled once, so a product is the dequantized weights against the
-//! dequantized activations, up to float rounding. A super-block is unpacked to its 256
-//! small integers first, which keeps the arithmetic the same for every format.
+//! dequantized activations, up to float rounding. The scalar kernels unpack a block's
+//! small integers and sum; the AVX2 ones do the same on the packed bytes, 32 values a step,
+//! and differ from them only in the order of the float additions.
 //!
 //! The layouts are ggml's (`ggml-common.h`, `block_q5_0`, `block_q4_K`, `block_q6_K`); the
 //! tests hold the dequantization to candle's on random blocks and on the real files.
@@ -185,108 +186,226 @@ pub fn dequantize_q6_k(blocks: &[Q6K], out: &mut Vec<f32>) {
     }
 }
 
-/// A weight row unpacked for dot products: its values as small integers, and for each
-/// block of 32 the factors `(f1, f2, f3)` of `dx·(f1·Σ₁ + f2·Σ₂) − f3·s`, where Σ₁ and Σ₂
-/// are the integer sums of its two 16-value halves against an activation block (`dx`,
-/// `s = dx·Σx`). One form for every format, so a row is unpacked once for all the tokens
-/// of a chunk, and the scalar and AVX2 kernels differ only in the integer sums (exact).
-#[derive(Clone, Debug, Default)]
-pub struct Unpacked {
-    pub q: Vec<i8>,
-    pub factors: Vec<[f32; 3]>,
+/// The integer dot product of two runs of small integers.
+fn isum<A: Copy + Into<i32>>(a: &[A], b: &[i8]) -> i32 {
+    a.iter().zip(b).map(|(&a, &b)| a.into() * b as i32).sum()
 }
 
-impl Unpacked {
-    pub fn q5_0(blocks: &[Q5_0], out: &mut Unpacked) {
-        out.clear();
-        for b in blocks {
-            out.q.extend(b.values());
-            out.factors.push([b.d, b.d, 0.0]);
+/// Q5_0 blocks against as many activation blocks: Σ d·dx·Σq·x.
+pub fn dot_q5_0(w: &[Q5_0], x: &[Q8_1]) -> f32 {
+    w.iter().zip(x).map(|(b, x)| b.d * x.d * isum(&b.values(), &x.qs) as f32).sum()
+}
+
+/// Q4_K super-blocks against eight activation blocks each: per sub-block
+/// `d·sc·dx·Σq·x − dmin·m·s` (the minimum meets the activations' sum).
+pub fn dot_q4_k(w: &[Q4K], x: &[Q8_1]) -> f32 {
+    let mut total = 0.0;
+    for (b, x) in w.iter().zip(x.chunks_exact(SUPER / BLOCK)) {
+        let q = b.values();
+        for (sub, (q, x)) in q.chunks_exact(BLOCK).zip(x).enumerate() {
+            let (sc, m) = b.scale_min(sub);
+            total += b.d * sc as f32 * x.d * isum(q, &x.qs) as f32 - b.dmin * m as f32 * x.s;
         }
     }
+    total
+}
 
-    pub fn q4_k(blocks: &[Q4K], out: &mut Unpacked) {
-        out.clear();
-        for b in blocks {
-            out.q.extend(b.values().map(|v| v as i8));
-            for sub in 0..SUPER / BLOCK {
-                let (sc, m) = b.scale_min(sub);
-                let scale = b.d * sc as f32;
-                out.factors.push([scale, scale, b.dmin * m as f32]);
-            }
+/// Q6_K super-blocks against eight activation blocks each: per 16 values `d·sc·dx·Σq·x`.
+pub fn dot_q6_k(w: &[Q6K], x: &[Q8_1]) -> f32 {
+    let mut total = 0.0;
+    for (b, x) in w.iter().zip(x.chunks_exact(SUPER / BLOCK)) {
+        let q = b.values();
+        for (sub, q) in q.chunks_exact(16).enumerate() {
+            let x = &x[sub / 2];
+            let qs = &x.qs[16 * (sub % 2)..16 * (sub % 2) + 16];
+            total += b.d * b.scales[sub] as f32 * x.d * isum(q, qs) as f32;
         }
     }
+    total
+}
 
-    pub fn q6_k(blocks: &[Q6K], out: &mut Unpacked) {
-        out.clear();
-        for b in blocks {
-            out.q.extend(b.values());
-            for sub in 0..SUPER / BLOCK {
-                out.factors.push([b.d * b.scales[2 * sub] as f32, b.d * b.scales[2 * sub + 1] as f32, 0.0]);
-            }
-        }
-    }
+/// A row's product with one token, and with four at once (the row's blocks unpacked once
+/// for the four).
+pub type Dot<B> = fn(&[B], &[Q8_1]) -> f32;
+pub type Dot4<B> = fn(&[B], [&[Q8_1]; 4]) -> [f32; 4];
 
-    fn clear(&mut self) {
-        self.q.clear();
-        self.factors.clear();
-    }
+/// The kernels of one format for this CPU: AVX2 and FMA where it has them, else scalar.
+pub struct FormatKernels<B> {
+    pub one: Dot<B>,
+    pub four: Dot4<B>,
+}
 
-    /// The row against activations `x` (as many blocks), the halves' sums from `halves`.
-    pub fn dot(&self, x: &[Q8_1], halves: Halves) -> f32 {
-        let mut total = 0f32;
-        for ((q, [f1, f2, f3]), x) in self.q.chunks_exact(BLOCK).zip(&self.factors).zip(x) {
-            let q: &[i8; BLOCK] = q.try_into().unwrap_or(&[0; BLOCK]);
-            let (s1, s2) = halves(q, &x.qs);
-            total += x.d * (f1 * s1 as f32 + f2 * s2 as f32) - f3 * x.s;
-        }
-        total
+// by hand: a derive would ask `B: Copy` of the blocks
+impl<B> Clone for FormatKernels<B> {
+    fn clone(&self) -> Self {
+        *self
     }
 }
 
-/// The integer dot products of the two 16-value halves of two blocks of 32.
-pub type Halves = fn(&[i8; BLOCK], &[i8; BLOCK]) -> (i32, i32);
+impl<B> Copy for FormatKernels<B> {}
 
-pub fn halves_scalar(a: &[i8; BLOCK], b: &[i8; BLOCK]) -> (i32, i32) {
-    let sum = |a: &[i8], b: &[i8]| a.iter().zip(b).map(|(&x, &y)| x as i32 * y as i32).sum::<i32>();
-    (sum(&a[..16], &b[..16]), sum(&a[16..], &b[16..]))
-}
-
-/// [`halves_scalar`] with AVX2, when the CPU has it (the same integers).
-pub fn halves() -> Halves {
+pub fn kernels() -> (FormatKernels<Q5_0>, FormatKernels<Q4K>, FormatKernels<Q6K>) {
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        return avx2::halves_safe;
+    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+        return (
+            FormatKernels { one: |w, x| avx2::q5_0_safe(w, [x])[0], four: avx2::q5_0_safe },
+            FormatKernels { one: |w, x| avx2::q4_k_safe(w, [x])[0], four: avx2::q4_k_safe },
+            FormatKernels { one: |w, x| avx2::q6_k_safe(w, [x])[0], four: avx2::q6_k_safe },
+        );
     }
-    halves_scalar
+    scalar_kernels()
 }
 
+pub fn scalar_kernels() -> (FormatKernels<Q5_0>, FormatKernels<Q4K>, FormatKernels<Q6K>) {
+    (
+        FormatKernels { one: dot_q5_0, four: |w, x| x.map(|x| dot_q5_0(w, x)) },
+        FormatKernels { one: dot_q4_k, four: |w, x| x.map(|x| dot_q4_k(w, x)) },
+        FormatKernels { one: dot_q6_k, four: |w, x| x.map(|x| dot_q6_k(w, x)) },
+    )
+}
+
+/// The same products on packed blocks, 32 values a step: a block's values as signed bytes,
+/// their products with a token's in 16-bit pairs (`maddubs` through the sign trick),
+/// summed to eight 32-bit lanes against 16-bit scales, scaled and accumulated in floats.
+/// Each block is unpacked once for all the tokens of a call.
 #[cfg(target_arch = "x86_64")]
 mod avx2 {
-    use super::BLOCK;
+    use super::{BLOCK, Q4K, Q5_0, Q6K, Q8_1, SUPER};
     use std::arch::x86_64::*;
 
-    pub fn halves_safe(a: &[i8; BLOCK], b: &[i8; BLOCK]) -> (i32, i32) {
-        // SAFETY: chosen only when the CPU has AVX2 (`super::halves`)
-        unsafe { halves(a, b) }
+    pub fn q5_0_safe<const N: usize>(w: &[Q5_0], x: [&[Q8_1]; N]) -> [f32; N] {
+        // SAFETY: chosen only when the CPU has AVX2 and FMA (`super::kernels`)
+        unsafe { q5_0(w, x) }
     }
 
-    /// `a`'s values are small (|a| ≤ 32 in every format here), so the pairwise 16-bit
-    /// sums of `|a|·(±b)` cannot saturate.
-    #[target_feature(enable = "avx2")]
-    fn halves(a: &[i8; BLOCK], b: &[i8; BLOCK]) -> (i32, i32) {
-        // SAFETY: both arrays are 32 bytes; unaligned loads
-        let (va, vb) = unsafe {
-            (_mm256_loadu_si256(a.as_ptr().cast::<__m256i>()), _mm256_loadu_si256(b.as_ptr().cast::<__m256i>()))
-        };
-        let products = _mm256_maddubs_epi16(_mm256_sign_epi8(va, va), _mm256_sign_epi8(vb, va));
-        let sums = _mm256_madd_epi16(products, _mm256_set1_epi16(1));
-        let half = |v: __m128i| {
-            let v = _mm_add_epi32(v, _mm_shuffle_epi32(v, 0b01_00_11_10));
-            let v = _mm_add_epi32(v, _mm_shuffle_epi32(v, 0b10_11_00_01));
-            _mm_cvtsi128_si32(v)
-        };
-        (half(_mm256_castsi256_si128(sums)), half(_mm256_extracti128_si256(sums, 1)))
+    pub fn q4_k_safe<const N: usize>(w: &[Q4K], x: [&[Q8_1]; N]) -> [f32; N] {
+        // SAFETY: as above
+        unsafe { q4_k(w, x) }
+    }
+
+    pub fn q6_k_safe<const N: usize>(w: &[Q6K], x: [&[Q8_1]; N]) -> [f32; N] {
+        // SAFETY: as above
+        unsafe { q6_k(w, x) }
+    }
+
+    /// `acc[t] += w·dx_t · Σ q·x_t·scale`, `q` signed with |q| ≤ 32 (so the 16-bit pairs
+    /// cannot saturate), `scales` 16-bit per pair of values.
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    fn add<const N: usize>(acc: &mut [__m256; N], q: __m256i, scales: __m256i, w: f32, x: [&Q8_1; N]) {
+        let magnitude = _mm256_sign_epi8(q, q);
+        for (acc, x) in acc.iter_mut().zip(x) {
+            // SAFETY: 32 bytes, an unaligned load
+            let xq = unsafe { _mm256_loadu_si256(x.qs.as_ptr().cast()) };
+            let pairs = _mm256_maddubs_epi16(magnitude, _mm256_sign_epi8(xq, q));
+            let sums = _mm256_madd_epi16(pairs, scales);
+            *acc = _mm256_fmadd_ps(_mm256_set1_ps(w * x.d), _mm256_cvtepi32_ps(sums), *acc);
+        }
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    fn hsum(v: __m256) -> f32 {
+        let v = _mm_add_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
+        let v = _mm_add_ps(v, _mm_movehl_ps(v, v));
+        let v = _mm_add_ss(v, _mm_movehdup_ps(v));
+        _mm_cvtss_f32(v)
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    fn q5_0<const N: usize>(w: &[Q5_0], x: [&[Q8_1]; N]) -> [f32; N] {
+        // byte j of the 32 takes byte j/8 of qh, and keeps bit j%8 of it
+        let spread = _mm256_set_epi64x(0x0303030303030303, 0x0202020202020202, 0x0101010101010101, 0);
+        let bit = _mm256_set1_epi64x(0x8040201008040201u64 as i64);
+        let (low, fifth, sixteen) = (_mm_set1_epi8(0x0f), _mm256_set1_epi8(0x10), _mm256_set1_epi8(16));
+        let ones = _mm256_set1_epi16(1);
+        let mut acc = [_mm256_setzero_ps(); N];
+        for (i, b) in w.iter().enumerate() {
+            // SAFETY: 16 bytes, an unaligned load
+            let packed = unsafe { _mm_loadu_si128(b.qs.as_ptr().cast()) };
+            let nibbles = _mm256_set_m128i(_mm_and_si128(_mm_srli_epi16(packed, 4), low), _mm_and_si128(packed, low));
+            let bits = _mm256_and_si256(_mm256_shuffle_epi8(_mm256_set1_epi32(b.qh as i32), spread), bit);
+            let high = _mm256_and_si256(_mm256_cmpeq_epi8(bits, bit), fifth);
+            let q = _mm256_sub_epi8(_mm256_or_si256(nibbles, high), sixteen);
+            let Some(xs) = blocks(&x, i) else { break };
+            add(&mut acc, q, ones, b.d, xs);
+        }
+        acc.map(|a| hsum(a))
+    }
+
+    /// Block `i` of each token's activations; `None` past the shortest.
+    #[inline]
+    fn blocks<'a, const N: usize>(x: &[&'a [Q8_1]; N], i: usize) -> Option<[&'a Q8_1; N]> {
+        if x.iter().any(|x| i >= x.len()) {
+            return None;
+        }
+        Some(std::array::from_fn(|t| &x[t][i]))
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    fn q4_k<const N: usize>(w: &[Q4K], x: [&[Q8_1]; N]) -> [f32; N] {
+        let (low, ones) = (_mm256_set1_epi8(0x0f), _mm256_set1_epi16(1));
+        let mut acc = [_mm256_setzero_ps(); N];
+        let mut mins = [0f32; N];
+        for (i, b) in w.iter().enumerate() {
+            for pair in 0..4 {
+                // SAFETY: 32 of the 128 bytes, an unaligned load
+                let packed = unsafe { _mm256_loadu_si256(b.qs.as_ptr().add(32 * pair).cast()) };
+                let halves = [_mm256_and_si256(packed, low), _mm256_and_si256(_mm256_srli_epi16(packed, 4), low)];
+                for (h, q) in halves.into_iter().enumerate() {
+                    let sub = 2 * pair + h;
+                    let Some(xs) = blocks(&x, i * (SUPER / BLOCK) + sub) else { return finish(acc, mins) };
+                    let (sc, m) = b.scale_min(sub);
+                    add(&mut acc, q, ones, b.d * sc as f32, xs);
+                    for (min, x) in mins.iter_mut().zip(xs) {
+                        *min += b.dmin * m as f32 * x.s;
+                    }
+                }
+            }
+        }
+        finish(acc, mins)
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    fn finish<const N: usize>(acc: [__m256; N], mins: [f32; N]) -> [f32; N] {
+        std::array::from_fn(|t| hsum(acc[t]) - mins[t])
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    fn q6_k<const N: usize>(w: &[Q6K], x: [&[Q8_1]; N]) -> [f32; N] {
+        let (low, top, offset) = (_mm256_set1_epi8(0x0f), _mm256_set1_epi8(0x30), _mm256_set1_epi8(32));
+        let mut acc = [_mm256_setzero_ps(); N];
+        for (i, b) in w.iter().enumerate() {
+            for n in 0..2 {
+                // SAFETY: 32-byte unaligned loads inside ql (128 bytes) and qh (64)
+                let (ql0, ql1, qh) = unsafe {
+                    (
+                        _mm256_loadu_si256(b.ql.as_ptr().add(64 * n).cast()),
+                        _mm256_loadu_si256(b.ql.as_ptr().add(64 * n + 32).cast()),
+                        _mm256_loadu_si256(b.qh.as_ptr().add(32 * n).cast()),
+                    )
+                };
+                let quarters = [
+                    _mm256_or_si256(_mm256_and_si256(ql0, low), _mm256_and_si256(_mm256_slli_epi16(qh, 4), top)),
+                    _mm256_or_si256(_mm256_and_si256(ql1, low), _mm256_and_si256(_mm256_slli_epi16(qh, 2), top)),
+                    _mm256_or_si256(_mm256_and_si256(_mm256_srli_epi16(ql0, 4), low), _mm256_and_si256(qh, top)),
+                    _mm256_or_si256(
+                        _mm256_and_si256(_mm256_srli_epi16(ql1, 4), low),
+                        _mm256_and_si256(_mm256_srli_epi16(qh, 2), top),
+                    ),
+                ];
+                for (j, q) in quarters.into_iter().enumerate() {
+                    let block = 4 * n + j;
+                    let Some(xs) = blocks(&x, i * (SUPER / BLOCK) + block) else { return acc.map(|a| hsum(a)) };
+                    // each 16-value half by its own scale
+                    let (s0, s1) = (b.scales[2 * block] as i16, b.scales[2 * block + 1] as i16);
+                    let scales = _mm256_set_m128i(_mm_set1_epi16(s1), _mm_set1_epi16(s0));
+                    add(&mut acc, _mm256_sub_epi8(q, offset), scales, b.d, xs);
+                }
+            }
+        }
+        acc.map(|a| hsum(a))
     }
 }
 
@@ -328,13 +447,6 @@ mod tests {
         tensor.dequantize(&Device::Cpu).unwrap().to_vec1::<f32>().unwrap()
     }
 
-    /// A row of blocks unpacked by `unpack`.
-    fn unpacked<B>(unpack: fn(&[B], &mut Unpacked), blocks: &[B]) -> Unpacked {
-        let mut row = Unpacked::default();
-        unpack(blocks, &mut row);
-        row
-    }
-
     fn ours(dtype: GgmlDType, bytes: &[u8]) -> Vec<f32> {
         let mut out = Vec::new();
         match dtype {
@@ -369,14 +481,16 @@ mod tests {
             let bytes = random_blocks(dtype, blocks, 13);
             let w = ours(dtype, &bytes);
             let want: f64 = w.iter().zip(&xd).map(|(a, b)| f64::from(*a) * f64::from(*b)).sum();
+            let (q5_0, q4_k, q6_k) = kernels();
             let got = match dtype {
-                GgmlDType::Q5_0 => unpacked(Unpacked::q5_0, &read_q5_0(&bytes)),
-                GgmlDType::Q4K => unpacked(Unpacked::q4_k, &read_q4_k(&bytes)),
-                _ => unpacked(Unpacked::q6_k, &read_q6_k(&bytes)),
-            }
-            .dot(&xq, halves_scalar);
+                GgmlDType::Q5_0 => [dot_q5_0(&read_q5_0(&bytes), &xq), (q5_0.one)(&read_q5_0(&bytes), &xq)],
+                GgmlDType::Q4K => [dot_q4_k(&read_q4_k(&bytes), &xq), (q4_k.one)(&read_q4_k(&bytes), &xq)],
+                _ => [dot_q6_k(&read_q6_k(&bytes), &xq), (q6_k.one)(&read_q6_k(&bytes), &xq)],
+            };
             let size: f64 = w.iter().zip(&xd).map(|(a, b)| (f64::from(*a) * f64::from(*b)).abs()).sum();
-            assert!((f64::from(got) - want).abs() <= 1e-5 * size, "{dtype:?}: {got} against {want}");
+            for got in got {
+                assert!((f64::from(got) - want).abs() <= 1e-5 * size, "{dtype:?}: {got} against {want}");
+            }
         }
     }
 
@@ -406,15 +520,41 @@ mod tests {
         assert_eq!(seen.len(), 3, "the file holds Q5_0, Q4_K and Q6_K tensors: {seen:?}");
     }
 
+    /// This CPU's kernels, one token and four, against the scalar ones on many random rows,
+    /// all formats, with activations at both ends of their range (the 16-bit pairs must not
+    /// saturate).
     #[test]
-    fn the_simd_halves_are_the_scalar_ones() {
+    fn the_simd_kernels_are_the_scalar_ones() {
+        let (q5_0, q4_k, q6_k) = kernels();
         let mut rng = SplitMix64::new(21);
-        for _ in 0..1000 {
-            let mut a = [0i8; BLOCK];
-            let mut b = [0i8; BLOCK];
-            a.iter_mut().for_each(|v| *v = rng.below(65) as i8 - 32);
-            b.iter_mut().for_each(|v| *v = (rng.below(255) as i32 - 127) as i8);
-            assert_eq!(halves()(&a, &b), halves_scalar(&a, &b), "{a:?} · {b:?}");
+        for round in 0..100 {
+            let supers = 1 + rng.below(4);
+            let xs: Vec<Vec<Q8_1>> = (0..4)
+                .map(|t| {
+                    let x: Vec<f32> = (0..supers * SUPER)
+                        .map(|i| match round % 10 {
+                            0 => [127.0, -127.0][(i + t) % 2],
+                            _ => (rng.unit() as f32 - 0.5) * 4.0,
+                        })
+                        .collect();
+                    let mut xq = Vec::new();
+                    quantize(&x, &mut xq);
+                    xq
+                })
+                .collect();
+            let x4 = [&xs[0][..], &xs[1][..], &xs[2][..], &xs[3][..]];
+            fn agree<B>(k: &FormatKernels<B>, scalar: Dot<B>, w: &[B], x4: [&[Q8_1]; 4], what: &str) {
+                let four = (k.four)(w, x4);
+                for (t, x) in x4.into_iter().enumerate() {
+                    let want = scalar(w, x);
+                    for got in [(k.one)(w, x), four[t]] {
+                        assert!((got - want).abs() <= 1e-4 * want.abs().max(1.0), "{what}: {got} against {want}");
+                    }
+                }
+            }
+            agree(&q5_0, dot_q5_0, &read_q5_0(&random_blocks(GgmlDType::Q5_0, supers * 8, round)), x4, "Q5_0");
+            agree(&q4_k, dot_q4_k, &read_q4_k(&random_blocks(GgmlDType::Q4K, supers, round)), x4, "Q4_K");
+            agree(&q6_k, dot_q6_k, &read_q6_k(&random_blocks(GgmlDType::Q6K, supers, round)), x4, "Q6_K");
         }
     }
 }

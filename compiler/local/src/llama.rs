@@ -23,12 +23,7 @@ use candle_core::quantized::GgmlDType;
 use candle_core::quantized::gguf_file::Content;
 
 use crate::adapter::{Adapter, Target, hf_to_gguf_rows};
-use crate::kquant::{self, Q4K, Q5_0, Q6K, SUPER, Unpacked};
-
-thread_local! {
-    /// A row being multiplied, unpacked ([`Matrix::row_all`]), kept between rows.
-    static UNPACKED: std::cell::RefCell<Unpacked> = std::cell::RefCell::new(Unpacked::default());
-}
+use crate::kquant::{self, Q4K, Q5_0, Q6K, SUPER};
 use crate::quant::{self, BLOCK, Heads, Kernels, Q4_1, Q8_0, Q8_1};
 
 /// A weight matrix: `rows` rows of `cols` values, row after row, in blocks (`per_row` of
@@ -66,20 +61,9 @@ impl Matrix {
         match self {
             Matrix::Q4_1 { blocks, per_row, .. } => (k.q4_1)(&blocks[r * per_row..(r + 1) * per_row], x),
             Matrix::Q8_0 { blocks, per_row, .. } => (k.q8_0)(&blocks[r * per_row..(r + 1) * per_row], x),
-            Matrix::Q5_0 { .. } | Matrix::Q4K { .. } | Matrix::Q6K { .. } => UNPACKED.with_borrow_mut(|row| {
-                self.unpack(r, row);
-                row.dot(x, k.halves)
-            }),
-        }
-    }
-
-    /// Row `r` of a K-format matrix (or Q5_0) unpacked; nothing for the others.
-    fn unpack(&self, r: usize, out: &mut Unpacked) {
-        match self {
-            Matrix::Q5_0 { blocks, per_row, .. } => Unpacked::q5_0(&blocks[r * per_row..(r + 1) * per_row], out),
-            Matrix::Q4K { blocks, per_row, .. } => Unpacked::q4_k(&blocks[r * per_row..(r + 1) * per_row], out),
-            Matrix::Q6K { blocks, per_row, .. } => Unpacked::q6_k(&blocks[r * per_row..(r + 1) * per_row], out),
-            Matrix::Q4_1 { .. } | Matrix::Q8_0 { .. } => {}
+            Matrix::Q5_0 { blocks, per_row, .. } => (k.q5_0.one)(&blocks[r * per_row..(r + 1) * per_row], x),
+            Matrix::Q4K { blocks, per_row, .. } => (k.q4_k.one)(&blocks[r * per_row..(r + 1) * per_row], x),
+            Matrix::Q6K { blocks, per_row, .. } => (k.q6_k.one)(&blocks[r * per_row..(r + 1) * per_row], x),
         }
     }
 
@@ -115,21 +99,13 @@ impl Matrix {
     /// Row `r` against every token of the chunk, four at a time where the kernel can.
     fn row_all(&self, k: &Kernels, r: usize, x: &[Vec<Q8_1>], out: &mut Vec<f32>) {
         out.clear();
-        let mut fours = x.chunks_exact(4);
-        if let Matrix::Q4_1 { blocks, per_row, .. } = self {
-            let w = &blocks[r * per_row..(r + 1) * per_row];
-            for four in fours.by_ref() {
-                out.extend((k.q4_1_x4)(w, [&four[0], &four[1], &four[2], &four[3]]));
-            }
-            out.extend(fours.remainder().iter().map(|xt| self.row(k, r, xt)));
-        } else if let Matrix::Q5_0 { .. } | Matrix::Q4K { .. } | Matrix::Q6K { .. } = self {
-            // unpacked once for the chunk's tokens
-            UNPACKED.with_borrow_mut(|row| {
-                self.unpack(r, row);
-                out.extend(x.iter().map(|xt| row.dot(xt, k.halves)));
-            });
-        } else {
-            out.extend(x.iter().map(|xt| self.row(k, r, xt)));
+        let row = |blocks: usize| r * blocks..(r + 1) * blocks;
+        match self {
+            Matrix::Q4_1 { blocks, per_row, .. } => fours(&blocks[row(*per_row)], x, (k.q4_1, k.q4_1_x4), out),
+            Matrix::Q5_0 { blocks, per_row, .. } => fours(&blocks[row(*per_row)], x, (k.q5_0.one, k.q5_0.four), out),
+            Matrix::Q4K { blocks, per_row, .. } => fours(&blocks[row(*per_row)], x, (k.q4_k.one, k.q4_k.four), out),
+            Matrix::Q6K { blocks, per_row, .. } => fours(&blocks[row(*per_row)], x, (k.q6_k.one, k.q6_k.four), out),
+            Matrix::Q8_0 { .. } => out.extend(x.iter().map(|xt| self.row(k, r, xt))),
         }
     }
 
@@ -168,6 +144,15 @@ impl Matrix {
             }
         }
     }
+}
+
+/// The row `w` against the tokens `x`, four at a time, the rest one by one.
+fn fours<B>(w: &[B], x: &[Vec<Q8_1>], (one, four): (kquant::Dot<B>, kquant::Dot4<B>), out: &mut Vec<f32>) {
+    let mut chunks = x.chunks_exact(4);
+    for c in chunks.by_ref() {
+        out.extend(four(w, [&c[0], &c[1], &c[2], &c[3]]));
+    }
+    out.extend(chunks.remainder().iter().map(|xt| one(w, xt)));
 }
 
 struct Layer {
@@ -492,15 +477,21 @@ impl Model {
             cache.k[li].extend_from_slice(&kk);
             cache.v[li].extend_from_slice(&vv);
             let (keys, values) = (&cache.k[li], &cache.v[li]);
-            for t in 0..n {
-                let positions = start + t + 1; // causal: positions 0..=start+t
-                for h in 0..heads {
-                    let kvh = h / group;
-                    let qh = &q[t * dim + h * head_dim..t * dim + (h + 1) * head_dim];
-                    let out = &mut attn[t * dim + h * head_dim..t * dim + (h + 1) * head_dim];
-                    let heads = Heads { keys, values, stride: kv_dim, offset: kvh * head_dim, positions };
-                    (k.attend)(qh, &heads, scale, &mut scores, out);
-                }
+            // one query head of one token: `i = t·heads + h`, causal over positions 0..=start+t
+            let attend = |i: usize, out: &mut [f32], scores: &mut Vec<f32>| {
+                let (t, h) = (i / heads, i % heads);
+                let heads =
+                    Heads { keys, values, stride: kv_dim, offset: (h / group) * head_dim, positions: start + t + 1 };
+                (k.attend)(&q[i * head_dim..(i + 1) * head_dim], &heads, scale, scores, out);
+            };
+            match pool {
+                Some(pool) => pool.install(|| {
+                    use rayon::prelude::*;
+                    attn.par_chunks_mut(head_dim)
+                        .enumerate()
+                        .for_each_init(Vec::new, |scores, (i, out)| attend(i, out, scores))
+                }),
+                None => attn.chunks_mut(head_dim).enumerate().for_each(|(i, out)| attend(i, out, &mut scores)),
             }
             for (t, xt) in xq.iter_mut().enumerate() {
                 quant::quantize(&attn[t * dim..(t + 1) * dim], xt);

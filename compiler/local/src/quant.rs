@@ -116,8 +116,9 @@ pub struct Kernels {
     /// One weight row against four tokens: the row is unpacked once.
     pub q4_1_x4: fn(&[Q4_1], [&[Q8_1]; 4]) -> [f32; 4],
     pub q8_0: fn(&[Q8_0], &[Q8_1]) -> f32,
-    /// The integer sums of the K formats' unpacked rows ([`crate::kquant::Unpacked`]).
-    pub halves: crate::kquant::Halves,
+    pub q5_0: crate::kquant::FormatKernels<crate::kquant::Q5_0>,
+    pub q4_k: crate::kquant::FormatKernels<crate::kquant::Q4K>,
+    pub q6_k: crate::kquant::FormatKernels<crate::kquant::Q6K>,
     /// `out = softmax(q·kᵀ·scale)·v` over a head's positions (`scores` is scratch).
     pub attend: fn(&[f32], &Heads, f32, &mut Vec<f32>, &mut [f32]),
     pub name: &'static str,
@@ -166,11 +167,14 @@ impl Kernels {
     pub fn detect() -> Kernels {
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+            let (q5_0, q4_k, q6_k) = crate::kquant::kernels();
             return Kernels {
                 q4_1: avx2::q4_1_safe,
                 q4_1_x4: avx2::q4_1_x4_safe,
                 q8_0: avx2::q8_0_safe,
-                halves: crate::kquant::halves(),
+                q5_0,
+                q4_k,
+                q6_k,
                 attend: avx2::attend_safe,
                 name: "avx2",
             };
@@ -179,11 +183,14 @@ impl Kernels {
     }
 
     pub fn scalar() -> Kernels {
+        let (q5_0, q4_k, q6_k) = crate::kquant::scalar_kernels();
         Kernels {
             q4_1: dot_q4_1_scalar,
             q4_1_x4: |w, x| x.map(|x| dot_q4_1_scalar(w, x)),
             q8_0: dot_q8_0_scalar,
-            halves: crate::kquant::halves_scalar,
+            q5_0,
+            q4_k,
+            q6_k,
             attend: |q, h, scale, scores, out| attend_with(dot_scalar, axpy_scalar, q, h, scale, scores, out),
             name: "scalar",
         }
