@@ -7,7 +7,8 @@
 //! language server do; the incremental row edits one line of a 2,000-line file and
 //! re-checks it, against checking that file from scratch. [`runtime`] measures the runtime
 //! instead (`bench --runtime`), [`lsp`] the language server (`--lsp`), [`llm`] the local
-//! model against llama-server (`--llm`); [`align`] runs the alignment recovery experiment
+//! model against llama-server (`--llm`), [`translate`] a model's faithfulness against
+//! hand-written ground truth (`--translate`); [`align`] runs the alignment recovery experiment
 //! (`--align`).
 //!
 //! Nothing here prints: each experiment returns a [`Report`], the text lines its host
@@ -18,6 +19,7 @@ pub mod llm;
 pub mod lsp;
 pub mod rl;
 pub mod runtime;
+pub mod translate;
 
 use std::hint::black_box;
 use std::path::Path;

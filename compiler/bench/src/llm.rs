@@ -31,6 +31,8 @@ pub struct LlmArgs {
     pub prompts: usize,
     pub max_tokens: u32,
     pub descriptions: PathBuf,
+    /// The local model (a name of `tad_local::model`; default: the embedded one).
+    pub model: Option<String>,
 }
 
 /// One side's totals.
@@ -84,10 +86,11 @@ fn requests(args: &LlmArgs) -> Result<(Vec<Request>, String, String), String> {
     Ok((out, lark, gbnf))
 }
 
-/// `bench --llm`: the local model, then llama-server, on the default model's GGUF; what
+/// `bench --llm`: the local model, then llama-server, on the chosen model's GGUF; what
 /// each side is about to do goes to `progress` as it starts.
 pub fn run(args: &LlmArgs, progress: &mut dyn FnMut(&str)) -> Result<Report, BenchError> {
-    let model = tad_local::model(tad_local::DEFAULT).ok_or("no default model")?;
+    let name = args.model.as_deref().unwrap_or(tad_local::DEFAULT);
+    let model = tad_local::model(name).ok_or_else(|| BenchError(format!("no local model named {name}")))?;
     let gguf = model.require()?;
     let (requests, lark, gbnf) = requests(args)?;
     progress(&format!(

@@ -163,6 +163,40 @@ fn constrain_sends_the_grammar_in_the_servers_field() {
     assert_eq!(openai.requests()[0]["response_format"]["type"], "json_schema");
 }
 
+/// `bench --translate` over the repository's descriptions: a server that answers each
+/// with its own ground truth scores 100 %; one that answers with one fixed program scores
+/// what that program gets right, and its answers are kept.
+#[test]
+fn bench_translate_scores_answers_against_the_ground_truth() {
+    let truth_dir = repo().join("tests/llm/truth");
+    let truth_of = move |body: &Value| {
+        let text = last_user_text(body);
+        let descriptions = std::fs::read_dir(repo().join("tests/llm/descriptions")).unwrap();
+        let stem = descriptions
+            .filter_map(|e| e.ok())
+            .find(|e| text.contains(std::fs::read_to_string(e.path()).unwrap().trim()))
+            .map(|e| e.path().file_stem().unwrap().to_string_lossy().into_owned())
+            .expect("the request holds a description");
+        std::fs::read_to_string(truth_dir.join(format!("{stem}.tad"))).unwrap()
+    };
+    let server = FakeLlm::start(move |_, body| fenced(&truth_of(body)));
+    let out = run(&["bench", "--translate", "--max-rounds", "0"], &env_of(&served(&server)));
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    let report = stdout(&out);
+    assert!(report.contains("on 88 descriptions"), "{report}");
+    assert!(report.contains("| **overall** |") && report.contains("**100.0 %**"), "{report}");
+
+    let dir = scratch("bench-translate");
+    let fixed = FakeLlm::start(|_, _| fenced(COMPLETE));
+    let args = ["bench", "--translate", "--max-rounds", "0", "--out", dir.to_str().unwrap()];
+    let out = run(&args, &env_of(&served(&fixed)));
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    let overall = stdout(&out).lines().find(|l| l.starts_with("| **overall**")).unwrap().to_string();
+    let percent: f64 = overall.rsplit("**").nth(1).unwrap().trim_end_matches(" %").parse().unwrap();
+    assert!(percent > 5.0 && percent < 40.0, "{overall}");
+    assert!(dir.join("faithfulness.jsonl").exists() && dir.join("06_los_angeles_boulevard_red_light.tad").exists());
+}
+
 #[test]
 fn a_batch_writes_programs_a_manifest_and_a_summary() {
     let dir = scratch("llm-batch");

@@ -1,6 +1,6 @@
 //! `tadslc bench`: the experiments of `tad-bench`, their reports printed.
 //!
-//! Check throughput against serde_json by default; `--runtime`, `--lsp`, `--llm` and
+//! Check throughput against serde_json by default; `--runtime`, `--lsp`, `--llm`, `--translate` and
 //! `--align` choose another experiment. A report's lines go to standard output, its notes
 //! and an experiment's progress to standard error; its outcome is the exit status.
 
@@ -16,7 +16,7 @@ use tad_eval::recovery::Extra;
 #[derive(clap::Args)]
 pub struct Args {
     /// Number of generated scenarios
-    #[arg(long, default_value_t = 10_000, conflicts_with_all = ["runtime", "lsp", "llm", "align"])]
+    #[arg(long, default_value_t = 10_000, conflicts_with_all = ["runtime", "lsp", "llm", "align", "translate"])]
     pub scenarios: usize,
     /// Seed of the corpus generator (and of the alignment experiment)
     #[arg(long, default_value_t = 1, conflicts_with_all = ["runtime", "lsp", "llm"])]
@@ -45,8 +45,8 @@ pub struct Args {
     /// the peer is skipped
     #[arg(long, value_name = "PATH", requires = "llm")]
     pub llama_server: Option<PathBuf>,
-    /// Threads of both models
-    #[arg(long, value_name = "N", default_value_t = 1, requires = "llm")]
+    /// Threads of both models (`--llm`), of the model (`--translate`)
+    #[arg(long, value_name = "N", default_value_t = 1)]
     pub threads: usize,
     /// Translate prompts measured (the first N descriptions)
     #[arg(long, value_name = "N", default_value_t = 4, requires = "llm")]
@@ -54,9 +54,27 @@ pub struct Args {
     /// Tokens per answer
     #[arg(long, value_name = "N", default_value_t = 256, requires = "llm")]
     pub max_tokens: u32,
-    /// The descriptions the prompts are made of
-    #[arg(long, value_name = "DIR", default_value = "tests/llm/descriptions", requires = "llm")]
+    /// The descriptions the prompts are made of (`--llm`), or that are translated
+    /// (`--translate`)
+    #[arg(long, value_name = "DIR", default_value = "tests/llm/descriptions")]
     pub descriptions: PathBuf,
+    /// Measure a model's faithfulness instead: each description translated (the compiler
+    /// in the loop, as `translate` does) and scored attribute by attribute against its
+    /// hand-written ground truth
+    #[arg(long, conflicts_with_all = ["runtime", "lsp", "llm", "align", "rl"])]
+    pub translate: bool,
+    /// The ground truth of each description (`NAME.tad` for `NAME.txt`)
+    #[arg(long, value_name = "DIR", default_value = "tests/llm/truth", requires = "translate")]
+    pub truth: PathBuf,
+    /// The model that translates, as `translate --model` takes it (default: as `translate`
+    /// chooses: the environment, else the embedded local model); `local:NAME` for another
+    /// of `tadslc model list`. With `--llm`, the local model measured (`NAME` or
+    /// `local:NAME`; default: the embedded one)
+    #[arg(long)]
+    pub model: Option<String>,
+    /// Repair and refinement requests after the first answer
+    #[arg(long, value_name = "N", default_value_t = 3, requires = "translate")]
+    pub max_rounds: u32,
     /// Samples of each language server measurement
     #[arg(long, value_name = "N", default_value_t = 200, requires = "lsp")]
     pub samples: usize,
@@ -106,8 +124,9 @@ pub struct Args {
     /// Bootstrap resamples
     #[arg(long, value_name = "N", default_value_t = 200, requires = "align")]
     pub resamples: usize,
-    /// Where the corpora are written (default: a directory under the system's temporary one)
-    #[arg(long, value_name = "DIR", requires = "align")]
+    /// Where the corpora are written (`--align`; default: a directory under the system's
+    /// temporary one), or the answers (`--translate`: `NAME.tad` and `faithfulness.jsonl`)
+    #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// Another generator's output to compare with a region's held-out sample
     #[arg(long = "corpus", value_name = "LABEL=REGION:DIR", value_parser = tad_bench::align::parse_extra, requires = "align")]
@@ -120,6 +139,9 @@ pub struct Args {
 pub fn run(args: &Args) -> Result<Status, CliError> {
     if args.align {
         return align(args);
+    }
+    if args.translate {
+        return translate(args);
     }
     if args.lsp {
         return streamed("bench --lsp: ", |progress| {
@@ -134,6 +156,7 @@ pub fn run(args: &Args) -> Result<Status, CliError> {
             prompts: args.prompts,
             max_tokens: args.max_tokens,
             descriptions: args.descriptions.clone(),
+            model: args.model.as_deref().map(|m| m.strip_prefix("local:").unwrap_or(m).to_string()),
         };
         return streamed("bench --llm: ", |progress| tad_bench::llm::run(&llm, progress));
     }
@@ -186,6 +209,68 @@ fn print(report: Result<Report, BenchError>, context: &str) -> Result<Status, Cl
         Outcome::Complete => Status::Ok,
         Outcome::InputErrors => Status::Failed,
         Outcome::Unusable => Status::Usage,
+    })
+}
+
+/// `bench --translate`: the session `translate` would build, each case through it, scored.
+fn translate(args: &Args) -> Result<Status, CliError> {
+    use tad_bench::translate::{Answer, Case};
+    use tad_frontend::{backend, store, translate::Translator};
+
+    /// The LLM flags parsed as `translate` parses them, so their defaults live there.
+    #[derive(clap::Parser)]
+    struct Flags {
+        #[command(flatten)]
+        llm: crate::llm::LlmArgs,
+    }
+    let mut argv = vec!["bench".to_string(), "--threads".into(), args.threads.to_string()];
+    argv.extend(["--max-rounds".into(), args.max_rounds.to_string()]);
+    argv.extend(args.model.iter().flat_map(|m| ["--model".to_string(), m.clone()]));
+    let llm = <Flags as clap::Parser>::try_parse_from(argv).map_err(|e| CliError::usage(e.to_string()))?.llm;
+
+    let cases = tad_bench::translate::cases(&args.descriptions, &args.truth).map_err(|e| CliError::usage(e.0))?;
+    let backend = llm.open(1).map_err(CliError::usage)?;
+    let checker = backend::checker(None).map_err(CliError::usage)?;
+    let constraint = backend.constraint_for(llm.constrained(&backend), None).map_err(CliError::usage)?;
+    let session = llm.session(&backend, &checker, constraint, 0.0);
+    let runtime = backend::runtime().map_err(CliError::usage)?;
+    let tool = format!("tadslc {}", env!("CARGO_PKG_VERSION"));
+    let translator = Translator { session: &session, runtime: &runtime, region: None, tool: &tool };
+    let mut manifest = match &args.out {
+        Some(dir) => Some(
+            store::Jsonl::append(&dir.join("faithfulness.jsonl"))
+                .map_err(|e| CliError::usage(format!("cannot write in {}: {e}", dir.display())))?,
+        ),
+        None => None,
+    };
+    let label = backend.chat().label();
+    streamed("bench --translate: ", |progress| {
+        progress(&format!("bench --translate: {} descriptions, model {label}", cases.len()));
+        let mut write_error = None;
+        let mut one = |case: &Case, text: &str| {
+            let start = std::time::Instant::now();
+            let (outcome, program) = translator.one(&case.description, text, &mut |_| {});
+            if let (Some(dir), Some(program)) = (&args.out, &program) {
+                let written = store::write_atomic(&store::inside(dir, &case.name, "tad"), program.as_bytes());
+                write_error = write_error.take().or(written.err().map(|e| e.to_string()));
+            }
+            if let Some(m) = manifest.as_mut() {
+                let record = serde_json::json!({ "case": case.name, "outcome": outcome });
+                write_error = write_error.take().or(m.write(&record).err().map(|e| e.to_string()));
+            }
+            Answer {
+                program: outcome.program,
+                valid_round: outcome.valid_round,
+                rounds: outcome.rounds,
+                tokens: outcome.usage.total(),
+                seconds: start.elapsed().as_secs_f64(),
+            }
+        };
+        let scored = tad_bench::translate::run(&cases, &mut one, progress)?;
+        match write_error {
+            Some(e) => Err(BenchError(format!("cannot write the answers: {e}"))),
+            None => Ok(tad_bench::translate::report(&label, &scored)),
+        }
     })
 }
 

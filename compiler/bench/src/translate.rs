@@ -1,0 +1,450 @@
+//! `bench --translate`: how faithfully a model turns descriptions into scenarios, scored
+//! attribute by attribute against hand-written ground truth.
+//!
+//! Each description `NN_name.txt` has a truth `NN_name.tad` (`tests/llm/truth/`). Both
+//! programs are resolved to the IR, so aliases and units compare as the compiler reads
+//! them. The scene's attributes (weather, time, road type, lanes, direction, light, signs)
+//! and the ego's (behaviour, speed, lane) count where the truth states them. Groups are
+//! matched one to one so that the most attributes agree (the assignment problem, solved
+//! exactly); a truth group without a partner counts every attribute it states as wrong,
+//! and an answer group without one counts as one wrong value of each group attribute. An
+//! answer without a program gets every attribute wrong. Speeds agree within 10 % or
+//! 1 m/s, whichever is wider; everything else agrees when equal.
+//!
+//! The translation itself is the host's (the CLI builds the session): this module pairs
+//! the files, runs the loop over them through a callback, and scores.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use tad_ir::{Entries, Field, Group, Kind, Named, Param, Reference, Scenario};
+
+use crate::{BenchError, Report};
+
+/// One description and its ground truth.
+#[derive(Clone, Debug)]
+pub struct Case {
+    pub name: String,
+    pub description: PathBuf,
+    pub truth: PathBuf,
+}
+
+/// The cases of `descriptions` (`*.txt`) with their truths in `truth` (same stem, `.tad`).
+/// A description without a truth is an error: the benchmark scores all or nothing.
+pub fn cases(descriptions: &Path, truth: &Path) -> Result<Vec<Case>, BenchError> {
+    let files = tad_db::host::with_extension(descriptions, "txt");
+    if files.is_empty() {
+        return Err(BenchError(format!("no descriptions (*.txt) in {}", descriptions.display())));
+    }
+    let mut cases = Vec::new();
+    let mut missing = Vec::new();
+    for description in files {
+        let name = description.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let truth = truth.join(format!("{name}.tad"));
+        if truth.is_file() {
+            cases.push(Case { name, description, truth });
+        } else {
+            missing.push(truth.display().to_string());
+        }
+    }
+    if !missing.is_empty() {
+        return Err(BenchError(format!("descriptions without a ground truth: {}", missing.join(", "))));
+    }
+    Ok(cases)
+}
+
+/// The scored attributes, in report order: the scene's, the ego's, then each group's.
+pub const SCENE: [&str; 7] = ["weather", "time", "road type", "lanes", "direction", "light", "signs"];
+pub const EGO: [&str; 3] = ["ego behaviour", "ego speed", "ego lane"];
+pub const GROUP: [&str; 5] = ["type", "count", "behaviour", "relation", "lane"];
+
+/// An attribute's value as the comparison sees it.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Value {
+    Text(String),
+    /// m/s
+    Speed(f64),
+}
+
+impl Value {
+    fn agrees(&self, other: &Value) -> bool {
+        match (self, other) {
+            (Value::Speed(t), Value::Speed(a)) => (t - a).abs() <= (0.1 * t.abs()).max(1.0),
+            (a, b) => a == b,
+        }
+    }
+}
+
+/// A scenario's scored attributes: `None` where it does not state one.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Attributes {
+    pub scene: Vec<Option<Value>>,
+    pub ego: Vec<Option<Value>>,
+    pub groups: Vec<Vec<Option<Value>>>,
+}
+
+/// The attributes of `program` resolved as the compiler reads it (its `use` lines
+/// included); `None` when it holds no scenario.
+pub fn attributes(program: &str) -> Option<Attributes> {
+    let mut db = tad_db::Database::new(tad_check::Options::default());
+    let file = db.set_file(PathBuf::from("answer.tad"), program.to_string());
+    let s = tad_db::resolve(&db, file).as_ref()?;
+    let e = &s.entries;
+    let text = |v: Option<String>| v.map(Value::Text);
+    let scene = vec![
+        text(param_name(e, &s.environment.weather)),
+        text(param_name(e, &s.environment.time)),
+        text(name(e, &s.road.road_type)),
+        text(s.road.lanes.get().map(|n| n.to_string())),
+        text(name(e, &s.road.direction)),
+        text(name(e, &s.road.light)),
+        text(s.road.signs.given().map(|signs| {
+            let mut names: Vec<&str> = signs.iter().map(|n| e.name(&n.value)).collect();
+            names.sort_unstable();
+            names.join(", ")
+        })),
+    ];
+    let ego = vec![
+        text(param_name(e, &s.ego.behavior)),
+        speed(&s.ego.speed),
+        text(s.ego.lane.get().map(|l| l.index().to_string())),
+    ];
+    let groups = s.groups.iter().map(|g| group(s, g)).collect();
+    Some(Attributes { scene, ego, groups })
+}
+
+fn group(s: &Scenario, g: &Group) -> Vec<Option<Value>> {
+    let e = &s.entries;
+    let count = g.count_param().map(|p| match p {
+        Param::Fixed(n) => n.to_string(),
+        Param::Range { min, max } => format!("{min}..{max}"),
+        Param::Choice(options) => options.iter().map(i64::to_string).collect::<Vec<_>>().join(" | "),
+    });
+    let relation = g.position.given().map(|p| {
+        let of = match &p.reference.value {
+            Reference::Ego => "ego".to_string(),
+            Reference::Group(id) => s.group(*id).and_then(|r| name(e, &r.actor_type)).unwrap_or_default(),
+            Reference::RoadElement(id) => e.get(*id).map(|r| r.name.clone()).unwrap_or_default(),
+            Reference::Unknown(written) => written.clone(),
+        };
+        format!("{} of {of}", e.name(&p.relation.value))
+    });
+    [name(e, &g.actor_type), count, param_name(e, &g.behavior), relation, g.lane.get().map(|l| l.index().to_string())]
+        .into_iter()
+        .map(|v| v.map(Value::Text))
+        .collect()
+}
+
+fn name<K: Kind>(e: &Entries, f: &Field<Named<K>>) -> Option<String> {
+    f.given().map(|n| e.name(n).to_string())
+}
+
+fn param_name<K: Kind>(e: &Entries, f: &Field<Param<Named<K>>>) -> Option<String> {
+    match f.given()? {
+        Param::Fixed(n) => Some(e.name(n).to_string()),
+        Param::Range { min, max } => Some(format!("{}..{}", e.name(min), e.name(max))),
+        Param::Choice(options) => {
+            let mut names: Vec<&str> = options.iter().map(|n| e.name(n)).collect();
+            names.sort_unstable();
+            Some(names.join(" | "))
+        }
+    }
+}
+
+fn speed(f: &Field<Param<tad_ir::MetresPerSecond>>) -> Option<Value> {
+    let mid = match f.given()? {
+        Param::Fixed(v) => v.0,
+        Param::Range { min, max } => (min.0 + max.0) / 2.0,
+        Param::Choice(options) => options.iter().map(|v| v.0).sum::<f64>() / options.len().max(1) as f64,
+    };
+    Some(Value::Speed(mid))
+}
+
+/// Right and total per attribute, in report order.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Tally {
+    pub per: BTreeMap<&'static str, (u32, u32)>,
+}
+
+impl Tally {
+    fn add(&mut self, key: &'static str, right: bool) {
+        let entry = self.per.entry(key).or_default();
+        entry.0 += u32::from(right);
+        entry.1 += 1;
+    }
+
+    /// Right and total over every attribute.
+    pub fn overall(&self) -> (u32, u32) {
+        self.per.values().fold((0, 0), |(r, t), (a, b)| (r + a, t + b))
+    }
+
+    pub fn merge(&mut self, other: &Tally) {
+        for (key, (r, t)) in &other.per {
+            let entry = self.per.entry(key).or_default();
+            entry.0 += r;
+            entry.1 += t;
+        }
+    }
+}
+
+/// The answer's attributes scored against the truth's.
+pub fn score(truth: &Attributes, answer: Option<&Attributes>) -> Tally {
+    let mut tally = Tally::default();
+    let empty = Attributes::default();
+    let a = answer.unwrap_or(&empty);
+    let mut fields = |keys: &[&'static str], t: &[Option<Value>], a: &[Option<Value>]| {
+        for (k, key) in keys.iter().enumerate() {
+            if let Some(t) = t.get(k).and_then(Option::as_ref) {
+                tally.add(key, a.get(k).and_then(Option::as_ref).is_some_and(|a| t.agrees(a)));
+            }
+        }
+    };
+    fields(&SCENE, &truth.scene, &a.scene);
+    fields(&EGO, &truth.ego, &a.ego);
+    let agreeing = |t: &[Option<Value>], a: &[Option<Value>]| {
+        t.iter().zip(a).filter(|(t, a)| matches!((t, a), (Some(t), Some(a)) if t.agrees(a))).count() as i64
+    };
+    let weights: Vec<Vec<i64>> =
+        truth.groups.iter().map(|t| a.groups.iter().map(|g| agreeing(t, g)).collect()).collect();
+    let partner = best_assignment(&weights, a.groups.len());
+    for (i, t) in truth.groups.iter().enumerate() {
+        let none = vec![None; GROUP.len()];
+        let answered = partner[i].map_or(&none, |j| &a.groups[j]);
+        fields(&GROUP, t, answered);
+    }
+    let matched = partner.iter().flatten().count();
+    for _ in matched..a.groups.len() {
+        for key in GROUP {
+            tally.add(key, false);
+        }
+    }
+    tally
+}
+
+/// For each row, the column it is assigned to (at most one row per column) so that the
+/// sum of `weights` is the largest: the Hungarian method on the padded square matrix.
+fn best_assignment(weights: &[Vec<i64>], columns: usize) -> Vec<Option<usize>> {
+    let n = weights.len().max(columns);
+    if n == 0 {
+        return Vec::new();
+    }
+    let cost = |i: usize, j: usize| -weights.get(i).and_then(|r| r.get(j)).copied().unwrap_or(0);
+    // potentials u (rows), v (columns); p[j] = the row assigned to column j (1-based; 0 = none)
+    let (mut u, mut v, mut p, mut way) =
+        (vec![0i64; n + 1], vec![0i64; n + 1], vec![0usize; n + 1], vec![0usize; n + 1]);
+    for i in 1..=n {
+        p[0] = i;
+        let mut j0 = 0;
+        let mut min = vec![i64::MAX; n + 1];
+        let mut used = vec![false; n + 1];
+        loop {
+            used[j0] = true;
+            let i0 = p[j0];
+            let (mut delta, mut j1) = (i64::MAX, 0);
+            for j in 1..=n {
+                if !used[j] {
+                    let reduced = cost(i0 - 1, j - 1) - u[i0] - v[j];
+                    if reduced < min[j] {
+                        min[j] = reduced;
+                        way[j] = j0;
+                    }
+                    if min[j] < delta {
+                        delta = min[j];
+                        j1 = j;
+                    }
+                }
+            }
+            for j in 0..=n {
+                if used[j] {
+                    u[p[j]] += delta;
+                    v[j] -= delta;
+                } else {
+                    min[j] -= delta;
+                }
+            }
+            j0 = j1;
+            if p[j0] == 0 {
+                break;
+            }
+        }
+        loop {
+            let j1 = way[j0];
+            p[j0] = p[j1];
+            j0 = j1;
+            if j0 == 0 {
+                break;
+            }
+        }
+    }
+    let mut partner = vec![None; weights.len()];
+    for j in 1..=n {
+        if p[j] >= 1 && p[j] <= weights.len() && j <= columns {
+            partner[p[j] - 1] = Some(j - 1);
+        }
+    }
+    partner
+}
+
+/// What the host's translation of one description gave.
+#[derive(Clone, Debug, Default)]
+pub struct Answer {
+    /// The best program of the rounds.
+    pub program: Option<String>,
+    /// The round whose program first had no errors.
+    pub valid_round: Option<u32>,
+    pub rounds: u32,
+    pub tokens: u64,
+    pub seconds: f64,
+}
+
+/// One scored case.
+#[derive(Clone, Debug)]
+pub struct Scored {
+    pub name: String,
+    pub answer: Answer,
+    pub tally: Tally,
+}
+
+/// Every case translated by `translate` (its text and path) and scored; `progress` gets a
+/// line per case as it finishes.
+pub fn run(
+    cases: &[Case],
+    translate: &mut dyn FnMut(&Case, &str) -> Answer,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Vec<Scored>, BenchError> {
+    let mut scored = Vec::new();
+    for case in cases {
+        let read = |p: &Path| std::fs::read_to_string(p).map_err(|e| BenchError(format!("{}: {e}", p.display())));
+        let (text, truth_text) = (read(&case.description)?, read(&case.truth)?);
+        let truth = attributes(&truth_text)
+            .ok_or_else(|| BenchError(format!("{}: the ground truth holds no scenario", case.truth.display())))?;
+        let answer = translate(case, text.trim());
+        let tally = score(&truth, answer.program.as_deref().and_then(attributes).as_ref());
+        let (right, total) = tally.overall();
+        progress(&format!(
+            "{}: {right}/{total} attributes, {}, {} round{}, {:.0} s",
+            case.name,
+            answer.valid_round.map_or("never valid".to_string(), |r| format!("valid at round {r}")),
+            answer.rounds,
+            if answer.rounds == 1 { "" } else { "s" },
+            answer.seconds
+        ));
+        scored.push(Scored { name: case.name.clone(), answer, tally });
+    }
+    Ok(scored)
+}
+
+/// The report: per-attribute and overall accuracy, valid@1, valid after repair, mean
+/// rounds, tokens and seconds per scenario.
+pub fn report(model: &str, scored: &[Scored]) -> Report {
+    let mut all = Tally::default();
+    for s in scored {
+        all.merge(&s.tally);
+    }
+    let n = scored.len().max(1) as f64;
+    let pct =
+        |(r, t): (u32, u32)| if t == 0 { "–".to_string() } else { format!("{:.1} %", 100.0 * r as f64 / t as f64) };
+    let mut lines = vec![
+        format!("faithfulness of {model} on {} descriptions with ground truth", scored.len()),
+        String::new(),
+        "| attribute | right | of | accuracy |".to_string(),
+        "|---|---:|---:|---:|".to_string(),
+    ];
+    for key in SCENE.iter().chain(&EGO).chain(&GROUP) {
+        if let Some(&(r, t)) = all.per.get(key) {
+            lines.push(format!("| {key} | {r} | {t} | {} |", pct((r, t))));
+        }
+    }
+    let (r, t) = all.overall();
+    lines.push(format!("| **overall** | {r} | {t} | **{}** |", pct((r, t))));
+    let count = |f: &dyn Fn(&Answer) -> bool| scored.iter().filter(|s| f(&s.answer)).count();
+    let mean = |f: &dyn Fn(&Answer) -> f64| scored.iter().map(|s| f(&s.answer)).sum::<f64>() / n;
+    lines.push(String::new());
+    lines.push(format!(
+        "valid@1 {:.1} %, valid after repair {:.1} %, {:.2} rounds, {:.0} tokens and {:.1} s per scenario",
+        100.0 * count(&|a| a.valid_round == Some(1)) as f64 / n,
+        100.0 * count(&|a| a.valid_round.is_some()) as f64 / n,
+        mean(&|a| a.rounds as f64),
+        mean(&|a| a.tokens as f64),
+        mean(&|a| a.seconds),
+    ));
+    Report { lines, ..Report::default() }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TRUTH: &str = r#"scenario t {
+  environment {
+    weather: rainy
+    time: night
+  }
+  road {
+    type: straight_road
+    context: urban
+    lanes: 2
+    direction: two_way
+    light: red
+  }
+  ego {
+    behavior: stopped
+    lane: 1
+  }
+  actor queue: 3 car {
+    behavior: stopped
+    position: front of ego
+    lane: 1
+  }
+  actor walkers: 2 pedestrian {
+    behavior: cross
+    position: front of queue
+  }
+}"#;
+
+    #[test]
+    fn the_truth_scores_itself_perfectly_and_the_group_order_does_not_matter() {
+        let truth = attributes(TRUTH).expect("a scenario");
+        let tally = score(&truth, Some(&truth));
+        let (r, t) = tally.overall();
+        assert_eq!(r, t);
+        assert!(t >= 15, "{t} attributes");
+        let mut swapped = truth.clone();
+        swapped.groups.reverse();
+        assert_eq!(score(&truth, Some(&swapped)), tally);
+    }
+
+    #[test]
+    fn misses_extra_groups_and_no_answer_count_as_wrong() {
+        let truth = attributes(TRUTH).expect("a scenario");
+        let wrong = TRUTH.replace("rainy", "clear").replace("3 car", "2 car");
+        let tally = score(&truth, attributes(&wrong).as_ref());
+        assert_eq!(tally.per["weather"], (0, 1));
+        assert_eq!(tally.per["count"], (1, 2));
+        assert_eq!(tally.per["type"], (2, 2));
+        let extra =
+            format!("{}  actor stray: 1 bicycle {{\n    behavior: cross\n  }}\n}}", TRUTH.trim_end_matches('}'));
+        let tally = score(&truth, attributes(&extra).as_ref());
+        assert_eq!(tally.per["type"], (2, 3), "an invented group is a wrong value of each attribute");
+        let nothing = score(&truth, None);
+        assert_eq!(nothing.overall().0, 0);
+        assert_eq!(nothing.overall().1, score(&truth, Some(&truth)).overall().1);
+    }
+
+    #[test]
+    fn speeds_agree_within_a_tenth_or_one_metre_per_second() {
+        let at = |kmh: f64| Value::Speed(kmh / 3.6);
+        assert!(at(50.0).agrees(&at(54.0)));
+        assert!(!at(50.0).agrees(&at(57.0)));
+        assert!(at(5.0).agrees(&at(8.0)));
+    }
+
+    #[test]
+    fn the_assignment_is_the_best_one() {
+        // greedy would take (0,0) = 3 and leave 0; the best is 2 + 2
+        let weights = vec![vec![3, 2], vec![2, 0]];
+        assert_eq!(best_assignment(&weights, 2), vec![Some(1), Some(0)]);
+        assert_eq!(best_assignment(&[vec![1]], 3), vec![Some(0)]);
+        assert_eq!(best_assignment(&[vec![], vec![]], 0), vec![None, None]);
+    }
+}
