@@ -3,7 +3,7 @@
 
 use crate::vocab::{Lookup, Vocabulary};
 use std::collections::HashMap;
-use tad_diagnostics::{Applicability, Code, Diagnostic, Payload};
+use tad_diagnostics::{Applicability, Code, Diagnostic, Payload, Span};
 use tad_syntax::model::{Attr, Known, Scenario, Symbol, Val};
 use tad_syntax::schema::{FieldDef, Unit};
 
@@ -82,6 +82,11 @@ pub fn resolve_symbol(vocabulary: &Vocabulary, kind: &str, field: &str, symbol: 
                     "`{}` is declared in the standard module `{module}`: write `use {module}` at the top{region}",
                     symbol.name
                 ))
+                .with_fix(
+                    Span { start: 0, end: 0 },
+                    format!("use {module}\n"),
+                    Applicability::MachineApplicable,
+                )
             } else if names.is_empty() {
                 d.with_note(format!("no {} is declared; is a `use` missing?", kind_label(kind)))
             } else if names.len() <= 12 {

@@ -308,6 +308,22 @@ pub fn vocabulary_of(modules: &[String]) -> Vocabulary {
     vocabulary(&db, file).vocabulary.clone()
 }
 
+/// A region as a user names it (a canonical name or an alias), as its canonical name; an
+/// unknown one is an error that lists the regions and suggests the nearest. Every
+/// `--region` flag is read through this, so every command refuses the same names.
+pub fn region(name: &str) -> Result<String, String> {
+    let core = vocabulary_of(&[]);
+    if let Some(entry) = core.get("region", name) {
+        return Ok(entry.name.clone());
+    }
+    let near = core.candidates("region", name, 1);
+    Err(format!(
+        "unknown region `{name}`{} (the regions are: {})",
+        near.first().map(|n| format!("; did you mean `{n}`?")).unwrap_or_default(),
+        core.names("region").join(", ")
+    ))
+}
+
 /// The standard module a region's scenarios see: the `module` its declaration names (the
 /// one place the region → module map is read).
 pub fn region_module(vocabulary: &tad_check::Vocabulary, region: &str) -> Option<String> {

@@ -25,14 +25,8 @@ pub fn scope(region: Option<&str>) -> Result<(Vocabulary, Vec<String>), String> 
     let modules = match region {
         None => tad_db::standard_modules(),
         Some(region) => {
-            let core = tad_db::vocabulary_of(&[]);
-            if core.get("region", region).is_none() {
-                return Err(format!(
-                    "unknown region `{region}` (the regions are: {})",
-                    core.names("region").join(", ")
-                ));
-            }
-            tad_db::region_module(&core, region).into_iter().collect()
+            let region = tad_db::region(region)?;
+            tad_db::region_module(&tad_db::vocabulary_of(&[]), &region).into_iter().collect()
         }
     };
     Ok((tad_db::vocabulary_of(&modules), modules))

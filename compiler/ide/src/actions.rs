@@ -70,6 +70,8 @@ pub fn fix_all(db: &Database, file: SourceFile) -> Vec<Edit> {
         .filter(|f| f.applicability == Applicability::MachineApplicable && f.span.end <= text.len())
         .collect();
     fixes.sort_by_key(|f| (f.span.start, f.span.end));
+    // the same edit from several diagnostics (one `use` line for several names) once
+    fixes.dedup_by(|a, b| a.span == b.span && a.replacement == b.replacement);
     let mut cursor = 0;
     let mut out = Vec::new();
     for fix in fixes {
@@ -202,6 +204,24 @@ mod tests {
         assert!(!fix.preferred);
         // fix-all leaves guesses alone
         assert!(fix_all(&db, file).iter().all(|e| e.text != "cloudy"));
+    }
+
+    /// A name another standard module declares gets a `use` line as its fix, once for
+    /// several such names, and the fixed file knows them.
+    #[test]
+    fn a_name_of_another_module_is_fixed_by_one_use_line() {
+        let text = "scenario demo {\n  actor a: 1 deer {\n    behavior: cross\n  }\n  actor b: 2 cow {\n    behavior: stopped\n  }\n}\n";
+        let (db, file) = testing::file(text);
+        let at = text.find("deer").unwrap();
+        let actions = code_actions(&db, file, Span::new(at, at));
+        let fix = actions.iter().find(|a| a.title == "Insert `use rural`").expect("the use fix");
+        assert_eq!(fix.applicability, Applicability::MachineApplicable);
+        let all = fix_all(&db, file);
+        assert_eq!(all.iter().filter(|e| e.text == "use rural\n").count(), 1, "{all:?}");
+        let fixed = apply(text, &all);
+        assert!(fixed.starts_with("use rural\nscenario demo {"), "{fixed}");
+        let (db, file) = testing::file(&fixed);
+        assert!(tad_db::check(&db, file).diagnostics.iter().all(|d| d.code.as_str() != "E0400"));
     }
 
     #[test]

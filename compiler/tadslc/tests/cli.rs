@@ -193,6 +193,44 @@ fn human_output_is_coloured_only_when_asked_or_on_a_terminal() {
     assert!(stderr(&coloured).contains('\u{1b}'));
 }
 
+/// Escape sequences and bidirectional overrides in a file are shown, not obeyed: the
+/// terminal gets none of them, and the caret still points at the character.
+#[test]
+fn control_bytes_in_a_file_are_escaped_in_diagnostics() {
+    let dir = scratch("control-bytes");
+    let path = dir.join("esc.tad");
+    std::fs::write(&path, "scenario x {\n  road {\n    lanes: 2\u{1b}[31m \u{202e}\n  }\n}\n").unwrap();
+    let out = tadslc(&["check", path.to_str().unwrap()], "");
+    let text = stderr(&out);
+    assert!(!text.contains('\u{1b}') && !text.contains('\u{202e}'), "{text}");
+    assert!(text.contains("lanes: 2?[31m \u{fffd}"), "{text}");
+    assert!(text.contains("error[E0001]: unexpected character `\\u{1b}`"), "{text}");
+}
+
+/// One region parser for every `--region`, and towns checked: unknown names are usage
+/// errors (status 2) that list what exists, before any work.
+#[test]
+fn unknown_regions_and_towns_are_refused_before_work() {
+    let example = "examples/safety/right_turn.tad";
+    for args in [
+        &["check", "--region", "yelowstone", example][..],
+        &["eval", "--region", "atlantis"],
+        &["eval", "--region", "los_angeles,Los_Angeles"],
+        &["gen", "--region", "mars", "-n", "1"],
+        &["translate", "--region", "mars", example],
+        &["grammar", "--region", "mars"],
+    ] {
+        let out = tadslc(args, "");
+        assert_eq!(code(&out), 2, "{args:?}");
+        assert!(stderr(&out).contains("(the regions are: los_angeles, new_york_city"), "{args:?}: {}", stderr(&out));
+    }
+    assert!(stderr(&tadslc(&["check", "--region", "yelowstone", example], "")).contains("did you mean `yellowstone`"));
+    assert_eq!(code(&tadslc(&["check", "--region", "yellowstone", example], "")), 0);
+    let town = tadslc(&["build", "--map", "Town99", example], "");
+    assert_eq!(code(&town), 2);
+    assert!(stderr(&town).contains("unknown town `Town99` (the towns are: Town10HD"), "{}", stderr(&town));
+}
+
 #[test]
 fn invalid_utf8_is_a_located_error() {
     let out = tadslc(&["check", "--format", "json", "tests/ui/lex/not_utf8.tad"], "");

@@ -157,6 +157,12 @@ pub fn known(map: &str) -> Option<&'static str> {
     KNOWN.iter().copied().find(|k| k.eq_ignore_ascii_case(map))
 }
 
+/// A town as a user names it, in its canonical spelling; an unknown one is an error that
+/// lists the towns (`build --map`).
+pub fn town(name: &str) -> Result<&'static str, String> {
+    known(name).ok_or_else(|| format!("unknown town `{name}` (the towns are: {})", KNOWN.join(", ")))
+}
+
 /// The most lanes per direction a map has (this way, other way).
 pub fn widest(map: &str) -> (u32, u32) {
     RUNS.iter().filter(|r| r.map == map).fold((0, 0), |(s, o), r| (s.max(r.same), o.max(r.other)))

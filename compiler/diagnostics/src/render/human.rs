@@ -1,4 +1,9 @@
 //! Terminal rendering through codespan-reporting, with or without colour.
+//!
+//! Text from the input (source lines, file names, messages quoting it) reaches the
+//! terminal through [`shown`]: a control character or a bidirectional override would
+//! otherwise act on the terminal instead of being read. Each is replaced by a character
+//! of the same UTF-8 length, so spans still point where they did.
 
 use super::FileReport;
 use crate::{Diagnostic, Severity};
@@ -11,9 +16,9 @@ use codespan_reporting::term::{self, Config, termcolor};
 /// Render every diagnostic of one file. `color` chooses ANSI escapes.
 pub fn render(report: &FileReport<'_>, color: bool) -> String {
     let mut files = SimpleFiles::new();
-    let own = files.add(report.name, report.text);
+    let own = files.add(shown(report.name), shown(report.text));
     let related: Vec<(crate::FileId, usize, usize)> =
-        report.related.iter().map(|s| (s.file, files.add(s.name, s.text), s.text.len())).collect();
+        report.related.iter().map(|s| (s.file, files.add(shown(s.name), shown(s.text)), s.text.len())).collect();
     let config = Config::default();
     let mut buffer = if color { termcolor::Buffer::ansi() } else { termcolor::Buffer::no_color() };
     for diagnostic in report.diagnostics {
@@ -25,6 +30,29 @@ pub fn render(report: &FileReport<'_>, color: bool) -> String {
         }
     }
     String::from_utf8_lossy(buffer.as_slice()).into_owned()
+}
+
+/// `text` with every control character (but tab and line breaks) and bidirectional
+/// control replaced by one of the same UTF-8 length: `?` for one byte, `¿` for two,
+/// U+FFFD for three.
+pub fn shown(text: &str) -> std::borrow::Cow<'_, str> {
+    let hidden = |c: char| {
+        (c.is_control() && !matches!(c, '\t' | '\n' | '\r'))
+            || matches!(c, '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}')
+    };
+    if !text.chars().any(hidden) {
+        return std::borrow::Cow::Borrowed(text);
+    }
+    let shown = text
+        .chars()
+        .map(|c| match (hidden(c), c.len_utf8()) {
+            (false, _) => c,
+            (true, 1) => '?',
+            (true, 2) => '¿',
+            (true, _) => '\u{fffd}',
+        })
+        .collect();
+    std::borrow::Cow::Owned(shown)
 }
 
 trait BufferExt {
@@ -55,8 +83,9 @@ fn convert(
         Severity::Hint => CsSeverity::Help,
     };
     let len = report.text.len();
-    let mut labels =
-        vec![CsLabel::new(LabelStyle::Primary, own, clamp(d.primary.span, len)).with_message(&d.primary.message)];
+    let mut labels = vec![
+        CsLabel::new(LabelStyle::Primary, own, clamp(d.primary.span, len)).with_message(shown(&d.primary.message)),
+    ];
     let mut notes = Vec::new();
     for l in &d.secondary {
         let place = match l.file {
@@ -65,19 +94,18 @@ fn convert(
             Some(f) => related.iter().find(|(id, ..)| *id == f).map(|(_, index, len)| (*index, *len)),
         };
         match place {
-            Some((file, len)) => {
-                labels.push(CsLabel::new(LabelStyle::Secondary, file, clamp(l.span, len)).with_message(&l.message))
-            }
-            None => notes.push(l.message.clone()),
+            Some((file, len)) => labels
+                .push(CsLabel::new(LabelStyle::Secondary, file, clamp(l.span, len)).with_message(shown(&l.message))),
+            None => notes.push(shown(&l.message).into_owned()),
         }
     }
-    notes.extend(d.notes.iter().cloned());
+    notes.extend(d.notes.iter().map(|n| shown(n).into_owned()));
     if let Some(help) = &d.help {
-        notes.push(format!("help: {help}"));
+        notes.push(format!("help: {}", shown(help)));
     }
     CsDiagnostic::new(severity)
         .with_code(d.code.as_str())
-        .with_message(&d.message)
+        .with_message(shown(&d.message))
         .with_labels(labels)
         .with_notes(notes)
 }

@@ -38,7 +38,7 @@ pub struct BuildArgs {
     #[arg(long)]
     pub map_dir: Option<PathBuf>,
     /// The town to use, e.g. `Town10HD` (default: the first map with the road's features)
-    #[arg(long)]
+    #[arg(long, value_parser = |s: &str| tad_scenic::maps::town(s).map(String::from))]
     pub map: Option<String>,
     /// Which simulator the behaviors are written for
     #[arg(long, value_enum, default_value_t = SimulatorArg::Carla)]

@@ -55,7 +55,7 @@ pub struct Rules {
     pub profile: ProfileArg,
     /// The region of scenarios that state none (e.g. `yellowstone`): its vocabulary module
     /// is in scope
-    #[arg(long, value_name = "REGION")]
+    #[arg(long, value_name = "REGION", value_parser = tad_db::region)]
     pub region: Option<String>,
     /// The essentials whose absence together makes a non-scenario
     #[arg(long, value_delimiter = ',', default_value = "weather,time,road")]

@@ -28,7 +28,7 @@ pub struct EvalArgs {
     /// repository's `examples/`, embedded in tadslc)
     pub corpus: Vec<PathBuf>,
     /// Regions, comma-separated or repeated
-    #[arg(long = "region", value_delimiter = ',')]
+    #[arg(long = "region", value_delimiter = ',', value_parser = tad_db::region)]
     pub regions: Vec<String>,
     /// Generators: `chatscene` (ChatScene's eight safety-critical categories with its
     /// parameter ranges), `fitted` (fitted on the region's scenarios), `baseline`

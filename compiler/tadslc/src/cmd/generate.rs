@@ -17,7 +17,7 @@ use crate::{Status, errln, out, plural};
 #[derive(clap::Args)]
 pub struct Args {
     /// The region (for `llm`; a fitted model knows its own)
-    #[arg(long, value_name = "REGION")]
+    #[arg(long, value_name = "REGION", value_parser = tad_db::region)]
     pub region: Option<String>,
     /// `llm`, or `fitted:MODEL` (a file written by `tadslc fit`)
     #[arg(long, value_name = "GENERATOR", default_value = "llm")]

@@ -11,7 +11,7 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = GrammarFormat::Gbnf)]
     pub format: GrammarFormat,
     /// Only the names a scenario of this region sees (default: every standard module)
-    #[arg(long, value_name = "REGION")]
+    #[arg(long, value_name = "REGION", value_parser = tad_db::region)]
     pub region: Option<String>,
 }
 

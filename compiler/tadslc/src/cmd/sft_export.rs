@@ -18,7 +18,7 @@ pub struct Args {
     #[arg(short, long, value_name = "DIR")]
     pub output: PathBuf,
     /// The region of scenarios that state none (and of every scenario, if given)
-    #[arg(long, value_name = "REGION")]
+    #[arg(long, value_name = "REGION", value_parser = tad_db::region)]
     pub region: Option<String>,
 }
 

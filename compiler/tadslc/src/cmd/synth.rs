@@ -23,7 +23,7 @@ pub struct Args {
     #[arg(long, value_name = "DIR")]
     pub frames: Option<PathBuf>,
     /// The region the video was recorded in
-    #[arg(long, value_name = "REGION")]
+    #[arg(long, value_name = "REGION", value_parser = tad_db::region)]
     pub region: String,
     /// The output directory
     #[arg(long, value_name = "DIR")]

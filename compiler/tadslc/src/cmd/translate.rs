@@ -29,7 +29,7 @@ pub struct Args {
     #[arg(long, value_name = "FILE")]
     pub transcript: Option<PathBuf>,
     /// The region: its module's names are in scope and in the prompt
-    #[arg(long, value_name = "REGION")]
+    #[arg(long, value_name = "REGION", value_parser = tad_db::region)]
     pub region: Option<String>,
     /// Show the model's answers on standard error as they are written (one description)
     #[arg(long)]
