@@ -253,27 +253,39 @@ pub fn sort(diagnostics: &mut [Diagnostic]) {
     });
 }
 
-/// Apply every machine-applicable fix of `diagnostics` to `text`, skipping fixes that
-/// overlap an earlier one. Returns the new text and how many fixes were applied.
-pub fn apply_fixes<'a>(text: &str, diagnostics: impl IntoIterator<Item = &'a Diagnostic>) -> (String, usize) {
+/// The machine-applicable fixes of `diagnostics` that can be applied together to a text
+/// of `len` bytes: in order, each once (several diagnostics may ask for the same edit, such
+/// as one `use` line), none overlapping an earlier one or past the end.
+pub fn machine_fixes<'a>(diagnostics: impl IntoIterator<Item = &'a Diagnostic>, len: usize) -> Vec<&'a Fix> {
     let mut fixes: Vec<&Fix> = diagnostics
         .into_iter()
         .flat_map(|d| &d.fixes)
-        .filter(|f| f.applicability == Applicability::MachineApplicable)
+        .filter(|f| f.applicability == Applicability::MachineApplicable && f.span.end <= len)
         .collect();
     fixes.sort_by_key(|f| (f.span.start, f.span.end));
+    fixes.dedup_by(|a, b| a.span == b.span && a.replacement == b.replacement);
+    let mut cursor = 0;
+    fixes.retain(|f| {
+        let keep = f.span.start >= cursor;
+        if keep {
+            cursor = f.span.end;
+        }
+        keep
+    });
+    fixes
+}
+
+/// Apply every machine-applicable fix of `diagnostics` to `text` ([`machine_fixes`]).
+/// Returns the new text and how many fixes were applied.
+pub fn apply_fixes<'a>(text: &str, diagnostics: impl IntoIterator<Item = &'a Diagnostic>) -> (String, usize) {
+    let fixes = machine_fixes(diagnostics, text.len());
     let mut out = String::with_capacity(text.len());
     let mut cursor = 0;
-    let mut applied = 0;
-    for fix in fixes {
-        if fix.span.start < cursor || fix.span.end > text.len() {
-            continue;
-        }
+    for fix in &fixes {
         out.push_str(&text[cursor..fix.span.start]);
         out.push_str(&fix.replacement);
         cursor = fix.span.end;
-        applied += 1;
     }
     out.push_str(&text[cursor..]);
-    (out, applied)
+    (out, fixes.len())
 }

@@ -86,7 +86,7 @@ fn round(x: f64) -> f64 {
 }
 
 /// The picture of an episode: an animated GIF, or an SVG figure.
-pub fn picture(scene: &Scene, ego: &str, e: &Episode, gif: bool) -> Vec<u8> {
+pub fn picture(scene: &Scene, ego: &str, e: &Episode, format: tad_render::Format) -> Vec<u8> {
     use tad_render::{ActorInfo, Frame, Kind};
     let size = scene.ego.size;
     let actors =
@@ -138,11 +138,7 @@ pub fn picture(scene: &Scene, ego: &str, e: &Episode, gif: bool) -> Vec<u8> {
         route,
         events,
     };
-    if gif {
-        tad_render::gif(&picture, tad_render::GifOptions::default())
-    } else {
-        tad_render::svg(&picture).into_bytes()
-    }
+    format.draw(&picture)
 }
 
 /// The table for people: one row per scenario and ego (aggregated over the seeds), then

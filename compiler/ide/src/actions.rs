@@ -62,26 +62,12 @@ pub fn code_actions(db: &Database, file: SourceFile, range: Span) -> Vec<Action>
 pub fn fix_all(db: &Database, file: SourceFile) -> Vec<Edit> {
     let text = file.text(db);
     let id = file.id(db);
-    let mut fixes: Vec<&Fix> = tad_db::check(db, file)
-        .diagnostics
-        .iter()
-        .filter(|d| d.file == id)
-        .flat_map(|d| &d.fixes)
-        .filter(|f| f.applicability == Applicability::MachineApplicable && f.span.end <= text.len())
-        .collect();
-    fixes.sort_by_key(|f| (f.span.start, f.span.end));
-    // the same edit from several diagnostics (one `use` line for several names) once
-    fixes.dedup_by(|a, b| a.span == b.span && a.replacement == b.replacement);
-    let mut cursor = 0;
-    let mut out = Vec::new();
-    for fix in fixes {
-        if fix.span.start < cursor {
-            continue;
-        }
-        cursor = fix.span.end;
-        out.push(Edit { span: fix.span, text: fix.replacement.clone() });
-    }
-    out
+    let checked = tad_db::check(db, file);
+    let mine = checked.diagnostics.iter().filter(|d| d.file == id);
+    tad_diagnostics::machine_fixes(mine, text.len())
+        .into_iter()
+        .map(|fix| Edit { span: fix.span, text: fix.replacement.clone() })
+        .collect()
 }
 
 fn usable(diagnostic: &Diagnostic) -> impl Iterator<Item = &Fix> {

@@ -125,6 +125,13 @@ fn changed(before: &[u8], now: &[u8], w: u32, h: u32, transparent: u8) -> ::gif:
     }
 }
 
+/// The last frame of the animation as a PNG: where everything ended, the events that
+/// happened, the time.
+pub fn png(scene: &Scene, options: GifOptions) -> Vec<u8> {
+    let last = GifOptions { every: usize::MAX, ..options };
+    frames(scene, last).pop().and_then(|pixmap| pixmap.encode_png().ok()).unwrap_or_default()
+}
+
 /// The view the GIF shows.
 pub fn view_of(scene: &Scene, options: GifOptions) -> View {
     let (w, h) = size(options);

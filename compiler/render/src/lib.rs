@@ -1,5 +1,5 @@
-//! Top-down pictures of a simulated scenario: an SVG figure ([`svg()`]) and an animated GIF
-//! ([`gif()`]) of the same view.
+//! Top-down pictures of a simulated scenario: an SVG figure ([`svg()`]), an animated GIF
+//! ([`gif()`]) of the same view, and a PNG of the GIF's last frame ([`png()`]).
 //!
 //! The input is plain data ([`Scene`]): the layout's abstract road, what each actor is, and
 //! one [`Frame`] of poses and light states per simulation step. Nothing here knows the
@@ -21,9 +21,39 @@ mod view;
 #[cfg(test)]
 mod tests;
 
-pub use anim::gif;
+pub use anim::{gif, png};
 pub use svg::svg;
 pub use tad_road::{Arm, Road};
+
+/// The kinds of picture, by the file extension that names them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    Svg,
+    Png,
+    Gif,
+}
+
+impl Format {
+    /// The format a path's extension names (any case); `None` for another one.
+    pub fn of(path: &std::path::Path) -> Option<Format> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "svg" => Some(Format::Svg),
+            "png" => Some(Format::Png),
+            "gif" => Some(Format::Gif),
+            _ => None,
+        }
+    }
+
+    /// `scene` drawn in this format.
+    pub fn draw(self, scene: &Scene) -> Vec<u8> {
+        match self {
+            Format::Svg => svg(scene).into_bytes(),
+            Format::Png => png(scene, GifOptions::default()),
+            Format::Gif => gif(scene, GifOptions::default()),
+        }
+    }
+}
 
 /// A simulated scenario to draw.
 #[derive(Clone, Debug)]

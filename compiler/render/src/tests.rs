@@ -2,7 +2,7 @@
 //! road shape written to `$CARGO_TARGET_DIR/render-samples/` to look at.
 
 use crate::view::View;
-use crate::{ActorInfo, Event, Frame, GifOptions, Kind, Light, Scene, anim, gif, palette, svg};
+use crate::{ActorInfo, Event, Frame, GifOptions, Kind, Light, Scene, anim, gif, palette, png, svg};
 use tad_road::geom::Vec2;
 use tad_road::road::{Junction, LANE_WIDTH, Station, Turn};
 use tad_road::{Arm, Road, Shape};
@@ -216,6 +216,18 @@ fn the_gif_decodes_with_one_frame_per_stride_and_the_ego_where_it_is() {
     let i = (y.round() as usize * 200 + x.round() as usize) * 4;
     let car = palette::kind(Kind::Vehicle).fill;
     assert_eq!(&first.buffer[i..i + 3], &[car.0, car.1, car.2]);
+}
+
+/// The PNG is the GIF's last frame, pixel for pixel.
+#[test]
+fn the_png_is_the_last_frame() {
+    let road = road(Shape::Junction { arms: 4, roundabout: false }, true);
+    let scene = junction_scene(&road);
+    let options = GifOptions { width: 200, height: 150, every: 4, fps: 10 };
+    let png = tiny_skia::Pixmap::decode_png(&png(&scene, options)).expect("a PNG");
+    let last = anim::frames(&scene, options).pop().expect("frames");
+    assert_eq!((png.width(), png.height()), (200, 150));
+    assert_eq!(png.data(), last.data());
 }
 
 #[test]

@@ -83,6 +83,19 @@ fn a_broken_program_is_repaired_in_round_two_from_every_diagnostic() {
     assert_eq!(rounds[1]["kind"], "repair");
 }
 
+/// A regional name without its `use` line is fixed by the compiler, not sent back to the
+/// model: one round, and the program carries the line.
+#[test]
+fn a_missing_use_line_is_the_compilers_fix_not_a_repair_round() {
+    let dir = scratch("llm-use");
+    let deer = COMPLETE.replace("actor bus: 1 bus", "actor deer: 1 deer");
+    let server = FakeLlm::script(vec![fenced(&deer)]);
+    let out = run(&["translate", &description(&dir, "A deer ahead.")], &env_of(&served(&server)));
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    assert!(stdout(&out).contains("use rural\n"), "{}", stdout(&out));
+    assert!(stderr(&out).contains("complete after 1 round"), "{}", stderr(&out));
+}
+
 #[test]
 fn an_incomplete_scenario_gets_the_refinement_request() {
     let dir = scratch("llm-refine");

@@ -90,6 +90,14 @@ fn bytecode_runs_like_its_source_and_traces_and_pictures_are_written() {
     let gif = out.join("run.gif").to_string_lossy().into_owned();
     assert_eq!(code(&tadslc(&["run", &tadc, "--seeds", "1", "--ego", "naive", "--render", &gif], "")), 0);
     assert!(std::fs::read(&gif).unwrap().starts_with(b"GIF89a"));
+    let png = out.join("run.PNG").to_string_lossy().into_owned();
+    assert_eq!(code(&tadslc(&["run", &tadc, "--seeds", "1", "--ego", "naive", "--render", &png], "")), 0);
+    assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG\r\n"));
+    // another extension is refused before anything runs
+    let jpg = out.join("run.jpg");
+    let refused = tadslc(&["run", &tadc, "--render", jpg.to_str().unwrap()], "");
+    assert_eq!(code(&refused), 2);
+    assert!(stderr(&refused).contains(".svg, .png or .gif") && !jpg.exists());
 }
 
 #[test]

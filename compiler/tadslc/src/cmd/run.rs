@@ -46,8 +46,9 @@ pub struct RunArgs {
     /// Write every actor's pose at every step as JSON lines
     #[arg(long, value_name = "FILE")]
     pub trace: Option<PathBuf>,
-    /// Draw the first episode: `.svg` (a figure) or `.gif` (an animation)
-    #[arg(long, value_name = "FILE")]
+    /// Draw the first episode: `.svg` (a figure), `.png` (where it ended) or `.gif` (an
+    /// animation)
+    #[arg(long, value_name = "FILE", value_parser = picture_path)]
     pub render: Option<PathBuf>,
     /// Score as SafeBench's scorer does, quirks included (TS 0 when nothing completes,
     /// yaw not unwrapped, off-road never ends an episode)
@@ -95,6 +96,15 @@ pub fn parse_seeds(text: &str) -> Result<Range<u64>, String> {
         return Err(format!("`{text}` holds no seed: give A..B with A < B (B excluded)"));
     }
     Ok(range)
+}
+
+/// `--render`'s path: its extension must name a picture format.
+fn picture_path(path: &str) -> Result<PathBuf, String> {
+    let path = PathBuf::from(path);
+    match tad_render::Format::of(&path) {
+        Some(_) => Ok(path),
+        None => Err("the picture's extension names its format: .svg, .png or .gif".into()),
+    }
 }
 
 pub fn run(args: &RunArgs, color: bool) -> Result<Status, CliError> {
@@ -182,8 +192,9 @@ pub fn run(args: &RunArgs, color: bool) -> Result<Status, CliError> {
     status = status.max(gate(args, &scenes, &names, &done)?);
     if let (Some(path), Some(first)) = (&args.render, done.first()) {
         let loaded = &scenes[first.scenario];
-        let gif = path.extension().is_some_and(|x| x.eq_ignore_ascii_case("gif"));
-        if let Err(e) = std::fs::write(path, record::picture(&loaded.scene, &names[first.ego], &first.episode, gif)) {
+        let format = tad_render::Format::of(path).unwrap_or(tad_render::Format::Svg);
+        if let Err(e) = std::fs::write(path, record::picture(&loaded.scene, &names[first.ego], &first.episode, format))
+        {
             status = Status::Usage;
             errln!("error: cannot write `{}`: {e}", path.display())?;
         } else {
