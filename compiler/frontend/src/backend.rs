@@ -45,6 +45,24 @@ impl Choice {
             let name = name.strip_prefix(':').filter(|n| !n.is_empty()).unwrap_or(tad_local::DEFAULT);
             return self.local(name, None);
         }
+        match self.server(concurrency)? {
+            Some(_) if self.adapter.is_some() => {
+                Err("--adapter applies to the local model only, and a server is configured (pass --model local)".into())
+            }
+            Some(config) => Ok(Backend::Server(Client::new(config).map_err(|e| e.to_string())?)),
+            None => self.local(
+                tad_local::DEFAULT,
+                Some(" (no server is configured: set TADSL_LLM_BASE_URL, e.g. http://127.0.0.1:8080/v1, or pass --base-url to use one)"),
+            ),
+        }
+    }
+
+    /// The server the choice, the environment and the config file name; `None` when they
+    /// name none, or the model is `local` (nothing is loaded either way).
+    pub fn server(&self, concurrency: usize) -> Result<Option<Config>, String> {
+        if self.model.as_deref().is_some_and(|m| m.starts_with("local")) {
+            return Ok(None);
+        }
         let file = config_file(self.config_file.as_deref())?;
         let overrides = Overrides {
             base_url: self.base_url.clone(),
@@ -55,18 +73,8 @@ impl Choice {
             concurrency: Some(concurrency),
         };
         let env = |k: &str| std::env::var(k).ok();
-        let config = Config::resolve(&overrides, &env, file.as_ref().map(|(n, t)| (n.as_str(), t.as_str())), self.seed)
-            .map_err(|e| e.to_string())?;
-        match config {
-            Some(_) if self.adapter.is_some() => {
-                Err("--adapter applies to the local model only, and a server is configured (pass --model local)".into())
-            }
-            Some(config) => Ok(Backend::Server(Client::new(config).map_err(|e| e.to_string())?)),
-            None => self.local(
-                tad_local::DEFAULT,
-                Some(" (no server is configured: set TADSL_LLM_BASE_URL, e.g. http://127.0.0.1:8080/v1, or pass --base-url to use one)"),
-            ),
-        }
+        Config::resolve(&overrides, &env, file.as_ref().map(|(n, t)| (n.as_str(), t.as_str())), self.seed)
+            .map_err(|e| e.to_string())
     }
 
     fn local(&self, name: &str, why: Option<&str>) -> Result<Backend, String> {

@@ -26,14 +26,25 @@ pub struct Summary {
     pub completion_tokens: u64,
     #[serde(skip)]
     rounds_to_valid: Vec<u32>,
+    /// Whether every item was asked for a scenario (`gen`, `synth`'s scenes): then a
+    /// non-scenario is a failure, not a valid answer. A description may be of a title card
+    /// (`translate`), where it is the right one.
+    #[serde(skip)]
+    scenarios_asked: bool,
 }
 
 impl Summary {
+    /// The summary of a run that asked every item for a scenario.
+    pub fn of_scenarios() -> Summary {
+        Summary { scenarios_asked: true, ..Summary::default() }
+    }
+
     pub fn add(&mut self, o: &Outcome) {
         self.items += 1;
         self.syntax_valid_first += usize::from(o.syntax_valid_first);
-        self.valid_first += usize::from(o.valid_round == Some(1));
-        let valid_now = o.class.is_some_and(|c| c != "invalid");
+        let counts = !(self.scenarios_asked && o.class == Some("non_scenario"));
+        self.valid_first += usize::from(o.valid_round == Some(1) && counts);
+        let valid_now = o.class.is_some_and(|c| c != "invalid") && counts;
         self.valid_after_repair += usize::from(valid_now);
         if let (Some(r), true) = (o.valid_round, valid_now) {
             self.rounds_to_valid.push(r);
@@ -73,5 +84,22 @@ impl Summary {
             out.push_str(&format!("; {} stopped early", self.stopped));
         }
         out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_non_scenario_is_valid_only_where_it_can_be_the_answer() {
+        let card = Outcome { class: Some("non_scenario"), valid_round: Some(1), rounds: 1, ..Outcome::default() };
+        let mut described = Summary::default();
+        described.add(&card);
+        assert_eq!((described.valid_first, described.valid_after_repair), (1, 1));
+        let mut generated = Summary::of_scenarios();
+        generated.add(&card);
+        assert_eq!((generated.valid_first, generated.valid_after_repair), (0, 0));
+        assert_eq!(generated.classes["non_scenario"], 1);
     }
 }

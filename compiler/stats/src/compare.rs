@@ -3,11 +3,12 @@
 //! Each of `resamples` rounds draws both corpora again with replacement (one seeded
 //! generator, so a seed gives the same intervals everywhere) and recomputes every
 //! distance. The value is the distance between the corpora as given; the interval is the
-//! value ± 1.96 bootstrap standard deviations (distances that cannot be negative clamped
-//! at 0). Not the percentiles of the resampled values: a resample repeats scenarios, which
-//! makes two samples look more different than they are, so plug-in distances of
-//! resamples sit above the value, often all of them (the spread is what they measure
-//! well).
+//! basic (reverse-percentile) bootstrap interval, `[2v − q97.5, 2v − q2.5]` of the
+//! resampled values `q`, clipped to the measure's range (JSD in [0, 1], the Wasserstein
+//! and Fréchet distances at least 0; squared MMD's unbiased estimate may be negative).
+//! Not the plain percentiles: a resample repeats scenarios, which makes two samples look
+//! more different than they are, so plug-in distances of resamples sit above the value,
+//! often all of them; reflecting the percentiles about the value corrects that bias.
 
 use std::collections::BTreeMap;
 
@@ -106,13 +107,12 @@ pub fn compare(
     }
     let n = ATTRIBUTES.len();
     let interval = |i: usize| {
-        let v: Vec<f64> = draws[i].iter().copied().filter(|x| x.is_finite()).collect();
-        let m = v.len().max(1) as f64;
-        let mean = v.iter().sum::<f64>() / m;
-        let sd = (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (m - 1.0).max(1.0)).sqrt();
-        // squared MMD's unbiased estimate may be negative; the others may not
-        let floor = if i == n + 2 { f64::NEG_INFINITY } else { 0.0 };
-        Interval { value: point[i], low: (point[i] - 1.96 * sd).max(floor), high: point[i] + 1.96 * sd }
+        let range = match i {
+            _ if i <= n => (0.0, 1.0),
+            _ if i == n + 2 => (f64::NEG_INFINITY, f64::INFINITY),
+            _ => (0.0, f64::INFINITY),
+        };
+        basic_interval(point[i], &draws[i], range)
     };
     let mut jsd: BTreeMap<String, Interval> =
         ATTRIBUTES.iter().enumerate().map(|(i, attr)| (attr.key.to_string(), interval(i))).collect();
@@ -131,11 +131,29 @@ pub fn compare(
     }
 }
 
+/// The basic bootstrap 95 % interval of `value` from its resampled values, clipped to
+/// `range` and holding the value; the value alone without resamples.
+pub fn basic_interval(value: f64, resampled: &[f64], (floor, ceiling): (f64, f64)) -> Interval {
+    let mut v: Vec<f64> = resampled.iter().copied().filter(|x| x.is_finite()).collect();
+    if v.is_empty() || !value.is_finite() {
+        return Interval { value, low: value, high: value };
+    }
+    v.sort_by(f64::total_cmp);
+    let quantile = |q: f64| {
+        let at = q * (v.len() - 1) as f64;
+        let (i, t) = (at.floor() as usize, at.fract());
+        v[i] + t * (v[(i + 1).min(v.len() - 1)] - v[i])
+    };
+    let low = (2.0 * value - quantile(0.975)).clamp(floor, ceiling).min(value);
+    let high = (2.0 * value - quantile(0.025)).clamp(floor, ceiling).max(value);
+    Interval { value, low, high }
+}
+
 impl Comparison {
     /// A Markdown table: each distance with its interval.
     pub fn markdown(&self) -> String {
         let mut out = format!(
-            "{} ({} scenarios) vs {} ({} scenarios); 95% intervals: ± 1.96 standard deviations of {} bootstrap resamples, seed {}\n\n| distance | value | 95% interval |\n|---|---:|---|\n",
+            "{} ({} scenarios) vs {} ({} scenarios); 95% intervals: basic bootstrap over {} resamples, seed {}, clipped to each distance's range\n\n| distance | value | 95% interval |\n|---|---:|---|\n",
             self.a, self.scenarios[0], self.b, self.scenarios[1], self.resamples, self.seed
         );
         let row = |out: &mut String, name: &str, i: &Interval| {
@@ -151,5 +169,27 @@ impl Comparison {
             row(&mut out, &format!("JSD {}", attr.key), &self.jsd[attr.key]);
         }
         out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn intervals_reflect_the_percentiles_and_stay_in_range() {
+        // resamples spread 0.45..0.75 about a value of 0.5: reflected about it
+        let draws: Vec<f64> = (0..=100).map(|k| 0.45 + 0.3 * k as f64 / 100.0).collect();
+        let i = basic_interval(0.5, &draws, (0.0, 1.0));
+        assert!((i.low - (1.0 - 0.7425)).abs() < 1e-9 && (i.high - (1.0 - 0.4575)).abs() < 1e-9, "{i:?}");
+        // all of them above the value: the interval still holds it
+        let above: Vec<f64> = draws.iter().map(|d| d + 0.2).collect();
+        let i = basic_interval(0.5, &above, (0.0, 1.0));
+        assert!(i.low <= i.value && i.value == i.high, "{i:?}");
+        // a JSD near its ceiling does not pass it, nor a distance its floor
+        let wide: Vec<f64> = (0..=100).map(|k| 0.5 + k as f64 / 100.0).collect();
+        assert_eq!(basic_interval(0.98, &wide, (0.0, 1.0)).high, 1.0);
+        assert_eq!(basic_interval(0.02, &wide, (0.0, f64::INFINITY)).low, 0.0);
+        assert_eq!(basic_interval(0.3, &[], (0.0, 1.0)), Interval { value: 0.3, low: 0.3, high: 0.3 });
     }
 }

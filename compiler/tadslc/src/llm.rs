@@ -71,6 +71,15 @@ pub struct LlmArgs {
 impl LlmArgs {
     /// Who answers, as the flags choose (the environment and config file fill the rest).
     pub(crate) fn open(&self, concurrency: usize) -> Result<Backend, String> {
+        self.choice().open(concurrency)
+    }
+
+    /// Whether a server answers (not the local model), loading nothing.
+    pub(crate) fn names_server(&self) -> Result<bool, String> {
+        Ok(self.choice().server(1)?.is_some())
+    }
+
+    fn choice(&self) -> Choice {
         Choice {
             base_url: self.base_url.clone(),
             model: self.model.clone(),
@@ -82,7 +91,6 @@ impl LlmArgs {
             threads: self.threads,
             seed: self.seed,
         }
-        .open(concurrency)
     }
 
     pub(crate) fn constrained(&self, backend: &Backend) -> bool {

@@ -342,6 +342,26 @@ fn synth_turns_a_video_into_scenarios_and_resumes_without_redoing_anything() {
     assert_eq!(std::fs::read_to_string(out_dir.join("manifest.jsonl")).unwrap().lines().count(), 3);
 }
 
+/// Without a server, synth refuses at once and says what to configure: no frame is taken.
+#[test]
+fn synth_without_a_multimodal_server_refuses_before_any_frame() {
+    let dir = scratch("synth-local");
+    let out_dir = dir.join("out");
+    for extra in [&[][..], &["--model", "local"]] {
+        let mut args =
+            vec!["synth", "--video", "missing.mp4", "--region", "yellowstone", "--out", out_dir.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        let out = run(&args, &[]);
+        assert_eq!(code(&out), 2, "{}", stderr(&out));
+        assert!(
+            stderr(&out).contains("the local model reads text only: configure a multimodal server"),
+            "{}",
+            stderr(&out)
+        );
+        assert!(!out_dir.exists());
+    }
+}
+
 #[test]
 fn synth_shards_split_the_frames() {
     if !ffmpeg() {

@@ -119,7 +119,7 @@ pub fn generate(g: &GenArgs, args: &LlmArgs) -> Result<Status, CliError> {
         model: backend.chat().label(),
     };
     let bar = crate::output::progress(g.n, "scenarios");
-    let mut summary = Summary::default();
+    let mut summary = Summary::of_scenarios();
     let mut transcript = match g.out {
         Some(dir) => Some(store::Jsonl::append(&dir.join("gen.transcript.jsonl")).map_err(CliError::usage)?),
         None => None,

@@ -51,6 +51,13 @@ pub fn run(s: &Args) -> Result<Status, CliError> {
         (None, Some(d)) => tad_frontend::synth::Input::Frames(d.to_path_buf()),
         _ => return Err(CliError::usage("give either --video FILE or --frames DIR")),
     };
+    // the frames are images: refuse the text-only local model before any frame is taken
+    if !args.names_server().map_err(CliError::usage)? {
+        return Err(CliError::usage(
+            "synth describes video frames, and the local model reads text only: configure a multimodal server \
+             (TADSL_LLM_BASE_URL and TADSL_LLM_MODEL, or --base-url and --model, or a TOML file with --llm-config)",
+        ));
+    }
     let backend = args.open(s.jobs.max(1)).map_err(CliError::usage)?;
     let checker = backend::checker(Some(&s.region)).map_err(CliError::usage)?;
     let constraint = backend.constraint_for(args.constrained(&backend), Some(&s.region)).map_err(CliError::usage)?;
