@@ -44,3 +44,13 @@ impl From<Status> for std::process::ExitCode {
 }
 
 pub use tad_base::plural;
+
+/// A count flag's value from 1 to `MAX`: numbers that would only exhaust memory or time
+/// are usage errors before anything is allocated. The bounds are in the flags' help.
+pub fn count<const MAX: usize>(text: &str) -> Result<usize, String> {
+    let n: usize = text.trim().parse().map_err(|_| format!("`{text}` is not a whole number"))?;
+    if n == 0 || n > MAX {
+        return Err(format!("must be from 1 to {MAX}"));
+    }
+    Ok(n)
+}

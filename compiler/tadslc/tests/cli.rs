@@ -231,6 +231,22 @@ fn unknown_regions_and_towns_are_refused_before_work() {
     assert!(stderr(&town).contains("unknown town `Town99` (the towns are: Town10HD"), "{}", stderr(&town));
 }
 
+/// Counts that would only exhaust memory are refused before anything is allocated.
+#[test]
+fn numeric_options_are_bounded_before_any_work() {
+    for (args, bound) in [
+        (&["search", "--samples", "99999999999999", "examples/safety"][..], "1 to 1000000"),
+        (&["train-ego", "--hidden", "100000,100000"], "1 to 4096"),
+        (&["eval", "-n", "999999999999"], "1 to 100000"),
+        (&["gen", "-n", "0"], "1 to 100000"),
+        (&["compare", "--resamples", "lots", "a", "b"], "is not a whole number"),
+    ] {
+        let out = tadslc(args, "");
+        assert_eq!(code(&out), 2, "{args:?}");
+        assert!(stderr(&out).contains(bound), "{args:?}: {}", stderr(&out));
+    }
+}
+
 #[test]
 fn invalid_utf8_is_a_located_error() {
     let out = tadslc(&["check", "--format", "json", "tests/ui/lex/not_utf8.tad"], "");

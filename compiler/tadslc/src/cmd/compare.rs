@@ -21,8 +21,8 @@ pub struct Args {
     /// The embedding model (fetched with `tadslc model fetch NAME`)
     #[arg(long, value_enum, default_value_t = Embedding::Minilm)]
     pub embedding: Embedding,
-    /// Bootstrap resamples for the intervals
-    #[arg(long, value_name = "N", default_value_t = 200)]
+    /// Bootstrap resamples for the intervals (at most 100,000)
+    #[arg(long, value_name = "N", default_value_t = 200, value_parser = crate::count::<100_000>)]
     pub resamples: usize,
     /// Seed of the resampling
     #[arg(long, default_value_t = 0)]

@@ -44,11 +44,11 @@ pub struct EvalArgs {
     /// The ego the scenes are searched against (ChatScene's surrogate: the pretrained SAC)
     #[arg(long, default_value = "sac")]
     pub search_ego: String,
-    /// Scenarios per region and generator
-    #[arg(short, default_value_t = 10)]
+    /// Scenarios per region and generator (at most 100,000)
+    #[arg(short, default_value_t = 10, value_parser = crate::count::<100_000>)]
     pub n: usize,
-    /// Scenes sampled per scenario by the search
-    #[arg(long, default_value_t = tad_search::Config::default().samples)]
+    /// Scenes sampled per scenario by the search (at most 1,000,000)
+    #[arg(long, default_value_t = tad_search::Config::default().samples, value_parser = crate::count::<1_000_000>)]
     pub samples: usize,
     /// Scenes kept per scenario
     #[arg(long, default_value_t = tad_search::Config::default().keep)]

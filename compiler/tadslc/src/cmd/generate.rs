@@ -22,8 +22,8 @@ pub struct Args {
     /// `llm`, or `fitted:MODEL` (a file written by `tadslc fit`)
     #[arg(long, value_name = "GENERATOR", default_value = "llm")]
     pub generator: String,
-    /// How many scenarios
-    #[arg(short = 'n', long = "count", value_name = "N", default_value_t = 40)]
+    /// How many scenarios (at most 100,000)
+    #[arg(short = 'n', long = "count", value_name = "N", default_value_t = 40, value_parser = crate::count::<100_000>)]
     pub count: usize,
     /// Write the scenarios, a manifest and a summary here (default: print them)
     #[arg(long, value_name = "DIR")]

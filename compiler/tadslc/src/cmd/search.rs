@@ -31,8 +31,8 @@ pub struct SearchArgs {
     /// The directory the chosen scenes and `search.json` are written to
     #[arg(short, long, value_name = "DIR")]
     pub out: PathBuf,
-    /// Scenes sampled per scenario
-    #[arg(long, default_value_t = tad_search::Config::default().samples)]
+    /// Scenes sampled per scenario (at most 1,000,000)
+    #[arg(long, default_value_t = tad_search::Config::default().samples, value_parser = crate::count::<1_000_000>)]
     pub samples: usize,
     /// Ranges are re-fitted after every this many scenes
     #[arg(long, default_value_t = tad_search::Config::default().round)]

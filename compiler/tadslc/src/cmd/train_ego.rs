@@ -39,14 +39,14 @@ pub struct TrainEgoArgs {
     /// What the actor sees: SafeBench's 4 values or the 13-value `state`
     #[arg(long, value_parser = ["safebench", "state"], default_value = "safebench")]
     pub observation: String,
-    /// Training episodes in all (SafeBench: 2000; ChatScene: 600)
-    #[arg(long, value_name = "N")]
+    /// Training episodes in all (SafeBench: 2000; ChatScene: 600) (at most 10,000,000)
+    #[arg(long, value_name = "N", value_parser = crate::count::<10_000_000>)]
     pub episodes: Option<usize>,
     /// Off-policy learning steps after each episode (SafeBench: 3; ChatScene: 1)
     #[arg(long, value_name = "N")]
     pub updates_per_episode: Option<usize>,
-    /// Hidden widths of the actor and the critics
-    #[arg(long, value_delimiter = ',')]
+    /// Hidden widths of the actor and the critics (at most 4,096 each)
+    #[arg(long, value_delimiter = ',', value_parser = crate::count::<4096>)]
     pub hidden: Option<Vec<usize>>,
     /// Learning rate of the actor and the critics
     #[arg(long)]
