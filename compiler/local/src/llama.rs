@@ -273,9 +273,10 @@ impl Shape {
 
 /// Keys and values of the positions read so far, per layer: `[position][kv head][dim]`.
 #[derive(Clone)]
+/// Keys and values per layer, in half precision ([`quant::Heads`]).
 pub struct Cache {
-    k: Vec<Vec<f32>>,
-    v: Vec<Vec<f32>>,
+    k: Vec<Vec<u16>>,
+    v: Vec<Vec<u16>>,
     pub len: usize,
 }
 
@@ -474,8 +475,8 @@ impl Model {
                     rotate(&mut kk[t * kv_dim + h * head_dim..t * kv_dim + (h + 1) * head_dim], angles);
                 }
             }
-            cache.k[li].extend_from_slice(&kk);
-            cache.v[li].extend_from_slice(&vv);
+            cache.k[li].extend(kk.iter().map(|&x| quant::f32_to_f16(x)));
+            cache.v[li].extend(vv.iter().map(|&x| quant::f32_to_f16(x)));
             let (keys, values) = (&cache.k[li], &cache.v[li]);
             // one query head of one token: `i = t·heads + h`, causal over positions 0..=start+t
             let attend = |i: usize, out: &mut [f32], scores: &mut Vec<f32>| {

@@ -65,6 +65,39 @@ pub fn f16_to_f32(h: u16) -> f32 {
     f32::from_bits(bits)
 }
 
+/// Single to half precision, rounded to nearest even (the KV cache's keys and values);
+/// beyond half's range, infinity; NaN stays NaN.
+pub fn f32_to_f16(x: f32) -> u16 {
+    let bits = x.to_bits();
+    let sign = ((bits >> 16) & 0x8000) as u16;
+    let exp = ((bits >> 23) & 0xff) as i32;
+    let mant = bits & 0x7f_ffff;
+    if exp == 0xff {
+        return sign | 0x7c00 | if mant != 0 { 0x200 } else { 0 };
+    }
+    let e = exp - 127 + 15;
+    if e >= 0x1f {
+        return sign | 0x7c00;
+    }
+    if e <= 0 {
+        // a subnormal half (or zero): the mantissa with its implicit bit, shifted
+        if e < -10 {
+            return sign;
+        }
+        let m = mant | 0x80_0000;
+        let shift = (14 - e) as u32;
+        let rounded = (m + (1 << (shift - 1)) - 1 + ((m >> shift) & 1)) >> shift;
+        return sign | rounded as u16;
+    }
+    let (m, rest) = (mant >> 13, mant & 0x1fff);
+    let mut h = ((e as u32) << 10) | m;
+    // a carry out of the mantissa raises the exponent, as it should
+    if rest > 0x1000 || (rest == 0x1000 && m & 1 == 1) {
+        h += 1;
+    }
+    sign | h as u16
+}
+
 /// Q4_1 blocks from a GGUF tensor's bytes (20 bytes a block: d, m as f16, 16 bytes).
 pub fn read_q4_1(bytes: &[u8]) -> Vec<Q4_1> {
     bytes
@@ -119,15 +152,17 @@ pub struct Kernels {
     pub q5_0: crate::kquant::FormatKernels<crate::kquant::Q5_0>,
     pub q4_k: crate::kquant::FormatKernels<crate::kquant::Q4K>,
     pub q6_k: crate::kquant::FormatKernels<crate::kquant::Q6K>,
-    /// `out = softmax(q·kᵀ·scale)·v` over a head's positions (`scores` is scratch).
+    /// `out = softmax(q·kᵀ·scale)·v` over a head's positions (`scores` is scratch), the
+    /// cache in half precision.
     pub attend: fn(&[f32], &Heads, f32, &mut Vec<f32>, &mut [f32]),
     pub name: &'static str,
 }
 
-/// One key/value head of the KV cache: position `p`'s vector at `p·stride + offset`.
+/// One key/value head of the KV cache: position `p`'s vector at `p·stride + offset`, in
+/// half precision (as llama.cpp keeps it: half the memory and the bandwidth of f32).
 pub struct Heads<'a> {
-    pub keys: &'a [f32],
-    pub values: &'a [f32],
+    pub keys: &'a [u16],
+    pub values: &'a [u16],
     pub stride: usize,
     pub offset: usize,
     pub positions: usize,
@@ -136,8 +171,8 @@ pub struct Heads<'a> {
 /// Attention written over any dot product and `axpy`.
 #[inline(always)]
 fn attend_with(
-    dot: impl Fn(&[f32], &[f32]) -> f32,
-    axpy: impl Fn(&mut [f32], f32, &[f32]),
+    dot: impl Fn(&[f32], &[u16]) -> f32,
+    axpy: impl Fn(&mut [f32], f32, &[u16]),
     q: &[f32],
     heads: &Heads,
     scale: f32,
@@ -166,7 +201,10 @@ fn attend_with(
 impl Kernels {
     pub fn detect() -> Kernels {
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+        if std::arch::is_x86_feature_detected!("avx2")
+            && std::arch::is_x86_feature_detected!("fma")
+            && std::arch::is_x86_feature_detected!("f16c")
+        {
             let (q5_0, q4_k, q6_k) = crate::kquant::kernels();
             return Kernels {
                 q4_1: avx2::q4_1_safe,
@@ -197,22 +235,22 @@ impl Kernels {
     }
 }
 
-fn dot_scalar(a: &[f32], b: &[f32]) -> f32 {
+fn dot_scalar(a: &[f32], b: &[u16]) -> f32 {
     // eight lanes, so the compiler keeps them in vector registers
     let mut lanes = [0f32; 8];
     let (ac, bc) = (a.chunks_exact(8), b.chunks_exact(8));
-    let rest: f32 = ac.remainder().iter().zip(bc.remainder()).map(|(x, y)| x * y).sum();
+    let rest: f32 = ac.remainder().iter().zip(bc.remainder()).map(|(x, &y)| x * f16_to_f32(y)).sum();
     for (x, y) in ac.zip(bc) {
         for i in 0..8 {
-            lanes[i] += x[i] * y[i];
+            lanes[i] += x[i] * f16_to_f32(y[i]);
         }
     }
     lanes.iter().sum::<f32>() + rest
 }
 
-fn axpy_scalar(out: &mut [f32], w: f32, v: &[f32]) {
-    for (o, x) in out.iter_mut().zip(v) {
-        *o += w * x;
+fn axpy_scalar(out: &mut [f32], w: f32, v: &[u16]) {
+    for (o, &x) in out.iter_mut().zip(v) {
+        *o += w * f16_to_f32(x);
     }
 }
 
@@ -259,11 +297,19 @@ mod avx2 {
     }
 
     pub fn attend_safe(q: &[f32], heads: &Heads, scale: f32, scores: &mut Vec<f32>, out: &mut [f32]) {
-        // SAFETY: as above
+        // SAFETY: as above (and F16C, also checked there)
         unsafe { attend(q, heads, scale, scores, out) }
     }
 
-    #[target_feature(enable = "avx2,fma")]
+    /// Eight halves from `at`, widened (F16C).
+    #[target_feature(enable = "avx2,fma,f16c")]
+    #[inline]
+    unsafe fn halves(at: *const u16) -> __m256 {
+        // SAFETY: the caller keeps `at + 8` within its slice
+        unsafe { _mm256_cvtph_ps(_mm_loadu_si128(at.cast())) }
+    }
+
+    #[target_feature(enable = "avx2,fma,f16c")]
     fn attend(q: &[f32], heads: &Heads, scale: f32, scores: &mut Vec<f32>, out: &mut [f32]) {
         if q.len() != 64 || out.len() != 64 {
             return super::attend_with(|a, b| dot(a, b), |o, w, v| axpy(o, w, v), q, heads, scale, scores, out);
@@ -280,14 +326,14 @@ mod avx2 {
             let mut max = f32::NEG_INFINITY;
             for p in 0..heads.positions {
                 let key = heads.keys.as_ptr().add(p * heads.stride + heads.offset);
-                let mut a = _mm256_mul_ps(qv[0], _mm256_loadu_ps(key));
-                let mut b = _mm256_mul_ps(qv[1], _mm256_loadu_ps(key.add(8)));
-                a = _mm256_fmadd_ps(qv[2], _mm256_loadu_ps(key.add(16)), a);
-                b = _mm256_fmadd_ps(qv[3], _mm256_loadu_ps(key.add(24)), b);
-                a = _mm256_fmadd_ps(qv[4], _mm256_loadu_ps(key.add(32)), a);
-                b = _mm256_fmadd_ps(qv[5], _mm256_loadu_ps(key.add(40)), b);
-                a = _mm256_fmadd_ps(qv[6], _mm256_loadu_ps(key.add(48)), a);
-                b = _mm256_fmadd_ps(qv[7], _mm256_loadu_ps(key.add(56)), b);
+                let mut a = _mm256_mul_ps(qv[0], halves(key));
+                let mut b = _mm256_mul_ps(qv[1], halves(key.add(8)));
+                a = _mm256_fmadd_ps(qv[2], halves(key.add(16)), a);
+                b = _mm256_fmadd_ps(qv[3], halves(key.add(24)), b);
+                a = _mm256_fmadd_ps(qv[4], halves(key.add(32)), a);
+                b = _mm256_fmadd_ps(qv[5], halves(key.add(40)), b);
+                a = _mm256_fmadd_ps(qv[6], halves(key.add(48)), a);
+                b = _mm256_fmadd_ps(qv[7], halves(key.add(56)), b);
                 let score = hsum(_mm256_add_ps(a, b)) * scale;
                 max = max.max(score);
                 scores.push(score);
@@ -302,7 +348,7 @@ mod avx2 {
                 let value = heads.values.as_ptr().add(p * heads.stride + heads.offset);
                 let w = _mm256_set1_ps(w);
                 for (j, o) in o.iter_mut().enumerate() {
-                    *o = _mm256_fmadd_ps(w, _mm256_loadu_ps(value.add(8 * j)), *o);
+                    *o = _mm256_fmadd_ps(w, halves(value.add(8 * j)), *o);
                 }
             }
             let inv = _mm256_set1_ps(1.0 / sum);
@@ -312,27 +358,27 @@ mod avx2 {
         }
     }
 
-    #[target_feature(enable = "avx2,fma")]
-    fn dot(a: &[f32], b: &[f32]) -> f32 {
+    #[target_feature(enable = "avx2,fma,f16c")]
+    fn dot(a: &[f32], b: &[u16]) -> f32 {
         let n = a.len().min(b.len());
         let mut acc = _mm256_setzero_ps();
         let mut i = 0;
         while i + 8 <= n {
             // SAFETY: i + 8 <= both lengths
-            let (x, y) = unsafe { (_mm256_loadu_ps(a.as_ptr().add(i)), _mm256_loadu_ps(b.as_ptr().add(i))) };
+            let (x, y) = unsafe { (_mm256_loadu_ps(a.as_ptr().add(i)), halves(b.as_ptr().add(i))) };
             acc = _mm256_fmadd_ps(x, y, acc);
             i += 8;
         }
         let mut total = hsum(acc);
         while i < n {
-            total += a[i] * b[i];
+            total += a[i] * super::f16_to_f32(b[i]);
             i += 1;
         }
         total
     }
 
-    #[target_feature(enable = "avx2,fma")]
-    fn axpy(out: &mut [f32], w: f32, v: &[f32]) {
+    #[target_feature(enable = "avx2,fma,f16c")]
+    fn axpy(out: &mut [f32], w: f32, v: &[u16]) {
         let n = out.len().min(v.len());
         let weight = _mm256_set1_ps(w);
         let mut i = 0;
@@ -340,12 +386,12 @@ mod avx2 {
             // SAFETY: i + 8 <= both lengths
             unsafe {
                 let o = out.as_mut_ptr().add(i);
-                _mm256_storeu_ps(o, _mm256_fmadd_ps(weight, _mm256_loadu_ps(v.as_ptr().add(i)), _mm256_loadu_ps(o)));
+                _mm256_storeu_ps(o, _mm256_fmadd_ps(weight, halves(v.as_ptr().add(i)), _mm256_loadu_ps(o)));
             }
             i += 8;
         }
         while i < n {
-            out[i] += w * v[i];
+            out[i] += w * super::f16_to_f32(v[i]);
             i += 1;
         }
     }
@@ -433,6 +479,26 @@ mod tests {
             .collect()
     }
 
+    /// Every half survives the way there and back, and single precision rounds to the
+    /// nearest half (ties to even) as IEEE's conversion does.
+    #[test]
+    fn halves_round_trip_and_round_to_nearest_even() {
+        for h in 0..=u16::MAX {
+            let x = f16_to_f32(h);
+            if x.is_nan() {
+                assert!(f16_to_f32(f32_to_f16(x)).is_nan());
+            } else {
+                assert_eq!(f32_to_f16(x), h, "{h:#06x} ({x})");
+            }
+        }
+        assert_eq!(f32_to_f16(1.0 + 2f32.powi(-11)), 0x3c00, "a tie goes to the even 1.0");
+        assert_eq!(f32_to_f16(1.0 + 3.0 * 2f32.powi(-11)), 0x3c02, "a tie goes to the even 1 + 2^-9");
+        assert_eq!(f32_to_f16(65520.0), 0x7c00, "past the largest half: infinity");
+        assert_eq!(f32_to_f16(2f32.powi(-25)), 0, "half the smallest subnormal: a tie to zero");
+        assert_eq!(f32_to_f16(3.0 * 2f32.powi(-26)), 1, "more than half of it: the smallest subnormal");
+        assert_eq!(f32_to_f16(-0.0), 0x8000);
+    }
+
     #[test]
     fn half_precision_converts_exactly() {
         assert_eq!(f16_to_f32(0x3c00), 1.0);
@@ -484,8 +550,14 @@ mod tests {
             assert!((k.q4_1_x4)(&w, four).iter().all(|v| (v - single).abs() <= 1e-4 * single.abs().max(1.0)));
             // attention over 5 positions of a 2-head cache: a 12-wide head and a 64-wide one
             for d in [12, 64] {
-                let (q, keys, values) = (seeded(d, 2), seeded(10 * d, 3), seeded(10 * d, 4));
-                let heads = Heads { keys: &keys, values: &values, stride: 2 * d, offset: d, positions: 5 };
+                let halves = |v: Vec<f32>| -> (Vec<u16>, Vec<f32>) {
+                    let h: Vec<u16> = v.iter().map(|&x| f32_to_f16(x)).collect();
+                    let back = h.iter().map(|&x| f16_to_f32(x)).collect();
+                    (h, back)
+                };
+                let q = seeded(d, 2);
+                let ((keys16, keys), (values16, values)) = (halves(seeded(10 * d, 3)), halves(seeded(10 * d, 4)));
+                let heads = Heads { keys: &keys16, values: &values16, stride: 2 * d, offset: d, positions: 5 };
                 let mut out = vec![0.0; d];
                 (k.attend)(&q, &heads, 0.5, &mut Vec::new(), &mut out);
                 let scores: Vec<f32> =
