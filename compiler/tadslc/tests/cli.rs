@@ -247,6 +247,24 @@ fn numeric_options_are_bounded_before_any_work() {
     }
 }
 
+/// An output directory holds one run's files: an earlier run's are refused, or removed
+/// with `--force`, so later commands that read the directory see this run's only.
+#[test]
+fn search_refuses_an_earlier_runs_scenes_unless_forced() {
+    let dir = scratch("search-stale");
+    let out = dir.join("out");
+    let args = ["search", "examples/safety/right_turn.tad", "--samples", "4", "--round", "2", "--keep", "1", "-o"];
+    let first = tadslc(&[&args[..], &[out.to_str().unwrap()]].concat(), "");
+    assert_eq!(code(&first), 0, "{}", stderr(&first));
+    std::fs::write(out.join("left_over.tad"), "scenario old {}\n").unwrap();
+    let again = tadslc(&[&args[..], &[out.to_str().unwrap()]].concat(), "");
+    assert_eq!(code(&again), 2);
+    assert!(stderr(&again).contains("from an earlier run") && stderr(&again).contains("--force"), "{}", stderr(&again));
+    let forced = tadslc(&[&args[..], &[out.to_str().unwrap(), "--force"]].concat(), "");
+    assert_eq!(code(&forced), 0, "{}", stderr(&forced));
+    assert!(!out.join("left_over.tad").exists() && out.join("search.json").exists());
+}
+
 #[test]
 fn invalid_utf8_is_a_located_error() {
     let out = tadslc(&["check", "--format", "json", "tests/ui/lex/not_utf8.tad"], "");

@@ -28,6 +28,9 @@ pub struct Args {
     /// Write the scenarios, a manifest and a summary here (default: print them)
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
+    /// Remove what an earlier run left in `--out` (else it is an error)
+    #[arg(long, requires = "out")]
+    pub force: bool,
     /// The paper's unaligned baseline: the region's name only, no examples, the general
     /// vocabulary
     #[arg(long, conflicts_with = "tuned")]
@@ -51,6 +54,12 @@ pub struct Args {
 
 /// `tadslc gen`: the fitted generator (`--generator fitted:MODEL`) or a language model.
 pub fn run(cmd: &Args) -> Result<Status, CliError> {
+    if let Some(dir) = &cmd.out {
+        let ours = |name: &str| {
+            name.ends_with(".tad") || name.starts_with("gen.") || name == "summary.json" || name == "manifest.jsonl"
+        };
+        crate::files::fresh_output(dir, cmd.force, &ours)?;
+    }
     if let Some(model) = cmd.generator.strip_prefix("fitted:") {
         return fitted(&FittedGen {
             model: Path::new(model),

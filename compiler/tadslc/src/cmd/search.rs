@@ -48,6 +48,10 @@ pub struct SearchArgs {
     /// Score as SafeBench's scorer does, quirks included
     #[arg(long)]
     pub compat: bool,
+    /// Remove the scenes and summaries an earlier run left in `--out` (else they are an
+    /// error; a shard of a job array leaves the other shards' files alone)
+    #[arg(long)]
+    pub force: bool,
 }
 
 pub fn run(args: &SearchArgs, color: bool) -> Result<Status, CliError> {
@@ -57,8 +61,12 @@ pub fn run(args: &SearchArgs, color: bool) -> Result<Status, CliError> {
     if scenes.is_empty() {
         return Err(CliError::usage("nothing to search"));
     }
-    std::fs::create_dir_all(&args.out)
-        .map_err(|e| CliError::usage(format!("cannot create `{}`: {e}", args.out.display())))?;
+    // a shard shares the directory with the other shards of its run
+    let ours = |name: &str| {
+        args.shard == tad_base::Shard::ALL
+            && (name.ends_with(".tad") || (name.starts_with("search") && name.ends_with(".json")))
+    };
+    crate::files::fresh_output(&args.out, args.force, &ours)?;
     let mode = if args.compat { Mode::Compat } else { Mode::Fixed };
     let config = Config { samples: args.samples, round: args.round, keep: args.keep, seed: args.seed, mode };
     let total: usize =
