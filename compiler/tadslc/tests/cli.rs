@@ -138,9 +138,17 @@ fn human_output_caps_the_diagnostics_of_a_file() {
     assert!(text.contains("checked 1 file: 80 errors"), "the summary counts all: {text}");
     let all = tadslc(&["check", "--max-diagnostics", "0", "-"], &many);
     assert_eq!(stderr(&all).matches("error[E0203]").count(), 80);
+    // every format: the first 50 and how many were left out
     let json = tadslc(&["check", "--format", "json", "-"], &many);
     let file: Value = serde_json::from_str(stdout(&json).trim()).unwrap();
-    assert_eq!(file["diagnostics"].as_array().unwrap().len(), 82);
+    assert_eq!((file["diagnostics"].as_array().unwrap().len(), file["omitted"].as_u64()), (50, Some(32)));
+    let json = tadslc(&["check", "--format", "json", "--max-diagnostics", "0", "-"], &many);
+    let file: Value = serde_json::from_str(stdout(&json).trim()).unwrap();
+    assert_eq!((file["diagnostics"].as_array().unwrap().len(), file["omitted"].as_u64()), (82, Some(0)));
+    let sarif = tadslc(&["check", "--format", "sarif", "-"], &many);
+    let log: Value = serde_json::from_str(stdout(&sarif).trim()).unwrap();
+    assert_eq!(log["runs"][0]["results"].as_array().unwrap().len(), 50);
+    assert_eq!(log["runs"][0]["artifacts"][0]["properties"]["omitted"], 32);
 }
 
 #[test]

@@ -29,8 +29,8 @@ pub struct Args {
     /// Treat warnings as errors for the exit code
     #[arg(long)]
     pub deny_warnings: bool,
-    /// In human output, show at most this many diagnostics per file, then how many more
-    /// there are (0: all); JSON and SARIF always carry all
+    /// Show at most this many diagnostics per file, then how many more there are (0: all);
+    /// in every format (JSON: `omitted`; SARIF: the artifact's `omitted` property)
     #[arg(long, value_name = "N", default_value_t = 50)]
     pub max_diagnostics: usize,
     #[command(flatten)]
@@ -202,23 +202,22 @@ pub fn run(args: &Args, color: bool) -> Result<Status, CliError> {
 
     let mut sarif_reports = Vec::new();
     for c in &done {
-        let related = related(&db, c.file, &c.result.diagnostics);
-        let report = report(&c.name, &c.text, &c.result.diagnostics, &related);
+        // a file with hundreds of problems: the first ones, and how many more
+        let shown = if limit > 0 && c.result.diagnostics.len() > limit {
+            &c.result.diagnostics[..limit]
+        } else {
+            &c.result.diagnostics[..]
+        };
+        let hidden = &c.result.diagnostics[shown.len()..];
+        let related = related(&db, c.file, shown);
+        let report = report(&c.name, &c.text, shown, &related);
         match format {
             Format::Human => {
-                // a file with hundreds of problems: the first ones, and how many more
-                let shown = if limit > 0 && c.result.diagnostics.len() > limit {
-                    &c.result.diagnostics[..limit]
-                } else {
-                    &c.result.diagnostics[..]
-                };
-                let report = FileReport { diagnostics: shown, ..report };
                 err!("{}", human::render(&report, color))?;
-                let hidden = &c.result.diagnostics[shown.len()..];
                 if !hidden.is_empty() {
                     let errors = hidden.iter().filter(|d| d.is_error()).count();
                     errln!(
-                        "{}: and {} ({}); `--max-diagnostics 0` or `--format json` shows all\n",
+                        "{}: and {} ({}); `--max-diagnostics 0` shows all\n",
                         c.name,
                         plural(hidden.len(), "more diagnostic"),
                         plural(errors, "error")
@@ -238,12 +237,13 @@ pub fn run(args: &Args, color: bool) -> Result<Status, CliError> {
                     _ => Vec::new(),
                 };
                 object.insert("refinement".into(), refinement.into());
+                object.insert("omitted".into(), hidden.len().into());
                 outln!("{}", serde_json::Value::Object(object))?;
             }
             Format::Sarif => sarif_reports.push((
                 c.name.clone(),
                 c.text.clone(),
-                c.result.diagnostics.clone(),
+                shown.to_vec(),
                 related.iter().map(|(n, t, f)| (n.clone(), t.to_string(), *f)).collect::<Vec<_>>(),
             )),
         }
@@ -262,7 +262,9 @@ pub fn run(args: &Args, color: bool) -> Result<Status, CliError> {
             if let Some(artifacts) = log["runs"][0]["artifacts"].as_array_mut() {
                 for (artifact, c) in artifacts.iter_mut().zip(&done) {
                     let class = c.result.class.map_or(serde_json::Value::Null, |c| c.as_str().into());
-                    artifact["properties"] = serde_json::json!({ "class": class });
+                    let omitted =
+                        c.result.diagnostics.len().saturating_sub(if limit == 0 { usize::MAX } else { limit });
+                    artifact["properties"] = serde_json::json!({ "class": class, "omitted": omitted });
                 }
             }
             outln!("{log}")?;
