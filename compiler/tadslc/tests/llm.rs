@@ -96,6 +96,17 @@ fn a_missing_use_line_is_the_compilers_fix_not_a_repair_round() {
     assert!(stderr(&out).contains("complete after 1 round"), "{}", stderr(&out));
 }
 
+/// `--text` takes the description itself.
+#[test]
+fn translate_takes_the_description_as_text() {
+    let server = FakeLlm::script(vec![fenced(COMPLETE)]);
+    let out = run(&["translate", "--text", "A bus ahead of the ego."], &env_of(&served(&server)));
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    assert!(stdout(&out).contains("scenario bus_ahead"), "{}", stdout(&out));
+    assert!(server.requests().iter().any(|r| last_user_text(r).contains("A bus ahead of the ego.")));
+    assert_eq!(code(&run(&["translate", "--text", "  "], &[])), 2);
+}
+
 #[test]
 fn an_incomplete_scenario_gets_the_refinement_request() {
     let dir = scratch("llm-refine");

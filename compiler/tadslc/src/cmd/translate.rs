@@ -19,8 +19,11 @@ use crate::{Status, errln, out};
 pub struct Args {
     /// The description (a text file; `-` reads standard input), or several, or
     /// directories of `*.txt` descriptions
-    #[arg(required = true)]
+    #[arg(required_unless_present = "text", conflicts_with = "text")]
     pub description: Vec<PathBuf>,
+    /// The description itself, instead of a file
+    #[arg(long, value_name = "WORDS")]
+    pub text: Option<String>,
     /// Write the program here (default: standard output); with several descriptions, the
     /// directory for their programs, `translate.jsonl` and `summary.json`
     #[arg(short, long, value_name = "PATH")]
@@ -42,7 +45,10 @@ pub fn run(t: &Args) -> Result<Status, CliError> {
     let args = &t.llm;
     let (paths, output, transcript, region, stream) =
         (&t.description, t.output.as_deref(), t.transcript.as_deref(), t.region.as_deref(), t.stream);
-    let files = translate::descriptions(paths).map_err(CliError::usage)?;
+    let files = match &t.text {
+        Some(_) => vec![PathBuf::from("text")],
+        None => translate::descriptions(paths).map_err(CliError::usage)?,
+    };
     let batch = files.len() > 1 || paths.iter().any(|p| p.is_dir());
     if batch && stream {
         return Err(CliError::usage("--stream shows one description's answers; a batch reports in translate.jsonl"));
@@ -86,7 +92,13 @@ pub fn run(t: &Args) -> Result<Status, CliError> {
     let tool = format!("tadslc {}", env!("CARGO_PKG_VERSION"));
     let translator = Translator { session: &session, runtime: &runtime, region, tool: &tool };
     if !batch {
-        let text = translate::read_description(&files[0]).map_err(CliError::usage)?;
+        let text = match &t.text {
+            Some(words) if words.trim().is_empty() => {
+                return Err(CliError::usage("--text is empty: there is nothing to translate"));
+            }
+            Some(words) => words.trim().to_string(),
+            None => translate::read_description(&files[0]).map_err(CliError::usage)?,
+        };
         let (outcome, program) = translator.one(&files[0], &text, &mut on_round);
         match (&program, output) {
             (Some(p), Some(path)) => store::write_atomic(path, p.as_bytes())
