@@ -273,6 +273,31 @@ fn search_refuses_an_earlier_runs_scenes_unless_forced() {
     assert!(!out.join("left_over.tad").exists() && out.join("search.json").exists());
 }
 
+/// Every manual page has EXIT STATUS, and every example on the pages parses: its flags
+/// exist (each is run with `--help` appended, which stops before any work).
+#[test]
+fn the_manual_pages_have_exit_status_and_examples_that_parse() {
+    let dir = scratch("man-pages");
+    assert_eq!(code(&tadslc(&["man", "-o", dir.to_str().unwrap()], "")), 0);
+    let check = std::fs::read_to_string(dir.join("tadslc-check.1")).unwrap();
+    assert!(check.contains(".SH \"EXIT STATUS\"") && check.contains(".SH EXAMPLES"), "{check}");
+    let exe = env!("CARGO_BIN_EXE_tadslc");
+    for (page, lines) in tadslc::cmd::man::EXAMPLES {
+        for line in *lines {
+            let command = line.split(" > ").next().unwrap();
+            let command = command.split_whitespace().skip_while(|w| w.contains('=')).collect::<Vec<_>>().join(" ");
+            let command = command.replacen("tadslc", exe, 1);
+            let out = std::process::Command::new("sh")
+                .arg("-c")
+                .arg(format!("{command} --help"))
+                .current_dir(repo())
+                .output()
+                .unwrap();
+            assert_eq!(out.status.code(), Some(0), "{page}: `{line}`: {}", String::from_utf8_lossy(&out.stderr));
+        }
+    }
+}
+
 #[test]
 fn invalid_utf8_is_a_located_error() {
     let out = tadslc(&["check", "--format", "json", "tests/ui/lex/not_utf8.tad"], "");
