@@ -219,6 +219,10 @@ fn bench_translate_scores_answers_against_the_ground_truth() {
     let percent: f64 = overall.rsplit("**").nth(1).unwrap().trim_end_matches(" %").parse().unwrap();
     assert!(percent > 5.0 && percent < 40.0, "{overall}");
     assert!(dir.join("faithfulness.jsonl").exists() && dir.join("06_los_angeles_boulevard_red_light.tad").exists());
+    // the kept answers score the same without a model
+    let rescored = run(&["bench", "--translate", "--answers", dir.to_str().unwrap()], &[]);
+    assert_eq!(code(&rescored), 0, "{}", stderr(&rescored));
+    assert!(stdout(&rescored).lines().any(|l| l == overall), "{}", stdout(&rescored));
 }
 
 #[test]

@@ -75,6 +75,11 @@ pub struct Args {
     /// Repair and refinement requests after the first answer
     #[arg(long, value_name = "N", default_value_t = 3, requires = "translate")]
     pub max_rounds: u32,
+    /// Score the translations already in DIR (`NAME.tad`, and `faithfulness.jsonl` for the
+    /// rounds, tokens and seconds, as `--out` writes them) instead of running a model: a
+    /// server's, or an interrupted run's
+    #[arg(long, value_name = "DIR", requires = "translate", conflicts_with_all = ["model", "out"])]
+    pub answers: Option<PathBuf>,
     /// Samples of each language server measurement
     #[arg(long, value_name = "N", default_value_t = 200, requires = "lsp")]
     pub samples: usize,
@@ -229,6 +234,9 @@ fn translate(args: &Args) -> Result<Status, CliError> {
     let llm = <Flags as clap::Parser>::try_parse_from(argv).map_err(|e| CliError::usage(e.to_string()))?.llm;
 
     let cases = tad_bench::translate::cases(&args.descriptions, &args.truth).map_err(|e| CliError::usage(e.0))?;
+    if let Some(dir) = &args.answers {
+        return answered(&cases, dir);
+    }
     let backend = llm.open(1).map_err(CliError::usage)?;
     let checker = backend::checker(None).map_err(CliError::usage)?;
     let constraint = backend.constraint_for(llm.constrained(&backend), None).map_err(CliError::usage)?;
@@ -254,8 +262,9 @@ fn translate(args: &Args) -> Result<Status, CliError> {
                 let written = store::write_atomic(&store::inside(dir, &case.name, "tad"), program.as_bytes());
                 write_error = write_error.take().or(written.err().map(|e| e.to_string()));
             }
+            let seconds = start.elapsed().as_secs_f64();
             if let Some(m) = manifest.as_mut() {
-                let record = serde_json::json!({ "case": case.name, "outcome": outcome });
+                let record = serde_json::json!({ "case": case.name, "outcome": outcome, "seconds": seconds });
                 write_error = write_error.take().or(m.write(&record).err().map(|e| e.to_string()));
             }
             Answer {
@@ -263,7 +272,7 @@ fn translate(args: &Args) -> Result<Status, CliError> {
                 valid_round: outcome.valid_round,
                 rounds: outcome.rounds,
                 tokens: outcome.usage.total(),
-                seconds: start.elapsed().as_secs_f64(),
+                seconds,
             }
         };
         let scored = tad_bench::translate::run(&cases, &mut one, progress)?;
@@ -271,6 +280,39 @@ fn translate(args: &Args) -> Result<Status, CliError> {
             Some(e) => Err(BenchError(format!("cannot write the answers: {e}"))),
             None => Ok(tad_bench::translate::report(&label, &scored)),
         }
+    })
+}
+
+/// `bench --translate --answers DIR`: the answers `--out DIR` kept, scored; a case without
+/// one has no program. With a manifest, only the cases it records (an interrupted run's).
+fn answered(cases: &[tad_bench::translate::Case], dir: &std::path::Path) -> Result<Status, CliError> {
+    use tad_bench::translate::{Answer, Case};
+    let mut records = std::collections::HashMap::new();
+    if let Ok(text) = std::fs::read_to_string(dir.join("faithfulness.jsonl")) {
+        for record in text.lines().filter_map(|l| serde_json::from_str::<serde_json::Value>(l).ok()) {
+            if let Some(case) = record["case"].as_str() {
+                records.insert(case.to_string(), record.clone());
+            }
+        }
+    }
+    let cases: Vec<Case> =
+        cases.iter().filter(|c| records.is_empty() || records.contains_key(&c.name)).cloned().collect();
+    let label = format!("the answers in {}", dir.display());
+    streamed("bench --translate: ", |progress| {
+        let mut one = |case: &Case, _: &str| {
+            let record = records.get(&case.name);
+            let outcome = |key: &str| record.map(|r| r["outcome"][key].clone()).unwrap_or_default();
+            let usage = outcome("usage");
+            Answer {
+                program: std::fs::read_to_string(dir.join(format!("{}.tad", case.name))).ok(),
+                valid_round: outcome("valid_round").as_u64().map(|r| r as u32),
+                rounds: outcome("rounds").as_u64().unwrap_or(0) as u32,
+                tokens: usage["prompt_tokens"].as_u64().unwrap_or(0) + usage["completion_tokens"].as_u64().unwrap_or(0),
+                seconds: record.and_then(|r| r["seconds"].as_f64()).unwrap_or(0.0),
+            }
+        };
+        let scored = tad_bench::translate::run(&cases, &mut one, progress)?;
+        Ok(tad_bench::translate::report(&label, &scored))
     })
 }
 
