@@ -49,7 +49,7 @@ pub fn resolve_symbol(vocabulary: &Vocabulary, kind: &str, field: &str, symbol: 
                 Code::E0400,
                 format!("unknown {} `{}`", kind_label(kind), symbol.name),
                 symbol.span,
-                format!("not {} `{field}` can take", with_article(&kind_label(kind))),
+                format!("not {} `{field}` can take", tad_base::a(&kind_label(kind))),
             );
             let candidates = vocabulary.candidates(kind, &symbol.name, 5);
             // a name another standard module declares is not a typo
@@ -97,12 +97,6 @@ pub fn resolve_symbol(vocabulary: &Vocabulary, kind: &str, field: &str, symbol: 
             out.push(d);
         }
     }
-}
-
-/// "a weather", "an actor type".
-fn with_article(noun: &str) -> String {
-    let vowel = noun.starts_with(['a', 'e', 'i', 'o', 'u']);
-    format!("{} {noun}", if vowel { "an" } else { "a" })
 }
 
 pub fn quoted(names: &[&str]) -> String {

@@ -371,9 +371,13 @@ fn speeds(
         out.push(
             Diagnostic::new(
                 Code::W0504,
-                format!("{what} moves at {moves_at}{}, implausibly fast for a {}", speed_text(speed), t.name),
+                format!(
+                    "{what} moves at {moves_at}{}, implausibly fast for {}",
+                    speed_text(speed),
+                    tad_base::a(&t.name)
+                ),
                 attr.value_span,
-                format!("a {} reaches about {}", t.name, speed_text(max)),
+                format!("{} reaches about {}", tad_base::a(&t.name), speed_text(max)),
             )
             .with_payload(speed_range(speed, None, Some(max))),
         );
@@ -386,9 +390,9 @@ fn speeds(
             Diagnostic::new(
                 Code::W0504,
                 format!(
-                    "{what} moves at {moves_at}{}, implausibly fast on a {} road",
+                    "{what} moves at {moves_at}{}, implausibly fast on {} road",
                     speed_text(speed),
-                    c.name.replace('_', " ")
+                    tad_base::a(&c.name.replace('_', " "))
                 ),
                 attr.value_span,
                 format!("more than {} there", speed_text(max)),
@@ -477,9 +481,9 @@ fn lights_and_signs(
             out.push(
                 Diagnostic::new(
                     Code::W0507,
-                    format!("a `{}` traffic light on a {}", light.name, place.name.replace('_', " ")),
+                    format!("a `{}` traffic light on {}", light.name, tad_base::a(&place.name.replace('_', " "))),
                     light_attr.value_span,
-                    format!("a {} has no traffic lights", place.name.replace('_', " ")),
+                    format!("{} has no traffic lights", tad_base::a(&place.name.replace('_', " "))),
                 )
                 .with_payload(Payload::Incompatible {
                     subject: place.name.clone(),
@@ -496,7 +500,11 @@ fn lights_and_signs(
         if sign_entry.symbols("conflicts_with").is_some_and(|c| c.contains(&light.name.as_str())) {
             let mut d = Diagnostic::new(
                 Code::W0508,
-                format!("a {} together with a {} light", sign_entry.name.replace('_', " "), light.name),
+                format!(
+                    "{} together with {} light",
+                    tad_base::a(&sign_entry.name.replace('_', " ")),
+                    tad_base::a(&light.name)
+                ),
                 sign.span,
                 format!("contradicts the `{}` light", light.name),
             )
