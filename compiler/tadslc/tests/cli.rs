@@ -298,6 +298,51 @@ fn the_manual_pages_have_exit_status_and_examples_that_parse() {
     }
 }
 
+/// Names people and other tools use (TrafficComposer's `in front of`, "day time", a
+/// traffic circle, give way, a dog, a trolleybus) are TAD's, as aliases or declarations.
+#[test]
+fn names_people_use_are_understood() {
+    let program = r#"scenario names {
+  environment {
+    weather: clear
+    time: day_time
+  }
+  road {
+    type: traffic_circle
+    context: urban
+    lanes: 1
+    direction: one_way
+    signs: [give_way_sign, one_way_sign]
+    light: none
+  }
+  ego {
+    behavior: give_way
+    speed: 10 km/h
+    lane: 1
+  }
+  actor pet: 1 dog {
+    behavior: cross
+    position: in_front_of of ego
+    lane: 1
+  }
+  actor trolley: 1 trolleybus {
+    behavior: move_forward
+    speed: 20 km/h
+    position: left_front of ego
+    lane: 1
+  }
+}
+"#;
+    let out = tadslc(&["check", "--format", "json", "-"], program);
+    assert_eq!(code(&out), 0, "{}", stdout(&out));
+    let file: Value = serde_json::from_str(stdout(&out).trim()).unwrap();
+    assert_eq!(file["class"], "complete");
+    let codes: Vec<&str> =
+        file["diagnostics"].as_array().unwrap().iter().map(|d| d["code"].as_str().unwrap()).collect();
+    assert!(codes.iter().all(|c| *c == "W0401"), "only alias hints: {codes:?}");
+    assert_eq!(codes.len(), 6, "day_time, traffic_circle, give_way_sign, give_way, in_front_of, trolleybus");
+}
+
 #[test]
 fn invalid_utf8_is_a_located_error() {
     let out = tadslc(&["check", "--format", "json", "tests/ui/lex/not_utf8.tad"], "");

@@ -78,7 +78,9 @@ pub fn scenarios() -> Vec<(String, String)> {
         let context = &contexts[i % contexts.len()];
         let context_signalised = v.get("road_context", context).and_then(|e| e.flag("signalised")) != Some(false);
         let light = if signalised && context_signalised { light.as_str() } else { "none" };
-        let sign = &signs[i % signs.len()];
+        // shifted every round of the lights, so that no sign always meets the light it
+        // conflicts with
+        let sign = &signs[(i + i / lights.len()) % signs.len()];
         let sign = if v
             .get("traffic_sign", sign)
             .and_then(|e| e.symbols("conflicts_with"))
