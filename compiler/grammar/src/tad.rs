@@ -6,8 +6,9 @@
 //! lines, one scenario with its sections in canonical order, two-space indentation, one
 //! field per line in the schema's order, each field at most once. A program in it parses;
 //! the checker still judges its meaning (lanes against the road, behaviours against the
-//! actor's kind, completeness). Numbers and names are bounded in length so that a decoder
-//! cannot run away inside one.
+//! actor's kind, completeness). Numbers and names are bounded in length, and lists and the
+//! groups in number, so that a decoder cannot run away inside one: a small model otherwise
+//! repeats groups or list items until its token limit cuts the program short.
 
 use tad_check::Vocabulary;
 use tad_syntax::lexer::UNITS;
@@ -19,6 +20,10 @@ use crate::ir::{Expr, Grammar, alt, class, lit, not_class, opt, r, rep, seq, sta
 const NAME_MAX: u32 = 48;
 /// Comment lines before the program.
 const COMMENTS_MAX: u32 = 8;
+/// Actor groups in a scenario (the examples and the benchmark's truths have at most 5).
+const GROUPS_MAX: u32 = 12;
+/// Names in a list field (the examples and truths have at most 5).
+const LIST_MAX: u32 = 8;
 
 pub fn grammar(vocabulary: &Vocabulary, modules: &[String]) -> Grammar {
     let mut g = Grammar::default();
@@ -36,7 +41,7 @@ pub fn grammar(vocabulary: &Vocabulary, modules: &[String]) -> Grammar {
             opt(r("environment")),
             opt(r("road")),
             opt(r("ego")),
-            star(r("actor")),
+            rep(r("actor"), 0, GROUPS_MAX),
             lit("}"),
             opt(lit("\n")),
         ]),
@@ -140,7 +145,7 @@ fn value(field: &FieldDef) -> Expr {
         }
         ValueType::SymbolList => {
             let name = r(&kind_rule(field.vocabulary.unwrap_or("none")));
-            alt([lit("[]"), seq([lit("["), name.clone(), rep(seq([lit(", "), name]), 0, 15), lit("]")])])
+            alt([lit("[]"), seq([lit("["), name.clone(), rep(seq([lit(", "), name]), 0, LIST_MAX - 1), lit("]")])])
         }
         ValueType::Integer => r("int"),
         ValueType::Speed | ValueType::Duration | ValueType::Length => {
