@@ -41,8 +41,7 @@ impl Choice {
     /// The server the choice, the environment and the config file name, or the local model
     /// when they name none (or `model` is `local`); `concurrency` requests at once.
     pub fn open(&self, concurrency: usize) -> Result<Backend, String> {
-        if let Some(name) = self.model.as_deref().and_then(|m| m.strip_prefix("local")) {
-            let name = name.strip_prefix(':').filter(|n| !n.is_empty()).unwrap_or(tad_local::DEFAULT);
+        if let Some(name) = self.local_name() {
             return self.local(name, None);
         }
         match self.server(concurrency)? {
@@ -60,7 +59,7 @@ impl Choice {
     /// The server the choice, the environment and the config file name; `None` when they
     /// name none, or the model is `local` (nothing is loaded either way).
     pub fn server(&self, concurrency: usize) -> Result<Option<Config>, String> {
-        if self.model.as_deref().is_some_and(|m| m.starts_with("local")) {
+        if self.local_name().is_some() {
             return Ok(None);
         }
         let file = config_file(self.config_file.as_deref())?;
@@ -75,6 +74,12 @@ impl Choice {
         let env = |k: &str| std::env::var(k).ok();
         Config::resolve(&overrides, &env, file.as_ref().map(|(n, t)| (n.as_str(), t.as_str())), self.seed)
             .map_err(|e| e.to_string())
+    }
+
+    /// The local model `--model` names (`local`, `local:NAME`), if it names one.
+    fn local_name(&self) -> Option<&str> {
+        let name = self.model.as_deref()?.strip_prefix("local")?;
+        Some(name.strip_prefix(':').filter(|n| !n.is_empty()).unwrap_or(tad_local::DEFAULT))
     }
 
     fn local(&self, name: &str, why: Option<&str>) -> Result<Backend, String> {

@@ -60,9 +60,6 @@ pub struct Verdict {
     /// The program as canonical TAD (a YAML answer converted), when it parses.
     pub tad: Option<String>,
     pub errors: usize,
-    /// The checker's own certain fixes of errors applied before the verdict (a missing
-    /// `use` line for a regional name).
-    pub fixed: usize,
 }
 
 /// Checks programs as `tadslc check` does, with the run's options.
@@ -75,26 +72,19 @@ impl Checker {
     /// The verdict on `text`, after the machine-applicable fixes of its errors: what the
     /// compiler knows for certain is not sent back to the model as a repair.
     pub fn check(&self, text: &str, language: Language) -> Verdict {
-        let verdict = self.check_as_is(text, language);
-        if language != Language::Tad || verdict.errors == 0 {
-            return verdict;
+        let (verdict, fixed) = self.check_as_is(text, language);
+        match fixed {
+            Some(fixed) => {
+                let (after, _) = self.check_as_is(&fixed, language);
+                if after.errors < verdict.errors { after } else { verdict }
+            }
+            None => verdict,
         }
-        let mut db = Database::new(self.options.clone());
-        let file = db.set_source(PathBuf::from("answer.tad"), text.to_string(), language, &NoFs);
-        let checked = tad_db::check(&db, file);
-        let errors = checked.diagnostics.iter().filter(|d| d.severity == Severity::Error);
-        let (fixed_text, fixed) = tad_diagnostics::apply_fixes(text, errors);
-        if fixed == 0 {
-            return verdict;
-        }
-        let after = self.check_as_is(&fixed_text, language);
-        if after.errors >= verdict.errors {
-            return verdict;
-        }
-        Verdict { fixed, ..after }
     }
 
-    fn check_as_is(&self, text: &str, language: Language) -> Verdict {
+    /// The verdict on `text` as it is, and for a TAD program with errors that have
+    /// machine-applicable fixes, the text with those fixes applied.
+    fn check_as_is(&self, text: &str, language: Language) -> (Verdict, Option<String>) {
         let mut db = Database::new(self.options.clone());
         let path = PathBuf::from(if language == Language::Yaml { "answer.yaml" } else { "answer.tad" });
         let file = db.set_source(path, text.to_string(), language, &NoFs);
@@ -102,6 +92,10 @@ impl Checker {
         let vocabulary = &tad_db::vocabulary(&db, file).vocabulary;
         let diagnostics = &checked.diagnostics;
         let errors = diagnostics.iter().filter(|d| d.severity == Severity::Error).count();
+        let fixed = match tad_diagnostics::apply_fixes(text, diagnostics.iter().filter(|d| d.is_error())) {
+            (fixed, n) if language == Language::Tad && n > 0 => Some(fixed),
+            _ => None,
+        };
         let syntax_valid = !diagnostics.iter().any(|d| {
             let code = d.code.as_str();
             d.severity == Severity::Error
@@ -119,7 +113,7 @@ impl Checker {
             Language::Yaml if module.scenario.is_some() => Some(tad_yaml::to_tad(module)),
             _ => None,
         };
-        Verdict { class, syntax_valid, lines, requests, tad, errors, fixed: 0 }
+        (Verdict { class, syntax_valid, lines, requests, tad, errors }, fixed)
     }
 }
 
