@@ -13,7 +13,7 @@
 //! The layouts are ggml's (`ggml-common.h`, `block_q5_0`, `block_q4_K`, `block_q6_K`); the
 //! tests hold the dequantization to candle's on random blocks and on the real files.
 
-use crate::quant::{BLOCK, Q8_1, f16_to_f32};
+use crate::quant::{BLOCK, FormatKernels, Q8_1, f16_to_f32};
 
 /// Values in a super-block.
 pub const SUPER: usize = 256;
@@ -224,39 +224,20 @@ pub fn dot_q6_k(w: &[Q6K], x: &[Q8_1]) -> f32 {
     total
 }
 
-/// A row's product with one token, and with four at once (the row's blocks unpacked once
-/// for the four).
-pub type Dot<B> = fn(&[B], &[Q8_1]) -> f32;
-pub type Dot4<B> = fn(&[B], [&[Q8_1]; 4]) -> [f32; 4];
+/// The three formats' kernels.
+pub type Formats = (FormatKernels<Q5_0>, FormatKernels<Q4K>, FormatKernels<Q6K>);
 
-/// The kernels of one format for this CPU: AVX2 and FMA where it has them, else scalar.
-pub struct FormatKernels<B> {
-    pub one: Dot<B>,
-    pub four: Dot4<B>,
+/// The AVX2 kernels; only for a CPU [`crate::quant::Kernels::detect`] found them on.
+#[cfg(target_arch = "x86_64")]
+pub(crate) fn avx2_kernels() -> Formats {
+    (
+        FormatKernels { one: |w, x| avx2::q5_0_safe(w, [x])[0], four: avx2::q5_0_safe },
+        FormatKernels { one: |w, x| avx2::q4_k_safe(w, [x])[0], four: avx2::q4_k_safe },
+        FormatKernels { one: |w, x| avx2::q6_k_safe(w, [x])[0], four: avx2::q6_k_safe },
+    )
 }
 
-// by hand: a derive would ask `B: Copy` of the blocks
-impl<B> Clone for FormatKernels<B> {
-    fn clone(&self) -> Self {
-        *self
-    }
-}
-
-impl<B> Copy for FormatKernels<B> {}
-
-pub fn kernels() -> (FormatKernels<Q5_0>, FormatKernels<Q4K>, FormatKernels<Q6K>) {
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
-        return (
-            FormatKernels { one: |w, x| avx2::q5_0_safe(w, [x])[0], four: avx2::q5_0_safe },
-            FormatKernels { one: |w, x| avx2::q4_k_safe(w, [x])[0], four: avx2::q4_k_safe },
-            FormatKernels { one: |w, x| avx2::q6_k_safe(w, [x])[0], four: avx2::q6_k_safe },
-        );
-    }
-    scalar_kernels()
-}
-
-pub fn scalar_kernels() -> (FormatKernels<Q5_0>, FormatKernels<Q4K>, FormatKernels<Q6K>) {
+pub fn scalar_kernels() -> Formats {
     (
         FormatKernels { one: dot_q5_0, four: |w, x| x.map(|x| dot_q5_0(w, x)) },
         FormatKernels { one: dot_q4_k, four: |w, x| x.map(|x| dot_q4_k(w, x)) },
@@ -274,7 +255,7 @@ mod avx2 {
     use std::arch::x86_64::*;
 
     pub fn q5_0_safe<const N: usize>(w: &[Q5_0], x: [&[Q8_1]; N]) -> [f32; N] {
-        // SAFETY: chosen only when the CPU has AVX2 and FMA (`super::kernels`)
+        // SAFETY: chosen only when the CPU has AVX2 and FMA (`Kernels::detect`)
         unsafe { q5_0(w, x) }
     }
 
@@ -412,7 +393,7 @@ mod avx2 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::quant::quantize;
+    use crate::quant::{Dot, quantize};
     use candle_core::Device;
     use candle_core::quantized::{GgmlDType, QStorage, QTensor};
     use tad_base::{Rng, SplitMix64};
@@ -481,7 +462,7 @@ mod tests {
             let bytes = random_blocks(dtype, blocks, 13);
             let w = ours(dtype, &bytes);
             let want: f64 = w.iter().zip(&xd).map(|(a, b)| f64::from(*a) * f64::from(*b)).sum();
-            let (q5_0, q4_k, q6_k) = kernels();
+            let crate::quant::Kernels { q5_0, q4_k, q6_k, .. } = crate::quant::Kernels::detect();
             let got = match dtype {
                 GgmlDType::Q5_0 => [dot_q5_0(&read_q5_0(&bytes), &xq), (q5_0.one)(&read_q5_0(&bytes), &xq)],
                 GgmlDType::Q4K => [dot_q4_k(&read_q4_k(&bytes), &xq), (q4_k.one)(&read_q4_k(&bytes), &xq)],
@@ -525,7 +506,7 @@ mod tests {
     /// saturate).
     #[test]
     fn the_simd_kernels_are_the_scalar_ones() {
-        let (q5_0, q4_k, q6_k) = kernels();
+        let crate::quant::Kernels { q5_0, q4_k, q6_k, .. } = crate::quant::Kernels::detect();
         let mut rng = SplitMix64::new(21);
         for round in 0..100 {
             let supers = 1 + rng.below(4);

@@ -59,7 +59,7 @@ impl Matrix {
 
     fn row(&self, k: &Kernels, r: usize, x: &[Q8_1]) -> f32 {
         match self {
-            Matrix::Q4_1 { blocks, per_row, .. } => (k.q4_1)(&blocks[r * per_row..(r + 1) * per_row], x),
+            Matrix::Q4_1 { blocks, per_row, .. } => (k.q4_1.one)(&blocks[r * per_row..(r + 1) * per_row], x),
             Matrix::Q8_0 { blocks, per_row, .. } => (k.q8_0)(&blocks[r * per_row..(r + 1) * per_row], x),
             Matrix::Q5_0 { blocks, per_row, .. } => (k.q5_0.one)(&blocks[r * per_row..(r + 1) * per_row], x),
             Matrix::Q4K { blocks, per_row, .. } => (k.q4_k.one)(&blocks[r * per_row..(r + 1) * per_row], x),
@@ -101,10 +101,10 @@ impl Matrix {
         out.clear();
         let row = |blocks: usize| r * blocks..(r + 1) * blocks;
         match self {
-            Matrix::Q4_1 { blocks, per_row, .. } => fours(&blocks[row(*per_row)], x, (k.q4_1, k.q4_1_x4), out),
-            Matrix::Q5_0 { blocks, per_row, .. } => fours(&blocks[row(*per_row)], x, (k.q5_0.one, k.q5_0.four), out),
-            Matrix::Q4K { blocks, per_row, .. } => fours(&blocks[row(*per_row)], x, (k.q4_k.one, k.q4_k.four), out),
-            Matrix::Q6K { blocks, per_row, .. } => fours(&blocks[row(*per_row)], x, (k.q6_k.one, k.q6_k.four), out),
+            Matrix::Q4_1 { blocks, per_row, .. } => fours(&blocks[row(*per_row)], x, k.q4_1, out),
+            Matrix::Q5_0 { blocks, per_row, .. } => fours(&blocks[row(*per_row)], x, k.q5_0, out),
+            Matrix::Q4K { blocks, per_row, .. } => fours(&blocks[row(*per_row)], x, k.q4_k, out),
+            Matrix::Q6K { blocks, per_row, .. } => fours(&blocks[row(*per_row)], x, k.q6_k, out),
             Matrix::Q8_0 { .. } => out.extend(x.iter().map(|xt| self.row(k, r, xt))),
         }
     }
@@ -147,12 +147,12 @@ impl Matrix {
 }
 
 /// The row `w` against the tokens `x`, four at a time, the rest one by one.
-fn fours<B>(w: &[B], x: &[Vec<Q8_1>], (one, four): (kquant::Dot<B>, kquant::Dot4<B>), out: &mut Vec<f32>) {
+fn fours<B>(w: &[B], x: &[Vec<Q8_1>], k: quant::FormatKernels<B>, out: &mut Vec<f32>) {
     let mut chunks = x.chunks_exact(4);
     for c in chunks.by_ref() {
-        out.extend(four(w, [&c[0], &c[1], &c[2], &c[3]]));
+        out.extend((k.four)(w, [&c[0], &c[1], &c[2], &c[3]]));
     }
-    out.extend(chunks.remainder().iter().map(|xt| one(w, xt)));
+    out.extend(chunks.remainder().iter().map(|xt| (k.one)(w, xt)));
 }
 
 struct Layer {

@@ -142,16 +142,34 @@ pub fn quantize(x: &[f32], out: &mut Vec<Q8_1>) {
     }
 }
 
+/// A row's product with one token, and with four at once (the row's blocks unpacked once
+/// for the four).
+pub type Dot<B> = fn(&[B], &[Q8_1]) -> f32;
+pub type Dot4<B> = fn(&[B], [&[Q8_1]; 4]) -> [f32; 4];
+
+/// The kernels of one format.
+pub struct FormatKernels<B> {
+    pub one: Dot<B>,
+    pub four: Dot4<B>,
+}
+
+// by hand: a derive would ask `B: Copy` of the blocks
+impl<B> Clone for FormatKernels<B> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<B> Copy for FormatKernels<B> {}
+
 /// The dot products, chosen once for this CPU.
 #[derive(Clone, Copy)]
 pub struct Kernels {
-    pub q4_1: fn(&[Q4_1], &[Q8_1]) -> f32,
-    /// One weight row against four tokens: the row is unpacked once.
-    pub q4_1_x4: fn(&[Q4_1], [&[Q8_1]; 4]) -> [f32; 4],
-    pub q8_0: fn(&[Q8_0], &[Q8_1]) -> f32,
-    pub q5_0: crate::kquant::FormatKernels<crate::kquant::Q5_0>,
-    pub q4_k: crate::kquant::FormatKernels<crate::kquant::Q4K>,
-    pub q6_k: crate::kquant::FormatKernels<crate::kquant::Q6K>,
+    pub q4_1: FormatKernels<Q4_1>,
+    pub q8_0: Dot<Q8_0>,
+    pub q5_0: FormatKernels<crate::kquant::Q5_0>,
+    pub q4_k: FormatKernels<crate::kquant::Q4K>,
+    pub q6_k: FormatKernels<crate::kquant::Q6K>,
     /// `out = softmax(q·kᵀ·scale)·v` over a head's positions (`scores` is scratch), the
     /// cache in half precision.
     pub attend: fn(&[f32], &Heads, f32, &mut Vec<f32>, &mut [f32]),
@@ -205,10 +223,9 @@ impl Kernels {
             && std::arch::is_x86_feature_detected!("fma")
             && std::arch::is_x86_feature_detected!("f16c")
         {
-            let (q5_0, q4_k, q6_k) = crate::kquant::kernels();
+            let (q5_0, q4_k, q6_k) = crate::kquant::avx2_kernels();
             return Kernels {
-                q4_1: avx2::q4_1_safe,
-                q4_1_x4: avx2::q4_1_x4_safe,
+                q4_1: FormatKernels { one: avx2::q4_1_safe, four: avx2::q4_1_x4_safe },
                 q8_0: avx2::q8_0_safe,
                 q5_0,
                 q4_k,
@@ -223,8 +240,7 @@ impl Kernels {
     pub fn scalar() -> Kernels {
         let (q5_0, q4_k, q6_k) = crate::kquant::scalar_kernels();
         Kernels {
-            q4_1: dot_q4_1_scalar,
-            q4_1_x4: |w, x| x.map(|x| dot_q4_1_scalar(w, x)),
+            q4_1: FormatKernels { one: dot_q4_1_scalar, four: |w, x| x.map(|x| dot_q4_1_scalar(w, x)) },
             q8_0: dot_q8_0_scalar,
             q5_0,
             q4_k,
@@ -531,7 +547,7 @@ mod tests {
             })
             .sum();
         for k in [Kernels::scalar(), Kernels::detect()] {
-            let got = (k.q4_1)(&w, &xq);
+            let got = (k.q4_1.one)(&w, &xq);
             assert!((got - exact).abs() < 0.02 * exact.abs().max(1.0), "{}: {got} vs {exact}", k.name);
         }
         let w8: Vec<Q8_0> = (0..8)
@@ -546,8 +562,8 @@ mod tests {
         let exact8: f32 = (0..256).map(|i| w8[i / 32].d * w8[i / 32].qs[i % 32] as f32 * x[i]).sum();
         let four = [xq.as_slice(); 4];
         for k in [Kernels::scalar(), Kernels::detect()] {
-            let single = (k.q4_1)(&w, &xq);
-            assert!((k.q4_1_x4)(&w, four).iter().all(|v| (v - single).abs() <= 1e-4 * single.abs().max(1.0)));
+            let single = (k.q4_1.one)(&w, &xq);
+            assert!((k.q4_1.four)(&w, four).iter().all(|v| (v - single).abs() <= 1e-4 * single.abs().max(1.0)));
             // attention over 5 positions of a 2-head cache: a 12-wide head and a 64-wide one
             for d in [12, 64] {
                 let halves = |v: Vec<f32>| -> (Vec<u16>, Vec<f32>) {
