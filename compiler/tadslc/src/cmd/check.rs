@@ -245,6 +245,7 @@ pub fn run(args: &Args, color: bool) -> Result<Status, CliError> {
                 c.text.clone(),
                 shown.to_vec(),
                 related.iter().map(|(n, t, f)| (n.clone(), t.to_string(), *f)).collect::<Vec<_>>(),
+                hidden.len(),
             )),
         }
     }
@@ -252,18 +253,17 @@ pub fn run(args: &Args, color: bool) -> Result<Status, CliError> {
         Format::Sarif => {
             let reports: Vec<FileReport<'_>> = sarif_reports
                 .iter()
-                .map(|(name, text, diagnostics, related)| {
+                .map(|(name, text, diagnostics, related, _)| {
                     FileReport::new(name, text, diagnostics)
                         .with_related(related.iter().map(|(n, t, f)| Source { file: *f, name: n, text: t }).collect())
                 })
                 .collect();
             let mut log = sarif::render(&reports, env!("CARGO_PKG_VERSION"));
-            // each artifact says its scenario's class
+            // each artifact says its scenario's class and how many diagnostics were left out
             if let Some(artifacts) = log["runs"][0]["artifacts"].as_array_mut() {
-                for (artifact, c) in artifacts.iter_mut().zip(&done) {
+                // one report per file checked, in the same order
+                for ((artifact, c), (.., omitted)) in artifacts.iter_mut().zip(&done).zip(&sarif_reports) {
                     let class = c.result.class.map_or(serde_json::Value::Null, |c| c.as_str().into());
-                    let omitted =
-                        c.result.diagnostics.len().saturating_sub(if limit == 0 { usize::MAX } else { limit });
                     artifact["properties"] = serde_json::json!({ "class": class, "omitted": omitted });
                 }
             }
