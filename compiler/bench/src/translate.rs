@@ -207,8 +207,8 @@ pub fn score(truth: &Attributes, answer: Option<&Attributes>) -> Tally {
     let weights: Vec<Vec<i64>> =
         truth.groups.iter().map(|t| a.groups.iter().map(|g| agreeing(t, g)).collect()).collect();
     let partner = best_assignment(&weights, a.groups.len());
+    let none = vec![None; GROUP.len()];
     for (i, t) in truth.groups.iter().enumerate() {
-        let none = vec![None; GROUP.len()];
         let answered = partner[i].map_or(&none, |j| &a.groups[j]);
         fields(&GROUP, t, answered);
     }

@@ -287,11 +287,12 @@ fn translate(args: &Args) -> Result<Status, CliError> {
 /// one has no program. With a manifest, only the cases it records (an interrupted run's).
 fn answered(cases: &[tad_bench::translate::Case], dir: &std::path::Path) -> Result<Status, CliError> {
     use tad_bench::translate::{Answer, Case};
+    use tad_frontend::store;
     let mut records = std::collections::HashMap::new();
     if let Ok(text) = std::fs::read_to_string(dir.join("faithfulness.jsonl")) {
         for record in text.lines().filter_map(|l| serde_json::from_str::<serde_json::Value>(l).ok()) {
-            if let Some(case) = record["case"].as_str() {
-                records.insert(case.to_string(), record.clone());
+            if let Some(case) = record["case"].as_str().map(String::from) {
+                records.insert(case, record);
             }
         }
     }
@@ -302,12 +303,12 @@ fn answered(cases: &[tad_bench::translate::Case], dir: &std::path::Path) -> Resu
         let mut one = |case: &Case, _: &str| {
             let record = records.get(&case.name);
             let outcome = |key: &str| record.map(|r| r["outcome"][key].clone()).unwrap_or_default();
-            let usage = outcome("usage");
+            let usage: tad_llm::Usage = serde_json::from_value(outcome("usage")).unwrap_or_default();
             Answer {
-                program: std::fs::read_to_string(dir.join(format!("{}.tad", case.name))).ok(),
+                program: std::fs::read_to_string(store::inside(dir, &case.name, "tad")).ok(),
                 valid_round: outcome("valid_round").as_u64().map(|r| r as u32),
                 rounds: outcome("rounds").as_u64().unwrap_or(0) as u32,
-                tokens: usage["prompt_tokens"].as_u64().unwrap_or(0) + usage["completion_tokens"].as_u64().unwrap_or(0),
+                tokens: usage.total(),
                 seconds: record.and_then(|r| r["seconds"].as_f64()).unwrap_or(0.0),
             }
         };

@@ -55,9 +55,7 @@ pub struct Args {
 /// `tadslc gen`: the fitted generator (`--generator fitted:MODEL`) or a language model.
 pub fn run(cmd: &Args) -> Result<Status, CliError> {
     if let Some(dir) = &cmd.out {
-        let ours = |name: &str| {
-            name.ends_with(".tad") || name.starts_with("gen.") || name == "summary.json" || name == "manifest.jsonl"
-        };
+        let ours = |name: &str| name.ends_with(".tad") || name.starts_with("gen.") || name == "summary.json";
         crate::files::fresh_output(dir, cmd.force, &ours)?;
     }
     if let Some(model) = cmd.generator.strip_prefix("fitted:") {
