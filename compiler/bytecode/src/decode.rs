@@ -436,6 +436,9 @@ impl Decoder {
             },
             Op::Wait => Instr::Wait { actor: actor(r)?, seconds: self.value(r)? },
             Op::WaitNear => Instr::WaitNear { actor: actor(r)?, distance: self.value(r)? },
+            Op::Meet => {
+                Instr::Meet { actor: actor(r)?, point: [self.number(r)?, self.number(r)?], travel: self.value(r)? }
+            }
             Op::Drive => Instr::Drive { actor: actor(r)?, speed: self.value(r)?, turn: r.tag()? },
             Op::Follow => Instr::Follow { actor: actor(r)?, path: r.u16("a path index")?, speed: self.value(r)? },
             Op::Cross => Instr::Cross { actor: actor(r)?, speed: self.value(r)? },

@@ -103,6 +103,9 @@ fn instruction(p: &Program, instr: &Instr) -> String {
         }
         Instr::Wait { actor, seconds } => (Op::Wait, format!("a{actor} {}s", v(seconds))),
         Instr::WaitNear { actor, distance } => (Op::WaitNear, format!("a{actor} {}m", v(distance))),
+        Instr::Meet { actor, point, travel } => {
+            (Op::Meet, format!("a{actor} at=({}, {}) {}s", num(point[0]), num(point[1]), v(travel)))
+        }
         Instr::Drive { actor, speed, turn } => {
             (Op::Drive, format!("a{actor} v={} turn={}", v(speed), format::turn_name(*turn)))
         }

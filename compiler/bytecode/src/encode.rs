@@ -105,39 +105,42 @@ impl Pool {
         }
     }
 
+    /// `road`: the shape, lanes, flags, light, approach and junction.
+    fn road(&mut self, out: &mut Vec<u8>, road: &tad_road::Road) {
+        out.push(Op::Road as u8);
+        out.push(road.shape.tag());
+        out.push(match road.shape {
+            tad_road::Shape::Junction { arms, .. } => arms,
+            _ => 0,
+        });
+        for n in [road.lanes, road.opposite, road.cross_lanes] {
+            uleb(out, u64::from(n));
+        }
+        self.number(out, road.lane_width);
+        let flags = if road.sidewalks { format::ROAD_SIDEWALKS } else { 0 }
+            | if road.crosswalks { format::ROAD_CROSSWALKS } else { 0 };
+        out.push(flags);
+        out.push(road.signal.tag());
+        self.number(out, road.approach);
+        match &road.junction {
+            None => out.push(0),
+            Some(j) => {
+                out.push(1);
+                out.push(j.arms.iter().fold(0, |set, a| set | format::arm_bit(*a)));
+                out.push(
+                    if j.roundabout { format::JUNCTION_ROUNDABOUT } else { 0 }
+                        | if j.signalised { format::JUNCTION_SIGNALISED } else { 0 }
+                        | if j.stop_signs { format::JUNCTION_STOP_SIGNS } else { 0 },
+                );
+                self.number(out, j.half);
+            }
+        }
+    }
+
     fn instr(&mut self, out: &mut Vec<u8>, instr: &Instr) {
         let op = |out: &mut Vec<u8>, op: Op| out.push(op as u8);
         match instr {
-            Instr::Road(road) => {
-                op(out, Op::Road);
-                out.push(road.shape.tag());
-                out.push(match road.shape {
-                    tad_road::Shape::Junction { arms, .. } => arms,
-                    _ => 0,
-                });
-                for n in [road.lanes, road.opposite, road.cross_lanes] {
-                    uleb(out, u64::from(n));
-                }
-                self.number(out, road.lane_width);
-                let flags = if road.sidewalks { format::ROAD_SIDEWALKS } else { 0 }
-                    | if road.crosswalks { format::ROAD_CROSSWALKS } else { 0 };
-                out.push(flags);
-                out.push(road.signal.tag());
-                self.number(out, road.approach);
-                match &road.junction {
-                    None => out.push(0),
-                    Some(j) => {
-                        out.push(1);
-                        out.push(j.arms.iter().fold(0, |set, a| set | format::arm_bit(*a)));
-                        out.push(
-                            if j.roundabout { format::JUNCTION_ROUNDABOUT } else { 0 }
-                                | if j.signalised { format::JUNCTION_SIGNALISED } else { 0 }
-                                | if j.stop_signs { format::JUNCTION_STOP_SIGNS } else { 0 },
-                        );
-                        self.number(out, j.half);
-                    }
-                }
-            }
+            Instr::Road(road) => self.road(out, road),
             Instr::Limits { dt, max_steps, max_distance, timeout } => {
                 op(out, Op::Limits);
                 self.number(out, *dt);
@@ -206,6 +209,13 @@ impl Pool {
                 op(out, Op::WaitNear);
                 uleb(out, u64::from(*actor));
                 self.value(out, *distance);
+            }
+            Instr::Meet { actor, point, travel } => {
+                op(out, Op::Meet);
+                uleb(out, u64::from(*actor));
+                self.number(out, point[0]);
+                self.number(out, point[1]);
+                self.value(out, *travel);
             }
             Instr::Drive { actor, speed, turn } => {
                 op(out, Op::Drive);

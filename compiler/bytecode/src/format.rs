@@ -10,7 +10,7 @@ use tad_road::{Arm, Body, Facing, Place, Shape, Side, Turn};
 pub const MAGIC: [u8; 4] = *b"TADC";
 /// The format this crate writes and reads (`spec/bytecode.md` §7: any change to the bytes
 /// or their meaning takes a new number).
-pub const FORMAT_VERSION: u16 = 1;
+pub const FORMAT_VERSION: u16 = 2;
 /// Bytes before the first section: magic, version, flags, three section lengths.
 pub const HEADER_LEN: usize = 20;
 
@@ -66,6 +66,7 @@ opcodes! {
     Stop = 0x17, "stop", false;
     Signals = 0x18, "signals", false;
     Mobil = 0x19, "mobil", false;
+    Meet = 0x1a, "meet", true;
 }
 
 impl Op {

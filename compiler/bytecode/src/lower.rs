@@ -347,6 +347,10 @@ impl Builder {
             };
             out.push(Instr::Wait { actor, seconds });
         }
+        if let Some(meet) = agent.start.meet {
+            let point = [meet.point.x, meet.point.y];
+            out.push(Instr::Meet { actor, point, travel: Value::lit(meet.travel) });
+        }
         if let Some(trigger) = agent.start.trigger {
             let distance = match group.trigger.given() {
                 Some(Param::Range { min, max }) => self.range(id, name, "trigger", min.0, max.0, trigger),

@@ -3,7 +3,7 @@
 //!
 //! A behaviour instruction either returns at once (it sets what the actor does: `Drive`,
 //! `Cross`, `Speed`, `ChangeLane`, `Stop`, `Signals`, `Mobil`) or blocks the actor's script
-//! until it holds (`Wait`, `WaitNear`); the motion it set goes on meanwhile.
+//! until it holds (`Wait`, `WaitNear`, `Meet`); the motion it set goes on meanwhile.
 
 use tad_road::{Arm, Body, Facing, Place, Turn};
 
@@ -170,6 +170,9 @@ pub enum Instr {
     Wait { actor: ActorId, seconds: Value },
     /// Block until the ego is within a distance of the actor, m.
     WaitNear { actor: ActorId, distance: Value },
+    /// Block until the ego's time to `point` (its arc to the point's nearest on its route,
+    /// at its speed) is `travel` seconds or less: the actor's own time to get there.
+    Meet { actor: ActorId, point: [f64; 2], travel: Value },
     /// Drive its lane from where it stands at `speed`, taking `turn` at the junction ahead
     /// (the path is `Road::vehicle_path`, kept `lateral` off the lane's centre).
     Drive { actor: ActorId, speed: Value, turn: Turn },

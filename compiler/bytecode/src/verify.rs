@@ -282,6 +282,13 @@ impl<'p> State<'p> {
                 self.actor(*actor)?;
                 value(p, "a trigger distance", *distance, true)
             }
+            Instr::Meet { actor, point, travel } => {
+                self.actor(*actor)?;
+                for v in point {
+                    within("a conflict point's coordinate", *v, v.abs() <= MAX_COORDINATE, "within ±1000 km")?;
+                }
+                value(p, "a travel time", *travel, true)
+            }
             Instr::Drive { actor, speed, .. } | Instr::Cross { actor, speed } | Instr::Speed { actor, speed } => {
                 self.actor(*actor)?;
                 value(p, "a speed", *speed, true)

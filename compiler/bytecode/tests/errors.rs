@@ -104,9 +104,12 @@ fn a_newer_or_unknown_format_is_refused_by_number() {
     bytes[4..6].copy_from_slice(&7u16.to_le_bytes());
     let e = decode(&bytes).unwrap_err();
     assert_eq!(e.offset, 4);
-    assert_eq!(e.to_string(), "built by a newer tadslc (format 7, this reads 1) (at byte 4)");
+    assert_eq!(e.to_string(), "built by a newer tadslc (format 7, this reads 2) (at byte 4)");
     // even when the rest is cut: the version says why
-    assert_eq!(decode(&bytes[..8]).unwrap_err().kind, ErrorKind::NewerFormat { found: 7, reads: 1 });
+    assert_eq!(decode(&bytes[..8]).unwrap_err().kind, ErrorKind::NewerFormat { found: 7, reads: 2 });
+    // format 1 (before `meet`) still loads
+    bytes[4..6].copy_from_slice(&1u16.to_le_bytes());
+    assert_eq!(decode(&bytes).map(|p| p.code.len()), Ok(valid().code.len()));
     bytes[4..6].copy_from_slice(&0u16.to_le_bytes());
     assert_eq!(decode(&bytes).unwrap_err().kind, ErrorKind::UnknownFormat { found: 0 });
     let mut bytes = encode(&valid());

@@ -36,10 +36,23 @@ use tad_ir::{GroupId, Motion, Span};
 /// When an actor starts doing its behavior.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Start {
-    /// Seconds it waits first (a written `delay`, or the layout's timing).
+    /// Seconds it waits first (a written `delay`).
     pub delay: f64,
     /// It waits until the ego is within this distance, m (a written `trigger`).
     pub trigger: Option<f64>,
+    /// It waits until the ego is as near its conflict point as it is itself (the layout's
+    /// timing of an adversary that would arrive early).
+    pub meet: Option<Meet>,
+}
+
+/// An adversary's start, measured while the scenario runs: it waits until the ego's time to
+/// `point`, at the ego's speed along its route, falls to `travel`, its own time to the
+/// point at its speed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Meet {
+    pub point: geom::Vec2,
+    /// s.
+    pub travel: f64,
 }
 
 /// One actor: the ego or one member of a group.
@@ -118,6 +131,9 @@ pub struct Conflict {
     pub point: geom::Vec2,
     /// When the ego reaches it at its stated speed, s.
     pub time: f64,
+    /// How long the first actor takes to reach it from its start, at its speed, s (no more
+    /// than `time`; less when it waits for the ego: [`Start::meet`]).
+    pub travel: f64,
     /// How far (m, along its path) the adversary's start may vary either way and still meet
     /// the ego within about a second.
     pub spread: f64,

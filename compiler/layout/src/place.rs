@@ -17,8 +17,9 @@
 //! 6. `paths`: every agent's path, through the junction by each vehicle's turn, lane changes,
 //!    overtaking, walking across;
 //! 7. `timing`: every moving group whose path meets the ego's ahead starts where it reaches
-//!    that point when the ego does at its stated speed (crossing walkers wait instead), kept
-//!    on the side of its reference that its relation says.
+//!    that point when the ego does at its stated speed, kept on the side of its reference
+//!    that its relation says; one that cannot start far enough out, and crossing walkers,
+//!    wait until the ego's time to the point falls to their own (`Start::meet`).
 //!
 //! `build` makes the agents and runs steps 6 and 7; while a walker cannot reach a junction's
 //! crossing in time, `wait_for_walkers` moves the ego's start back and they run again.
@@ -31,7 +32,7 @@ use crate::Limits;
 use crate::facts::{self, Body, Chosen, Facts};
 use crate::geom::{Path, Pose, Vec2};
 use crate::road::{self, Arm, CROSSWALK, Junction, Road, Shape, Side, Station, Turn};
-use crate::{Agent, Conflict, Facing, Finding, GroupLayout, Layout, Place, Start};
+use crate::{Agent, Conflict, Facing, Finding, GroupLayout, Layout, Meet, Place, Start};
 
 /// The farthest from the ego anything is put by timing or a late walker, m.
 const MAX_REACH: f64 = 150.0;
@@ -699,7 +700,7 @@ impl<'a> Planner<'a> {
                     turn: turn_of(f.motion),
                     speed: if f.is_static() { 0.0 } else { f.speed },
                     moving: !f.is_static() && !waits && f.body == Body::Vehicle,
-                    start: Start { delay, trigger },
+                    start: Start { delay, trigger, meet: None },
                     pose,
                     path: Path::default(),
                     path_start: 0.0,
@@ -1289,13 +1290,16 @@ fn time_group(road: &Road, ego: &Agent, d: &Decision, g: &mut GroupLayout) -> Op
     let v = first.speed.max(0.1);
     let point = own_ahead.pose(s_own).position;
     if d.crosser {
-        // walkers wait on the sidewalk, then cross in time
-        let wait = time - s_own / v;
+        // walkers wait on the sidewalk until the ego is as near as their walk, then cross
+        let travel = s_own / v;
+        let wait = time - travel;
         for a in &mut g.agents {
-            a.start.delay = wait.max(0.0);
+            if wait > 0.0 {
+                a.start.meet = Some(Meet { point, travel });
+            }
             a.moving = false;
         }
-        return Some((Conflict { group: g.group, point, time, spread: 1.0 }, -wait));
+        return Some((Conflict { group: g.group, point, time, travel, spread: 1.0 }, -wait));
     }
     // move the whole group along its path by the difference, keeping its relation
     let mut shift = s_own - v * time; // > 0: start nearer the conflict point
@@ -1336,11 +1340,12 @@ fn time_group(road: &Road, ego: &Agent, d: &Decision, g: &mut GroupLayout) -> Op
         a.pose = Pose { yaw: a.pose.yaw, ..pose };
         a.path_start = a.path.project(a.pose.position).0;
         if early > 0.05 && d.arm != Arm::Ego {
-            a.start.delay = early;
+            // early: it stands until the ego is as near the point as it is
+            a.start.meet = Some(Meet { point, travel: arrival });
             a.moving = false;
         }
     }
-    Some((Conflict { group: g.group, point, time, spread: v }, (-early).max(0.0)))
+    Some((Conflict { group: g.group, point, time, travel: arrival, spread: v }, (-early).max(0.0)))
 }
 
 fn sample_path(path: &Path, from: f64, to: f64) -> Vec<Vec2> {

@@ -46,7 +46,12 @@ pub fn roll_out(layout: &Layout, steps: usize, dt: f64) -> Trace {
             if !started[k] {
                 let due = t >= a.start.delay;
                 let near = a.start.trigger.is_none_or(|d| ego.distance(current[k].position) <= d);
-                if due && near {
+                // the ego's time to the point along its path, at its speed
+                let met = a.start.meet.is_none_or(|m| {
+                    let (at, _) = agents[0].path.project(m.point);
+                    (at - s[0]) / agents[0].speed.max(0.1) <= m.travel + 1e-9
+                });
+                if due && near && met {
                     started[k] = true;
                 } else {
                     continue;

@@ -96,8 +96,8 @@ pub const DASH: (f64, f64) = (3.0, 6.0);
 /// How far an edge line lies inside the curb, m.
 pub const EDGE_INSET: f64 = 0.3;
 pub const STOP_LINE: f64 = 0.5;
-/// A crosswalk's extent along its road, and its stripes' width and pitch across it, m.
-pub const CROSSWALK_DEPTH: f64 = 2.5;
+/// A crosswalk's extent along its road (the road's), and its stripes' width and pitch across it, m.
+pub use tad_road::road::CROSSWALK_DEPTH;
 pub const STRIPE: f64 = 0.5;
 pub const STRIPE_PITCH: f64 = 1.0;
 /// A roundabout's ring (the carriageway round the island) is this many lane widths wide.

@@ -551,7 +551,8 @@ pub fn bezier(a: Vec2, da: Vec2, b: Vec2, db: Vec2) -> Vec<Vec2> {
     // a quarter circle of radius r has chord r·√2 and control arms of 0.552·r
     let arm = chord * 0.39;
     let (c1, c2) = (a + da * arm, b - db * arm);
-    let n = (chord.ceil() as usize).clamp(4, 400);
+    // four points a metre: within 5 mm of the curve on the tightest turns of a junction
+    let n = ((chord * 4.0).ceil() as usize).clamp(8, 1600);
     (0..=n)
         .map(|k| {
             let t = k as f64 / n as f64;

@@ -23,6 +23,8 @@ pub const CURVE_RADIUS: f64 = 60.0;
 pub const RUN: f64 = 200.0;
 /// Where an arm's crosswalk is: metres past its stop line, towards the junction's centre.
 pub const CROSSWALK: f64 = 2.0;
+/// How deep a crosswalk is, along the road, m.
+pub const CROSSWALK_DEPTH: f64 = 2.5;
 /// The radius of a roundabout's ring (where vehicles circle), as a fraction of [`Junction::half`].
 pub const RING: f64 = 0.75;
 
@@ -76,6 +78,17 @@ pub enum Turn {
 }
 
 impl Turn {
+    /// The lane a vehicle in `lane` leaves by, onto an arm with `outgoing` lanes: its own
+    /// going straight on, the innermost after a left turn or a U-turn, the outermost after a
+    /// right turn.
+    pub fn exit_lane(self, lane: i64, outgoing: u32) -> i64 {
+        match self {
+            Turn::Straight => lane.min(i64::from(outgoing.max(1))),
+            Turn::Left | Turn::UTurn => 1,
+            Turn::Right => i64::from(outgoing.max(1)),
+        }
+    }
+
     /// The arm a vehicle coming in on `arm` leaves by.
     pub fn exit(self, arm: Arm) -> Arm {
         let d = -arm.outward();
@@ -218,6 +231,11 @@ impl Road {
         }
     }
 
+    /// Where an arm meets the junction: the ego's stop line, or another arm's.
+    pub fn edge(&self, arm: Arm) -> Station {
+        Station { arm, along: if arm == Arm::Ego { self.approach } else { 0.0 } }
+    }
+
     /// A station's distance before the arm's stop line (incoming lanes), or after the
     /// junction (outgoing lanes, given as a positive `along`).
     pub fn before_stop_line(&self, station: Station) -> f64 {
@@ -242,21 +260,20 @@ impl Road {
         };
         let arm = station.arm;
         let before = self.before_stop_line(station);
-        let entry = self.lane_pose(Station { arm, along: if arm == Arm::Ego { self.approach } else { 0.0 } }, lane);
+        let entry = self.lane_pose(self.edge(arm), lane);
         let d = Vec2::from_yaw(entry.yaw);
         let mut points: Vec<Vec2> = sample(-(before + RUN), 0.0, |t| entry.position + d * t);
         let exit_arm = turn.exit(arm);
         let (_, outgoing) = self.arm_lanes(exit_arm);
-        let exit_lane = match turn {
-            Turn::Straight => lane.min(i64::from(outgoing.max(1))),
-            Turn::Left | Turn::UTurn => 1,
-            Turn::Right => i64::from(outgoing.max(1)),
-        };
-        let out_station = Station { arm: exit_arm, along: 0.0 };
-        let exit = self.pose_at(out_station, -exit_lane, self.lateral(-exit_lane));
+        let exit_lane = turn.exit_lane(lane, outgoing);
+        let exit = self.pose_at(self.edge(exit_arm), -exit_lane, self.lateral(-exit_lane));
         let u = Vec2::from_yaw(exit.yaw);
         if junction.roundabout {
-            points.extend(ring(self.centre(), junction.half * RING, entry.position, turn));
+            let ring = Ring::of(self.centre(), junction.half * RING, entry.position, turn);
+            let (on, off) = (ring.at(0.0), ring.at(ring.sweep));
+            points.extend(bezier(entry.position, d, on, ring.tangent(0.0)));
+            points.extend(ring.points());
+            points.extend(bezier(off, ring.tangent(ring.sweep), exit.position, u));
         } else if turn == Turn::UTurn {
             let mid = self.centre() + d * (junction.half * 0.5);
             points.extend(bezier(entry.position, d, mid, d.left()));
@@ -275,18 +292,49 @@ fn sample(a: f64, b: f64, f: impl Fn(f64) -> Vec2) -> Vec<Vec2> {
     (0..=n).map(|k| f(a + (b - a) * k as f64 / n as f64)).collect()
 }
 
-/// Round a roundabout's island counter-clockwise, from the entry towards the exit.
-fn ring(centre: Vec2, radius: f64, entry: Vec2, turn: Turn) -> Vec<Vec2> {
-    let start = (entry - centre).yaw() + 0.35;
-    let quarters = match turn {
-        Turn::Right => 1.0,
-        Turn::Straight => 2.0,
-        Turn::Left => 3.0,
-        Turn::UTurn => 4.0,
-    };
-    let sweep = quarters * std::f64::consts::FRAC_PI_2 - 0.7;
-    let n = (sweep * radius).ceil().max(4.0) as usize;
-    (0..=n).map(|k| centre + Vec2::from_yaw(start + sweep * k as f64 / n as f64) * radius).collect()
+/// A vehicle's way round a roundabout's island: counter-clockwise on the circle of `radius`
+/// about `centre`, from `start` (radians) through `sweep`. It joins the ring a little past
+/// its entry's bearing and leaves it a little before its exit's, by a Bézier each way.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ring {
+    pub centre: Vec2,
+    pub radius: f64,
+    pub start: f64,
+    pub sweep: f64,
+}
+
+impl Ring {
+    /// The ring of a vehicle entering at `entry` and taking `turn`.
+    pub fn of(centre: Vec2, radius: f64, entry: Vec2, turn: Turn) -> Ring {
+        let quarters = match turn {
+            Turn::Right => 1.0,
+            Turn::Straight => 2.0,
+            Turn::Left => 3.0,
+            Turn::UTurn => 4.0,
+        };
+        Ring {
+            centre,
+            radius,
+            start: (entry - centre).yaw() + 0.35,
+            sweep: quarters * std::f64::consts::FRAC_PI_2 - 0.7,
+        }
+    }
+
+    /// The point `angle` radians into the ring.
+    pub fn at(&self, angle: f64) -> Vec2 {
+        self.centre + Vec2::from_yaw(self.start + angle) * self.radius
+    }
+
+    /// The direction of travel `angle` radians into the ring.
+    pub fn tangent(&self, angle: f64) -> Vec2 {
+        Vec2::from_yaw(self.start + angle).left()
+    }
+
+    /// Points every metre or so, strictly inside the arc.
+    fn points(&self) -> Vec<Vec2> {
+        let n = (self.sweep * self.radius).ceil().max(4.0) as usize;
+        (1..n).map(|k| self.at(self.sweep * k as f64 / n as f64)).collect()
+    }
 }
 
 #[cfg(test)]

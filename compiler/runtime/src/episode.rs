@@ -112,7 +112,24 @@ enum Block {
     None,
     Until(f64),
     Near(f64),
+    /// The ego's arc to the conflict point on its route, and the actor's travel time, s.
+    Meet {
+        at: f64,
+        travel: f64,
+    },
 }
+
+/// What a script may wait on: the ego at the step's start.
+#[derive(Clone, Copy)]
+struct EgoNow {
+    position: Vec2,
+    /// Its arc on its route, m, and its speed, m/s.
+    s: f64,
+    speed: f64,
+}
+
+/// The slowest the ego counts as moving when its time to a point is measured, m/s.
+const MEET_SPEED: f64 = 0.1;
 
 struct Actor {
     body: Body,
@@ -406,7 +423,8 @@ impl<S: Deref<Target = Scene>> Runner<S> {
     /// Scripts advance, on the previous state.
     fn scripts(&mut self, t: f64) {
         for (setup, actor) in self.scene.actors.iter().zip(self.actors.iter_mut()) {
-            run_script(&self.scene, &setup.script, actor, &self.params, t, self.ego.position);
+            let ego = EgoNow { position: self.ego.position, s: self.ego_s, speed: self.ego.speed };
+            run_script(&self.scene, &setup.script, actor, &self.params, t, ego);
         }
     }
 
@@ -669,7 +687,7 @@ fn set_track(scene: &Scene, a: &mut Actor, track: Path) {
 }
 
 /// Advance an actor's script until it blocks or ends.
-fn run_script(scene: &Scene, script: &[Instr], a: &mut Actor, params: &[f64], t: f64, ego: Vec2) {
+fn run_script(scene: &Scene, script: &[Instr], a: &mut Actor, params: &[f64], t: f64, ego: EgoNow) {
     let v = |value: &Value| value.eval(params);
     while let Some(instr) = script.get(a.pc) {
         match (instr, a.block) {
@@ -681,9 +699,19 @@ fn run_script(scene: &Scene, script: &[Instr], a: &mut Actor, params: &[f64], t:
                 a.block = Block::Near(v(distance).max(0.0));
                 continue;
             }
+            (Instr::Meet { point, travel, .. }, Block::None) => {
+                let (at, _) = scene.ego.route.project(Vec2::new(point[0], point[1]));
+                a.block = Block::Meet { at, travel: v(travel).max(0.0) };
+                continue;
+            }
             (Instr::Wait { .. }, Block::Until(until)) if t + 1e-9 < until => return,
-            (Instr::WaitNear { .. }, Block::Near(d)) if ego.distance(a.kin.position) > d => return,
-            (Instr::Wait { .. } | Instr::WaitNear { .. }, _) => {}
+            (Instr::WaitNear { .. }, Block::Near(d)) if ego.position.distance(a.kin.position) > d => return,
+            (Instr::Meet { .. }, Block::Meet { at, travel })
+                if (at - ego.s) / ego.speed.max(MEET_SPEED) > travel + 1e-9 =>
+            {
+                return;
+            }
+            (Instr::Wait { .. } | Instr::WaitNear { .. } | Instr::Meet { .. }, _) => {}
             (Instr::Drive { speed, turn, .. }, _) => {
                 a.turn = *turn;
                 a.target = v(speed).max(0.0);

@@ -197,6 +197,7 @@ pub fn actor_of(instr: &Instr) -> Option<ActorId> {
     match instr {
         Instr::Wait { actor, .. }
         | Instr::WaitNear { actor, .. }
+        | Instr::Meet { actor, .. }
         | Instr::Drive { actor, .. }
         | Instr::Follow { actor, .. }
         | Instr::Cross { actor, .. }

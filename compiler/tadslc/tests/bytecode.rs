@@ -21,7 +21,7 @@ fn every_example_builds_to_bytecode_and_disassembles() {
         assert!(stdout(&listing).contains(&format!("program  {stem}")), "{}", stdout(&listing));
     }
     let listing = stdout(&tadslc(&["disasm", &out.join("red_light_running.tadc").to_string_lossy()], ""));
-    assert!(listing.starts_with("; TADSL bytecode, format 1\n"), "{listing}");
+    assert!(listing.starts_with("; TADSL bytecode, format 2\n"), "{listing}");
     assert!(listing.contains("\n  signal   arm=ego green 30.0s"), "{listing}");
     assert!(listing.contains("\n  signals  a0 ignore\n"), "{listing}");
 }
@@ -36,7 +36,7 @@ fn a_corrupt_file_is_an_error_with_its_offset_not_a_panic() {
         ("text.tadc", b"scenario x {}".to_vec(), "not a TADSL bytecode file"),
         ("empty.tadc", Vec::new(), "not a TADSL bytecode file"),
         ("cut.tadc", good[..good.len() / 2].to_vec(), "truncated"),
-        ("newer.tadc", [&good[..4], &[9, 0], &good[6..]].concat(), "built by a newer tadslc (format 9, this reads 1)"),
+        ("newer.tadc", [&good[..4], &[9, 0], &good[6..]].concat(), "built by a newer tadslc (format 9, this reads 2)"),
         ("trailing.tadc", [&good[..], b"x"].concat(), "1 trailing byte after the last section"),
     ];
     for (name, bytes, message) in cases {

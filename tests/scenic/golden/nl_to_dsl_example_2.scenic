@@ -426,6 +426,43 @@ def tadPlace(lane, arc, index, place='centre', width=0.0, clamp=False):
         position = position + Vector(shift, 0).rotatedBy(heading)
     return (position, heading)
 
+def tadWay(obj, maneuver):
+    """The way `obj` goes from where it stands, as a shapely line: its lane on to the junction,
+    through it by its first maneuver of type `maneuver` ('STRAIGHT', 'LEFT_TURN', ...) and
+    along the lane after; straight ahead along its heading for 150 m without a maneuver, a
+    lane, or a maneuver of that type."""
+    from shapely.geometry import LineString, Point
+    from shapely.ops import substring
+    here = obj.position
+    lane = getattr(obj, '_lane', None)
+    turns = [] if lane is None or maneuver is None else [m for m in lane.maneuvers if m.type.name == maneuver]
+    if not turns:
+        ahead = here + Vector(0, 150).rotatedBy(obj.heading)
+        return LineString([(here.x, here.y), (ahead.x, ahead.y)])
+    line = lane.centerline.lineString
+    points = list(substring(line, line.project(Point(here.x, here.y)), line.length).coords)
+    parts = [turns[0].connectingLane, turns[0].endLane]
+    for part in [p for p in parts if p is not None]:
+        points.extend(part.centerline.lineString.coords)
+    return LineString([(p[0], p[1]) for p in points])
+
+def tadMeeting(own, way, reach):
+    """The first point of the line `own` within `reach` of the line `way`: its arc along
+    each, or None."""
+    s = 0.0
+    while s <= own.length:
+        p = own.interpolate(s)
+        if way.distance(p) <= reach:
+            return s, way.project(p)
+        s += 0.5
+    return None
+
+def tadTimeTo(car, way, arc):
+    """How long `car` takes to reach `arc` metres along `way` at its speed (at least 0.1 m/s)."""
+    from shapely.geometry import Point
+    here = way.project(Point(car.position.x, car.position.y))
+    return (arc - here) / max(car.speed or 0.0, 0.1)
+
 behavior TadStop():
     """A vehicle halted in traffic."""
     while True:

@@ -426,6 +426,43 @@ def tadPlace(lane, arc, index, place='centre', width=0.0, clamp=False):
         position = position + Vector(shift, 0).rotatedBy(heading)
     return (position, heading)
 
+def tadWay(obj, maneuver):
+    """The way `obj` goes from where it stands, as a shapely line: its lane on to the junction,
+    through it by its first maneuver of type `maneuver` ('STRAIGHT', 'LEFT_TURN', ...) and
+    along the lane after; straight ahead along its heading for 150 m without a maneuver, a
+    lane, or a maneuver of that type."""
+    from shapely.geometry import LineString, Point
+    from shapely.ops import substring
+    here = obj.position
+    lane = getattr(obj, '_lane', None)
+    turns = [] if lane is None or maneuver is None else [m for m in lane.maneuvers if m.type.name == maneuver]
+    if not turns:
+        ahead = here + Vector(0, 150).rotatedBy(obj.heading)
+        return LineString([(here.x, here.y), (ahead.x, ahead.y)])
+    line = lane.centerline.lineString
+    points = list(substring(line, line.project(Point(here.x, here.y)), line.length).coords)
+    parts = [turns[0].connectingLane, turns[0].endLane]
+    for part in [p for p in parts if p is not None]:
+        points.extend(part.centerline.lineString.coords)
+    return LineString([(p[0], p[1]) for p in points])
+
+def tadMeeting(own, way, reach):
+    """The first point of the line `own` within `reach` of the line `way`: its arc along
+    each, or None."""
+    s = 0.0
+    while s <= own.length:
+        p = own.interpolate(s)
+        if way.distance(p) <= reach:
+            return s, way.project(p)
+        s += 0.5
+    return None
+
+def tadTimeTo(car, way, arc):
+    """How long `car` takes to reach `arc` metres along `way` at its speed (at least 0.1 m/s)."""
+    from shapely.geometry import Point
+    here = way.project(Point(car.position.x, car.position.y))
+    return (arc - here) / max(car.speed or 0.0, 0.1)
+
 behavior TadStop():
     """A vehicle halted in traffic."""
     while True:
@@ -583,6 +620,17 @@ behavior TadTriggered(distance, hold, then):
     """Hold still until the ego vehicle is within `distance` metres, then behave."""
     do hold until (distance from self to ego) < distance
     do then
+
+behavior TadMeet(ownTurn, egoTurn, speed, offset, hold, then):
+    """Hold still until the ego's time to where its way first meets ours, measured on the map
+    while the scenario runs, falls to our own time to that point at `speed` (plus `offset`
+    seconds), then behave: the layout's conflict start on the map's own junction."""
+    way = tadWay(ego, egoTurn)
+    meeting = tadMeeting(tadWay(self, ownTurn), way, (self.width + ego.width) / 2 + 0.3)
+    if meeting is not None:
+        travel = max(meeting[0] / speed + offset, 0)
+        do hold until tadTimeTo(ego, way, meeting[1]) <= travel
+    do then
 # ---- end of the prelude ----
 
 # The road around the ego vehicle: 2 lanes in the ego's direction, 2 lanes in the other direction, a sidewalk beside the ego's lane.
@@ -629,12 +677,11 @@ delivery_van = new Car at tadAt6[0], facing tadAt6[1],
     with regionContainedIn None, with behavior TadParked()
 
 # group `darting_pedestrian`: 1 pedestrian, cross, 6 km/h, front of ego, lane 1
-tadDelay3 = 0.63
 tadJitter3 = Range(-0.5, 0.5)
 tadAt7 = tadCrossAt(tadAnchor, 49.125 + tadJitter3, True, 0.0)
 darting_pedestrian = new Pedestrian at tadAt7[0], facing tadAt7[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
-    with regionContainedIn None, with behavior TadDelayed(tadDelay3, TadStand(), TadWalk(1.667))
+    with regionContainedIn None, with behavior TadMeet(None, None, 1.667, tadJitter3 / 1.667, TadStand(), TadWalk(1.667))
 
 # group `oncoming_cars`: 2 car, move_forward, 40 km/h, front of ego, lane -1
 tadShift4 = Range(0, 3.625)

@@ -428,6 +428,43 @@ def tadPlace(lane, arc, index, place='centre', width=0.0, clamp=False):
         position = position + Vector(shift, 0).rotatedBy(heading)
     return (position, heading)
 
+def tadWay(obj, maneuver):
+    """The way `obj` goes from where it stands, as a shapely line: its lane on to the junction,
+    through it by its first maneuver of type `maneuver` ('STRAIGHT', 'LEFT_TURN', ...) and
+    along the lane after; straight ahead along its heading for 150 m without a maneuver, a
+    lane, or a maneuver of that type."""
+    from shapely.geometry import LineString, Point
+    from shapely.ops import substring
+    here = obj.position
+    lane = getattr(obj, '_lane', None)
+    turns = [] if lane is None or maneuver is None else [m for m in lane.maneuvers if m.type.name == maneuver]
+    if not turns:
+        ahead = here + Vector(0, 150).rotatedBy(obj.heading)
+        return LineString([(here.x, here.y), (ahead.x, ahead.y)])
+    line = lane.centerline.lineString
+    points = list(substring(line, line.project(Point(here.x, here.y)), line.length).coords)
+    parts = [turns[0].connectingLane, turns[0].endLane]
+    for part in [p for p in parts if p is not None]:
+        points.extend(part.centerline.lineString.coords)
+    return LineString([(p[0], p[1]) for p in points])
+
+def tadMeeting(own, way, reach):
+    """The first point of the line `own` within `reach` of the line `way`: its arc along
+    each, or None."""
+    s = 0.0
+    while s <= own.length:
+        p = own.interpolate(s)
+        if way.distance(p) <= reach:
+            return s, way.project(p)
+        s += 0.5
+    return None
+
+def tadTimeTo(car, way, arc):
+    """How long `car` takes to reach `arc` metres along `way` at its speed (at least 0.1 m/s)."""
+    from shapely.geometry import Point
+    here = way.project(Point(car.position.x, car.position.y))
+    return (arc - here) / max(car.speed or 0.0, 0.1)
+
 behavior TadStop():
     """A vehicle halted in traffic."""
     while True:
@@ -585,6 +622,17 @@ behavior TadTriggered(distance, hold, then):
     """Hold still until the ego vehicle is within `distance` metres, then behave."""
     do hold until (distance from self to ego) < distance
     do then
+
+behavior TadMeet(ownTurn, egoTurn, speed, offset, hold, then):
+    """Hold still until the ego's time to where its way first meets ours, measured on the map
+    while the scenario runs, falls to our own time to that point at `speed` (plus `offset`
+    seconds), then behave: the layout's conflict start on the map's own junction."""
+    way = tadWay(ego, egoTurn)
+    meeting = tadMeeting(tadWay(self, ownTurn), way, (self.width + ego.width) / 2 + 0.3)
+    if meeting is not None:
+        travel = max(meeting[0] / speed + offset, 0)
+        do hold until tadTimeTo(ego, way, meeting[1]) <= travel
+    do then
 # ---- end of the prelude ----
 
 # The road around the ego vehicle: 1 lane in the ego's direction, 1 lane in the other direction, a sidewalk beside the ego's lane, a straight stretch of 84 m.
@@ -602,20 +650,19 @@ ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
     with blueprint 'vehicle.lincoln.mkz_2017', with rolename 'hero', with width 1.8, with length 4.5, with speed 6.944, with behavior TadFollow(6.944)
 
 # group `crossing_pedestrians`: 3 pedestrian, cross, 5 km/h, front of ego, lane 1
-tadDelay1 = 0.864
 tadJitter1 = Range(-0.5, 0.5)
 tadAt1 = tadCrossAt(tadAnchor, 16.0 + tadJitter1, True, 0.0)
 crossing_pedestrians_1 = new Pedestrian at tadAt1[0], facing tadAt1[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
-    with regionContainedIn None, with behavior TadDelayed(tadDelay1, TadStand(), TadWalk(1.389))
+    with regionContainedIn None, with behavior TadMeet(None, None, 1.389, tadJitter1 / 1.389, TadStand(), TadWalk(1.389))
 tadAt2 = tadCrossAt(tadAnchor, 16.9 + tadJitter1, True, 0.0)
 crossing_pedestrians_2 = new Pedestrian at tadAt2[0], facing tadAt2[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
-    with regionContainedIn None, with behavior TadDelayed(tadDelay1, TadStand(), TadWalk(1.389))
+    with regionContainedIn None, with behavior TadMeet(None, None, 1.389, tadJitter1 / 1.389, TadStand(), TadWalk(1.389))
 tadAt3 = tadCrossAt(tadAnchor, 17.8 + tadJitter1, True, 0.0)
 crossing_pedestrians_3 = new Pedestrian at tadAt3[0], facing tadAt3[1],
     with blueprint 'walker.pedestrian.0001', with width 0.6, with length 0.5,
-    with regionContainedIn None, with behavior TadDelayed(tadDelay1, TadStand(), TadWalk(1.389))
+    with regionContainedIn None, with behavior TadMeet(None, None, 1.389, tadJitter1 / 1.389, TadStand(), TadWalk(1.389))
 
 # group `cyclist`: 1 bicycle, move_forward, 18 km/h, right_front of ego, lane 1
 tadShift2 = Range(0, 2.236)

@@ -391,6 +391,15 @@ fn actor(out: &mut String, a: &Actor, spot: &str, needs: &maps::Needs) {
         Some(_) => format!("TadDelayed(tadDelay{}, {hold}, {call})", p.tag),
         None => call,
     });
+    // an adversary waiting for the ego: the sampled jitter of its place, as time at its speed
+    let call = call.map(|call| match p.meet {
+        Some(meet) => {
+            let turn = |letter: Option<char>| letter.map_or("None".to_string(), |l| string(mapping::maneuver(l)));
+            let offset = if p.jitter.is_some() { format!("tadJitter{} / {speed}", p.tag) } else { "0".into() };
+            format!("TadMeet({}, {}, {speed}, {offset}, {hold}, {call})", turn(meet.own), turn(meet.ego))
+        }
+        None => call,
+    });
     let call = call.map(|call| match p.trigger {
         Some(_) => format!("TadTriggered(tadTrigger{}, {hold}, {call})", p.tag),
         None => call,

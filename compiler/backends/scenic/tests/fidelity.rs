@@ -3,7 +3,9 @@
 //! per step (`tools/scenic_trace.py` through `tad_test_support::trace`), and the traces
 //! checked with the same `tad_layout::fidelity::assess` that checks the layout's own
 //! roll-out (`compiler/layout/tests/fidelity.rs`): relations at the start, no overlap of
-//! actors other than the ego in the first 3 s, every adversary within reach of the ego.
+//! actors other than the ego in the first 3 s, every adversary within reach of the ego; and
+//! every safety example's conflict (the ego touched, or an actor's centre within 2.5 m of
+//! its centre) in at least two seeds of three.
 //! Prints the table (scenario × property); `TADSL_FIDELITY_REPORT=FILE` also writes it to
 //! FILE, `TADSL_FIDELITY_SEEDS=N` runs N seeds (3 by default). Needs the Scenic venv;
 //! skipped (loudly) without it unless `TAD_REQUIRE_SCENIC=1`.
@@ -17,8 +19,10 @@ use std::time::Instant;
 use tad_scenic::{EmitOptions, Simulator};
 use tad_test_support::trace::{self, Group, Label, Trace, TraceOptions, Tracer};
 
-/// Steps simulated: 15 s, long enough for the slowest conflict of the examples.
-const STEPS: u32 = 150;
+/// Steps simulated: 20 s, long enough for the slowest conflict of the examples.
+const STEPS: u32 = 200;
+/// A safety example's conflict: the ego touched, or an actor's centre this near its centre, m.
+const CONFLICT_CENTRES: f64 = 2.5;
 
 /// What does not hold yet on the CARLA maps, with why: (example, property, reason). These
 /// are printed, not failed; everything else must hold for every seed. A property listed
@@ -69,6 +73,21 @@ const KNOWN: &[(&str, &str, &str)] = &[
         "pennsylvania_small_town_main_street",
         "overlaps",
         "with some seeds the map's shoulder is narrower than a car, and the pickup truck brushes the first parked car",
+    ),
+    (
+        "crossing_negotiation",
+        "conflict",
+        "the SUV is on time on the layout's junction and starts moving; on the map it reaches the crossing late, and a late actor cannot wait its way back (nearest 3.5 m)",
+    ),
+    (
+        "red_light_running",
+        "conflict",
+        "the runner is on time on the layout's 15 m junction; on Town06 the ego's time to the crossing is 3.3 s against the runner's 4.3 s, so it passes behind the ego (nearest 4.6 m)",
+    ),
+    (
+        "turning_obstacle",
+        "conflict",
+        "the one-way road's junction on the map: the cyclist's crossing is not where the ego turns (nearest 2.0–3.5 m)",
     ),
     (
         "unprotected_left_turn",
@@ -164,6 +183,28 @@ fn convert(scenario: &tad_ir::Scenario, t: &Trace, labels: &[Option<Label>]) -> 
     tad_layout::fidelity::Trace { dt: t.dt, objects, states }
 }
 
+/// The nearest any actor's centre comes to the ego's (m, at s), and whether one touches it.
+fn nearest_to_ego(t: &tad_layout::fidelity::Trace) -> (f64, f64, bool) {
+    let mut nearest = (f64::INFINITY, 0.0);
+    let mut touched = false;
+    let footprint = |k: usize, pose: tad_layout::geom::Pose| tad_layout::geom::Footprint {
+        pose,
+        length: t.objects[k].length,
+        width: t.objects[k].width,
+    };
+    for (step, row) in t.states.iter().enumerate() {
+        let Some(ego) = row.first() else { continue };
+        for (k, pose) in row.iter().enumerate().skip(1) {
+            let d = pose.position.distance(ego.position);
+            if d < nearest.0 {
+                nearest = (d, step as f64 * t.dt);
+            }
+            touched |= footprint(0, *ego).overlaps(&footprint(k, *pose));
+        }
+    }
+    (nearest.0, nearest.1, touched)
+}
+
 fn resolved(path: &Path) -> tad_ir::Scenario {
     let text = std::fs::read_to_string(path).unwrap();
     common::checked(path, &text).1.expect("an example has a scenario")
@@ -188,14 +229,29 @@ fn every_example_keeps_its_meaning_in_scenic() {
     );
     let _ = writeln!(table, "|---|---|---|---|---|---|---|");
     let mut failures: Vec<(String, &str, String)> = Vec::new();
+    let mut conflicts =
+        String::from("| safety scenario | seed | nearest centre to the ego (time) | touched |\n|---|---|---|---|\n");
     for (program, example) in programs.iter().zip(&examples) {
         let scenario = resolved(example);
         let layout = tad_layout::lay_out(&scenario);
+        let safety = example.parent().is_some_and(|d| d.ends_with("safety"));
+        let mut met = 0;
         for t in traces.iter().filter(|t| t.file == program.file) {
             let labels = trace::labels(t, &program.groups);
             let who = |k: usize| labels.get(k).cloned().flatten().map_or("?".to_string(), |l| l.to_string());
             let converted = convert(&scenario, t, &labels);
             let a = tad_layout::fidelity::assess(&scenario, &layout, &converted);
+            if safety {
+                let (nearest, at, touched) = nearest_to_ego(&converted);
+                met += usize::from(touched || nearest <= CONFLICT_CENTRES);
+                let _ = writeln!(
+                    conflicts,
+                    "| {} | {} | {nearest:.1} m ({at:.1} s) | {} |",
+                    program.stem,
+                    t.seed,
+                    if touched { "yes" } else { "no" }
+                );
+            }
             let relations = format!("{}/{}", a.relations.iter().filter(|r| r.holds).count(), a.relations.len());
             let overlaps: Vec<String> =
                 a.overlaps.iter().map(|o| format!("{}×{} {:.1} s", who(o.a), who(o.b), o.time)).collect();
@@ -239,10 +295,16 @@ fn every_example_keeps_its_meaning_in_scenic() {
                 failures.push((stem.clone(), "adversaries", what));
             }
         }
+        // a safety example produces its conflict in at least two seeds of three
+        let runs = traces.iter().filter(|t| t.file == program.file).count();
+        if safety && 3 * met < 2 * runs {
+            let what = format!("{}: the conflict happens in {met} of {runs} seeds", program.stem);
+            failures.push((program.stem.clone(), "conflict", what));
+        }
     }
-    println!("{table}\n{} traces in {seconds:.0} s", traces.len());
+    println!("{table}\n{conflicts}\n{} traces in {seconds:.0} s", traces.len());
     if let Some(path) = std::env::var_os("TADSL_FIDELITY_REPORT") {
-        std::fs::write(path, &table).unwrap();
+        std::fs::write(path, format!("{table}\n{conflicts}")).unwrap();
     }
     let known = |stem: &str, property: &str| KNOWN.iter().find(|(s, p, _)| *s == stem && *p == property);
     for (stem, property, why) in KNOWN {

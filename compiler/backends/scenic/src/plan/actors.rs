@@ -8,7 +8,7 @@ use tad_layout::{Arm, Facing, Layout, Place, Side};
 
 use super::ego::EgoPlan;
 use super::groups::Resolved;
-use super::{Actor, Group, Sampled};
+use super::{Actor, Group, MeetPlan, Sampled};
 use crate::mapping::{self, Class};
 use crate::python::Names;
 
@@ -74,6 +74,17 @@ pub fn build(
                 _ => 0.0,
             };
         let away = first.map_or(1.0, |f| if f.station.along >= reference_along { 1.0 } else { -1.0 });
+        // an adversary waiting for the ego meets it on the map's own ways: its maneuver (a
+        // crosser goes straight across) and the ego's, through the junction the map kept
+        let meet = first
+            .filter(|f| f.start.meet.is_some() && g.delay.is_none())
+            .filter(|_| junction || laid.ego.turn == tad_layout::Turn::Straight)
+            .map(|f| MeetPlan {
+                own: (f.body == tad_layout::Body::Vehicle && f.facing == Facing::Along)
+                    .then(|| letter(f.turn))
+                    .filter(|_| junction),
+                ego: Some(letter(laid.ego.turn)).filter(|_| junction),
+            });
         let params = Sampled {
             tag: (i + 1).to_string(),
             speed: g.speed_range,
@@ -87,10 +98,16 @@ pub fn build(
             } else {
                 None
             },
-            delay: g.delay.or_else(|| first.map(|f| f.start.delay).filter(|d| *d > 0.05).map(|d| (d, d))),
+            delay: g.delay.or_else(|| {
+                // a meeting TadMeet cannot find on this map: the wait at the ego's stated speed
+                let waits = first.and_then(|f| f.start.meet).zip(conflict).map(|(m, c)| c.time - m.travel);
+                let waits = waits.filter(|_| meet.is_none());
+                first.map(|f| f.start.delay).filter(|d| *d > 0.05).or(waits.filter(|d| *d > 0.05)).map(|d| (d, d))
+            }),
             trigger: g.trigger,
             jitter: first.map(|f| laid.conflict_spread(f)).filter(|j| *j >= 0.3 && g.offset.is_none()),
             offset: g.offset.filter(|(low, high)| low < high),
+            meet,
         };
         // a single written offset moves the group's place
         let moved_by = g.offset.filter(|(low, high)| low >= high).map_or(0.0, |(low, _)| low);
@@ -151,4 +168,14 @@ fn ego_summary(scenario: &Scenario, lane: i64) -> String {
     }
     parts.push(format!("lane {lane}"));
     format!("ego vehicle: {}", parts.join(", "))
+}
+
+/// A turn as the map table's maneuver letter (`mapping::maneuver`).
+fn letter(turn: tad_layout::Turn) -> char {
+    match turn {
+        tad_layout::Turn::Straight => 'S',
+        tad_layout::Turn::Left => 'L',
+        tad_layout::Turn::Right => 'R',
+        tad_layout::Turn::UTurn => 'U',
+    }
 }

@@ -100,12 +100,23 @@ pub struct Sampled {
     /// A written `offset` range: `tadOffsetTAG = Range(low, high)` added to its place (it
     /// replaces the shift and the jitter; a single offset is in the place already).
     pub offset: Option<(f64, f64)>,
+    /// An adversary that waits for the ego (the layout's `Start::meet`), measured on the map:
+    /// `TadMeet` with its own maneuver and the ego's.
+    pub meet: Option<MeetPlan>,
+}
+
+/// The maneuvers (`mapping::maneuver` letters; `None`: straight ahead along its heading,
+/// a walker or a road without a junction) whose ways `TadMeet` intersects.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MeetPlan {
+    pub own: Option<char>,
+    pub ego: Option<char>,
 }
 
 impl Sampled {
     /// Whether the actor starts at rest, waiting.
     pub fn waits(&self) -> bool {
-        self.delay.is_some() || self.trigger.is_some()
+        self.delay.is_some() || self.trigger.is_some() || self.meet.is_some()
     }
 }
 

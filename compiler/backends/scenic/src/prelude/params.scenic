@@ -11,3 +11,14 @@ behavior TadTriggered(distance, hold, then):
     """Hold still until the ego vehicle is within `distance` metres, then behave."""
     do hold until (distance from self to ego) < distance
     do then
+
+behavior TadMeet(ownTurn, egoTurn, speed, offset, hold, then):
+    """Hold still until the ego's time to where its way first meets ours, measured on the map
+    while the scenario runs, falls to our own time to that point at `speed` (plus `offset`
+    seconds), then behave: the layout's conflict start on the map's own junction."""
+    way = tadWay(ego, egoTurn)
+    meeting = tadMeeting(tadWay(self, ownTurn), way, (self.width + ego.width) / 2 + 0.3)
+    if meeting is not None:
+        travel = max(meeting[0] / speed + offset, 0)
+        do hold until tadTimeTo(ego, way, meeting[1]) <= travel
+    do then
