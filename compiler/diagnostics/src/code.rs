@@ -108,6 +108,9 @@ codes! {
     W0706 => Warning,
     W0707 => Warning,
     // end of Scenic codes
+    // OpenSCENARIO backend
+    W0710 => Warning,
+    W0711 => Warning,
 }
 
 impl Code {

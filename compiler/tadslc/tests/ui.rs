@@ -172,11 +172,13 @@ fn main() {
     }
     // every diagnostic code is expected by at least one fixture: these, or the YAML answer
     // fixtures of `tests/yaml/answers` (annotated `# error[CODE]: ...`, run by tad-yaml)
-    // and the Scenic backend's fixtures (`tests/scenic/fixtures`, run by tad-scenic)
+    // and the backends' fixtures (`tests/scenic/fixtures`, run by tad-scenic;
+    // `tests/openscenario/fixtures`, run by tad-openscenario)
     let mut yaml = Vec::new();
     fixtures(&repo().join("tests/yaml/answers"), &mut yaml);
     let mut scenic = Vec::new();
     fixtures(&repo().join("tests/scenic/fixtures"), &mut scenic);
+    fixtures(&repo().join("tests/openscenario/fixtures"), &mut scenic);
     let all: Vec<String> = files
         .iter()
         .filter(|p| p.extension().is_some_and(|e| e == "tad"))

@@ -21,7 +21,8 @@ fn tad_block(text: &str) -> Option<String> {
 
 #[test]
 fn every_scenic_code_is_produced_by_its_example() {
-    let codes: Vec<Code> = Code::ALL.iter().copied().filter(|c| c.as_str()[1..].starts_with("07")).collect();
+    // W0700–W0709; W071x are the OpenSCENARIO backend's
+    let codes: Vec<Code> = Code::ALL.iter().copied().filter(|c| c.as_str()[1..].starts_with("070")).collect();
     assert_eq!(codes.len(), 9);
     for code in codes {
         let text = tad_block(code.explanation()).unwrap_or_else(|| panic!("{code}: no tad example"));

@@ -52,6 +52,9 @@ pub enum Target {
     Scenic,
     /// Bytecode for the runtime (`NAME.tadc`, `spec/bytecode.md`)
     Bytecode,
+    /// OpenSCENARIO XML 1.2 on a generated OpenDRIVE 1.7 road (`NAME.xosc`, `NAME.xodr`,
+    /// `NAME.distribution.xosc`; `spec/backends/openscenario.md`)
+    Openscenario,
 }
 
 /// `--simulator`: `tad_scenic::Simulator` on the command line.
@@ -75,6 +78,7 @@ pub fn run(args: &BuildArgs, color: bool) -> Result<Status, CliError> {
     match args.target {
         Target::Scenic => scenic(args, color),
         Target::Bytecode => bytecode(args, color),
+        Target::Openscenario => openscenario(args, color),
     }
 }
 
@@ -218,6 +222,72 @@ fn bytecode(args: &BuildArgs, color: bool) -> Result<Status, CliError> {
     Ok(status)
 }
 
+/// `--target openscenario`: `NAME.xosc`, `NAME.xodr` and (with parameters)
+/// `NAME.distribution.xosc` per scenario into the `-o` directory, which it requires.
+fn openscenario(args: &BuildArgs, color: bool) -> Result<Status, CliError> {
+    if args.map_dir.is_some() || args.map.is_some() {
+        return Err(CliError::usage(
+            "the openscenario target generates its road: `--map` and `--map-dir` are options of the scenic target",
+        ));
+    }
+    let dir = args.output.as_deref().ok_or_else(|| {
+        CliError::usage(
+            "the openscenario target writes two or three files per scenario: give an output directory with -o",
+        )
+    })?;
+    let mut status = Status::Ok;
+    let (inputs, read) = files::load(&args.paths, Search::Tad)?;
+    status = status.max(read);
+    std::fs::create_dir_all(dir).map_err(|e| CliError::usage(format!("cannot create `{}`: {e}", dir.display())))?;
+    let mut written: Vec<PathBuf> = Vec::new();
+    let mut db = Database::new(Options::default());
+    for input in &inputs {
+        let checked = tad_db::host::diagnose_in(&mut db, input);
+        if checked.diagnostics.iter().any(|d| d.is_error()) {
+            status = status.max(Status::Failed);
+            let errors: Vec<_> = checked.diagnostics.iter().filter(|d| d.is_error()).cloned().collect();
+            err!("{}", human::render(&FileReport::new(&input.name, &input.text, &errors), color))?;
+            errln!("{}: not built: it has errors", input.name)?;
+            continue;
+        }
+        let file = tad_db::host::register(&mut db, input);
+        let Some(scenario) = tad_db::resolve(&db, file) else {
+            let module = &tad_db::analyze(&db, file).module;
+            let missing = tad_check::no_scenario(module);
+            err!("{}", human::render(&FileReport::new(&input.name, &input.text, &[missing]), color))?;
+            status = status.max(Status::Failed);
+            continue;
+        };
+        let stem = stem(input);
+        let options = tad_openscenario::EmitOptions { stem: stem.clone(), source: input.name.clone() };
+        let emitted = tad_openscenario::emit(scenario, &options);
+        err!("{}", human::render(&FileReport::new(&input.name, &input.text, &emitted.diagnostics), color))?;
+        let mut names = Vec::new();
+        for (name, text) in emitted.files(&stem) {
+            let ext = name.strip_prefix(&format!("{stem}.")).unwrap_or(&name).to_string();
+            match write_into(dir, input, &ext, text.as_bytes(), &mut written)? {
+                Some(target) => names.push(target.display().to_string()),
+                None => status = status.max(Status::Usage),
+            }
+        }
+        let warnings = match emitted.diagnostics.len() {
+            0 => "no warnings".to_string(),
+            n => plural(n, "warning"),
+        };
+        errln!("{}: wrote {} ({warnings})", input.name, names.join(", "))?;
+    }
+    Ok(status)
+}
+
+/// The stem of an input's outputs: its file's (`stdin` without a path).
+fn stem(input: &files::Input) -> String {
+    input
+        .path
+        .as_deref()
+        .and_then(Path::file_stem)
+        .map_or_else(|| "stdin".to_string(), |s| s.to_string_lossy().into_owned())
+}
+
 /// Writes `bytes` for `input` as `DIR/STEM.EXT` (`stdin` without a path) and adds it to
 /// `written`; `None` when it would overwrite what an earlier input wrote or cannot be
 /// written (said on standard error; the caller's status is 2).
@@ -228,12 +298,7 @@ fn write_into(
     bytes: &[u8],
     written: &mut Vec<PathBuf>,
 ) -> Result<Option<PathBuf>, Closed> {
-    let stem = input
-        .path
-        .as_deref()
-        .and_then(Path::file_stem)
-        .map_or_else(|| "stdin".to_string(), |s| s.to_string_lossy().into_owned());
-    let target = dir.join(format!("{stem}.{ext}"));
+    let target = dir.join(format!("{}.{ext}", stem(input)));
     if written.contains(&target) {
         errln!("error: {} would overwrite `{}`, written for an earlier file", input.name, target.display())?;
         return Ok(None);

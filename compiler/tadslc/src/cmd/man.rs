@@ -35,6 +35,7 @@ pub const EXAMPLES: &[(&str, &[&str])] = &[
         &[
             "tadslc build examples/safety/right_turn.tad -o out/",
             "tadslc build --target bytecode examples/safety/ -o out/",
+            "tadslc build --target openscenario examples/safety/right_turn.tad -o out/",
         ],
     ),
     ("import", &["tadslc import answer.yaml -o scene.tad"]),

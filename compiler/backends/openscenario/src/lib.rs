@@ -1,0 +1,76 @@
+//! The OpenSCENARIO backend: a checked TAD scenario as OpenSCENARIO XML 1.2 on an OpenDRIVE
+//! 1.6 road generated from the layout (`spec/backends/openscenario.md`).
+//!
+//! ```text
+//! Scenario ──tad_layout──▶ Layout ──network──▶ Network ──xodr──▶ NAME.xodr
+//!                            └──tad_bytecode::lower──▶ Program ──xosc──▶ NAME.xosc
+//!                                                                 └────▶ NAME.distribution.xosc
+//! ```
+//!
+//! Nothing is placed here: the road is the layout's, and every actor's start, script and
+//! parameter slot is the lowered program's (the runtime's own), written in OpenSCENARIO's
+//! terms. What has no counterpart is a coded warning (W0710, W0711). [`emit`] is pure.
+
+pub mod mapping;
+pub mod network;
+pub mod xml;
+pub mod xodr;
+pub mod xosc;
+
+use tad_diagnostics::Diagnostic;
+use tad_ir::Scenario;
+
+/// The date both files carry: fixed, so that the same source gives the same bytes.
+pub const DATE: &str = "2026-01-01T00:00:00";
+
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct EmitOptions {
+    /// The scenario's file stem: the files are `STEM.xosc`, `STEM.xodr` and
+    /// `STEM.distribution.xosc`, and reference each other by these names.
+    pub stem: String,
+    /// The source file's name, for the header.
+    pub source: String,
+}
+
+/// The files of one scenario and the backend's warnings.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Emitted {
+    pub xosc: String,
+    pub xodr: String,
+    /// The parameter value distribution, when the scenario has parameters.
+    pub distribution: Option<String>,
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+impl Emitted {
+    /// The files to write: `(name, text)`.
+    pub fn files(&self, stem: &str) -> Vec<(String, &str)> {
+        let mut files =
+            vec![(format!("{stem}.xosc"), self.xosc.as_str()), (format!("{stem}.xodr"), self.xodr.as_str())];
+        if let Some(d) = &self.distribution {
+            files.push((format!("{stem}.distribution.xosc"), d.as_str()));
+        }
+        files
+    }
+}
+
+/// The OpenSCENARIO files of a resolved scenario.
+pub fn emit(scenario: &Scenario, options: &EmitOptions) -> Emitted {
+    let layout = tad_layout::lay_out(scenario);
+    let program = tad_bytecode::lower(scenario, &layout, &options.source);
+    let net = network::network(&layout);
+    let name = program.name.clone();
+    let xodr_file = format!("{}.xodr", options.stem);
+    let context = xosc::Context {
+        scenario,
+        layout: &layout,
+        program: &program,
+        net: &net,
+        road_file: xosc::RoadFile::Generated(&xodr_file),
+    };
+    let out = xosc::print(&context, &format!("{}.xosc", options.stem));
+    let mut diagnostics = out.diagnostics;
+    tad_diagnostics::sort(&mut diagnostics);
+    diagnostics.dedup_by(|a, b| a.code == b.code && a.message == b.message);
+    Emitted { xosc: out.text, xodr: xodr::print(&net, &name), distribution: out.distribution, diagnostics }
+}

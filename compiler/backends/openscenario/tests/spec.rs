@@ -1,0 +1,96 @@
+//! `spec/backends/openscenario.md` and `spec/diagnostics.md` against the backend: the
+//! category table is `mapping::TABLE` and names every actor type of the standard library;
+//! the example of each W071x section, built, gives its code.
+
+use std::path::Path;
+
+use tad_diagnostics::Code;
+use tad_openscenario::mapping::{self, Category};
+
+fn tad_block(text: &str) -> Option<String> {
+    let mut lines = text.lines();
+    while let Some(line) = lines.next() {
+        if line.trim_end() == "```tad" {
+            let block: Vec<&str> = lines.by_ref().take_while(|l| l.trim_end() != "```").collect();
+            return Some(block.join("\n") + "\n");
+        }
+    }
+    None
+}
+
+fn build(text: &str) -> tad_openscenario::Emitted {
+    let mut db = tad_db::Database::new(tad_check::Options::default());
+    let file = db.set_file(Path::new("/nonexistent/example.tad").to_path_buf(), text.to_string());
+    let checked = tad_db::check(&db, file);
+    assert!(!checked.diagnostics.iter().any(|d| d.is_error()), "{:#?}", checked.diagnostics);
+    let scenario = tad_db::resolve(&db, file).clone().expect("a scenario");
+    tad_openscenario::emit(
+        &scenario,
+        &tad_openscenario::EmitOptions { stem: "example".into(), source: "example.tad".into() },
+    )
+}
+
+#[test]
+fn every_openscenario_code_is_produced_by_its_example() {
+    let codes: Vec<Code> = Code::ALL.iter().copied().filter(|c| c.as_str()[1..].starts_with("071")).collect();
+    assert_eq!(codes, [Code::W0710, Code::W0711]);
+    for code in codes {
+        let text = tad_block(code.explanation()).unwrap_or_else(|| panic!("{code}: no tad example"));
+        let emitted = build(&text);
+        assert!(
+            emitted.diagnostics.iter().any(|d| d.code == code),
+            "{code}: the example gives {:#?}",
+            emitted.diagnostics
+        );
+    }
+}
+
+/// The rows of §3.2's table: (actor types, category cell).
+fn table() -> Vec<(Vec<String>, String)> {
+    let doc = std::fs::read_to_string(tad_test_support::repo().join("spec/backends/openscenario.md")).unwrap();
+    let start = doc.find("| actor types | OpenSCENARIO |").expect("the category table");
+    doc[start..]
+        .lines()
+        .skip(2)
+        .take_while(|l| l.starts_with('|'))
+        .filter(|l| !l.contains("any other type"))
+        .map(|l| {
+            let cells: Vec<&str> = l.trim_matches('|').split('|').map(str::trim).collect();
+            (cells[0].split(", ").map(String::from).collect(), cells[1].to_string())
+        })
+        .collect()
+}
+
+#[test]
+fn the_category_table_is_the_mappings_and_lists_every_standard_type() {
+    let rows = table();
+    let mut listed = Vec::new();
+    for (names, cell) in &rows {
+        for name in names {
+            let category = mapping::listed(name).unwrap_or_else(|| panic!("`{name}` is in the spec, not the code"));
+            let want = match category {
+                Category::Vehicle(c) => format!("`Vehicle` `{c}`"),
+                Category::Pedestrian(c) => format!("`Pedestrian` `{c}`"),
+                Category::Misc(c) => format!("`MiscObject` `{c}`"),
+            };
+            assert_eq!(&want, cell, "{name}");
+            listed.push(name.clone());
+        }
+    }
+    for (name, _) in mapping::TABLE {
+        assert!(listed.iter().any(|l| l == name), "`{name}` is in the code, not the spec");
+    }
+    // every actor type the standard library declares
+    let stdlib = tad_test_support::repo().join("stdlib");
+    for entry in std::fs::read_dir(stdlib).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_none_or(|e| e != "tad") {
+            continue;
+        }
+        let text = std::fs::read_to_string(path).unwrap();
+        for line in text.lines().filter(|l| l.starts_with("actor_type ")) {
+            let name = line["actor_type ".len()..].trim_end_matches(" {").trim();
+            assert!(mapping::listed(name).is_some(), "the standard type `{name}` has no category");
+        }
+    }
+}
