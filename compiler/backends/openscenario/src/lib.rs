@@ -11,6 +11,7 @@
 //! parameter slot is the lowered program's (the runtime's own), written in OpenSCENARIO's
 //! terms. What has no counterpart is a coded warning (W0710, W0711). [`emit`] is pure.
 
+pub mod environment;
 pub mod mapping;
 pub mod network;
 pub mod xml;

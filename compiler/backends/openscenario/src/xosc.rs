@@ -469,6 +469,7 @@ fn storyboard(x: &mut Xml, c: &Context, actors: &[Actor], diagnostics: &mut Vec<
     x.open("Storyboard", &[]);
     x.open("Init", &[]);
     x.open("Actions", &[]);
+    crate::environment::write(x, c.scenario, diagnostics);
     ego_init(x, c);
     for a in actors {
         x.open("Private", attrs!("entityRef" => a.name));

@@ -94,3 +94,21 @@ fn the_category_table_is_the_mappings_and_lists_every_standard_type() {
         }
     }
 }
+
+#[test]
+fn a_rainy_night_is_written_from_the_vocabularys_parameters() {
+    let text = "scenario wet_night {\n  environment {\n    weather: rainy\n    time: nighttime\n  }\n  road {\n    type: straight_road\n    lanes: 1\n    direction: two_way\n  }\n  ego {\n    behavior: move_forward\n    speed: 30 km/h\n    lane: 1\n  }\n}\n";
+    let xosc = build(text).xosc;
+    // rainy: cloudiness 90, precipitation 70, deposits 60, wetness 80, wind 40, fog 10
+    for part in [
+        "<Weather fractionalCloudCover=\"sevenOktas\">",
+        "precipitationType=\"rain\" precipitationIntensity=\"7\"",
+        "<Wind direction=\"0\" speed=\"8\"/>",
+        "<Fog visualRange=\"900\"/>",
+        "<RoadCondition frictionScaleFactor=\"0.68\" wetness=\"wetWithPuddles\"/>",
+        "illuminance=\"0.001\"",
+        "dateTime=\"2026-06-21T23:00:00\"",
+    ] {
+        assert!(xosc.contains(part), "{part} not in\n{xosc}");
+    }
+}
