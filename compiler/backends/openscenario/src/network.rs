@@ -308,7 +308,7 @@ impl Network {
     }
 }
 
-/// The network of a layout's road. `turns` adds connecting roads for what actors take.
+/// The network of a layout's road, with connecting roads for every turn its actors take.
 pub fn network(layout: &Layout) -> Network {
     let road = &layout.road;
     let mut net = Network { roundabout: road.junction.as_ref().is_some_and(|j| j.roundabout), ..Network::default() };
