@@ -1,5 +1,5 @@
 //! The OpenSCENARIO backend: a checked TAD scenario as OpenSCENARIO XML 1.2 on an OpenDRIVE
-//! 1.6 road generated from the layout (`spec/backends/openscenario.md`).
+//! 1.7 road generated from the layout (`spec/backends/openscenario.md`).
 //!
 //! ```text
 //! Scenario ──tad_layout──▶ Layout ──network──▶ Network ──xodr──▶ NAME.xodr
