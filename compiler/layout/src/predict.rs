@@ -1,9 +1,9 @@
 //! A kinematic roll-out of a layout: the ego keeps its stated speed along its path; every
-//! other actor waits for its start (delay, trigger), then moves along its path at its
-//! speed, vehicles following whatever is ahead on their path with the Intelligent Driver
-//! Model (`crate::idm`, the runtime's). Adversaries (groups timed to a conflict) do not yield to the ego. It is what the
-//! layout promises, checked by `crate::fidelity` without a simulator; the runtime is the
-//! real simulation.
+//! other actor waits for its start (delay, trigger, the ego's time to its conflict point),
+//! then moves along its path at its speed, vehicles following whatever is ahead on their
+//! path with the Intelligent Driver Model (`crate::idm`, the runtime's). Adversaries (groups
+//! timed to a conflict) do not yield to the ego. It is what the layout promises, checked by
+//! `crate::fidelity` without a simulator; the runtime is the real simulation.
 
 use crate::fidelity::{Trace, TraceObject};
 use crate::geom::{Pose, Vec2};
@@ -19,6 +19,9 @@ pub fn roll_out(layout: &Layout, steps: usize, dt: f64) -> Trace {
     let mut s: Vec<f64> = agents.iter().map(|a| a.path_start).collect();
     let mut v: Vec<f64> = agents.iter().map(|a| if a.moving { a.speed } else { 0.0 }).collect();
     let mut started: Vec<bool> = agents.iter().map(|a| a.group.is_none() || a.moving).collect();
+    // a meeting's point as an arc of the ego's path, and the travel time it waits for
+    let meets: Vec<Option<(f64, f64)>> =
+        agents.iter().map(|a| a.start.meet.map(|m| (agents[0].path.project(m.point).0, m.travel))).collect();
     let objects = agents
         .iter()
         .map(|a| TraceObject { group: a.group, index: a.index, length: a.length, width: a.width })
@@ -47,10 +50,7 @@ pub fn roll_out(layout: &Layout, steps: usize, dt: f64) -> Trace {
                 let due = t >= a.start.delay;
                 let near = a.start.trigger.is_none_or(|d| ego.distance(current[k].position) <= d);
                 // the ego's time to the point along its path, at its speed
-                let met = a.start.meet.is_none_or(|m| {
-                    let (at, _) = agents[0].path.project(m.point);
-                    (at - s[0]) / agents[0].speed.max(0.1) <= m.travel + 1e-9
-                });
+                let met = meets[k].is_none_or(|(at, travel)| (at - s[0]) / agents[0].speed.max(0.1) <= travel + 1e-9);
                 if due && near && met {
                     started[k] = true;
                 } else {
