@@ -45,15 +45,21 @@ impl Refusal {
 /// An input's program: checked (a file with errors is refused), resolved, laid out and
 /// lowered. What `build --target bytecode` writes and `run` and `search` run.
 pub fn compile(db: &mut Database, input: &Input) -> Result<tad_bytecode::Program, Refusal> {
+    resolved(db, input).map(|scenario| program(&scenario, &input.name))
+}
+
+/// An input's resolved scenario: checked (a file with errors is refused), then resolved.
+/// What every backend is given.
+pub fn resolved(db: &mut Database, input: &Input) -> Result<tad_ir::Scenario, Refusal> {
     let checked = tad_db::host::diagnose_in(db, input);
     if checked.diagnostics.iter().any(Diagnostic::is_error) {
         return Err(Refusal::Errors(checked.diagnostics.into_iter().filter(Diagnostic::is_error).collect()));
     }
     let file = tad_db::host::register(db, input);
-    let Some(scenario) = tad_db::resolve(db, file) else {
-        return Err(Refusal::NoScenario(Box::new(tad_check::no_scenario(&tad_db::analyze(db, file).module))));
-    };
-    Ok(program(scenario, &input.name))
+    match tad_db::resolve(db, file) {
+        Some(scenario) => Ok(scenario.clone()),
+        None => Err(Refusal::NoScenario(Box::new(tad_check::no_scenario(&tad_db::analyze(db, file).module)))),
+    }
 }
 
 /// The scene of a file the database holds; `None` when it holds no scenario.

@@ -1,5 +1,6 @@
-//! `tadslc build`: a Scenic 3 program per scenario (`--target scenic`), or a bytecode
-//! program for the runtime (`--target bytecode`, `spec/bytecode.md`).
+//! `tadslc build`: a Scenic 3 program per scenario (`--target scenic`), a bytecode
+//! program for the runtime (`--target bytecode`, `spec/bytecode.md`), or OpenSCENARIO on a
+//! generated OpenDRIVE road (`--target openscenario`, `spec/backends/openscenario.md`).
 //!
 //! Each file is checked first: a file with errors is refused (its errors are printed and
 //! the status is 1); the others are resolved (`tad_db::resolve`, the typed IR) and emitted
@@ -8,7 +9,8 @@
 //! from (`--map-dir`, or beside the program) is a warning, once per map
 //! (`spec/output.md`). The bytecode target checks each file the same way, lays the
 //! scenario out and lowers it (`tad_eval::pipeline`), and writes `NAME.tadc` into the `-o`
-//! directory, which it requires.
+//! directory, which it requires; the openscenario target resolves each file the same way
+//! (`tad_eval::pipeline::resolved`) and writes its two or three files there.
 
 use std::path::{Path, PathBuf};
 
@@ -242,25 +244,17 @@ fn openscenario(args: &BuildArgs, color: bool) -> Result<Status, CliError> {
     let mut written: Vec<PathBuf> = Vec::new();
     let mut db = Database::new(Options::default());
     for input in &inputs {
-        let checked = tad_db::host::diagnose_in(&mut db, input);
-        if checked.diagnostics.iter().any(|d| d.is_error()) {
-            status = status.max(Status::Failed);
-            let errors: Vec<_> = checked.diagnostics.iter().filter(|d| d.is_error()).cloned().collect();
-            err!("{}", human::render(&FileReport::new(&input.name, &input.text, &errors), color))?;
-            errln!("{}: not built: it has errors", input.name)?;
-            continue;
-        }
-        let file = tad_db::host::register(&mut db, input);
-        let Some(scenario) = tad_db::resolve(&db, file) else {
-            let module = &tad_db::analyze(&db, file).module;
-            let missing = tad_check::no_scenario(module);
-            err!("{}", human::render(&FileReport::new(&input.name, &input.text, &[missing]), color))?;
-            status = status.max(Status::Failed);
-            continue;
+        let scenario = match tad_eval::pipeline::resolved(&mut db, input) {
+            Ok(scenario) => scenario,
+            Err(refusal) => {
+                err!("{}", refusal.render(input, "built", color))?;
+                status = status.max(Status::Failed);
+                continue;
+            }
         };
         let stem = stem(input);
         let options = tad_openscenario::EmitOptions { stem: stem.clone(), source: input.name.clone() };
-        let emitted = tad_openscenario::emit(scenario, &options);
+        let emitted = tad_openscenario::emit(&scenario, &options);
         err!("{}", human::render(&FileReport::new(&input.name, &input.text, &emitted.diagnostics), color))?;
         let mut names = Vec::new();
         for (name, text) in emitted.files(&stem) {
