@@ -6,7 +6,8 @@
 //! - [`fnv1a`]: the one stable hash (FNV-1a, 64 bits), for names turned into seeds and
 //!   content-addressed folders;
 //! - [`Shard`]: one job of a job array (`--shard I/N`) and its files' names;
-//! - [`plural`]: a count with its noun in the right number, for messages.
+//! - [`plural`]: a count with its noun in the right number, for messages;
+//! - [`xml_escape`]: text for an XML attribute or element.
 //!
 //! Each is written once here and read everywhere else; the crate depends on serde only.
 
@@ -30,6 +31,32 @@ pub fn a(noun: &str) -> String {
     let sounds_like_you = ["uni", "use", "usu", "u-", "u_", "eu", "one"].iter().any(|p| lower.starts_with(p));
     let vowel = lower.starts_with(['a', 'e', 'i', 'o', 'u']) && !sounds_like_you;
     format!("{} {noun}", if vowel { "an" } else { "a" })
+}
+
+/// Text for an XML attribute (double-quoted) or element: `& < > "` escaped, and every
+/// control character XML 1.0 cannot hold replaced by U+FFFD.
+pub fn xml_escape(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            c if c.is_control() && !matches!(c, '\n' | '\t' | '\r') => out.push('\u{FFFD}'),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod xml {
+    #[test]
+    fn names_are_escaped_for_xml() {
+        // a file named by a user, an ego path: nothing breaks a report
+        assert_eq!(super::xml_escape("a&b <c> \"d\"\u{1}e\n"), "a&amp;b &lt;c&gt; &quot;d&quot;\u{FFFD}e\n");
+    }
 }
 
 #[cfg(test)]

@@ -236,22 +236,6 @@ pub fn failed<'e>(episode: &'e Episode, criteria: &[EventKind]) -> Option<&'e Ev
     episode.events.iter().find(|e| criteria.contains(&e.kind))
 }
 
-fn escape(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    for c in text.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            // XML 1.0 has no other control characters
-            c if c.is_control() && !matches!(c, '\n' | '\t' | '\r') => out.push('\u{FFFD}'),
-            c => out.push(c),
-        }
-    }
-    out
-}
-
 /// The JUnit XML report: one `<testsuite>` per scenario (`scenarios`: its name and step
 /// length, as `played` indexes them), one `<testcase>` per ego and seed, named `EGO seed N`,
 /// with its simulated time; a `<failure>` for an episode that met one of `criteria` (its
@@ -273,14 +257,14 @@ pub fn junit(scenarios: &[(&str, f64)], egos: &[String], played: &[Played], crit
         let cases: Vec<&Played> = played.iter().filter(|p| p.scenario == k).collect();
         let failing = cases.iter().filter(|p| fails(p)).count();
         let time: f64 = cases.iter().map(|p| seconds(p)).sum();
-        let name = escape(scenario);
+        let name = tad_base::xml_escape(scenario);
         let _ = writeln!(
             xml,
             "  <testsuite name=\"{name}\" tests=\"{}\" failures=\"{failing}\" errors=\"0\" skipped=\"0\" time=\"{time:.3}\">",
             cases.len()
         );
         for p in cases {
-            let ego = escape(egos.get(p.ego).map_or("", String::as_str));
+            let ego = tad_base::xml_escape(egos.get(p.ego).map_or("", String::as_str));
             let seed = p.episode.seed.unwrap_or(0);
             let _ = writeln!(
                 xml,
@@ -313,13 +297,4 @@ pub fn junit(scenarios: &[(&str, f64)], egos: &[String], played: &[Played], crit
     }
     xml.push_str("</testsuites>\n");
     xml
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn names_are_escaped_for_xml() {
-        // a file named by a user, an ego path: nothing breaks the report
-        assert_eq!(super::escape("a&b <c> \"d\"\u{1}e\n"), "a&amp;b &lt;c&gt; &quot;d&quot;\u{FFFD}e\n");
-    }
 }

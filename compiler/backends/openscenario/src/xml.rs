@@ -1,7 +1,9 @@
 //! A small XML writer: elements with attributes in the order given, two-space indentation,
-//! escaped text, and numbers written the same way everywhere ([`num`]).
+//! text escaped by `tad_base::xml_escape`, and numbers written the same way everywhere ([`num`]).
 
 use std::fmt::Write as _;
+
+use tad_base::xml_escape;
 
 /// A number as the files write it: at most six decimals, no trailing zeros, never `-0`.
 pub fn num(v: f64) -> String {
@@ -16,23 +18,6 @@ pub fn num(v: f64) -> String {
         s.pop();
     }
     if s == "-0" { "0".into() } else { s }
-}
-
-fn escape(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    for c in text.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&apos;"),
-            // XML 1.0 cannot carry other control characters
-            c if (c as u32) < 0x20 && !matches!(c, '\t' | '\n' | '\r') => out.push(' '),
-            c => out.push(c),
-        }
-    }
-    out
 }
 
 #[derive(Default)]
@@ -58,7 +43,7 @@ impl Xml {
         self.indent();
         let _ = write!(self.out, "<{name}");
         for (k, v) in attrs {
-            let _ = write!(self.out, " {k}=\"{}\"", escape(v));
+            let _ = write!(self.out, " {k}=\"{}\"", xml_escape(v));
         }
     }
 
@@ -78,13 +63,13 @@ impl Xml {
     /// `<name>text</name>`.
     pub fn text(&mut self, name: &str, text: &str) {
         self.indent();
-        let _ = writeln!(self.out, "<{name}>{}</{name}>", escape(text));
+        let _ = writeln!(self.out, "<{name}>{}</{name}>", xml_escape(text));
     }
 
     /// `<!-- text -->` (a `--` inside becomes `- -`).
     pub fn comment(&mut self, text: &str) {
         self.indent();
-        let _ = writeln!(self.out, "<!-- {} -->", escape(text).replace("--", "- -"));
+        let _ = writeln!(self.out, "<!-- {} -->", xml_escape(text).replace("--", "- -"));
     }
 
     pub fn close(&mut self) {
@@ -123,7 +108,7 @@ mod tests {
         x.comment("a -- b");
         x.empty("c", &[]);
         let s = x.finish();
-        assert!(s.contains("<a b=\"&lt;&quot;&amp;&apos;&gt;\">"), "{s}");
+        assert!(s.contains("<a b=\"&lt;&quot;&amp;'&gt;\">"), "{s}");
         assert!(s.contains("<!-- a - - b -->") && s.contains("  <c/>") && s.ends_with("</a>\n"), "{s}");
     }
 }
