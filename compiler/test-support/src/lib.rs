@@ -1,5 +1,6 @@
 //! What TADSL's tests share: where the repository and `../shared` are, the files of a
-//! directory, the examples, a scratch directory, seeded mutations of TAD texts, and the
+//! directory, the examples, a scratch directory, seeded mutations of TAD texts, the
+//! backends' fixtures judged against what a backend reported (`fixtures`), and the
 //! Scenic oracle (the real Scenic 3.1.1 in a Python venv), traces of programs in Scenic's
 //! Newtonian simulator, and the footprint geometry to judge them by.
 //!
@@ -8,6 +9,7 @@
 //! `TADSL_SCENIC_CHECK`, `TADSL_SCENIC_MAPS`, `TADSL_SCENIC_TRACE`).
 
 pub mod fake_llm;
+pub mod fixtures;
 pub mod mutate;
 pub mod scenic;
 pub mod trace;

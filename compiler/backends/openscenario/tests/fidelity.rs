@@ -11,6 +11,8 @@
 //! - the ego's route ends on the arm its turn leads to, through a connecting road the
 //!   junction links to its lane.
 
+mod common;
+
 use std::collections::HashMap;
 use tad_layout::geom::Vec2;
 use tad_layout::road::Station;
@@ -29,16 +31,10 @@ struct Example {
 }
 
 fn examples() -> Vec<Example> {
-    scenarios()
-        .into_iter()
+    common::scenarios()
+        .iter()
         .map(|path| {
-            let text = std::fs::read_to_string(&path).unwrap();
-            let mut db = tad_db::Database::new(tad_check::Options::default());
-            let file = db.set_file(path.clone(), text);
-            let scenario = tad_db::resolve(&db, file).clone().expect("an example has a scenario");
-            let stem = path.file_stem().unwrap().to_string_lossy().into_owned();
-            let options = tad_openscenario::EmitOptions { stem: stem.clone(), source: path.display().to_string() };
-            let emitted = tad_openscenario::emit(&scenario, &options);
+            let (stem, scenario, emitted) = common::emit_file(path);
             Example { stem, layout: tad_layout::lay_out(&scenario), xosc: emitted.xosc, xodr: emitted.xodr }
         })
         .collect()
@@ -341,12 +337,4 @@ fn doc_connections(xodr: &str) -> Vec<(i64, i64, i64)> {
             )
         })
         .collect()
-}
-
-/// The examples and the backend's own scenarios (`tests/openscenario/`: a roundabout, a
-/// T-junction with stop signs, a U-turn at lights, a bend with a crossing).
-fn scenarios() -> Vec<std::path::PathBuf> {
-    let mut files = tad_test_support::examples();
-    files.extend(tad_test_support::files(&tad_test_support::repo().join("tests/openscenario"), "tad"));
-    files
 }

@@ -2,32 +2,15 @@
 //! category table is `mapping::TABLE` and names every actor type of the standard library;
 //! the example of each W071x section, built, gives its code.
 
+mod common;
+
 use std::path::Path;
 
 use tad_diagnostics::Code;
 use tad_openscenario::mapping::{self, Category};
 
-fn tad_block(text: &str) -> Option<String> {
-    let mut lines = text.lines();
-    while let Some(line) = lines.next() {
-        if line.trim_end() == "```tad" {
-            let block: Vec<&str> = lines.by_ref().take_while(|l| l.trim_end() != "```").collect();
-            return Some(block.join("\n") + "\n");
-        }
-    }
-    None
-}
-
 fn build(text: &str) -> tad_openscenario::Emitted {
-    let mut db = tad_db::Database::new(tad_check::Options::default());
-    let file = db.set_file(Path::new("/nonexistent/example.tad").to_path_buf(), text.to_string());
-    let checked = tad_db::check(&db, file);
-    assert!(!checked.diagnostics.iter().any(|d| d.is_error()), "{:#?}", checked.diagnostics);
-    let scenario = tad_db::resolve(&db, file).clone().expect("a scenario");
-    tad_openscenario::emit(
-        &scenario,
-        &tad_openscenario::EmitOptions { stem: "example".into(), source: "example.tad".into() },
-    )
+    common::emit(Path::new("/nonexistent/example.tad"), text, "example").1
 }
 
 #[test]
@@ -35,7 +18,8 @@ fn every_openscenario_code_is_produced_by_its_example() {
     let codes: Vec<Code> = Code::ALL.iter().copied().filter(|c| c.as_str()[1..].starts_with("071")).collect();
     assert_eq!(codes, [Code::W0710, Code::W0711]);
     for code in codes {
-        let text = tad_block(code.explanation()).unwrap_or_else(|| panic!("{code}: no tad example"));
+        let text = tad_test_support::fixtures::tad_block(code.explanation())
+            .unwrap_or_else(|| panic!("{code}: no tad example"));
         let emitted = build(&text);
         assert!(
             emitted.diagnostics.iter().any(|d| d.code == code),

@@ -6,6 +6,8 @@
 //! `TADSL_OPENSCENARIO_PYTHON` and `netconvert` on the path; skipped (loudly) without
 //! them unless `TAD_REQUIRE_OPENSCENARIO=1`.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -24,14 +26,8 @@ fn build_examples(dir: &Path) -> Vec<String> {
     let _ = std::fs::remove_dir_all(dir);
     std::fs::create_dir_all(dir).unwrap();
     let mut stems = Vec::new();
-    for path in scenarios() {
-        let text = std::fs::read_to_string(&path).unwrap();
-        let mut db = tad_db::Database::new(tad_check::Options::default());
-        let file = db.set_file(path.clone(), text);
-        let scenario = tad_db::resolve(&db, file).clone().expect("an example has a scenario");
-        let stem = path.file_stem().unwrap().to_string_lossy().into_owned();
-        let options = tad_openscenario::EmitOptions { stem: stem.clone(), source: path.display().to_string() };
-        let emitted = tad_openscenario::emit(&scenario, &options);
+    for path in common::scenarios() {
+        let (stem, _, emitted) = common::emit_file(&path);
         for (name, text) in emitted.files(&stem) {
             std::fs::write(dir.join(name), text).unwrap();
         }
@@ -104,11 +100,4 @@ fn asam_checkers_netconvert_and_scenariogeneration_pass_every_example() {
     assert!(xosc >= stems.len(), "{xosc} .xosc files");
     assert!(problems.is_empty(), "{} problems:\n{}", problems.len(), problems.join("\n"));
     assert!(out.status.success(), "the checker's status: {}", out.status);
-}
-
-/// The examples and the backend's own scenarios (`tests/openscenario/`).
-fn scenarios() -> Vec<std::path::PathBuf> {
-    let mut files = tad_test_support::examples();
-    files.extend(tad_test_support::files(&tad_test_support::repo().join("tests/openscenario"), "tad"));
-    files
 }

@@ -8,24 +8,14 @@ use std::path::Path;
 use tad_diagnostics::Code;
 use tad_scenic::{EmitOptions, Simulator};
 
-fn tad_block(text: &str) -> Option<String> {
-    let mut lines = text.lines();
-    while let Some(line) = lines.next() {
-        if line.trim_end() == "```tad" {
-            let block: Vec<&str> = lines.by_ref().take_while(|l| l.trim_end() != "```").collect();
-            return Some(block.join("\n") + "\n");
-        }
-    }
-    None
-}
-
 #[test]
 fn every_scenic_code_is_produced_by_its_example() {
     // W0700–W0709; W071x are the OpenSCENARIO backend's
     let codes: Vec<Code> = Code::ALL.iter().copied().filter(|c| c.as_str()[1..].starts_with("070")).collect();
     assert_eq!(codes.len(), 9);
     for code in codes {
-        let text = tad_block(code.explanation()).unwrap_or_else(|| panic!("{code}: no tad example"));
+        let text = tad_test_support::fixtures::tad_block(code.explanation())
+            .unwrap_or_else(|| panic!("{code}: no tad example"));
         let options = match code {
             Code::W0704 => EmitOptions { simulator: Simulator::Newtonian, ..EmitOptions::default() },
             Code::W0705 => EmitOptions { map: Some("Town05".into()), ..EmitOptions::default() },
