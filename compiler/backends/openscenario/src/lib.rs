@@ -43,13 +43,17 @@ pub struct Emitted {
     pub diagnostics: Vec<Diagnostic>,
 }
 
+/// The files' extensions: each is written as `STEM.EXT`, the name the others reference it by.
+pub const XOSC: &str = "xosc";
+pub const XODR: &str = "xodr";
+pub const DISTRIBUTION: &str = "distribution.xosc";
+
 impl Emitted {
-    /// The files to write: `(name, text)`.
-    pub fn files(&self, stem: &str) -> Vec<(String, &str)> {
-        let mut files =
-            vec![(format!("{stem}.xosc"), self.xosc.as_str()), (format!("{stem}.xodr"), self.xodr.as_str())];
+    /// The files to write: `(extension, text)`.
+    pub fn files(&self) -> Vec<(&'static str, &str)> {
+        let mut files = vec![(XOSC, self.xosc.as_str()), (XODR, self.xodr.as_str())];
         if let Some(d) = &self.distribution {
-            files.push((format!("{stem}.distribution.xosc"), d.as_str()));
+            files.push((DISTRIBUTION, d.as_str()));
         }
         files
     }
@@ -61,15 +65,9 @@ pub fn emit(scenario: &Scenario, options: &EmitOptions) -> Emitted {
     let program = tad_bytecode::lower(scenario, &layout, &options.source);
     let net = network::network(&layout);
     let name = program.name.clone();
-    let xodr_file = format!("{}.xodr", options.stem);
-    let context = xosc::Context {
-        scenario,
-        layout: &layout,
-        program: &program,
-        net: &net,
-        road_file: xosc::RoadFile::Generated(&xodr_file),
-    };
-    let out = xosc::print(&context, &format!("{}.xosc", options.stem));
+    let xodr_file = format!("{}.{XODR}", options.stem);
+    let context = xosc::Context { scenario, layout: &layout, program: &program, net: &net, xodr_file: &xodr_file };
+    let out = xosc::print(&context, &format!("{}.{XOSC}", options.stem));
     let mut diagnostics = out.diagnostics;
     tad_diagnostics::sort(&mut diagnostics);
     diagnostics.dedup_by(|a, b| a.code == b.code && a.message == b.message);

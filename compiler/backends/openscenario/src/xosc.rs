@@ -28,18 +28,13 @@ const ROUTE_BEYOND: f64 = 20.0;
 const LANE_CHANGE_TIME: f64 = 3.0;
 const STOP_RATE: f64 = 6.0;
 
-/// Where the road network comes from: the generated `.xodr` (its file name) or a CARLA town.
-pub enum RoadFile<'a> {
-    Generated(&'a str),
-    Town(&'a str),
-}
-
 pub struct Context<'a> {
     pub scenario: &'a Scenario,
     pub layout: &'a Layout,
     pub program: &'a Program,
     pub net: &'a Network,
-    pub road_file: RoadFile<'a>,
+    /// The generated road's file name.
+    pub xodr_file: &'a str,
 }
 
 /// A parameter's name: the slot's `group.what` as `group_what`.
@@ -99,9 +94,6 @@ impl Position {
 /// Where a pose of an arm is, on the generated road; `along` (the slot of the station's
 /// `along`) moves `s` with it.
 fn locate(c: &Context, arm: Arm, pose: Pose, along: Option<Value>) -> Position {
-    if matches!(c.road_file, RoadFile::Town(_)) {
-        return Position::World(pose);
-    }
     let Some((road_id, s, t)) = c.net.locate(arm, pose.position) else { return Position::World(pose) };
     let Some(road) = c.net.road(road_id) else { return Position::World(pose) };
     let Some((lane, offset)) = road.lane_at(t) else { return Position::World(pose) };
@@ -186,10 +178,7 @@ fn parameters(x: &mut Xml, program: &Program) {
 
 fn road_network(x: &mut Xml, c: &Context) {
     x.open("RoadNetwork", &[]);
-    let file = match c.road_file {
-        RoadFile::Generated(f) | RoadFile::Town(f) => f,
-    };
-    x.empty("LogicFile", attrs!("filepath" => file));
+    x.empty("LogicFile", attrs!("filepath" => c.xodr_file));
     let controllers: Vec<(Arm, &[tad_bytecode::Phase])> = c
         .program
         .code
@@ -199,7 +188,7 @@ fn road_network(x: &mut Xml, c: &Context) {
             _ => None,
         })
         .collect();
-    if !controllers.is_empty() && matches!(c.road_file, RoadFile::Generated(_)) {
+    if !controllers.is_empty() {
         x.open("TrafficSignals", &[]);
         for (arm, phases) in controllers {
             let Some(signal) = c.net.controllers.iter().find(|k| k.arm == arm).and_then(|k| k.signals.first()) else {

@@ -28,8 +28,8 @@ fn build_examples(dir: &Path) -> Vec<String> {
     let mut stems = Vec::new();
     for path in common::scenarios() {
         let (stem, _, emitted) = common::emit_file(&path);
-        for (name, text) in emitted.files(&stem) {
-            std::fs::write(dir.join(name), text).unwrap();
+        for (ext, text) in emitted.files() {
+            std::fs::write(dir.join(format!("{stem}.{ext}")), text).unwrap();
         }
         stems.push(stem);
     }

@@ -252,14 +252,12 @@ fn openscenario(args: &BuildArgs, color: bool) -> Result<Status, CliError> {
                 continue;
             }
         };
-        let stem = stem(input);
-        let options = tad_openscenario::EmitOptions { stem: stem.clone(), source: input.name.clone() };
+        let options = tad_openscenario::EmitOptions { stem: stem(input), source: input.name.clone() };
         let emitted = tad_openscenario::emit(&scenario, &options);
         err!("{}", human::render(&FileReport::new(&input.name, &input.text, &emitted.diagnostics), color))?;
         let mut names = Vec::new();
-        for (name, text) in emitted.files(&stem) {
-            let ext = name.strip_prefix(&format!("{stem}.")).unwrap_or(&name).to_string();
-            match write_into(dir, input, &ext, text.as_bytes(), &mut written)? {
+        for (ext, text) in emitted.files() {
+            match write_into(dir, input, ext, text.as_bytes(), &mut written)? {
                 Some(target) => names.push(target.display().to_string()),
                 None => status = status.max(Status::Usage),
             }
