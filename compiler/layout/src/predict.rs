@@ -50,7 +50,8 @@ pub fn roll_out(layout: &Layout, steps: usize, dt: f64) -> Trace {
                 let due = t >= a.start.delay;
                 let near = a.start.trigger.is_none_or(|d| ego.distance(current[k].position) <= d);
                 // the ego's time to the point along its path, at its speed
-                let met = meets[k].is_none_or(|(at, travel)| (at - s[0]) / agents[0].speed.max(0.1) <= travel + 1e-9);
+                let met =
+                    meets[k].is_none_or(|(at, travel)| tad_road::time_to(at - s[0], agents[0].speed) <= travel + 1e-9);
                 if due && near && met {
                     started[k] = true;
                 } else {

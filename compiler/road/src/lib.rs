@@ -5,12 +5,22 @@
 //! Modules: `geom` (points, poses, polyline paths, footprints) and `road` (the road's shape,
 //! arms, lanes, stations, junction paths); here, how a placed actor is described: its
 //! [`Body`], where across its lane it stands ([`Place`]) and which way it faces
-//! ([`Facing`]).
+//! ([`Facing`]); and how long an actor takes to cover the rest of its way ([`time_to`]), by
+//! which an adversary's start is measured (`meet`).
 
 pub mod geom;
 pub mod road;
 
 pub use road::{Arm, Junction, Road, Shape, Side, Station, Turn};
+
+/// The slowest an actor counts as moving when its time to a point is measured, m/s.
+pub const CREEP: f64 = 0.1;
+
+/// How long an actor at `speed` takes to cover `distance` more metres of its way (negative
+/// once past the point); a standing actor counts as creeping ([`CREEP`]).
+pub fn time_to(distance: f64, speed: f64) -> f64 {
+    distance / speed.max(CREEP)
+}
 use tad_ir::{Motion, SimulatedAs};
 
 /// The body an actor is simulated as (its type's `simulated_as`, else its kind's).

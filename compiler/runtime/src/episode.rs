@@ -128,9 +128,6 @@ struct EgoNow {
     speed: f64,
 }
 
-/// The slowest the ego counts as moving when its time to a point is measured, m/s.
-const MEET_SPEED: f64 = 0.1;
-
 struct Actor {
     body: Body,
     length: f64,
@@ -707,7 +704,7 @@ fn run_script(scene: &Scene, script: &[Instr], a: &mut Actor, params: &[f64], t:
             (Instr::Wait { .. }, Block::Until(until)) if t + 1e-9 < until => return,
             (Instr::WaitNear { .. }, Block::Near(d)) if ego.position.distance(a.kin.position) > d => return,
             (Instr::Meet { .. }, Block::Meet { at, travel })
-                if (at - ego.s) / ego.speed.max(MEET_SPEED) > travel + 1e-9 =>
+                if tad_road::time_to(at - ego.s, ego.speed) > travel + 1e-9 =>
             {
                 return;
             }

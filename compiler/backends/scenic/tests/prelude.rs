@@ -29,3 +29,11 @@ fn prelude_programs_keep_their_facts() {
     assert!(output.status.success() && failed.is_empty(), "{stderr}\n{}", failed.join("\n"));
     assert!(stdout.lines().count() >= 20, "too few runs:\n{stdout}");
 }
+
+/// `TadMeet` measures the ego's time to its meeting as the runtime does (`tad_road::time_to`):
+/// a standing ego counts as creeping at `tad_road::CREEP`.
+#[test]
+fn the_meeting_time_creeps_as_the_runtimes() {
+    let rule = format!("return (arc - here) / max(car.speed or 0.0, {})", tad_road::CREEP);
+    assert!(tad_scenic::PRELUDE_PLACEMENT.contains(&rule), "the prelude's tadTimeTo is not `{rule}`");
+}
