@@ -544,13 +544,19 @@ impl Path {
     }
 }
 
+/// The cubic Bézier's four points from `a` heading `da` to `b` heading `db` (unit
+/// directions): its control arms are 0.39 of the chord.
+pub fn bezier_controls(a: Vec2, da: Vec2, b: Vec2, db: Vec2) -> [Vec2; 4] {
+    // a quarter circle of radius r has chord r·√2 and control arms of 0.552·r
+    let arm = a.distance(b) * 0.39;
+    [a, a + da * arm, b - db * arm, b]
+}
+
 /// A cubic Bézier curve from `a` (leaving along `da`) to `b` (arriving along `db`),
-/// sampled every metre or so.
+/// sampled four times a metre (at least 8 segments), on [`bezier_controls`].
 pub fn bezier(a: Vec2, da: Vec2, b: Vec2, db: Vec2) -> Vec<Vec2> {
     let chord = a.distance(b);
-    // a quarter circle of radius r has chord r·√2 and control arms of 0.552·r
-    let arm = chord * 0.39;
-    let (c1, c2) = (a + da * arm, b - db * arm);
+    let [_, c1, c2, _] = bezier_controls(a, da, b, db);
     // four points a metre: within 5 mm of the curve on the tightest turns of a junction
     let n = ((chord * 4.0).ceil() as usize).clamp(8, 1600);
     (0..=n)

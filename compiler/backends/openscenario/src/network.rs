@@ -17,7 +17,7 @@
 //! the innermost, right from the outermost) and every turn an actor of the layout takes.
 
 use tad_layout::Layout;
-use tad_road::geom::{Pose, Vec2};
+use tad_road::geom::{Pose, Vec2, bezier_controls};
 use tad_road::road::{CROSSWALK, CROSSWALK_DEPTH, RING, RUN, Ring, SIDEWALK_WIDTH};
 use tad_road::{Arm, Road, Shape, Turn};
 
@@ -493,10 +493,10 @@ pub fn turn_name(turn: Turn) -> &'static str {
     }
 }
 
-/// `tad_road::geom::bezier`'s curve as a `paramPoly3` piece starting at `s`.
+/// `tad_road::geom::bezier`'s curve (its control points) as a `paramPoly3` piece starting
+/// at `s`.
 fn bezier(s: f64, a: Vec2, da: Vec2, b: Vec2, db: Vec2) -> Geometry {
-    let arm = a.distance(b) * 0.39;
-    let (c1, c2) = (a + da * arm, b - db * arm);
+    let [_, c1, c2, _] = bezier_controls(a, da, b, db);
     // the power basis: B(p) = a + p1 p + p2 p² + p3 p³
     let p1 = (c1 - a) * 3.0;
     let p2 = (a - c1 * 2.0 + c2) * 3.0;
