@@ -23,7 +23,7 @@ mod place;
 pub mod predict;
 
 pub use facts::{Body, Chosen, Facts, MAX_GROUP};
-pub use place::{lay_out, lay_out_within};
+pub use place::{MEET_MARGIN, lay_out, lay_out_within};
 pub use road::{Arm, Road, Shape, Side, Station, Turn};
 /// What a traffic light shows: the schema's closed set, the one light state of the workspace.
 pub use tad_ir::{ClosedSet, Signal};

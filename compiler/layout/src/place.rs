@@ -41,6 +41,9 @@ const APPROACH_TIME: f64 = 2.0;
 /// The farthest a timed adversary starts from its arm's stop line, m; one that would need
 /// more waits there and starts late.
 const MAX_ARM_START: f64 = 150.0;
+/// Two paths meet where they come within this much (m) of touching: half of each one's
+/// width, plus this margin.
+pub const MEET_MARGIN: f64 = 0.3;
 /// Spacing of walkers standing side by side.
 const WALKER_SPACING: f64 = 0.9;
 
@@ -1275,7 +1278,7 @@ fn blend(a: f64, b: f64, x1: f64, x2: f64, x: f64) -> f64 {
 /// path when the ego does; `None` when their paths do not meet ahead of both.
 fn time_group(road: &Road, ego: &Agent, d: &Decision, g: &mut GroupLayout) -> Option<(Conflict, f64)> {
     let first = g.agents.first()?;
-    let reach = (ego.width + first.width) / 2.0 + 0.3;
+    let reach = (ego.width + first.width) / 2.0 + MEET_MARGIN;
     // the ego's path ahead of it
     let ego_ahead = Path::new(sample_path(&ego.path, ego.path_start, ego.path.length()));
     let own_ahead = Path::new(sample_path(&first.path, first.path_start, first.path.length()));

@@ -26,6 +26,15 @@ import math as tadMath
 from scenic.core.distributions import distributionFunction as tadLazy
 from scenic.core.distributions import RejectionException as TadRejection
 
+# A two-wheeler's throttle (TadRide), and how fast a vehicle released from rest picks up
+# speed under it (m/s²): half of the Newtonian simulator's 5.6 m/s² at full throttle.
+# FollowLaneBehavior's controller starts at full throttle and eases in, about the same.
+TAD_RIDE_THROTTLE = 0.5
+TAD_LAUNCH = TAD_RIDE_THROTTLE * 5.6
+# Two ways meet where they come within half of each one's width plus this (m): the
+# layout's `MEET_MARGIN`.
+TAD_MEET_MARGIN = 0.3
+
 def tadLanes(section):
     """The lane sections of the road section holding `section`, in TAD lane order: those of its
     direction from the left (TAD 1, 2, ...) and those of the other direction from the centre
@@ -426,25 +435,76 @@ def tadPlace(lane, arc, index, place='centre', width=0.0, clamp=False):
         position = position + Vector(shift, 0).rotatedBy(heading)
     return (position, heading)
 
-def tadWay(obj, maneuver):
-    """The way `obj` goes from where it stands, as a shapely line: its lane on to the junction,
-    through it by its first maneuver of type `maneuver` ('STRAIGHT', 'LEFT_TURN', ...) and
-    along the lane after; straight ahead along its heading for 150 m without a maneuver, a
-    lane, or a maneuver of that type."""
+def tadWay(obj, maneuver, follow=False):
+    """The way `obj` goes from where it stands, as a shapely line: as `tadLaneWay` from its
+    place in its lane; without a maneuver and with `follow`, along its lane and the ordinary
+    lanes it leads into (150 m at most); else straight ahead along its heading for 150 m."""
     from shapely.geometry import LineString, Point
-    from shapely.ops import substring
-    here = obj.position
     lane = getattr(obj, '_lane', None)
-    turns = [] if lane is None or maneuver is None else [m for m in lane.maneuvers if m.type.name == maneuver]
-    if not turns:
-        ahead = here + Vector(0, 150).rotatedBy(obj.heading)
-        return LineString([(here.x, here.y), (ahead.x, ahead.y)])
+    if lane is not None and (maneuver is not None or follow):
+        arc = lane.centerline.lineString.project(Point(obj.position.x, obj.position.y))
+        way = tadLaneWay(lane, arc, maneuver) if maneuver is not None else tadFollowWay(lane, arc, 150.0)
+        if way is not None:
+            return way
+    here = obj.position
+    ahead = here + Vector(0, 150).rotatedBy(obj.heading)
+    return LineString([(here.x, here.y), (ahead.x, ahead.y)])
+
+def tadFollowWay(lane, arc, length):
+    """The way from `arc` metres along `lane` on along it and the ordinary lanes it leads
+    into, for `length` metres or to where they end: a shapely line."""
+    from shapely.geometry import LineString
+    from shapely.ops import substring
     line = lane.centerline.lineString
-    points = list(substring(line, line.project(Point(here.x, here.y)), line.length).coords)
-    parts = [turns[0].connectingLane, turns[0].endLane]
-    for part in [p for p in parts if p is not None]:
+    points = list(substring(line, arc, line.length).coords)
+    total, seen = line.length - arc, {lane.uid}
+    while total < length:
+        nxt = lane._successor
+        if nxt is None or not hasattr(nxt, 'centerline') or nxt.uid in seen or not tadOrdinary(nxt):
+            break
+        seen.add(nxt.uid)
+        lane = nxt
+        points.extend(lane.centerline.lineString.coords)
+        total += lane.centerline.length
+    if len(points) < 2:
+        return None
+    return LineString([(p[0], p[1]) for p in points])
+
+def tadLaneWay(lane, arc, maneuver):
+    """The way from `arc` metres along `lane`, as a shapely line: on to the lane's end, through
+    the junction there by its first maneuver of type `maneuver` ('STRAIGHT', 'LEFT_TURN', ...)
+    and along the lane after; None if the lane has no maneuver of that type."""
+    from shapely.geometry import LineString
+    from shapely.ops import substring
+    turns = [m for m in lane.maneuvers if m.type.name == maneuver]
+    if not turns:
+        return None
+    line = lane.centerline.lineString
+    points = list(substring(line, arc, line.length).coords)
+    for part in [p for p in (turns[0].connectingLane, turns[0].endLane) if p is not None]:
         points.extend(part.centerline.lineString.coords)
     return LineString([(p[0], p[1]) for p in points])
+
+@tadLazy
+def tadOnTime(anchor, arm, index, ownTurn, egoTurn, egoSpeed, speed, reach, length, before):
+    """How far before the stop line of arm `arm` (TAD lane `index`) a vehicle driving at
+    `speed` through the junction by maneuver `ownTurn` starts so that it reaches where its
+    way first comes within `reach` of the ego's (the ego at `egoSpeed` by `egoTurn`) when the
+    ego does: the layout's start rule for an adversary on time, measured again on the map's
+    own junction. `before` (the layout's distance) where the ways do not meet on the map;
+    never inside the junction (a vehicle of `length`), never farther out than the arm goes."""
+    ins, outs = tadArmLanes(anchor, arm)
+    if not ins:
+        return before
+    lane = ins[min(max(index, 1), len(ins)) - 1]
+    own = tadLaneWay(lane, lane.centerline.length, ownTurn)
+    # (not `ego`: in a Scenic program that name is the ego object)
+    egoWay = tadLaneWay(anchor[0], anchor[1], egoTurn)
+    meeting = None if own is None or egoWay is None else tadMeeting(own, egoWay, reach)
+    if meeting is None:
+        return before
+    spot = speed * meeting[1] / max(egoSpeed, 0.1) - meeting[0]
+    return min(max(spot, length / 2 + 0.5), max(tadReach(ins[0]) - length / 2, length / 2 + 0.5))
 
 def tadMeeting(own, way, reach):
     """The first point of the line `own` within `reach` of the line `way`: its arc along
@@ -487,7 +547,7 @@ behavior TadWalk(speed):
 behavior TadRide(speed):
     """A vehicle keeping its heading at a steady speed (a two-wheeler crossing the road)."""
     while True:
-        take SetThrottleAction(0.5 if self.speed < speed else 0), SetBrakeAction(0), SetSteerAction(0)
+        take SetThrottleAction(TAD_RIDE_THROTTLE if self.speed < speed else 0), SetBrakeAction(0), SetSteerAction(0)
 
 behavior TadReverse(speed):
     """A vehicle driving backwards."""
@@ -513,12 +573,14 @@ behavior TadTurn(speed, maneuver):
 def tadGapAhead(car, reach):
     """The free distance (metres, bumper to bumper) from `car` to the nearest object ahead of
     it in its path within `reach`, else None. In its path: ahead of its front, and overlapping
-    the band of its width (plus 0.3 m each side) along its heading, or in the same lane."""
+    the band of its width (plus 0.3 m each side) along its heading, or in the same lane. An
+    adversary (`tadAdversary`) keeps to its timing: the ego is not in its path."""
     forward = Vector(0, 1).rotatedBy(car.heading)
     right = Vector(1, 0).rotatedBy(car.heading)
     best = None
+    heedless = getattr(car, 'tadAdversary', False)
     for obj in simulation().objects:
-        if obj is car:
+        if obj is car or (heedless and obj is ego):
             continue
         offset = obj.position - car.position
         along = offset.dot(forward)
@@ -624,10 +686,11 @@ ego = new Car at tadEgoAt[0], facing tadEgoAt[1],
 
 # group `red_light_runner`: 1 sedan, move_forward, 60 km/h, right_front of ego, lane 2
 tadJitter1 = Range(-5.0, 5.0)
-tadAt1 = tadArmSpot(tadAnchor, 'right', 52.4 + tadJitter1, 2)
+tadOnTime1 = tadOnTime(tadAnchor, 'right', 2, 'STRAIGHT', 'STRAIGHT', 13.889, 16.667, 2.125, 4.8, 52.4)
+tadAt1 = tadArmSpot(tadAnchor, 'right', tadOnTime1 + tadJitter1, 2)
 red_light_runner = new Car at tadAt1[0], facing tadAt1[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
-    with regionContainedIn None, with speed 16.667, with behavior TadThrough(16.667, 'STRAIGHT')
+    with regionContainedIn None, with tadAdversary True, with speed 16.667, with behavior TadThrough(16.667, 'STRAIGHT')
 
 # group `box_truck`: 1 truck, move_forward, 40 km/h, right_front of ego, lane 3
 tadAt2 = tadArmSpot(tadAnchor, 'opposite', 4.25, -3)

@@ -12,7 +12,7 @@ use tad_ir::{Motion, Scenario};
 
 use crate::mapping::{self, Class};
 use crate::maps;
-use crate::plan::{Actor, Light, Plan, Sampled};
+use crate::plan::{Actor, Light, OnTime, Plan, Sampled};
 use crate::python::{comment_lines, comment_text, number, string};
 use crate::{EmitOptions, PRELUDE_BEHAVIORS, PRELUDE_PARAMS, PRELUDE_PLACEMENT, Simulator};
 use tad_layout::Arm;
@@ -238,6 +238,9 @@ fn objects(out: &mut String, plan: &Plan) {
         out.push_str(&comment_lines(&group.summary, ""));
         if let Some(first) = group.actors.first() {
             params(out, &first.params);
+            if let Some(on) = first.params.on_time {
+                on_time(out, first, &on, &speed_of(&plan.ego));
+            }
         }
         for a in &group.actors {
             spot += 1;
@@ -310,6 +313,28 @@ fn params(out: &mut String, p: &Sampled) {
     }
 }
 
+/// `tadOnTimeTAG = tadOnTime(...)`: where on its arm the map puts an adversary on time.
+fn on_time(out: &mut String, first: &Actor, on: &OnTime, ego_speed: &str) {
+    let _ = writeln!(
+        out,
+        "tadOnTime{} = tadOnTime(tadAnchor, {}, {}, {}, {}, {ego_speed}, {}, {}, {}, {})",
+        first.params.tag,
+        string(on.arm.as_str()),
+        on.lane,
+        string(mapping::maneuver(on.own)),
+        string(mapping::maneuver(on.ego)),
+        speed_of(first),
+        number(on.reach),
+        number(first.length),
+        number(on.before)
+    );
+}
+
+/// The speed an actor's behavior keeps: its group's sampled `tadSpeedTAG`, or the number.
+fn speed_of(a: &Actor) -> String {
+    if a.params.speed.is_some() { format!("tadSpeed{}", a.params.tag) } else { number(a.target_speed) }
+}
+
 /// `SPOT = tadSpot(...)` (on the ego's road), `tadArmSpot(...)` (on another arm of the
 /// junction), `tadCrossAt(...)`/`tadCross(...)` (about to walk across), and `NAME = new CLASS
 /// at SPOT[0], facing SPOT[1], ...`.
@@ -321,10 +346,18 @@ fn actor(out: &mut String, a: &Actor, spot: &str, needs: &maps::Needs) {
         Place::Shoulder => format!(", 'shoulder', {}", number(a.width)),
     };
     let p = &a.params;
-    let mut offset = match p.shift {
-        Some((_, sign)) if sign < 0.0 => format!("{} - tadShift{}", number(a.offset), p.tag),
-        Some(_) => format!("{} + tadShift{}", number(a.offset), p.tag),
+    // an adversary on time: where the map's junction puts the group's first, and the rest
+    // behind it as on the layout
+    let base = match p.on_time {
+        Some(on) if (a.offset - on.before).abs() < 5e-4 => format!("tadOnTime{}", p.tag),
+        Some(on) if a.offset > on.before => format!("tadOnTime{} + {}", p.tag, number(a.offset - on.before)),
+        Some(on) => format!("tadOnTime{} - {}", p.tag, number(on.before - a.offset)),
         None => number(a.offset),
+    };
+    let mut offset = match p.shift {
+        Some((_, sign)) if sign < 0.0 => format!("{base} - tadShift{}", p.tag),
+        Some(_) => format!("{base} + tadShift{}", p.tag),
+        None => base,
     };
     if p.jitter.is_some() {
         offset = format!("{offset} + tadJitter{}", p.tag);
@@ -368,13 +401,16 @@ fn actor(out: &mut String, a: &Actor, spot: &str, needs: &maps::Needs) {
     if !a.is_ego {
         out.push_str(",\n    with regionContainedIn None");
     }
+    if a.adversary && a.class == Class::Car {
+        out.push_str(", with tadAdversary True");
+    }
     if a.class == Class::Debris {
         // the Newtonian model's Debris is a plain object, which must be visible by default
         out.push_str(", with requireVisible False");
     }
     // through a junction ahead, a vehicle takes the maneuver it is given (straight on too)
     let through = junction && a.cross.is_none() && a.lane > 0;
-    let speed = if p.speed.is_some() { format!("tadSpeed{}", p.tag) } else { number(a.target_speed) };
+    let speed = speed_of(a);
     if a.initial_speed > 0.0 {
         let initial = if p.speed.is_some() { speed.clone() } else { number(a.initial_speed) };
         let _ = write!(out, ", with speed {initial}");

@@ -58,11 +58,6 @@ const KNOWN: &[(&str, &str, &str)] = &[
         "adversaries",
         "the merging SUV is kept in front of the ego (its relation) and passes 7 m ahead of it",
     ),
-    (
-        "red_light_running",
-        "adversaries",
-        "the map's junction is larger than the layout's: with some seeds the runner crosses up to 8 m ahead of the ego",
-    ),
     ("straight_obstacle", "relations", "with some seeds the chosen stretch of the map bends ahead of the ego"),
     (
         "turning_obstacle",
@@ -73,21 +68,6 @@ const KNOWN: &[(&str, &str, &str)] = &[
         "pennsylvania_small_town_main_street",
         "overlaps",
         "with some seeds the map's shoulder is narrower than a car, and the pickup truck brushes the first parked car",
-    ),
-    (
-        "crossing_negotiation",
-        "conflict",
-        "the SUV is on time on the layout's junction and starts moving; on the map it reaches the crossing late, and a late actor cannot wait its way back (nearest 3.5 m)",
-    ),
-    (
-        "red_light_running",
-        "conflict",
-        "the runner is on time on the layout's 15 m junction; on Town06 the ego's time to the crossing is 3.3 s against the runner's 4.3 s, so it passes behind the ego (nearest 4.6 m)",
-    ),
-    (
-        "turning_obstacle",
-        "conflict",
-        "the one-way road's junction on the map: the cyclist's crossing is not where the ego turns (nearest 2.0–3.5 m)",
     ),
     (
         "unprotected_left_turn",

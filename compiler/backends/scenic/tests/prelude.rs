@@ -37,3 +37,12 @@ fn the_meeting_time_creeps_as_the_runtimes() {
     let rule = format!("return (arc - here) / max(car.speed or 0.0, {})", tad_road::CREEP);
     assert!(tad_scenic::PRELUDE_PLACEMENT.contains(&rule), "the prelude's tadTimeTo is not `{rule}`");
 }
+
+/// Where two ways meet is the layout's rule (`tad_layout::MEET_MARGIN`), in `TadMeet` and,
+/// through the reach the program passes, in `tadOnTime`.
+#[test]
+fn ways_meet_within_the_layouts_margin() {
+    let rule = format!("TAD_MEET_MARGIN = {}", tad_layout::MEET_MARGIN);
+    assert!(tad_scenic::PRELUDE_PLACEMENT.contains(&rule), "the prelude's margin is not `{rule}`");
+    assert!(tad_scenic::PRELUDE_PARAMS.contains("(self.width + ego.width) / 2 + TAD_MEET_MARGIN"));
+}

@@ -8,7 +8,7 @@ use tad_layout::{Arm, Facing, Layout, Place, Side};
 
 use super::ego::EgoPlan;
 use super::groups::Resolved;
-use super::{Actor, Group, MeetPlan, Sampled};
+use super::{Actor, Group, MeetPlan, OnTime, Sampled};
 use crate::mapping::{self, Class};
 use crate::python::Names;
 
@@ -37,6 +37,7 @@ pub fn build(
         class: Class::Car,
         blueprint: mapping::EGO_BLUEPRINT.to_string(),
         is_ego: true,
+        adversary: false,
         length: ego.length,
         width: ego.width,
         lane: ego.lane,
@@ -74,17 +75,7 @@ pub fn build(
                 _ => 0.0,
             };
         let away = first.map_or(1.0, |f| if f.station.along >= reference_along { 1.0 } else { -1.0 });
-        // an adversary waiting for the ego meets it on the map's own ways: its maneuver (a
-        // crosser goes straight across) and the ego's, through the junction the map kept
-        let meet = first
-            .filter(|f| f.start.meet.is_some() && g.delay.is_none())
-            .filter(|_| junction || laid.ego.turn == tad_layout::Turn::Straight)
-            .map(|f| MeetPlan {
-                own: (f.body == tad_layout::Body::Vehicle && f.facing == Facing::Along)
-                    .then(|| letter(f.turn))
-                    .filter(|_| junction),
-                ego: Some(letter(laid.ego.turn)).filter(|_| junction),
-            });
+        let (meet, on_time) = first.map_or((None, None), |f| timing(f, g, laid, ego, conflict.is_some(), junction));
         let params = Sampled {
             tag: (i + 1).to_string(),
             speed: g.speed_range,
@@ -108,6 +99,7 @@ pub fn build(
             jitter: first.map(|f| laid.conflict_spread(f)).filter(|j| *j >= 0.3 && g.offset.is_none()),
             offset: g.offset.filter(|(low, high)| low < high),
             meet,
+            on_time,
         };
         // a single written offset moves the group's place
         let moved_by = g.offset.filter(|(low, high)| low >= high).map_or(0.0, |(low, _)| low);
@@ -138,6 +130,7 @@ pub fn build(
                 class,
                 blueprint: g.mapping.blueprint.clone(),
                 is_ego: false,
+                adversary: conflict.is_some(),
                 length: g.length,
                 width: g.width,
                 lane: a.lane,
@@ -154,6 +147,46 @@ pub fn build(
         out.push(Group { summary: g.summary.clone(), actors });
     }
     Actors { ego: ego_actor, ego_summary: ego_summary(scenario, ego.lane), groups: out }
+}
+
+/// How an adversary of group `g` (`first` its first actor) is timed on the map: waiting for
+/// the ego (`TadMeet`), or started moving from where the map's junction puts it on time
+/// (`tadOnTime`); neither for the rest.
+fn timing(
+    first: &tad_layout::Agent,
+    g: &Resolved,
+    laid: &Layout,
+    ego: &EgoPlan,
+    conflict: bool,
+    junction: bool,
+) -> (Option<MeetPlan>, Option<OnTime>) {
+    let vehicle = first.body == tad_layout::Body::Vehicle && first.facing == Facing::Along;
+    // an adversary waiting for the ego meets it on the map's own ways: its maneuver (a
+    // crosser goes straight across) and the ego's, through the junction the map kept;
+    // without the junction the ego's way is its lane onward: a walker's crossing of the
+    // road still meets it, a vehicle's way from another arm may not
+    let meet = (first.start.meet.is_some() && g.delay.is_none())
+        .then_some(first)
+        .filter(|f| junction || laid.ego.turn == tad_layout::Turn::Straight || f.facing != Facing::Along)
+        .map(|f| MeetPlan {
+            own: vehicle.then(|| letter(f.turn)).filter(|_| junction),
+            ego: Some(letter(laid.ego.turn)).filter(|_| junction),
+        });
+    // an adversary on another arm started moving, on time on the layout's junction: on the
+    // map's junction the same rule places it again
+    let on_time = (first.start.meet.is_none() && first.moving && conflict && vehicle)
+        .then_some(first)
+        .filter(|f| junction && laid.ego.moving && f.station.arm != Arm::Ego && f.lane > 0)
+        .filter(|_| g.delay.is_none() && g.trigger.is_none() && g.offset.is_none())
+        .map(|f| OnTime {
+            arm: f.station.arm,
+            lane: f.lane,
+            own: letter(f.turn),
+            ego: letter(laid.ego.turn),
+            reach: (ego.width + f.width) / 2.0 + tad_layout::MEET_MARGIN,
+            before: f.station.along,
+        });
+    (meet, on_time)
 }
 
 /// `ego vehicle: BEHAVIOR, SPEED, lane N`, for a comment.

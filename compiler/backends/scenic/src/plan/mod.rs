@@ -53,6 +53,9 @@ pub struct Actor {
     pub blueprint: String,
     /// The ego vehicle (`with rolename 'hero'`).
     pub is_ego: bool,
+    /// An adversary (its group has a conflict with the ego in the layout): it keeps to its
+    /// timing and does not brake for the ego (`with tadAdversary True`).
+    pub adversary: bool,
     pub length: f64,
     pub width: f64,
     /// TAD lane index on its arm.
@@ -103,6 +106,23 @@ pub struct Sampled {
     /// An adversary that waits for the ego (the layout's `Start::meet`), measured on the map:
     /// `TadMeet` with its own maneuver and the ego's.
     pub meet: Option<MeetPlan>,
+    /// An adversary on another arm that the layout starts moving, on time for its conflict:
+    /// its distance before the stop line measured again on the map's junction (`tadOnTime`).
+    pub on_time: Option<OnTime>,
+}
+
+/// What `tadOnTime` needs to place an on-time adversary on the map: the arm and lane of
+/// the group's first actor, its maneuver and the ego's (`mapping::maneuver` letters), the
+/// distance within which their ways meet (as the layout's), and the layout's distance before
+/// the stop line (kept where the map's ways do not meet).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OnTime {
+    pub arm: tad_layout::Arm,
+    pub lane: i64,
+    pub own: char,
+    pub ego: char,
+    pub reach: f64,
+    pub before: f64,
 }
 
 /// The maneuvers (`mapping::maneuver` letters; `None`: straight ahead along its heading,

@@ -22,7 +22,7 @@ behavior TadWalk(speed):
 behavior TadRide(speed):
     """A vehicle keeping its heading at a steady speed (a two-wheeler crossing the road)."""
     while True:
-        take SetThrottleAction(0.5 if self.speed < speed else 0), SetBrakeAction(0), SetSteerAction(0)
+        take SetThrottleAction(TAD_RIDE_THROTTLE if self.speed < speed else 0), SetBrakeAction(0), SetSteerAction(0)
 
 behavior TadReverse(speed):
     """A vehicle driving backwards."""
@@ -48,12 +48,14 @@ behavior TadTurn(speed, maneuver):
 def tadGapAhead(car, reach):
     """The free distance (metres, bumper to bumper) from `car` to the nearest object ahead of
     it in its path within `reach`, else None. In its path: ahead of its front, and overlapping
-    the band of its width (plus 0.3 m each side) along its heading, or in the same lane."""
+    the band of its width (plus 0.3 m each side) along its heading, or in the same lane. An
+    adversary (`tadAdversary`) keeps to its timing: the ego is not in its path."""
     forward = Vector(0, 1).rotatedBy(car.heading)
     right = Vector(1, 0).rotatedBy(car.heading)
     best = None
+    heedless = getattr(car, 'tadAdversary', False)
     for obj in simulation().objects:
-        if obj is car:
+        if obj is car or (heedless and obj is ego):
             continue
         offset = obj.position - car.position
         along = offset.dot(forward)
