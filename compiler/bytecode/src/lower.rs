@@ -30,6 +30,10 @@ const MIN_TIMEOUT: f64 = 10.0;
 /// The ego's route: through the junction and this far past it, else this far ahead, m.
 const PAST_JUNCTION: f64 = 30.0;
 const WITHOUT_JUNCTION: f64 = 100.0;
+/// The route lasts, at the ego's speed, at least this long, s, and this long past the last
+/// thing timed to happen (a conflict, a start delay): a fast ego's 100 m would end first.
+const MIN_ROUTE_TIME: f64 = 6.0;
+const AFTER_LAST_EVENT: f64 = 2.0;
 /// How long a lane changer drives its lane before it changes, s (the layout's `ego_road_path`).
 const LANE_CHANGE_AFTER: f64 = 1.5;
 /// A slot for the layout's free room is made only when its range is at least this wide, m.
@@ -102,10 +106,13 @@ pub fn lower(scenario: &Scenario, layout: &Layout, source: &str) -> Program {
     let on_path = path_of(&ego_line);
     let start = on_path.project(ego.pose.position).0;
     let ahead = (on_path.length() - start).max(0.0);
+    let last_event = layout.conflicts.iter().map(|c| c.time).chain(layout.agents().map(|a| a.start.delay));
+    let lasting = ego.speed * (last_event.fold(0.0, f64::max) + AFTER_LAST_EVENT).max(MIN_ROUTE_TIME);
     let route = match past_junction(&road, &on_path, start) {
         Some(exit) => exit + PAST_JUNCTION - start,
         None => WITHOUT_JUNCTION,
     }
+    .max(lasting)
     .min(ahead);
     let ego_path_id = b.path(ego_line);
 

@@ -298,3 +298,27 @@ fn standing_actors_have_no_motion_and_baked_paths_are_followed() {
     assert!(route.0.iter().any(|q| q[1] > 0.0), "the overtaking path uses the other lane");
     assert!(start + route_length <= route.length() + 1e-9);
 }
+
+/// The ego's route and what its scene times: (route length, stated speed, latest conflict).
+fn route_of(name: &str) -> (f64, f64, f64) {
+    let path = common::example(name);
+    let p = common::program(&path);
+    let layout = lay_out(&common::resolved(&path).expect("a scenario"));
+    let latest = layout.conflicts.iter().map(|c| c.time).fold(0.0, f64::max);
+    let route = p.code.iter().find_map(|i| match i {
+        Instr::Ego { route_length, speed, .. } => Some((*route_length, speed.base)),
+        _ => None,
+    });
+    let (route, speed) = route.expect("an ego");
+    (route, speed, latest)
+}
+
+#[test]
+fn a_fast_egos_route_lasts_until_its_scenario_has_happened() {
+    // 96.6 km/h on a highway: 100 m would be 3.7 s, before the fast sedan comes alongside
+    let (route, speed, latest) = route_of("lane_changing");
+    assert!(route >= 6.0 * speed - 1e-6 && route >= (latest + 2.0) * speed - 1e-6, "{route} m at {speed} m/s");
+    // 10 km/h through a junction: the junction's rule, the conflict long before its end
+    let (route, speed, latest) = route_of("crossing_negotiation");
+    assert!(route < 100.0 && route >= (latest + 2.0) * speed, "{route} m at {speed} m/s, conflict at {latest} s");
+}
