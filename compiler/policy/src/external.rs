@@ -232,8 +232,10 @@ mod tests {
         }
     }
 
-    fn drive(command: &str, steps: usize) -> (Vec<Action>, Option<String>) {
-        let mut ego = External::new(command, Duration::from_millis(500));
+    /// `steps` actions of `command` with `timeout` (a well-behaved process gets the default:
+    /// a loaded machine may take a while to start a shell).
+    fn drive(command: &str, steps: usize, timeout: Duration) -> (Vec<Action>, Option<String>) {
+        let mut ego = External::new(command, timeout);
         ego.reset();
         let actions = (0..steps).map(|_| ego.act(&view())).collect();
         (actions, ego.failure().map(String::from))
@@ -241,12 +243,12 @@ mod tests {
 
     #[test]
     fn a_process_drives_over_json_lines() {
-        let (actions, failure) = drive("while read line; do echo '[1.5, -0.25]'; done", 3);
+        let (actions, failure) = drive("while read line; do echo '[1.5, -0.25]'; done", 3, TIMEOUT);
         assert_eq!(failure, None);
         assert_eq!(actions, vec![Action { accel: 1.5, steer: -0.25 }; 3]);
         // the object form, and the view it received, echoed back as its speed
         let command = r#"while read line; do s=$(echo "$line" | sed 's/.*"speed":\([0-9.]*\).*/\1/'); echo "{\"accel\": $s, \"steer\": 2}"; done"#;
-        let (actions, failure) = drive(command, 2);
+        let (actions, failure) = drive(command, 2, TIMEOUT);
         assert_eq!(failure, None);
         assert_eq!(actions[0], Action { accel: 8.0, steer: 1.0 }, "steer clamped to 1");
     }
@@ -263,12 +265,14 @@ mod tests {
             ("read line; yes 1 | tr -d '\\n'", "an answer longer than 65536 bytes"),
         ];
         for (command, reason) in cases {
+            // the silent process is timed out quickly; the others fail on what they say
+            let timeout = if command.starts_with("sleep") { Duration::from_millis(500) } else { TIMEOUT };
             let started = std::time::Instant::now();
-            let (actions, failure) = drive(command, 3);
+            let (actions, failure) = drive(command, 3, timeout);
             let failure = failure.unwrap_or_else(|| panic!("`{command}` did not fail"));
             assert!(failure.contains(reason), "`{command}`: {failure}");
             assert_eq!(actions[1], Action::default(), "nothing is asked of a failed process");
-            assert!(started.elapsed() < Duration::from_secs(3), "`{command}` held the run");
+            assert!(started.elapsed() < timeout + Duration::from_millis(2500), "`{command}` held the run");
         }
     }
 }
