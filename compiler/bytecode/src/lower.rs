@@ -120,7 +120,8 @@ pub fn lower(scenario: &Scenario, layout: &Layout, source: &str) -> Program {
     b.program.code.push(Instr::Limits {
         dt: DT,
         max_steps: MAX_STEPS,
-        max_distance: (route + DRIVE_BEYOND_ROUTE).clamp(MIN_DRIVE, MAX_DRIVE),
+        // SafeBench's 150–200 m, and never short of a longer route
+        max_distance: (route + DRIVE_BEYOND_ROUTE).clamp(MIN_DRIVE, MAX_DRIVE.max(route + DRIVE_BEYOND_ROUTE)),
         timeout: route.floor().max(MIN_TIMEOUT),
     });
     if let (Some(signal), Some(junction)) = (road.signal, road.junction.as_ref().filter(|j| j.signalised)) {

@@ -86,6 +86,7 @@ pub fn check(
                 .with_help("remove the group if nothing is there"),
             );
         }
+        scene_limits(group, &what, out);
         let actor_type = match &group.kind.value {
             Known::Given(kind) => vocabulary.get("actor_type", &kind.name),
             Known::Unspecified => None,
@@ -530,6 +531,48 @@ fn range(quantity: &str, value: f64, min: Option<f64>, max: Option<f64>, unit: O
 fn speed_range(speed: f64, min: Option<f64>, max: Option<f64>) -> Payload {
     let kmh = |v: f64| (v * 36.0).round() / 10.0;
     range("speed", kmh(speed), min.map(kmh), max.map(kmh), Some("km/h"))
+}
+
+/// What a scene cannot hold as written, so that it would differ from the file without a
+/// word: more actors than a group becomes (W0512), a group farther from its reference
+/// than the scene's road reaches (W0513).
+fn scene_limits(group: &tad_syntax::model::ActorGroup, what: &str, out: &mut Vec<Diagnostic>) {
+    use tad_syntax::schema::{MAX_GROUP, SCENE_REACH};
+    if let Some(count) = &group.count
+        && let Known::Given(n) = count.value
+        && let (_, most) = n.bounds()
+        && most > MAX_GROUP as i64
+    {
+        out.push(
+            Diagnostic::new(
+                Code::W0512,
+                format!("{what} is capped at {MAX_GROUP} actors"),
+                count.span,
+                format!("{} placed of {most}", MAX_GROUP),
+            )
+            .with_payload(range("count", most as f64, Some(1.0), Some(MAX_GROUP as f64), None))
+            .with_note(format!("a group becomes at most {MAX_GROUP} actors in every target (`run`, `build`)"))
+            .with_help("for a crowd, write several groups, or the nearest ones"),
+        );
+    }
+    let Some(attr) = group.attr("distance") else { return };
+    let far = match &attr.value {
+        Known::Given(Val::Quantity(q)) => q.value,
+        Known::Given(Val::Range(_, high)) => high.value,
+        _ => return,
+    };
+    if far > SCENE_REACH {
+        out.push(
+            Diagnostic::new(
+                Code::W0513,
+                format!("{what} is {} m from its reference, beyond the scene's road", format_number(far)),
+                attr.value_span,
+                format!("the road reaches {} m", format_number(SCENE_REACH)),
+            )
+            .with_payload(range("distance", far, Some(0.0), Some(SCENE_REACH), Some("m")))
+            .with_note("the group starts off the road the scene models, and never meets the ego vehicle"),
+        );
+    }
 }
 
 /// Groups positioned relative to each other in a circle have no anchor.

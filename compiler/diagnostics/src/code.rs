@@ -95,6 +95,8 @@ codes! {
     W0505 => Warning,
     W0507 => Warning,
     W0508 => Warning,
+    W0512 => Warning,
+    W0513 => Warning,
     W0600 => Warning,
     W0601 => Warning,
     // Scenic backend (7xx): add codes below this line

@@ -62,6 +62,16 @@ pub fn resolved(db: &mut Database, input: &Input) -> Result<tad_ir::Scenario, Re
     }
 }
 
+/// The warnings that say a scene will differ from its file (a group capped, a group
+/// beyond the scene's road): what `build` and `run` print beside what they make.
+pub const SCENE_WARNINGS: [tad_diagnostics::Code; 2] = [tad_diagnostics::Code::W0512, tad_diagnostics::Code::W0513];
+
+/// An input's [`SCENE_WARNINGS`] (its check is the database's, done once).
+pub fn scene_warnings(db: &mut Database, input: &Input) -> Vec<Diagnostic> {
+    let checked = tad_db::host::diagnose_in(db, input);
+    checked.diagnostics.into_iter().filter(|d| SCENE_WARNINGS.contains(&d.code)).collect()
+}
+
 /// The scene of a file the database holds; `None` when it holds no scenario.
 pub fn scene(db: &Database, file: SourceFile, name: &str) -> Option<Result<Scene, SetupError>> {
     let scenario = tad_db::resolve(db, file).as_ref()?;

@@ -32,4 +32,6 @@ pub use resolve::resolve;
 pub use scenario::*;
 pub use tad_diagnostics::Span;
 pub use tad_syntax::model::Spanned;
-pub use tad_syntax::schema::{ClosedSet, Lateral, Longitudinal, Motion, RoadShape, Signal, SimulatedAs};
+pub use tad_syntax::schema::{
+    ClosedSet, Lateral, Longitudinal, MAX_GROUP, Motion, RoadShape, SCENE_REACH, Signal, SimulatedAs,
+};

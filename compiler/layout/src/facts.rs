@@ -8,7 +8,7 @@ use tad_ir::{ActorType, Behavior, ClosedSet, Entry, Field, Group, Id, Motion, Na
 pub use tad_road::Body;
 
 /// The most actors one group becomes.
-pub const MAX_GROUP: usize = 20;
+pub use tad_ir::MAX_GROUP;
 
 /// A value the scenario does not state, chosen by the layout.
 #[derive(Clone, Debug, PartialEq)]

@@ -19,8 +19,8 @@ pub const LANE_WIDTH: f64 = 3.5;
 pub const SIDEWALK_WIDTH: f64 = 2.0;
 /// Radius of a curved road's centre line, m (a 30° bend every 31 m).
 pub const CURVE_RADIUS: f64 = 60.0;
-/// How far paths run before a start and after a junction, m.
-pub const RUN: f64 = 200.0;
+/// How far paths run before a start and after a junction, m: the scene's reach.
+pub const RUN: f64 = tad_ir::SCENE_REACH;
 /// Where an arm's crosswalk is: metres past its stop line, towards the junction's centre.
 pub const CROSSWALK: f64 = 2.0;
 /// How deep a crosswalk is, along the road, m.

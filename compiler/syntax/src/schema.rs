@@ -266,6 +266,14 @@ macro_rules! field {
     };
 }
 
+/// The most actors one group becomes in a scene (the layout caps a larger count; the
+/// checker warns, W0512).
+pub const MAX_GROUP: usize = 20;
+
+/// How far a scene's road runs on either side of the ego's start and past a junction, m:
+/// what is farther is not in the scene (the checker warns of a `distance` beyond it, W0513).
+pub const SCENE_REACH: f64 = 200.0;
+
 pub const SOURCE: SectionDef = SectionDef {
     name: "source",
     doc: "where the scenario comes from",

@@ -23,12 +23,25 @@ pub fn compile(
     color: bool,
 ) -> Result<Option<tad_bytecode::Program>, Closed> {
     match tad_eval::pipeline::compile(db, input) {
-        Ok(program) => Ok(Some(program)),
+        Ok(program) => {
+            warn_scene(db, input, color)?;
+            Ok(Some(program))
+        }
         Err(refusal) => {
             err!("{}", refusal.render(input, verb, color))?;
             Ok(None)
         }
     }
+}
+
+/// The input's warnings that its scene differs from the file, on standard error.
+pub fn warn_scene(db: &mut Database, input: &files::Input, color: bool) -> Result<(), Closed> {
+    use tad_diagnostics::render::{FileReport, human};
+    let warnings = tad_eval::pipeline::scene_warnings(db, input);
+    if !warnings.is_empty() {
+        err!("{}", human::render(&FileReport::new(&input.name, &input.text, &warnings), color))?;
+    }
+    Ok(())
 }
 
 /// One scenario ready to run, named for people.
