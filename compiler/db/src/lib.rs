@@ -284,7 +284,18 @@ pub fn check(db: &dyn Db, file: SourceFile) -> Checked {
     let analysis = analyze(db, file);
     let scope = vocabulary(db, file);
     let mut options = db.settings().options(db).clone();
-    options.answer = file.language(db) == Language::Yaml;
+    if file.language(db) == Language::Yaml {
+        // a YAML file is a dash-cam answer unless it states its profile (as `export` writes)
+        let stated = tad_yaml::profile(file.text(db));
+        options.answer = stated.is_none();
+        if options.profile == tad_check::Profile::Auto {
+            options.profile = match stated {
+                Some("default") => tad_check::Profile::Default,
+                Some("dashcam") => tad_check::Profile::Dashcam,
+                _ => tad_check::Profile::Auto,
+            };
+        }
+    }
     let mut checked = tad_check::check(&analysis.module, &scope.vocabulary, &options, &analysis.diagnostics);
     checked.diagnostics = stamp(std::mem::take(&mut checked.diagnostics), file.id(db));
     checked.diagnostics.extend(analysis.diagnostics.iter().cloned());

@@ -26,7 +26,8 @@ pub fn json_schema(vocabulary: &Vocabulary, title: &str) -> Value {
 
 fn object(place: Place, vocabulary: &Vocabulary) -> Value {
     let mut properties = Map::new();
-    for key in dialect::written(place) {
+    // an answer states no camera profile: it is judged as a dash-cam answer
+    for key in dialect::written(place).into_iter().filter(|k| !matches!(k.tad, Tad::Profile)) {
         properties.insert(key.key.to_string(), value(key, vocabulary));
     }
     json!({ "type": "object", "properties": properties, "additionalProperties": false })
@@ -53,6 +54,7 @@ fn value(key: &Key, vocabulary: &Vocabulary) -> Value {
             { "const": UNSPECIFIED },
         ]}),
         Tad::Nothing => json!({ "type": "string" }),
+        Tad::Profile => json!({ "enum": tad_yaml::PROFILES }),
         Tad::Field(..) => match (key.form, key.field()) {
             (Form::Relation, _) => names("relation", vocabulary),
             (Form::Target, _) => json!({ "type": "string", "pattern": "^[A-Za-z_][A-Za-z0-9_ -]*$" }),

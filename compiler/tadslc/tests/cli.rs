@@ -3,6 +3,7 @@
 mod common;
 use common::*;
 use serde_json::Value;
+use std::path::{Path, PathBuf};
 
 const CLEAN: &str = "scenario demo {\n  environment {\n    weather: clear\n    time: daytime\n  }\n  road {\n    type: straight_road\n    lanes: 1\n    direction: two_way\n  }\n  ego {\n    behavior: move_forward\n    speed: 30 km/h\n    lane: 1\n  }\n}\n";
 const WARNING_ONLY: &str = "scenario demo {\n  environment {\n  }\n}\n";
@@ -603,6 +604,89 @@ fn import_writes_canonical_tad_and_export_round_trips() {
     assert_eq!(code(&tadslc(&["export", "--yaml", "tests/ui/structure/unknown_field.tad"], "")), 1);
 }
 
+/// `file` exported to YAML and imported back, as the CLI does it (the checker included);
+/// and the file without its leading comments, which the import must equal.
+fn through_yaml(file: &Path, dir: &Path) -> (String, String) {
+    let yaml = dir.join("exported.yaml");
+    let out = tadslc(&["export", file.to_str().unwrap(), "-o", yaml.to_str().unwrap()], "");
+    assert_eq!(code(&out), 0, "{}: {}", file.display(), stderr(&out));
+    let back = tadslc(&["import", yaml.to_str().unwrap()], "");
+    assert_eq!(code(&back), 0, "{}: {}", file.display(), stderr(&back));
+    let original = std::fs::read_to_string(file).unwrap();
+    let without_comments: String =
+        original.lines().filter(|l| !l.starts_with("//")).collect::<Vec<_>>().join("\n").trim_start().to_string()
+            + "\n";
+    (stdout(&back), without_comments)
+}
+
+#[test]
+fn every_example_and_every_searched_scene_round_trips_through_yaml() {
+    let dir = scratch("round-trip");
+    let examples = tad_test_support::examples();
+    let scenes = dir.join("scenes");
+    let out =
+        tadslc(&["search", "examples/safety", "--ego", "naive", "-o", scenes.to_str().unwrap(), "--seed", "3"], "");
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    let mut searched: Vec<PathBuf> = std::fs::read_dir(&scenes)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "tad"))
+        .collect();
+    searched.sort();
+    // the scenes carry what search fixed: a sampled place (`offset`) or start (`delay`)
+    assert!(searched.len() >= 8, "{searched:?}");
+    let mut fixed = 0;
+    for file in examples.iter().chain(&searched) {
+        let (back, original) = through_yaml(file, &dir);
+        assert_eq!(back, original, "{}", file.display());
+        fixed += usize::from(["offset:", "delay:", "distance:", "trigger:"].iter().any(|k| original.contains(k)));
+    }
+    assert!(fixed * 2 >= searched.len(), "{fixed} files with a fixed place or start");
+}
+
+#[test]
+fn a_failed_import_writes_no_file_and_keys_with_a_hash_are_read_as_meant() {
+    let dir = scratch("failed-import");
+    let tad = dir.join("out.tad");
+    let out = tadslc(&["import", "README.md", "-o", tad.to_str().unwrap()], "");
+    assert_eq!(code(&out), 1, "{}", stderr(&out));
+    assert!(!tad.exists(), "a failed import wrote {}", tad.display());
+    assert!(stderr(&out).contains("not written"), "{}", stderr(&out));
+
+    let yaml = dir.join("hash.yaml");
+    let lines = [
+        "environment:",
+        "    weather: clear",
+        "    time: daytime",
+        "road_network:",
+        "    road_type: straight road",
+        "actors:",
+        "    ego_vehicle:",
+        "        behavior: move forward",
+        "        lane_index: 1",
+        "    Cyclist #1:",
+        "        type: bicycle",
+        "        position_relation: front",
+        "        lane_index: 2",
+    ];
+    std::fs::write(&yaml, lines.join("\n") + "\n").unwrap();
+    let out = tadslc(&["import", yaml.to_str().unwrap()], "");
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    assert!(stdout(&out).contains("actor cyclist_1: bicycle {"), "{}", stdout(&out));
+
+    // the camera rules: an answer that states no profile gets the dash-cam rule, `--profile` decides
+    let behind = dir.join("behind.yaml");
+    let answer = [&lines[..7], &["        lane_index: 1", "    car:", "        type: car"]].concat().join("\n")
+        + "\n        position_relation: behind\n        lane_index: 1\n";
+    std::fs::write(&behind, &answer).unwrap();
+    assert!(stderr(&tadslc(&["import", behind.to_str().unwrap()], "")).contains("E0510"));
+    let out = tadslc(&["import", "--profile", "default", behind.to_str().unwrap()], "");
+    assert!(!stderr(&out).contains("E0510"), "{}", stderr(&out));
+    std::fs::write(&behind, format!("profile: auto\n{answer}")).unwrap();
+    assert!(!stderr(&tadslc(&["check", behind.to_str().unwrap()], "")).contains("E0510"));
+    assert!(stderr(&tadslc(&["check", "--profile", "dashcam", behind.to_str().unwrap()], "")).contains("E0510"));
+}
+
 #[test]
 fn build_writes_scenic_programs_and_refuses_broken_files() {
     let dir = scratch("build");
@@ -970,4 +1054,30 @@ fn the_language_server_answers_garbage_and_leaves_when_its_client_does() {
     // a client that closes at once: the server stops by itself
     let out = tadslc(&["lsp"], "");
     assert_eq!(code(&out), 0);
+}
+
+#[test]
+fn a_scene_that_differs_from_its_file_is_a_warning_in_check_build_and_run() {
+    let dir = scratch("scene-warnings");
+    let file = dir.join("crowd.tad");
+    let text = CLEAN.replace(
+        "  ego {",
+        "  actor crowd: 500 pedestrian {\n    position: right_front of ego\n  }\n  actor far: 1 car {\n    position: front of ego\n    distance: 5000 m\n  }\n  ego {",
+    );
+    std::fs::write(&file, text).unwrap();
+    let f = file.to_str().unwrap();
+    let out_dir = dir.join("out");
+    let o = out_dir.to_str().unwrap();
+    for args in [
+        vec!["check", f],
+        vec!["run", f, "--seeds", "0", "--ego", "idm"],
+        vec!["build", "--target", "bytecode", f, "-o", o],
+        vec!["build", "--target", "openscenario", f, "-o", o],
+    ] {
+        let out = tadslc(&args, "");
+        assert_eq!(code(&out), 0, "{args:?}: {}", stderr(&out));
+        for code in ["W0512", "W0513"] {
+            assert!(stderr(&out).contains(code), "{args:?}: no {code} in\n{}", stderr(&out));
+        }
+    }
 }

@@ -91,6 +91,9 @@ pub enum Tad {
     ScenarioName,
     /// The `use` declarations.
     Uses,
+    /// The camera rules to check the file with ([`crate::PROFILES`]): what `export` writes
+    /// so that its YAML is checked as its TAD source, not as a dash-cam answer.
+    Profile,
     /// An actor group's type (in the TAD header); the ego vehicle has none.
     Type,
     /// An actor group's count (in the TAD header); there is one ego vehicle.
@@ -214,13 +217,14 @@ pub const EGO_KEY: &str = "ego_vehicle";
 #[rustfmt::skip]
 pub const KEYS: &[Key] = &[
     // ---- the top level
-    Key { key: "environment", tad: Tad::Block(Environment), form: Form::Mapping, export: Some(4), ..KEY },
-    Key { key: "road_network", hints: &["road"], tad: Tad::Block(Road), form: Form::Mapping, export: Some(5),
+    Key { key: "environment", tad: Tad::Block(Environment), form: Form::Mapping, export: Some(5), ..KEY },
+    Key { key: "road_network", hints: &["road"], tad: Tad::Block(Road), form: Form::Mapping, export: Some(6),
           identifies: Identifies::AsList(Dialect::TrafficComposer), ..KEY },
-    Key { key: "actors", hints: &["ego", "npcs"], tad: Tad::Actors, form: Form::Mapping, export: Some(6), ..KEY },
-    Key { key: "source", origin: Extra, tad: Tad::Block(Source), form: Form::Mapping, export: Some(3), ..KEY },
-    Key { key: "scenario", origin: Extra, tad: Tad::ScenarioName, export: Some(1), ..KEY },
-    Key { key: "use", origin: Extra, tad: Tad::Uses, export: Some(2), ..KEY },
+    Key { key: "actors", hints: &["ego", "npcs"], tad: Tad::Actors, form: Form::Mapping, export: Some(7), ..KEY },
+    Key { key: "source", origin: Extra, tad: Tad::Block(Source), form: Form::Mapping, export: Some(4), ..KEY },
+    Key { key: "profile", origin: Extra, tad: Tad::Profile, export: Some(1), ..KEY },
+    Key { key: "scenario", origin: Extra, tad: Tad::ScenarioName, export: Some(2), ..KEY },
+    Key { key: "use", origin: Extra, tad: Tad::Uses, export: Some(3), ..KEY },
     Key { key: "participant", aliases: &["participants"], origin: Composer, tad: Tad::Actors, form: Form::Mapping,
           identifies: TC, ..KEY },
     Key { key: "weather", origin: Composer, tad: Tad::Field(&ENV, "weather"), form: Form::Weather, identifies: TC, ..KEY },
@@ -278,6 +282,10 @@ pub const KEYS: &[Key] = &[
           form: Form::Relation, export: Some(6), ..KEY },
     Key { place: Actor, key: "lane_index", hints: LANE_HINTS, tad: Tad::Field(&ACTOR, "lane"), export: Some(7), ..KEY },
     Key { place: Actor, key: "lane_idx", origin: Composer, tad: Tad::Field(&ACTOR, "lane"), ..KEY },
+    Key { place: Actor, key: "distance", origin: Extra, tad: Tad::Field(&ACTOR, "distance"), export: Some(8), ..KEY },
+    Key { place: Actor, key: "delay", origin: Extra, tad: Tad::Field(&ACTOR, "delay"), export: Some(9), ..KEY },
+    Key { place: Actor, key: "trigger", origin: Extra, tad: Tad::Field(&ACTOR, "trigger"), export: Some(10), ..KEY },
+    Key { place: Actor, key: "offset", origin: Extra, tad: Tad::Field(&ACTOR, "offset"), export: Some(11), ..KEY },
     // ---- source
     Key { place: Source, key: "video", origin: Extra, tad: Tad::Field(&SRC, "video"), export: Some(1), ..KEY },
     Key { place: Source, key: "time", hints: TIME_HINTS, origin: Extra, tad: Tad::Field(&SRC, "time"), export: Some(2), ..KEY },

@@ -46,6 +46,7 @@ pub fn export(module: &Module, src: &str) -> String {
                     out.push_str(&format!("{}: {}\n", row.key, scalar(&name.text)));
                 }
             }
+            Tad::Profile => out.push_str(&format!("{}: {}\n", row.key, crate::PROFILES[0])),
             Tad::Uses => {
                 if !module.uses.is_empty() {
                     let paths: Vec<String> = module
@@ -267,7 +268,10 @@ impl Writer<'_> {
             return format!("{}-{} {}", number(low.value), number(high.value), high.unit.as_str());
         }
         let Known::Given(Val::Quantity(q)) = &a.value else { return self.other(&a.value) };
-        let default = if q.unit == Unit::Seconds { Unit::Seconds } else { Unit::KilometresPerHour };
+        let default = match q.unit {
+            Unit::Seconds | Unit::Metres => q.unit,
+            _ => Unit::KilometresPerHour,
+        };
         if let Some(written) = self.src.get(a.value_span.start..a.value_span.end) {
             let written = written.split_whitespace().collect::<Vec<_>>().join(" ");
             if norm::parse_quantity(&written, default) == Some((q.value, q.unit)) && !written.contains(['#', ':']) {

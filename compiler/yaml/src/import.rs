@@ -539,7 +539,11 @@ impl Importer<'_> {
             return Some(Known::Unspecified);
         }
         let span = at.value_span;
-        let what = if default == Unit::Seconds { "a duration" } else { "a speed" };
+        let what = match default {
+            Unit::Seconds => "a duration",
+            Unit::Metres => "a length",
+            _ => "a speed",
+        };
         match untag(v) {
             Value::Number(n) => match n.as_f64().filter(|f| f.is_finite()) {
                 Some(value) => Some(Known::Given(Quantity { value, unit: default })),
@@ -550,18 +554,20 @@ impl Importer<'_> {
             },
             Value::String(s) => match norm::parse_quantity(s, default) {
                 Some((value, unit)) => Some(Known::Given(Quantity { value, unit })),
-                None => match norm::speed_word(s).filter(|_| default != Unit::Seconds) {
-                    // the paper: a stopped vehicle is 0 km/h
-                    Some(norm::SpeedWord::Still) => Some(Known::Given(Quantity { value: 0.0, unit: default })),
-                    Some(norm::SpeedWord::Vague) => {
-                        self.vague(key, s, span, what, "the speed is not known");
-                        Some(Known::Unspecified)
+                None => {
+                    match norm::speed_word(s).filter(|_| default.measures() == Unit::KilometresPerHour.measures()) {
+                        // the paper: a stopped vehicle is 0 km/h
+                        Some(norm::SpeedWord::Still) => Some(Known::Given(Quantity { value: 0.0, unit: default })),
+                        Some(norm::SpeedWord::Vague) => {
+                            self.vague(key, s, span, what, "the speed is not known");
+                            Some(Known::Unspecified)
+                        }
+                        None => {
+                            self.malformed(key, s.trim(), span, what, example);
+                            None
+                        }
                     }
-                    None => {
-                        self.malformed(key, s.trim(), span, what, example);
-                        None
-                    }
-                },
+                }
             },
             Value::Bool(b) => {
                 self.malformed(key, &b.to_string(), span, what, example);
@@ -711,7 +717,11 @@ impl Importer<'_> {
 
     fn set_quantity(&mut self, claim: Claim, v: &Value, unit: Unit) {
         let Claim { field, key, at, .. } = claim;
-        let example = if unit == Unit::Seconds { "195 s" } else { "30 km/h" };
+        let example = match unit {
+            Unit::Seconds => "195 s",
+            Unit::Metres => "15 m",
+            _ => "30 km/h",
+        };
         // a range, where the field takes one (`25-30 km/h`, `between 25 and 30 km/h`)
         let takes_range =
             schema::SECTIONS.iter().chain([&&schema::ACTOR]).any(|s| s.field(field).is_some_and(|f| f.param));
@@ -742,12 +752,13 @@ impl Importer<'_> {
                 ValueType::Integer => self.set_integer(claim, v),
                 ValueType::Speed => self.set_quantity(claim, v, Unit::KilometresPerHour),
                 ValueType::Duration => self.set_quantity(claim, v, Unit::Seconds),
+                ValueType::Length => self.set_quantity(claim, v, Unit::Metres),
                 ValueType::Text => {
                     if let Some(t) = self.text_value(key, v, at) {
                         self.set(claim, known_map(t, Val::Text), false);
                     }
                 }
-                ValueType::Length | ValueType::Position | ValueType::Flag | ValueType::Choice(_) => {}
+                ValueType::Position | ValueType::Flag | ValueType::Choice(_) => {}
             },
             // read by their place: the parts of a position, blocks, fixed values
             Form::Mapping | Form::Relation | Form::Target | Form::Fixed(_) => {}
@@ -799,6 +810,7 @@ impl Importer<'_> {
                 Tad::Actors => self.actors(&key, v, at),
                 Tad::ScenarioName => self.scenario_name(&key, v, at),
                 Tad::Uses => self.uses(&key, v, at),
+                Tad::Profile => self.profile(&key, v, at),
                 Tad::Field(section, _) => {
                     let target = Target::Section(self.section_at(section.name, at));
                     self.field(target, row, &key, v, at);
@@ -834,6 +846,15 @@ impl Importer<'_> {
             }
             Value::Null => {}
             other => self.wrong_shape(key, other, at.value_span, "a name"),
+        }
+    }
+
+    /// `profile`: read by the host before checking ([`crate::profile`]); here only judged.
+    fn profile(&mut self, key: &str, v: &Value, at: At) {
+        let known = untag(v).as_str().map(normalize).is_some_and(|p| crate::PROFILES.contains(&p.as_str()));
+        if !known {
+            let found = untag(v).as_str().map_or_else(|| format!("{v:?}"), |s| s.trim().to_string());
+            self.malformed(key, &found, at.value_span, "a camera profile (`auto`, `default` or `dashcam`)", "auto");
         }
     }
 
@@ -1143,7 +1164,7 @@ impl Importer<'_> {
                     }
                 }
                 Tad::Field(..) => self.field(ego, row, &key, v, at),
-                Tad::Block(_) | Tad::Actors | Tad::ScenarioName | Tad::Uses => {}
+                Tad::Block(_) | Tad::Actors | Tad::ScenarioName | Tad::Uses | Tad::Profile => {}
             }
         }
         if let Some(span) = position {

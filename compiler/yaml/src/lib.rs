@@ -30,6 +30,32 @@ pub use extract::extract;
 pub use import::lower;
 pub use tad::to_tad;
 
+/// The camera rules a YAML file may state for itself (its top-level `profile`), as
+/// `tadslc check --profile` names them: `auto` (the dash-cam rules only for a `source` that
+/// names a video, frame or time, as for TAD), `default` (none), `dashcam`. `export` writes
+/// `auto`; an answer that states none is checked with the dash-cam rules.
+pub const PROFILES: [&str; 3] = ["auto", "default", "dashcam"];
+
+/// The profile `answer` states ([`PROFILES`]), if it is a YAML mapping with a known one.
+pub fn profile(answer: &str) -> Option<&'static str> {
+    let range = extract(answer)?;
+    let text = &answer[range];
+    if parse::too_deep(text).is_some() {
+        return None;
+    }
+    let serde_norway::Value::Mapping(map) = serde_norway::from_str::<serde_norway::Value>(text).ok()? else {
+        return None;
+    };
+    map.iter().find_map(|(key, value)| {
+        let row = dialect::find(dialect::Place::Top, key.as_str()?)?;
+        if !matches!(row.tad, dialect::Tad::Profile) {
+            return None;
+        }
+        let name = norm::normalize(value.as_str()?);
+        PROFILES.into_iter().find(|p| *p == name)
+    })
+}
+
 /// The dialect of the YAML in `answer`, if there is a YAML mapping to judge.
 pub fn dialect(answer: &str) -> Option<Dialect> {
     let range = extract(answer)?;

@@ -17,7 +17,7 @@ const MAX_ATTEMPTS: usize = 24;
 /// parsed (same length, possibly with blanked lines) and its value, if any attempt parsed.
 pub fn parse(text: &str, base: usize, diagnostics: &mut Vec<Diagnostic>) -> (String, Option<Value>) {
     let mut work = text.to_string();
-    let mut tabs_fixed = false;
+    let (mut tabs_fixed, mut hashes_fixed) = (false, false);
     for _ in 0..MAX_ATTEMPTS {
         // the YAML reader takes quadratic time on deep flow nesting before it gives up
         if let Some(at) = too_deep(&work) {
@@ -62,6 +62,13 @@ pub fn parse(text: &str, base: usize, diagnostics: &mut Vec<Diagnostic>) -> (Str
                     })
                     .with_note("most YAML readers, including the one TrafficAlign's pipeline uses, reject this file"),
                 );
+                continue;
+            }
+        }
+        // `Cyclist #1:` is a key to its writer, a comment to YAML: read it as meant
+        if !hashes_fixed {
+            hashes_fixed = true;
+            if unhash_keys(&mut work) {
                 continue;
             }
         }
@@ -115,6 +122,41 @@ fn untab(text: &mut String) -> Option<usize> {
     }
     *text = String::from_utf8(bytes).unwrap_or_default();
     first
+}
+
+/// Make a key written with ` #` in it (`Cyclist #1:`, where YAML starts a comment) one
+/// key: each ` #` of the key loses its space (`#` after a character starts no comment),
+/// and the spaces go before the key's colon, so that every offset after the line holds.
+/// Lines that are comments, quoted, lists or flows are left alone; whether any changed.
+fn unhash_keys(text: &mut String) -> bool {
+    let mut changed = false;
+    let lines: Vec<String> =
+        text.split_inclusive('\n')
+            .map(|line| {
+                let body = line.trim_end_matches(['\n', '\r']);
+                let indent = body.len() - body.trim_start_matches(' ').len();
+                let content = &body[indent..];
+                let Some(hash) = content.find(" #") else { return line.to_string() };
+                // the key's colon: the first `:` after the `#` that ends the line or meets a space
+                let colon = content[hash..].char_indices().map(|(i, _)| hash + i).find(|&i| {
+                    content[i..].starts_with(':') && content[i + 1..].chars().next().is_none_or(|c| c == ' ')
+                });
+                let plain = !content.starts_with(['#', '"', '\'', '-', '{', '[', '&', '*', '!', '|', '>']);
+                match colon.filter(|_| plain && !content[..hash].contains(':')) {
+                    Some(colon) => {
+                        let key = content[..colon].replace(" #", "#");
+                        let pad = " ".repeat(colon - key.len());
+                        changed = true;
+                        format!("{}{key}{pad}{}{}", &body[..indent], &content[colon..], &line[body.len()..])
+                    }
+                    None => line.to_string(),
+                }
+            })
+            .collect();
+    if changed {
+        *text = lines.concat();
+    }
+    changed
 }
 
 /// Blank the given lines (0-based); whether anything changed.

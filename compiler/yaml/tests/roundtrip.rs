@@ -90,6 +90,14 @@ scenario everything {
   actor on: 3 pedestrian {
     position: left_front of yes
     speed: 3 mph
+    distance: 12..20 m
+    delay: 1.5 s
+  }
+  actor late: 1 car {
+    position: behind of ego
+    lane: 1
+    trigger: 30 m
+    offset: -2.5..4 m
   }
   actor x_9: bus {
     position: behind of traffic_light

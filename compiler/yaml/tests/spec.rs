@@ -106,6 +106,7 @@ fn tad_cell(k: &Key) -> String {
         Tad::Block(place) => place.section().map_or("-", |s| s.name).to_string(),
         Tad::Actors => "ego".into(),
         Tad::Uses => "use".into(),
+        Tad::Profile => "--profile".into(),
         Tad::Type | Tad::Count if k.place == Place::Actor => "actor <key>: <number> <type>".into(),
         Tad::Type | Tad::Count | Tad::ScenarioName | Tad::Nothing => "-".into(),
     }

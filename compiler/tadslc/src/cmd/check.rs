@@ -69,6 +69,16 @@ pub enum ProfileArg {
     Dashcam,
 }
 
+impl From<ProfileArg> for tad_check::Profile {
+    fn from(arg: ProfileArg) -> Self {
+        match arg {
+            ProfileArg::Auto => tad_check::Profile::Auto,
+            ProfileArg::Default => tad_check::Profile::Default,
+            ProfileArg::Dashcam => tad_check::Profile::Dashcam,
+        }
+    }
+}
+
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum EssentialArg {
     Weather,
@@ -80,13 +90,9 @@ pub enum EssentialArg {
 
 impl Rules {
     pub fn options(&self) -> tad_check::Options {
-        use tad_check::{Essential, Profile};
+        use tad_check::Essential;
         tad_check::Options {
-            profile: match self.profile {
-                ProfileArg::Auto => Profile::Auto,
-                ProfileArg::Default => Profile::Default,
-                ProfileArg::Dashcam => Profile::Dashcam,
-            },
+            profile: self.profile.into(),
             region: self.region.clone(),
             answer: false,
             non_scenario: self

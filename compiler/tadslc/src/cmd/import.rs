@@ -3,8 +3,13 @@
 //!
 //! The YAML is read through the database, so every diagnostic, the checker's included,
 //! points at a YAML line; the model is then printed as TAD in canonical form (aliases,
-//! units and 0-based lanes corrected, then formatted). What was understood is written
-//! even when something was not: the errors say what is missing, and the status is 1.
+//! units and 0-based lanes corrected, then formatted). With errors the status is 1 and
+//! `-o` writes no file (what was understood still goes to standard output without `-o`):
+//! a `.tad` on disk is one that imported whole.
+//!
+//! The camera rules are `--profile`'s; under `auto` a YAML file that states its `profile`
+//! (as `export` writes) is checked with it, and an answer that states none as a dash-cam
+//! answer.
 
 use std::path::{Path, PathBuf};
 
@@ -22,22 +27,38 @@ use crate::{Status, err, errln, out, plural};
 pub struct Args {
     /// The YAML file or answer
     pub path: PathBuf,
-    /// Where to write the TAD (default: standard output)
+    /// Where to write the TAD (default: standard output); nothing is written when the
+    /// import has errors
     #[arg(short, long)]
     pub output: Option<PathBuf>,
+    /// Camera rules: `auto` takes the file's own `profile` (what `export` writes), else the
+    /// dash-cam rules of a model's answer; `default` never applies them; `dashcam` always
+    #[arg(long, value_enum, default_value_t = super::check::ProfileArg::Auto)]
+    pub profile: super::check::ProfileArg,
 }
 
 pub fn run(args: &Args, color: bool) -> Result<Status, CliError> {
     let (path, out) = (&args.path, args.output.as_deref());
     let input = tad_db::host::read(path).map_err(CliError::usage)?;
-    let mut db = Database::new(Options::default());
+    let mut db = Database::new(Options { profile: args.profile.into(), ..Options::default() });
     let (text, diagnostics) = import(&mut db, &input);
     let errors = report(&input, &diagnostics, color)?;
-    write_output(out, &text)?;
     if errors == 0 {
+        write_output(out, &text)?;
         return Ok(Status::Ok);
     }
-    errln!("imported `{}` with {}: the output lacks what they name", input.name, plural(errors, "error"))?;
+    match out {
+        Some(path) => errln!(
+            "imported `{}` with {}: `{}` not written (without `-o` the TAD understood goes to standard output)",
+            input.name,
+            plural(errors, "error"),
+            path.display()
+        )?,
+        None => {
+            write_output(None, &text)?;
+            errln!("imported `{}` with {}: the output lacks what they name", input.name, plural(errors, "error"))?
+        }
+    }
     Ok(Status::Failed)
 }
 
