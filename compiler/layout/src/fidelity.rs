@@ -8,7 +8,8 @@
 //!   gave it; facing the way the layout says (along, oncoming, from the left or the right,
 //!   across);
 //! - **no overlap**: no two actors other than the ego overlap in the first
-//!   [`OVERLAP_WINDOW`] seconds;
+//!   [`OVERLAP_WINDOW`] seconds, up to the ego's first contact (where an episode ends in the
+//!   runtime and in SafeBench: what follows it is a consequence, not the scenario);
 //! - **adversaries**: every group timed to a conflict comes within [`ADVERSARY_REACH`]
 //!   metres of the ego.
 
@@ -185,6 +186,8 @@ pub fn assess(scenario: &Scenario, layout: &Layout, trace: &Trace) -> Assessment
     let window = (OVERLAP_WINDOW / trace.dt.max(1e-3)).round() as usize;
     let n = trace.objects.len();
     let mut seen = vec![false; n * n];
+    // the step of the ego's first contact: later overlaps are not the scenario's
+    let mut ego_hit: Option<usize> = None;
     for (step, _) in trace.states.iter().enumerate() {
         for a in 0..n {
             for b in a + 1..n {
@@ -196,7 +199,11 @@ pub fn assess(scenario: &Scenario, layout: &Layout, trace: &Trace) -> Assessment
                     out.first_contact = Some(Overlap { a, b, time });
                 }
                 let with_ego = Some(a) == ego || Some(b) == ego;
-                if step <= window && !with_ego && !seen[a * n + b] {
+                if with_ego {
+                    ego_hit.get_or_insert(step);
+                }
+                let ended = ego_hit.is_some_and(|hit| step > hit);
+                if step <= window && !with_ego && !ended && !seen[a * n + b] {
                     seen[a * n + b] = true;
                     out.overlaps.push(Overlap { a, b, time });
                 }

@@ -39,19 +39,9 @@ const KNOWN: &[(&str, &str, &str)] = &[
         "a curved road: the layout's bend (60 m radius, to the left) is not the map's",
     ),
     (
-        "yosemite_deer_on_curve",
-        "overlaps",
-        "on the map's bend the oncoming RV reaches the deer's crossing sooner than on the layout's",
-    ),
-    (
         "extraction_prompt_example",
         "relations",
         "the map's road has a median: its third opposite lane is 4.5 m further out than three lanes",
-    ),
-    (
-        "lane_changing",
-        "overlaps",
-        "two adversaries timed into one gap: Scenic's lane change takes longer than the layout's, so they meet each other",
     ),
     (
         "lane_changing",
