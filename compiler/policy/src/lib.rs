@@ -402,6 +402,17 @@ impl EgoSpec {
     }
 }
 
+/// The egos named without a path or command, with what each is (for help and shell
+/// completion); besides them, `learned:PATH` and `external:CMD` ([`EgoSpec::parse`]).
+pub fn named_egos() -> Vec<(&'static str, &'static str)> {
+    let mut named = vec![
+        ("idm", "the Intelligent Driver Model, braking for what is ahead"),
+        ("naive", "keeps its lane and speed, blind"),
+    ];
+    named.extend(pretrained::ALL.iter().map(|m| (m.name, "a shipped driving model")));
+    named
+}
+
 /// The ego specs of a comma-separated list (`idm,naive,learned:a.safetensors`); an
 /// `external:CMD` takes the rest of the list, commas and all, as its command.
 pub fn split_specs(list: &str) -> Vec<String> {

@@ -45,6 +45,35 @@ impl From<Status> for std::process::ExitCode {
 
 pub use tad_base::plural;
 
+/// An ego flag's value (`--ego`, `--egos`, `--search-ego`): any text, checked where the
+/// policies are made; its named values are offered by help and shell completion
+/// ([`tad_policy::named_egos`], `learned:PATH`, `external:CMD`).
+#[derive(Clone, Copy, Debug)]
+pub struct EgoNames;
+
+impl clap::builder::TypedValueParser for EgoNames {
+    type Value = String;
+
+    fn parse_ref(
+        &self,
+        cmd: &clap::Command,
+        arg: Option<&clap::Arg>,
+        value: &std::ffi::OsStr,
+    ) -> Result<String, clap::Error> {
+        clap::builder::StringValueParser::new().parse_ref(cmd, arg, value)
+    }
+
+    fn possible_values(&self) -> Option<Box<dyn Iterator<Item = clap::builder::PossibleValue> + '_>> {
+        use clap::builder::PossibleValue;
+        let named = tad_policy::named_egos().into_iter().map(|(name, what)| PossibleValue::new(name).help(what));
+        let with_argument = [
+            PossibleValue::new("learned:").help("learned:PATH, an actor in safetensors (train-ego's, SafeBench's SAC)"),
+            PossibleValue::new("external:").help("external:CMD, a process answering JSON lines"),
+        ];
+        Some(Box::new(named.chain(with_argument)))
+    }
+}
+
 /// A count flag's value from 1 to `MAX`: numbers that would only exhaust memory or time
 /// are usage errors before anything is allocated. The bounds are in the flags' help.
 pub fn count<const MAX: usize>(text: &str) -> Result<usize, String> {

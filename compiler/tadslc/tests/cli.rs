@@ -970,7 +970,13 @@ fn completions_and_man_pages_name_every_subcommand() {
         for sub in SUBCOMMANDS {
             assert!(script.contains(sub), "{shell} completion lacks {sub}");
         }
+        // the values of `--ego`: the named egos and the two with an argument
+        for ego in ["idm", "naive", "ppo", "sac", "td3", "learned", "external"] {
+            assert!(script.contains(ego), "{shell} completion lacks the ego `{ego}`");
+        }
     }
+    let bash = stdout(&tadslc(&["completions", "bash"], ""));
+    assert!(bash.contains("idm naive ppo sac td3 learned: external:"), "bash completes --ego's values");
     assert_eq!(code(&tadslc(&["completions", "tcsh"], "")), 2);
     let out = tadslc(&["man"], "");
     assert_eq!(code(&out), 0, "{}", stderr(&out));

@@ -39,10 +39,10 @@ pub struct EvalArgs {
     pub generators: Vec<String>,
     /// The egos evaluated, comma-separated or repeated: the shipped `ppo`, `sac`, `td3`, `idm`, `naive`, `learned:PATH`,
     /// `external:CMD` (which takes the rest of its list, commas and all)
-    #[arg(long, default_value = "ppo,sac,td3,idm,naive")]
+    #[arg(long, default_value = "ppo,sac,td3,idm,naive", value_parser = crate::EgoNames)]
     pub egos: Vec<String>,
     /// The ego the scenes are searched against (ChatScene's surrogate: the pretrained SAC)
-    #[arg(long, default_value = "sac")]
+    #[arg(long, default_value = "sac", value_parser = crate::EgoNames)]
     pub search_ego: String,
     /// Scenarios per region and generator (at most 100,000)
     #[arg(short, default_value_t = 10, value_parser = crate::count::<100_000>)]

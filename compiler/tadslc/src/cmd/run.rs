@@ -34,7 +34,7 @@ pub struct RunArgs {
     /// The ego policies, comma-separated or repeated: `idm`, `naive`, the shipped models
     /// `ppo`, `sac`, `td3`, `learned:PATH` (an actor in safetensors: `train-ego`'s, or
     /// SafeBench's SAC), `external:CMD` (a process answering JSON lines, `spec/runtime.md`)
-    #[arg(long = "ego", default_value = "idm,naive")]
+    #[arg(long = "ego", default_value = "idm,naive", value_parser = crate::EgoNames)]
     pub egos: Vec<String>,
     /// Seeds `A..B` (B excluded, as in Rust), `A..=B` (B included) or one seed `A`
     #[arg(long, default_value = "0..3", value_parser = parse_seeds)]

@@ -26,7 +26,7 @@ pub struct SearchArgs {
     pub paths: Vec<PathBuf>,
     /// The ego the scenes are searched against: `idm`, `naive`, `ppo`, `sac`, `td3`,
     /// `learned:PATH`
-    #[arg(long, default_value = "idm")]
+    #[arg(long, default_value = "idm", value_parser = crate::EgoNames)]
     pub ego: String,
     /// The directory the chosen scenes and `search.json` are written to
     #[arg(short, long, value_name = "DIR")]
