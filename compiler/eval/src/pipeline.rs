@@ -72,6 +72,45 @@ pub fn scene_warnings(db: &mut Database, input: &Input) -> Vec<Diagnostic> {
     checked.diagnostics.into_iter().filter(|d| SCENE_WARNINGS.contains(&d.code)).collect()
 }
 
+/// What a scenario states that the runtime does not model (W0712): a weather with rain,
+/// wet roads or fog (its road keeps dry grip and its view clear), a time with the sun
+/// below the horizon (its egos sense as by day). The Scenic and OpenSCENARIO targets carry
+/// both; the note says so where the runtime runs the scene.
+pub fn runtime_notes(scenario: &tad_ir::Scenario) -> Vec<Diagnostic> {
+    use tad_diagnostics::{Code, Payload};
+    let environment = &scenario.environment;
+    let entries = &scenario.entries;
+    let note = |field: &str, name: &str, span, label: &str| {
+        Diagnostic::new(Code::W0712, format!("{field} `{name}` does not act in the runtime"), span, label)
+            .with_payload(Payload::Unsupported {
+                backend: "runtime".into(),
+                construct: format!("{field} `{name}`"),
+                instead: Some(label.into()),
+            })
+            .with_note("`build --target openscenario` and `--target scenic` carry it to a simulator that models it")
+    };
+    let mut out = Vec::new();
+    if let (Some(p), Some(span)) = (environment.weather.given(), environment.weather.span()) {
+        let named = p.nominal();
+        let acts = entries.resolved(&named).map(|e| e.attrs).is_some_and(|w| {
+            [w.precipitation, w.precipitation_deposits, w.wetness, w.fog_density]
+                .iter()
+                .any(|v| v.is_some_and(|v| v > 0))
+        });
+        if acts {
+            out.push(note("weather", entries.name(&named), span, "dry grip and a clear view there"));
+        }
+    }
+    if let (Some(p), Some(span)) = (environment.time.given(), environment.time.span()) {
+        let named = p.nominal();
+        let dark = entries.resolved(&named).and_then(|e| e.attrs.sun_altitude).is_some_and(|a| a < 0);
+        if dark {
+            out.push(note("time", entries.name(&named), span, "the egos sense as by day there"));
+        }
+    }
+    out
+}
+
 /// The scene of a file the database holds; `None` when it holds no scenario.
 pub fn scene(db: &Database, file: SourceFile, name: &str) -> Option<Result<Scene, SetupError>> {
     let scenario = tad_db::resolve(db, file).as_ref()?;

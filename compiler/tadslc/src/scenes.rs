@@ -22,10 +22,10 @@ pub fn compile(
     verb: &str,
     color: bool,
 ) -> Result<Option<tad_bytecode::Program>, Closed> {
-    match tad_eval::pipeline::compile(db, input) {
-        Ok(program) => {
-            warn_scene(db, input, color)?;
-            Ok(Some(program))
+    match tad_eval::pipeline::resolved(db, input) {
+        Ok(scenario) => {
+            warn_scene(db, input, tad_eval::pipeline::runtime_notes(&scenario), color)?;
+            Ok(Some(tad_eval::pipeline::program(&scenario, &input.name)))
         }
         Err(refusal) => {
             err!("{}", refusal.render(input, verb, color))?;
@@ -34,10 +34,18 @@ pub fn compile(
     }
 }
 
-/// The input's warnings that its scene differs from the file, on standard error.
-pub fn warn_scene(db: &mut Database, input: &files::Input, color: bool) -> Result<(), Closed> {
+/// The input's warnings that its scene differs from the file (and `more`: the runtime's
+/// notes, where it runs), on standard error.
+pub fn warn_scene(
+    db: &mut Database,
+    input: &files::Input,
+    more: Vec<tad_diagnostics::Diagnostic>,
+    color: bool,
+) -> Result<(), Closed> {
     use tad_diagnostics::render::{FileReport, human};
-    let warnings = tad_eval::pipeline::scene_warnings(db, input);
+    let mut warnings = tad_eval::pipeline::scene_warnings(db, input);
+    warnings.extend(more);
+    tad_diagnostics::sort(&mut warnings);
     if !warnings.is_empty() {
         err!("{}", human::render(&FileReport::new(&input.name, &input.text, &warnings), color))?;
     }

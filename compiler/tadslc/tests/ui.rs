@@ -173,12 +173,14 @@ fn main() {
     // every diagnostic code is expected by at least one fixture: these, or the YAML answer
     // fixtures of `tests/yaml/answers` (annotated `# error[CODE]: ...`, run by tad-yaml)
     // and the backends' fixtures (`tests/scenic/fixtures`, run by tad-scenic;
-    // `tests/openscenario/fixtures`, run by tad-openscenario)
+    // `tests/openscenario/fixtures`, run by tad-openscenario; `tests/runtime/fixtures`, the
+    // runtime's notes, run by tad-eval)
     let mut yaml = Vec::new();
     fixtures(&repo().join("tests/yaml/answers"), &mut yaml);
     let mut scenic = Vec::new();
     fixtures(&repo().join("tests/scenic/fixtures"), &mut scenic);
     fixtures(&repo().join("tests/openscenario/fixtures"), &mut scenic);
+    fixtures(&repo().join("tests/runtime/fixtures"), &mut scenic);
     let all: Vec<String> = files
         .iter()
         .filter(|p| p.extension().is_some_and(|e| e == "tad"))

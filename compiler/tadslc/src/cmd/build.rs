@@ -252,7 +252,7 @@ fn openscenario(args: &BuildArgs, color: bool) -> Result<Status, CliError> {
                 continue;
             }
         };
-        crate::scenes::warn_scene(&mut db, input, color)?;
+        crate::scenes::warn_scene(&mut db, input, Vec::new(), color)?;
         let options = tad_openscenario::EmitOptions { stem: stem(input), source: input.name.clone() };
         let emitted = tad_openscenario::emit(&scenario, &options);
         err!("{}", human::render(&FileReport::new(&input.name, &input.text, &emitted.diagnostics), color))?;
