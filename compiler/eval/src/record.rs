@@ -190,7 +190,8 @@ pub fn table(scenarios: &[&str], egos: &[String], played: &[Played], mode: Mode)
     let _ = writeln!(out);
     let _ = writeln!(
         out,
-        "values normalised as in TrafficAlign's tables (value / max; OS 1 is perfect); {} scoring",
+        "values normalised as in TrafficAlign's tables ({}; OS 1 is perfect); {} scoring",
+        tad_metrics::normalisation(),
         mode.as_str()
     );
     out

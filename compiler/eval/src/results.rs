@@ -260,7 +260,8 @@ pub fn table(all: &[Results], format: TableFormat) -> String {
                 };
                 let _ = writeln!(
                     out,
-                    "Normalised as in TrafficAlign's tables (value / max; lower is better but for RF and Comp; OS 1 is perfect); {scenes}."
+                    "Normalised as in TrafficAlign's tables ({}; lower is better but for RF and Comp; OS 1 is perfect); {scenes}.",
+                    tad_metrics::normalisation()
                 );
             }
         }

@@ -155,6 +155,15 @@ pub const METRICS: [MetricDef; 10] = [
     def(Metric::Li, "LI", "avg_lane_invasion_freq", Group::Comfort, 20.0, 0.2, false),
 ];
 
+/// What a normalised column is, for a table's footer: `value / max`, unclipped, with the
+/// maxima past which a value is above 1 (OR, TS, ACC, YV, LI: those whose value is not a
+/// share already).
+pub fn normalisation() -> String {
+    let maxima: Vec<String> =
+        METRICS.iter().filter(|d| d.max != 1.0).map(|d| format!("{} {}", d.key, d.max)).collect();
+    format!("value / max, unclipped: a value past SafeBench's maximum ({}) is above 1", maxima.join(", "))
+}
+
 /// RF: the mean distance to the route (m) at which route-following stability reaches 0.
 pub const RF_ZERO_DISTANCE: f64 = 5.0;
 
