@@ -159,8 +159,7 @@ pub const METRICS: [MetricDef; 10] = [
 /// maxima past which a value is above 1 (OR, TS, ACC, YV, LI: those whose value is not a
 /// share already).
 pub fn normalisation() -> String {
-    let maxima: Vec<String> =
-        METRICS.iter().filter(|d| d.max != 1.0).map(|d| format!("{} {}", d.key, d.max)).collect();
+    let maxima: Vec<String> = METRICS.iter().filter(|d| d.max != 1.0).map(|d| format!("{} {}", d.key, d.max)).collect();
     format!("value / max, unclipped: a value past SafeBench's maximum ({}) is above 1", maxima.join(", "))
 }
 

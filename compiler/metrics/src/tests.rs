@@ -333,3 +333,11 @@ fn bad_records_are_errors() {
     assert_eq!(err, MetricsError::TimeBackwards { step: 3 });
     assert_eq!(err.to_string(), "step 3: `time` is earlier than the previous step's");
 }
+
+#[test]
+fn the_normalisation_footer_names_every_maximum_that_is_not_a_share() {
+    let text = normalisation();
+    for d in METRICS {
+        assert_eq!(text.contains(&format!("{} {}", d.key, d.max)), d.max != 1.0, "{text}");
+    }
+}
