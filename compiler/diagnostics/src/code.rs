@@ -113,7 +113,7 @@ codes! {
     // OpenSCENARIO backend
     W0710 => Warning,
     W0711 => Warning,
-    W0712 => Warning,
+    W0720 => Warning,
 }
 
 impl Code {

@@ -72,7 +72,7 @@ pub fn scene_warnings(db: &mut Database, input: &Input) -> Vec<Diagnostic> {
     checked.diagnostics.into_iter().filter(|d| SCENE_WARNINGS.contains(&d.code)).collect()
 }
 
-/// What a scenario states that the runtime does not model (W0712): a weather with rain,
+/// What a scenario states that the runtime does not model (W0720): a weather with rain,
 /// wet roads or fog (its road keeps dry grip and its view clear), a time with the sun
 /// below the horizon (its egos sense as by day). The Scenic and OpenSCENARIO targets carry
 /// both; the note says so where the runtime runs the scene.
@@ -81,7 +81,7 @@ pub fn runtime_notes(scenario: &tad_ir::Scenario) -> Vec<Diagnostic> {
     let environment = &scenario.environment;
     let entries = &scenario.entries;
     let note = |field: &str, name: &str, span, label: &str| {
-        Diagnostic::new(Code::W0712, format!("{field} `{name}` does not act in the runtime"), span, label)
+        Diagnostic::new(Code::W0720, format!("{field} `{name}` does not act in the runtime"), span, label)
             .with_payload(Payload::Unsupported {
                 backend: "runtime".into(),
                 construct: format!("{field} `{name}`"),

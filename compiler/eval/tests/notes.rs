@@ -1,4 +1,4 @@
-//! The runtime's notes (`tad_eval::pipeline::runtime_notes`, W0712) on the fixtures of
+//! The runtime's notes (`tad_eval::pipeline::runtime_notes`, W0720) on the fixtures of
 //! `tests/runtime/fixtures`, judged by `tad_test_support::fixtures` (the annotations in each,
 //! `NAME.stderr` beside it, a typed payload on each).
 //!

@@ -1099,13 +1099,13 @@ fn the_runtime_says_where_it_does_not_model_the_weather_or_the_night() {
     .unwrap();
     let out = tadslc(&["run", file.to_str().unwrap(), "--seeds", "0", "--ego", "idm"], "");
     assert_eq!(code(&out), 0, "{}", stderr(&out));
-    assert_eq!(stderr(&out).matches("W0712").count(), 2, "{}", stderr(&out));
+    assert_eq!(stderr(&out).matches("W0720").count(), 2, "{}", stderr(&out));
     // a clear day, and a target that carries the weather, say nothing
     let clear = dir.join("clear.tad");
     std::fs::write(&clear, CLEAN).unwrap();
-    assert!(!stderr(&tadslc(&["run", clear.to_str().unwrap(), "--seeds", "0", "--ego", "idm"], "")).contains("W0712"));
+    assert!(!stderr(&tadslc(&["run", clear.to_str().unwrap(), "--seeds", "0", "--ego", "idm"], "")).contains("W0720"));
     let out_dir = dir.join("xosc");
     let out =
         tadslc(&["build", "--target", "openscenario", file.to_str().unwrap(), "-o", out_dir.to_str().unwrap()], "");
-    assert!(!stderr(&out).contains("W0712"), "{}", stderr(&out));
+    assert!(!stderr(&out).contains("W0720"), "{}", stderr(&out));
 }
