@@ -555,6 +555,21 @@ fn time_condition(x: &mut Xml, name: &str, value: &str) {
     x.close();
 }
 
+/// `<Condition>` on the ego (`<ByEntityCondition>`, the ego its triggering entity), its
+/// `<EntityCondition>` written by `condition`.
+fn ego_condition(x: &mut Xml, name: &str, edge: &str, condition: impl FnOnce(&mut Xml)) {
+    x.open("Condition", attrs!("name" => name, "delay" => 0, "conditionEdge" => edge));
+    x.open("ByEntityCondition", &[]);
+    x.open("TriggeringEntities", attrs!("triggeringEntitiesRule" => "any"));
+    x.empty("EntityRef", attrs!("entityRef" => "ego"));
+    x.close();
+    x.open("EntityCondition", &[]);
+    condition(x);
+    x.close();
+    x.close();
+    x.close();
+}
+
 /// `<PrivateAction>` with a speed action (or, with a name, inside an `<Action>`).
 fn speed_action(x: &mut Xml, target: &str, dynamics: Option<(&str, f64, &str)>) {
     x.open("PrivateAction", &[]);
@@ -679,13 +694,7 @@ fn event(x: &mut Xml, e: &Event) {
                 x.close();
                 x.close();
             }
-            Start::Meet { point, travel } => {
-                x.open("Condition", attrs!("name" => name, "delay" => 0, "conditionEdge" => "none"));
-                x.open("ByEntityCondition", &[]);
-                x.open("TriggeringEntities", attrs!("triggeringEntitiesRule" => "any"));
-                x.empty("EntityRef", attrs!("entityRef" => "ego"));
-                x.close();
-                x.open("EntityCondition", &[]);
+            Start::Meet { point, travel } => ego_condition(x, &name, "none", |x| {
                 x.open(
                     "TimeToCollisionCondition",
                     attrs!("value" => travel, "freespace" => "false", "rule" => "lessOrEqual",
@@ -695,26 +704,14 @@ fn event(x: &mut Xml, e: &Event) {
                 Position::World(Pose { position: *point, yaw: 0.0 }).write(x);
                 x.close();
                 x.close();
-                x.close();
-                x.close();
-                x.close();
-            }
-            Start::Near(distance) => {
-                x.open("Condition", attrs!("name" => name, "delay" => 0, "conditionEdge" => "rising"));
-                x.open("ByEntityCondition", &[]);
-                x.open("TriggeringEntities", attrs!("triggeringEntitiesRule" => "any"));
-                x.empty("EntityRef", attrs!("entityRef" => "ego"));
-                x.close();
-                x.open("EntityCondition", &[]);
+            }),
+            Start::Near(distance) => ego_condition(x, &name, "rising", |x| {
                 x.empty(
                     "RelativeDistanceCondition",
                     attrs!("entityRef" => e.actor, "relativeDistanceType" => "euclidianDistance", "freespace" => "false",
                            "rule" => "lessThan", "value" => distance),
                 );
-                x.close();
-                x.close();
-                x.close();
-            }
+            }),
         }
     }
     x.close();
