@@ -38,15 +38,7 @@ pub const PROFILES: [&str; 3] = ["auto", "default", "dashcam"];
 
 /// The profile `answer` states ([`PROFILES`]), if it is a YAML mapping with a known one.
 pub fn profile(answer: &str) -> Option<&'static str> {
-    let range = extract(answer)?;
-    let text = &answer[range];
-    if parse::too_deep(text).is_some() {
-        return None;
-    }
-    let serde_norway::Value::Mapping(map) = serde_norway::from_str::<serde_norway::Value>(text).ok()? else {
-        return None;
-    };
-    map.iter().find_map(|(key, value)| {
+    top_level(answer)?.iter().find_map(|(key, value)| {
         let row = dialect::find(dialect::Place::Top, key.as_str()?)?;
         if !matches!(row.tad, dialect::Tad::Profile) {
             return None;
@@ -58,13 +50,19 @@ pub fn profile(answer: &str) -> Option<&'static str> {
 
 /// The dialect of the YAML in `answer`, if there is a YAML mapping to judge.
 pub fn dialect(answer: &str) -> Option<Dialect> {
+    top_level(answer).map(|map| import::detect(&map))
+}
+
+/// The top-level mapping of the YAML in `answer`, read as it stands (no repairs), if it
+/// is one; `None` for nesting too deep to read.
+fn top_level(answer: &str) -> Option<serde_norway::Mapping> {
     let range = extract(answer)?;
     let text = &answer[range];
     if parse::too_deep(text).is_some() {
         return None;
     }
     match serde_norway::from_str::<serde_norway::Value>(text).ok()? {
-        serde_norway::Value::Mapping(map) => Some(import::detect(&map)),
+        serde_norway::Value::Mapping(map) => Some(map),
         _ => None,
     }
 }
