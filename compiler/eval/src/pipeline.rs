@@ -51,25 +51,25 @@ pub fn compile(db: &mut Database, input: &Input) -> Result<tad_bytecode::Program
 /// An input's resolved scenario: checked (a file with errors is refused), then resolved.
 /// What every backend is given.
 pub fn resolved(db: &mut Database, input: &Input) -> Result<tad_ir::Scenario, Refusal> {
-    let checked = tad_db::host::diagnose_in(db, input);
-    if checked.diagnostics.iter().any(Diagnostic::is_error) {
-        return Err(Refusal::Errors(checked.diagnostics.into_iter().filter(Diagnostic::is_error).collect()));
-    }
-    let file = tad_db::host::register(db, input);
-    match tad_db::resolve(db, file) {
-        Some(scenario) => Ok(scenario.clone()),
-        None => Err(Refusal::NoScenario(Box::new(tad_check::no_scenario(&tad_db::analyze(db, file).module)))),
-    }
+    resolved_warned(db, input).map(|(scenario, _)| scenario)
 }
 
 /// The warnings that say a scene will differ from its file (a group capped, a group
 /// beyond the scene's road): what `build` and `run` print beside what they make.
 pub const SCENE_WARNINGS: [tad_diagnostics::Code; 2] = [tad_diagnostics::Code::W0512, tad_diagnostics::Code::W0513];
 
-/// An input's [`SCENE_WARNINGS`] (its check is the database's, done once).
-pub fn scene_warnings(db: &mut Database, input: &Input) -> Vec<Diagnostic> {
-    let checked = tad_db::host::diagnose_in(db, input);
-    checked.diagnostics.into_iter().filter(|d| SCENE_WARNINGS.contains(&d.code)).collect()
+/// [`resolved`], with the input's [`SCENE_WARNINGS`] from the same check.
+pub fn resolved_warned(db: &mut Database, input: &Input) -> Result<(tad_ir::Scenario, Vec<Diagnostic>), Refusal> {
+    let file = tad_db::host::register(db, input);
+    let checked = tad_db::host::checked(db, file, input);
+    if checked.diagnostics.iter().any(Diagnostic::is_error) {
+        return Err(Refusal::Errors(checked.diagnostics.into_iter().filter(Diagnostic::is_error).collect()));
+    }
+    let warnings = checked.diagnostics.into_iter().filter(|d| SCENE_WARNINGS.contains(&d.code)).collect();
+    match tad_db::resolve(db, file) {
+        Some(scenario) => Ok((scenario.clone(), warnings)),
+        None => Err(Refusal::NoScenario(Box::new(tad_check::no_scenario(&tad_db::analyze(db, file).module)))),
+    }
 }
 
 /// What a scenario states that the runtime does not model (W0720): a weather with rain,

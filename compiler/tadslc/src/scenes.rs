@@ -22,9 +22,10 @@ pub fn compile(
     verb: &str,
     color: bool,
 ) -> Result<Option<tad_bytecode::Program>, Closed> {
-    match tad_eval::pipeline::resolved(db, input) {
-        Ok(scenario) => {
-            warn_scene(db, input, tad_eval::pipeline::runtime_notes(&scenario), color)?;
+    match tad_eval::pipeline::resolved_warned(db, input) {
+        Ok((scenario, mut warnings)) => {
+            warnings.extend(tad_eval::pipeline::runtime_notes(&scenario));
+            warn_scene(input, warnings, color)?;
             Ok(Some(tad_eval::pipeline::program(&scenario, &input.name)))
         }
         Err(refusal) => {
@@ -34,17 +35,14 @@ pub fn compile(
     }
 }
 
-/// The input's warnings that its scene differs from the file (and `more`: the runtime's
-/// notes, where it runs), on standard error.
+/// An input's warnings that its scene differs from the file (and, where the runtime runs
+/// it, the runtime's notes), on standard error.
 pub fn warn_scene(
-    db: &mut Database,
     input: &files::Input,
-    more: Vec<tad_diagnostics::Diagnostic>,
+    mut warnings: Vec<tad_diagnostics::Diagnostic>,
     color: bool,
 ) -> Result<(), Closed> {
     use tad_diagnostics::render::{FileReport, human};
-    let mut warnings = tad_eval::pipeline::scene_warnings(db, input);
-    warnings.extend(more);
     tad_diagnostics::sort(&mut warnings);
     if !warnings.is_empty() {
         err!("{}", human::render(&FileReport::new(&input.name, &input.text, &warnings), color))?;

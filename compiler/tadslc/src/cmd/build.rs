@@ -244,15 +244,17 @@ fn openscenario(args: &BuildArgs, color: bool) -> Result<Status, CliError> {
     let mut written: Vec<PathBuf> = Vec::new();
     let mut db = Database::new(Options::default());
     for input in &inputs {
-        let scenario = match tad_eval::pipeline::resolved(&mut db, input) {
-            Ok(scenario) => scenario,
+        let scenario = match tad_eval::pipeline::resolved_warned(&mut db, input) {
+            Ok((scenario, warnings)) => {
+                crate::scenes::warn_scene(input, warnings, color)?;
+                scenario
+            }
             Err(refusal) => {
                 err!("{}", refusal.render(input, "built", color))?;
                 status = status.max(Status::Failed);
                 continue;
             }
         };
-        crate::scenes::warn_scene(&mut db, input, Vec::new(), color)?;
         let options = tad_openscenario::EmitOptions { stem: stem(input), source: input.name.clone() };
         let emitted = tad_openscenario::emit(&scenario, &options);
         err!("{}", human::render(&FileReport::new(&input.name, &input.text, &emitted.diagnostics), color))?;
