@@ -587,18 +587,11 @@ fn import_writes_canonical_tad_and_export_round_trips() {
     }
     assert_eq!(code(&tadslc(&["fmt", "--check", tad.to_str().unwrap()], "")), 0, "imported TAD is formatted");
 
-    // export then import gives back the example
+    // export then import gives back the example (every example and searched scene: below;
+    // `--yaml` is the default form: `export_needs_no_format_flag`)
     for example in ["examples/paper/nl_to_dsl_example_2.tad", "examples/regions/switzerland_tram_street.tad"] {
-        let yaml = dir.join("exported.yaml");
-        let out = tadslc(&["export", "--yaml", example, "-o", yaml.to_str().unwrap()], "");
-        assert_eq!(code(&out), 0, "{}", stderr(&out));
-        let back = tadslc(&["import", yaml.to_str().unwrap()], "");
-        assert_eq!(code(&back), 0, "{}", stderr(&back));
-        let original = std::fs::read_to_string(repo().join(example)).unwrap();
-        let without_comments: String =
-            original.lines().filter(|l| !l.starts_with("//")).collect::<Vec<_>>().join("\n").trim_start().to_string()
-                + "\n";
-        assert_eq!(stdout(&back), without_comments, "{example}");
+        let (back, original) = through_yaml(&repo().join(example), &dir);
+        assert_eq!(back, original, "{example}");
     }
     // a file with errors is not exported
     assert_eq!(code(&tadslc(&["export", "--yaml", "tests/ui/structure/unknown_field.tad"], "")), 1);
