@@ -122,6 +122,8 @@ pub trait Db: salsa::Database {
 pub struct Analysis {
     pub module: Module,
     pub diagnostics: Vec<Diagnostic>,
+    /// The camera profile a YAML file states for itself (`tad_yaml::PROFILES`).
+    pub profile: Option<&'static str>,
 }
 
 /// The vocabulary a file sees, and the problems found gathering it.
@@ -139,11 +141,14 @@ fn stamp(diagnostics: impl IntoIterator<Item = Diagnostic>, file: FileId) -> Vec
 /// with spans into the file's own text.
 #[salsa::tracked(returns(ref))]
 pub fn analyze(db: &dyn Db, file: SourceFile) -> Analysis {
-    let (module, diagnostics) = match file.language(db) {
-        Language::Tad => tad_syntax::analyze(file.text(db)),
-        Language::Yaml => tad_yaml::lower(file.text(db)),
+    let (module, diagnostics, profile) = match file.language(db) {
+        Language::Tad => {
+            let (module, diagnostics) = tad_syntax::analyze(file.text(db));
+            (module, diagnostics, None)
+        }
+        Language::Yaml => tad_yaml::lower_answer(file.text(db)),
     };
-    Analysis { module, diagnostics: stamp(diagnostics, file.id(db)) }
+    Analysis { module, diagnostics: stamp(diagnostics, file.id(db)), profile }
 }
 
 /// The module name a file is known by.
@@ -286,7 +291,7 @@ pub fn check(db: &dyn Db, file: SourceFile) -> Checked {
     let mut options = db.settings().options(db).clone();
     if file.language(db) == Language::Yaml {
         // a YAML file is a dash-cam answer unless it states its profile (as `export` writes)
-        let stated = tad_yaml::profile(file.text(db));
+        let stated = analysis.profile;
         options.answer = stated.is_none();
         if options.profile == tad_check::Profile::Auto {
             options.profile = match stated {

@@ -25,6 +25,13 @@ fn shape(key: &str, expected: &str, found: &str) -> Payload {
 }
 
 pub fn lower(text: &str) -> (Module, Vec<Diagnostic>) {
+    let (module, diagnostics, _) = lower_answer(text);
+    (module, diagnostics)
+}
+
+/// [`lower`], and the camera profile the YAML states (its top-level `profile`, one of
+/// [`crate::PROFILES`]; `None` when it states none or an unknown one, which is an error).
+pub fn lower_answer(text: &str) -> (Module, Vec<Diagnostic>, Option<&'static str>) {
     let mut diagnostics = Vec::new();
     let Some(range) = extract::extract(text) else {
         let first = text.lines().find(|l| !l.trim().is_empty()).unwrap_or("");
@@ -36,7 +43,7 @@ pub fn lower(text: &str) -> (Module, Vec<Diagnostic>) {
                 .with_help("put the scenario between `<YAML>` and `</YAML>`, or in a ```yaml code fence")
                 .with_note("a plain YAML file must be a mapping with `environment`, `road_network` and `actors`"),
         );
-        return (Module::default(), diagnostics);
+        return (Module::default(), diagnostics, None);
     };
     let slice = &text[range.clone()];
     let whole = Span::new(range.start, range.end);
@@ -46,12 +53,12 @@ pub fn lower(text: &str) -> (Module, Vec<Diagnostic>) {
                 .with_payload(no_yaml())
                 .with_help("the block must hold the scenario: `environment`, `road_network` and `actors`"),
         );
-        return (Module::default(), diagnostics);
+        return (Module::default(), diagnostics, None);
     }
     let (work, value) = parse::parse(slice, range.start, &mut diagnostics);
     let Some(value) = value else {
         tad_diagnostics::sort(&mut diagnostics);
-        return (Module::default(), diagnostics);
+        return (Module::default(), diagnostics, None);
     };
     let tree = scan::scan(&work, range.start);
     let mut importer = Importer {
@@ -65,11 +72,12 @@ pub fn lower(text: &str) -> (Module, Vec<Diagnostic>) {
         name: None,
         uses: Vec::new(),
         whole,
+        profile: None,
     };
     let module = importer.module(&value);
     let mut diagnostics = importer.diagnostics;
     tad_diagnostics::sort(&mut diagnostics);
-    (module, diagnostics)
+    (module, diagnostics, importer.profile)
 }
 
 /// The dialect of a top-level mapping.
@@ -163,6 +171,8 @@ struct Importer<'a> {
     name: Option<Name>,
     uses: Vec<Use>,
     whole: Span,
+    /// The camera profile the YAML states (`profile`).
+    profile: Option<&'static str>,
 }
 
 /// Where a value is: its key's node in the scanned tree, with fallbacks.
@@ -849,10 +859,11 @@ impl Importer<'_> {
         }
     }
 
-    /// `profile`: read by the host before checking ([`crate::profile`]); here only judged.
+    /// `profile`: the camera rules the host checks the file with ([`lower_answer`]).
     fn profile(&mut self, key: &str, v: &Value, at: At) {
-        let known = untag(v).as_str().map(normalize).is_some_and(|p| crate::PROFILES.contains(&p.as_str()));
-        if !known {
+        let name = untag(v).as_str().map(normalize);
+        self.profile = crate::PROFILES.into_iter().find(|p| name.as_deref() == Some(*p));
+        if self.profile.is_none() {
             let found = untag(v).as_str().map_or_else(|| format!("{v:?}"), |s| s.trim().to_string());
             self.malformed(key, &found, at.value_span, "a camera profile (`auto`, `default` or `dashcam`)", "auto");
         }

@@ -27,7 +27,7 @@ mod tad;
 pub use dialect::Dialect;
 pub use export::export;
 pub use extract::extract;
-pub use import::lower;
+pub use import::{lower, lower_answer};
 pub use tad::to_tad;
 
 /// The camera rules a YAML file may state for itself (its top-level `profile`), as
@@ -36,33 +36,15 @@ pub use tad::to_tad;
 /// `auto`; an answer that states none is checked with the dash-cam rules.
 pub const PROFILES: [&str; 3] = ["auto", "default", "dashcam"];
 
-/// The profile `answer` states ([`PROFILES`]), if it is a YAML mapping with a known one.
-pub fn profile(answer: &str) -> Option<&'static str> {
-    top_level(answer)?.iter().find_map(|(key, value)| {
-        let row = dialect::find(dialect::Place::Top, key.as_str()?)?;
-        if !matches!(row.tad, dialect::Tad::Profile) {
-            return None;
-        }
-        let name = norm::normalize(value.as_str()?);
-        PROFILES.into_iter().find(|p| *p == name)
-    })
-}
-
 /// The dialect of the YAML in `answer`, if there is a YAML mapping to judge.
 pub fn dialect(answer: &str) -> Option<Dialect> {
-    top_level(answer).map(|map| import::detect(&map))
-}
-
-/// The top-level mapping of the YAML in `answer`, read as it stands (no repairs), if it
-/// is one; `None` for nesting too deep to read.
-fn top_level(answer: &str) -> Option<serde_norway::Mapping> {
     let range = extract(answer)?;
     let text = &answer[range];
     if parse::too_deep(text).is_some() {
         return None;
     }
     match serde_norway::from_str::<serde_norway::Value>(text).ok()? {
-        serde_norway::Value::Mapping(map) => Some(map),
+        serde_norway::Value::Mapping(map) => Some(import::detect(&map)),
         _ => None,
     }
 }
