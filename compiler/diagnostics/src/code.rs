@@ -61,6 +61,7 @@ codes! {
     E0214 => Error,
     E0215 => Error,
     E0216 => Error,
+    E0217 => Error,
     // YAML import (3xx): add codes below this line
     E0300 => Error,
     E0301 => Error,

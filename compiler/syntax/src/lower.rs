@@ -10,12 +10,12 @@
 use crate::cst::{self, Name, Value, words_span};
 use crate::lexer;
 use crate::model::*;
-use crate::schema::{self, FieldDef, SectionDef, Unit, ValueType};
+use crate::schema::{self, ClosedSet, FieldDef, LaneWord, SectionDef, Unit, ValueType};
 use crate::suggest;
 use tad_diagnostics::{Applicability, Code, Diagnostic, Payload, Span};
 
 pub fn lower(src: &str, file: &cst::File) -> (Module, Vec<Diagnostic>) {
-    let mut lowerer = Lowerer { src, diagnostics: Vec::new(), groups: Default::default() };
+    let mut lowerer = Lowerer { src, diagnostics: Vec::new(), groups: Default::default(), rightmost: Vec::new() };
     let module = lowerer.file(file);
     (module, lowerer.diagnostics)
 }
@@ -25,6 +25,9 @@ struct Lowerer<'a> {
     diagnostics: Vec<Diagnostic>,
     /// The scenario's actor groups by name, for duplicates without a quadratic search.
     groups: std::collections::HashMap<String, usize>,
+    /// Where the scenario's `lane: rightmost` values are: the road's `lanes`, known once
+    /// the whole scenario is read.
+    rightmost: Vec<Span>,
 }
 
 impl Lowerer<'_> {
@@ -140,6 +143,8 @@ impl Lowerer<'_> {
                 cst::Member::Error(_) => {}
             }
         }
+        let pending = std::mem::take(&mut self.rightmost);
+        self.diagnostics.extend(rightmost_lanes(&mut scenario, &pending));
         scenario
     }
 
@@ -408,6 +413,15 @@ impl Lowerer<'_> {
                 if words.len() == 1 && matches!(words[0].text.as_str(), "yes" | "no") =>
             {
                 Val::Flag(words[0].text == "yes")
+            }
+            (ValueType::Integer, Value::Words(words))
+                if def.name == "lane" && words.len() == 1 && LaneWord::parse(&words[0].text).is_some() =>
+            {
+                // leftmost is lane 1; rightmost waits for the road's lanes
+                if LaneWord::parse(&words[0].text) == Some(LaneWord::Rightmost) {
+                    self.rightmost.push(value.span());
+                }
+                Val::Integer(1)
             }
             (ValueType::Integer, Value::Number { number, unit, span }) => {
                 if let Some(unit) = unit {
@@ -771,6 +785,39 @@ impl Lowerer<'_> {
         }
         Some(Quantity { value, unit })
     }
+}
+
+/// The scenario's `lane: rightmost` values (at the value spans `at`) become the road's
+/// `lanes`: a word whose number depends on the whole scenario, so it is resolved after
+/// the scenario is read (by this lowering and by the YAML importer). Without the road's
+/// `lanes` it is E0217 and the lane is left unspecified.
+pub fn rightmost_lanes(scenario: &mut Scenario, at: &[Span]) -> Vec<Diagnostic> {
+    let mut diagnostics = Vec::new();
+    if at.is_empty() {
+        return diagnostics;
+    }
+    let lanes = scenario.attr("road", "lanes").and_then(Attr::integer).filter(|n| *n > 0);
+    let attrs = scenario.sections.iter_mut().flat_map(|s| &mut s.attrs);
+    let attrs = attrs.chain(scenario.actors.iter_mut().flat_map(|g| &mut g.attrs));
+    for attr in attrs.filter(|a| a.def.name == "lane" && at.contains(&a.value_span)) {
+        match lanes {
+            Some(lanes) => attr.value = Known::Given(Val::Integer(lanes)),
+            None => {
+                attr.value = Known::Unspecified;
+                diagnostics.push(
+                    Diagnostic::new(
+                        Code::E0217,
+                        "`rightmost` needs the road's number of lanes",
+                        attr.value_span,
+                        "which lane this is depends on `road { lanes }`",
+                    )
+                    .with_payload(wrong("lane", "a whole number", "rightmost"))
+                    .with_help("give the road's `lanes`, or write the lane's number"),
+                );
+            }
+        }
+    }
+    diagnostics
 }
 
 fn wrong(field: &str, expected: &str, found: &str) -> Payload {

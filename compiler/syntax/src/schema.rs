@@ -97,6 +97,16 @@ macro_rules! closed_set {
 }
 
 closed_set! {
+    /// The words a `lane` field takes besides its number, in the ego's direction.
+    LaneWord {
+        /// Lane 1.
+        Leftmost = "leftmost",
+        /// The road's last lane, `lanes`.
+        Rightmost = "rightmost",
+    }
+}
+
+closed_set! {
     /// Where a relation is across the road from its reference.
     Lateral {
         Left = "left",

@@ -8,7 +8,7 @@ use serde_norway::Value;
 use tad_diagnostics::{Applicability, Code, Diagnostic, Payload, Span};
 use tad_syntax::cst::{Name, Use};
 use tad_syntax::model::*;
-use tad_syntax::schema::{self, FieldDef, SectionDef, Unit, ValueType};
+use tad_syntax::schema::{self, ClosedSet, FieldDef, LaneWord, SectionDef, Unit, ValueType};
 use tad_syntax::suggest;
 
 /// How strongly a key states a field, when several keys state the same one.
@@ -73,6 +73,7 @@ pub fn lower_answer(text: &str) -> (Module, Vec<Diagnostic>, Option<&'static str
         uses: Vec::new(),
         whole,
         profile: None,
+        rightmost: Vec::new(),
     };
     let module = importer.module(&value);
     let mut diagnostics = importer.diagnostics;
@@ -173,6 +174,8 @@ struct Importer<'a> {
     whole: Span,
     /// The camera profile the YAML states (`profile`).
     profile: Option<&'static str>,
+    /// Where lanes are given as `rightmost`: the road's `lanes`, known at the end.
+    rightmost: Vec<Span>,
 }
 
 /// Where a value is: its key's node in the scanned tree, with fallbacks.
@@ -720,6 +723,16 @@ impl Importer<'_> {
     }
 
     fn set_integer(&mut self, claim: Claim, v: &Value) {
+        // a lane named by where it is (`rightmost`, `leftmost lane`)
+        if let ("lane", Value::String(text)) = (claim.field, untag(v))
+            && let Some(word) = LaneWord::parse(text.trim().to_ascii_lowercase().trim_end_matches(" lane").trim())
+        {
+            if word == LaneWord::Rightmost {
+                self.rightmost.push(claim.at.value_span);
+            }
+            self.set(claim, Known::Given(Val::Integer(1)), false);
+            return;
+        }
         if let Some(n) = self.integer(claim.key, v, claim.at, "1") {
             self.set(claim, known_map(n, Val::Integer), false);
         }
@@ -1350,11 +1363,10 @@ impl Importer<'_> {
                 }
             })
             .collect();
-        Module {
-            uses: std::mem::take(&mut self.uses),
-            declarations: Vec::new(),
-            scenario: Some(Scenario { span: self.whole, name: self.name.take(), sections, actors }),
-        }
+        let mut scenario = Scenario { span: self.whole, name: self.name.take(), sections, actors };
+        let rightmost = std::mem::take(&mut self.rightmost);
+        self.diagnostics.extend(tad_syntax::lower::rightmost_lanes(&mut scenario, &rightmost));
+        Module { uses: std::mem::take(&mut self.uses), declarations: Vec::new(), scenario: Some(scenario) }
     }
 }
 

@@ -289,3 +289,28 @@ fn a_stray_closing_fence_does_not_hide_the_answer() {
     assert!(errors(&d).is_empty(), "{d:?}");
     assert!(model.scenario.unwrap().attr("environment", "time").is_some());
 }
+
+#[test]
+fn lanes_named_by_where_they_are() {
+    let lane = |s: &Scenario, group: Option<&str>| match group {
+        Some(g) => s.actor(g).unwrap().attr("lane").unwrap().value.clone(),
+        None => s.attr("ego", "lane").unwrap().value.clone(),
+    };
+    let text = "road_network:\n  lane_number: 3\nactors:\n  ego_vehicle:\n    lane_index: Rightmost lane\n  Car 1:\n    type: car\n    lane_index: leftmost\n";
+    let (model, d) = lower(text);
+    assert!(errors(&d).is_empty(), "{d:?}");
+    let s = model.scenario.unwrap();
+    assert_eq!(lane(&s, None), Known::Given(Val::Integer(3)));
+    assert_eq!(lane(&s, Some("car_1")), Known::Given(Val::Integer(1)));
+    // without the road's lanes, rightmost has no number
+    let text = "actors:\n  ego_vehicle:\n    lane_index: rightmost\n";
+    assert_eq!(codes_at(text), ["E0217@3"]);
+    // the same words in TAD
+    let (model, d) = tad_syntax::analyze(
+        "scenario lanes { road { lanes: 4 } ego { lane: rightmost } actor a: car { lane: leftmost } }",
+    );
+    assert!(d.is_empty(), "{d:?}");
+    let s = model.scenario.unwrap();
+    assert_eq!(lane(&s, None), Known::Given(Val::Integer(4)));
+    assert_eq!(lane(&s, Some("a")), Known::Given(Val::Integer(1)));
+}
