@@ -1,14 +1,16 @@
 //! `tadslc check`: report every problem of every file, in the chosen format.
 //!
-//! Each input is set in one database; a diagnostic whose label points into another file
-//! (a used module, the prelude) is rendered with that file's text. A local module used by
-//! an input and having errors is reported once, in its own file, after the inputs.
+//! Each input is set in a database (a fresh one every [`BATCH`] files, so memory does not
+//! grow with the directory) and reported as soon as it is checked; a diagnostic whose label
+//! points into another file (a used module, the prelude) is rendered with that file's text.
+//! A local module used by an input and having errors is reported once, in its own file,
+//! after the inputs.
 
 use std::path::PathBuf;
 
 use crate::files::{self, Input, Search};
-use crate::output::CliError;
-use crate::{Status, err, errln, outln, plural};
+use crate::output::{CliError, Closed};
+use crate::{Status, err, errln, out, outln, plural};
 use tad_check::{Checked, Class, Options};
 use tad_db::host::checked;
 use tad_db::host::{diagnose_in, register};
@@ -38,8 +40,9 @@ pub struct Args {
 }
 
 /// Output format of `check`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
 pub enum Format {
+    #[default]
     Human,
     Json,
     Sarif,
@@ -144,143 +147,171 @@ pub fn report<'a>(
         .with_related(related.iter().map(|(name, text, file)| Source { file: *file, name, text }).collect())
 }
 
-/// One checked file, ready to render.
-struct Checked1 {
-    name: String,
-    text: String,
-    file: SourceFile,
-    result: Checked,
-}
+/// Files one database holds before the next one is started: a check of a large directory
+/// holds this many files' analyses at a time, and reads the prelude once per batch. Each
+/// file's result does not depend on the batch it is in.
+const BATCH: usize = 256;
 
-/// Check every file `paths` name, then report. Every file is checked before anything is
-/// reported, so the status is the whole run's even if the reader of the report stops
-/// reading early (`spec/output.md`).
+/// Check every file `paths` name, reporting each as it is checked. A reader who stops
+/// reading early does not stop the check, so the status is the whole run's
+/// (`spec/output.md`).
 pub fn run(args: &Args, color: bool) -> Result<Status, CliError> {
     let Args { paths, format, deny_warnings, max_diagnostics: limit, rules } = args;
-    let (format, deny_warnings, limit, options) = (*format, *deny_warnings, *limit, rules.options());
+    let options = rules.options();
     // raised by unreadable paths, then by errors (and warnings with --deny-warnings)
     let mut status = Status::Ok;
-    let (inputs, read) = files::load(paths, Search::Scenarios)?;
-    status = status.max(read);
-    let mut db = Database::new(options);
-    let mut done: Vec<Checked1> = Vec::new();
-    for input in &inputs {
-        let file = register(&mut db, input);
-        let result = checked(&db, file, input);
-        done.push(Checked1 { name: input.name.clone(), text: input.text.clone(), file, result });
+    let (paths, errors) = tad_db::host::collect(paths, Search::Scenarios);
+    for error in &errors {
+        status = Status::Usage;
+        errln!("error: {error}")?;
     }
-    // local modules with errors of their own, each once, in their own file
-    let inputs_files: Vec<SourceFile> = done.iter().map(|c| c.file).collect();
-    let mut modules: Vec<SourceFile> = Vec::new();
-    for c in &done {
-        for m in db.local_modules(c.file) {
-            if !inputs_files.contains(&m)
-                && !modules.contains(&m)
+    let mut reporter = Reporter { format: *format, color, limit: *limit, ..Reporter::default() };
+    if *format == Format::Sarif {
+        out!("{}", sarif::Stream::HEAD)?;
+    }
+    let inputs: std::collections::HashSet<PathBuf> = paths.iter().map(|p| canonical(p)).collect();
+    // local modules used by an input and having errors of their own, each once
+    let mut modules: Vec<PathBuf> = Vec::new();
+    let mut db = Database::new(options.clone());
+    for (i, path) in paths.iter().enumerate() {
+        if i > 0 && i % BATCH == 0 {
+            db = Database::new(options.clone());
+        }
+        let input = match files::read(path) {
+            Ok(input) => input,
+            Err(e) => {
+                status = Status::Usage;
+                errln!("error: {e}")?;
+                continue;
+            }
+        };
+        let file = register(&mut db, &input);
+        let result = checked(&db, file, &input);
+        for m in db.local_modules(file) {
+            let at = canonical(m.path(&db));
+            if !inputs.contains(&at)
+                && !modules.contains(&at)
                 && tad_db::check(&db, m).diagnostics.iter().any(Diagnostic::is_error)
             {
-                modules.push(m);
+                modules.push(at);
             }
         }
+        reporter.files += 1;
+        reporter.file(&db, &input.name, &input.text, file, &result)?;
     }
-    for m in modules {
-        done.push(Checked1 {
-            name: m.path(&db).display().to_string(),
-            text: m.text(&db).clone(),
-            file: m,
-            result: tad_db::check(&db, m).clone(),
-        });
+    // each in its own file, after the inputs
+    let mut db = Database::new(options);
+    for path in &modules {
+        let Ok(input) = files::read(path) else { continue };
+        let file = register(&mut db, &input);
+        let result = tad_db::check(&db, file).clone();
+        reporter.file(&db, &path.display().to_string(), &input.text, file, &result)?;
     }
-
-    let (mut errors, mut warnings) = (0, 0);
-    let mut classes = [0usize; Class::ALL.len()];
-    let mut hints = 0;
-    for c in &done {
-        errors += c.result.diagnostics.iter().filter(|d| d.severity == Severity::Error).count();
-        warnings += c.result.diagnostics.iter().filter(|d| d.severity == Severity::Warning).count();
-        hints += c.result.diagnostics.iter().filter(|d| d.severity == Severity::Hint).count();
-        if let Some(class) = c.result.class {
-            classes[class as usize] += 1;
-        }
-    }
-    if errors > 0 || (deny_warnings && warnings > 0) {
+    let Tally { errors, warnings, .. } = reporter.tally;
+    if errors > 0 || (*deny_warnings && warnings > 0) {
         status = status.max(Status::Failed);
     }
+    reporter.end()?;
+    Ok(status)
+}
 
-    let mut sarif_reports = Vec::new();
-    for c in &done {
+/// A path as the file system names it, to tell whether two paths are one file.
+fn canonical(path: &std::path::Path) -> PathBuf {
+    std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf())
+}
+
+/// What the summary counts.
+#[derive(Default)]
+struct Tally {
+    errors: usize,
+    warnings: usize,
+    hints: usize,
+    classes: [usize; Class::ALL.len()],
+}
+
+/// Writes each file's report as it comes, in the run's format, and what the run's end
+/// says: the summary (human), the rest of the log (SARIF).
+#[derive(Default)]
+struct Reporter {
+    format: Format,
+    color: bool,
+    limit: usize,
+    /// The inputs read (not the modules reported after them).
+    files: usize,
+    tally: Tally,
+    sarif: sarif::Stream,
+}
+
+impl Reporter {
+    fn file(
+        &mut self,
+        db: &Database,
+        name: &str,
+        text: &str,
+        file: SourceFile,
+        result: &Checked,
+    ) -> Result<(), Closed> {
+        let all = &result.diagnostics;
+        let count = |severity| all.iter().filter(|d| d.severity == severity).count();
+        self.tally.errors += count(Severity::Error);
+        self.tally.warnings += count(Severity::Warning);
+        self.tally.hints += count(Severity::Hint);
+        if let Some(class) = result.class {
+            self.tally.classes[class as usize] += 1;
+        }
         // a file with hundreds of problems: the first ones, and how many more
-        let shown = if limit > 0 && c.result.diagnostics.len() > limit {
-            &c.result.diagnostics[..limit]
-        } else {
-            &c.result.diagnostics[..]
-        };
-        let hidden = &c.result.diagnostics[shown.len()..];
-        let related = related(&db, c.file, shown);
-        let report = report(&c.name, &c.text, shown, &related);
-        match format {
+        let shown = if self.limit > 0 && all.len() > self.limit { &all[..self.limit] } else { &all[..] };
+        let hidden = &all[shown.len()..];
+        let related = related(db, file, shown);
+        let report = report(name, text, shown, &related);
+        let class = result.class.map_or(serde_json::Value::Null, |c| c.as_str().into());
+        match self.format {
             Format::Human => {
-                err!("{}", human::render(&report, color))?;
+                err!("{}", human::render(&report, self.color))?;
                 if !hidden.is_empty() {
                     let errors = hidden.iter().filter(|d| d.is_error()).count();
                     errln!(
-                        "{}: and {} ({}); `--max-diagnostics 0` shows all\n",
-                        c.name,
+                        "{name}: and {} ({}); `--max-diagnostics 0` shows all\n",
                         plural(hidden.len(), "more diagnostic"),
                         plural(errors, "error")
                     )?;
                 }
-                if let Some(class) = c.result.class.filter(|c| *c != Class::Complete) {
-                    errln!("{}: {}", c.name, class.as_str())?;
+                if let Some(class) = result.class.filter(|c| *c != Class::Complete) {
+                    errln!("{name}: {}", class.as_str())?;
                 }
             }
             Format::Json => {
                 let mut object = json::file_object(&report);
-                object.insert("class".into(), c.result.class.map_or(serde_json::Value::Null, |c| c.as_str().into()));
-                let vocabulary = &tad_db::vocabulary(&db, c.file).vocabulary;
+                object.insert("class".into(), class);
+                let vocabulary = &tad_db::vocabulary(db, file).vocabulary;
                 // only what an otherwise valid scenario lacks is asked for
-                let refinement = match c.result.class {
-                    Some(Class::Incomplete) => tad_feedback::refinement(&c.result.diagnostics, vocabulary),
+                let refinement = match result.class {
+                    Some(Class::Incomplete) => tad_feedback::refinement(all, vocabulary),
                     _ => Vec::new(),
                 };
                 object.insert("refinement".into(), refinement.into());
                 object.insert("omitted".into(), hidden.len().into());
                 outln!("{}", serde_json::Value::Object(object))?;
             }
-            Format::Sarif => sarif_reports.push((
-                c.name.clone(),
-                c.text.clone(),
-                shown.to_vec(),
-                related.iter().map(|(n, t, f)| (n.clone(), t.to_string(), *f)).collect::<Vec<_>>(),
-                hidden.len(),
-            )),
-        }
-    }
-    match format {
-        Format::Sarif => {
-            let reports: Vec<FileReport<'_>> = sarif_reports
-                .iter()
-                .map(|(name, text, diagnostics, related, _)| {
-                    FileReport::new(name, text, diagnostics)
-                        .with_related(related.iter().map(|(n, t, f)| Source { file: *f, name: n, text: t }).collect())
-                })
-                .collect();
-            let mut log = sarif::render(&reports, env!("CARGO_PKG_VERSION"));
             // each artifact says its scenario's class and how many diagnostics were left out
-            if let Some(artifacts) = log["runs"][0]["artifacts"].as_array_mut() {
-                // one report per file checked, in the same order
-                for ((artifact, c), (.., omitted)) in artifacts.iter_mut().zip(&done).zip(&sarif_reports) {
-                    let class = c.result.class.map_or(serde_json::Value::Null, |c| c.as_str().into());
-                    artifact["properties"] = serde_json::json!({ "class": class, "omitted": omitted });
-                }
+            Format::Sarif => {
+                let properties = serde_json::json!({ "class": class, "omitted": hidden.len() });
+                out!("{}", self.sarif.file(&report, properties))?;
             }
-            outln!("{log}")?;
         }
-        // nothing was checked: the errors above say why
-        Format::Human if inputs.is_empty() => {}
-        Format::Human => errln!("{}", summary(inputs.len(), errors, warnings, hints, classes))?,
-        Format::Json => {}
+        Ok(())
     }
-    Ok(status)
+
+    fn end(self) -> Result<(), Closed> {
+        let Tally { errors, warnings, hints, classes } = self.tally;
+        match self.format {
+            Format::Sarif => outln!("{}", self.sarif.end(env!("CARGO_PKG_VERSION"))),
+            // nothing was checked: the errors above say why
+            Format::Human if self.files == 0 => Ok(()),
+            Format::Human => errln!("{}", summary(self.files, errors, warnings, hints, classes)),
+            Format::Json => Ok(()),
+        }
+    }
 }
 
 fn summary(files: usize, errors: usize, warnings: usize, hints: usize, classes: [usize; Class::ALL.len()]) -> String {
