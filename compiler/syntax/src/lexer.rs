@@ -214,11 +214,22 @@ pub fn lex(src: &str) -> Lexed {
     out
 }
 
+/// Characters of a run of unexpected ones that its message quotes.
+const QUOTED: usize = 16;
+
 /// Names the run of unexpected characters that the last token and diagnostic hold, once
 /// it has ended: naming it at every character it grew by made a long run quadratic.
 fn name_run(src: &str, out: &mut Lexed) {
     if let (Some(token), Some(d)) = (out.tokens.last(), out.diagnostics.last_mut()) {
-        d.message = format!("unexpected characters `{}`", src[token.0..token.2].escape_debug());
+        let run = &src[token.0..token.2];
+        let count = run.chars().count();
+        d.message = if count <= QUOTED {
+            format!("unexpected characters `{}`", run.escape_debug())
+        } else {
+            // a long run is quoted by its start and counted
+            let start: String = run.chars().take(QUOTED).collect();
+            format!("unexpected characters `{}…` ({count} of them)", start.escape_debug())
+        };
     }
 }
 
@@ -478,7 +489,11 @@ mod tests {
         let lexed = lex(&"@".repeat(100_000));
         assert_eq!((lexed.tokens.len(), lexed.diagnostics.len()), (1, 1));
         assert_eq!(lexed.diagnostics[0].primary.span, Span::new(0, 100_000));
-        assert_eq!(lexed.diagnostics[0].message.len(), "unexpected characters ``".len() + 100_000);
+        // quoted by its start and counted, so the message does not grow with the run
+        assert_eq!(
+            lexed.diagnostics[0].message,
+            format!("unexpected characters `{}…` (100000 of them)", "@".repeat(16))
+        );
     }
 
     #[test]

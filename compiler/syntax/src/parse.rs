@@ -174,7 +174,13 @@ fn close_braces(src: &str, tokens: &mut Vec<Spanned>, diagnostics: &mut Vec<Diag
     let suspect =
         pairs.iter().copied().find(|&(opened, closed)| line_leading(closed) && indent(opened) > indent(closed));
     let end = src.len();
+    // thousands of open braces (a pasted or generated file) are one report, not one each
+    let many = open.len() > MANY_UNCLOSED;
     for (i, &opened) in open.iter().enumerate().rev() {
+        tokens.push((end, Token::RBrace, end));
+        if many && i > 0 {
+            continue;
+        }
         let mut d =
             Diagnostic::new(Code::E0102, "unclosed `{`", Span::new(opened, opened + 1), "this `{` is never closed")
                 .with_secondary(Span::new(end, end), "the file ends here");
@@ -188,15 +194,26 @@ fn close_braces(src: &str, tokens: &mut Vec<Spanned>, diagnostics: &mut Vec<Diag
             .with_secondary(Span::new(closer, closer + 1), "this `}`, indented like an outer block, closes it instead")
             .with_secondary(Span::new(opened, opened + 1), "so this `{` is still open at the end of the file");
         }
+        if many {
+            let last = index.line_col(src, open[open.len() - 1]);
+            d = d.with_note(format!(
+                "{} `{{` in all are never closed, the last at {}:{}",
+                open.len(),
+                last.line,
+                last.column
+            ));
+        }
         if report {
             diagnostics.push(
                 d.with_help("add the missing `}`")
                     .with_payload(Payload::Syntax { expected: vec!["`}`".into()], found: None }),
             );
         }
-        tokens.push((end, Token::RBrace, end));
     }
 }
+
+/// Unclosed braces past which only the first is reported, with their count.
+const MANY_UNCLOSED: usize = 8;
 
 fn parse_error(src: &str, tokens: &[Spanned], error: ParseError<usize, Token, ()>) -> Option<Diagnostic> {
     match error {

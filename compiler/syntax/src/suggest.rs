@@ -28,9 +28,10 @@ pub fn distance(a: &str, b: &str) -> usize {
 /// The candidate closest to `word`, if it is close enough to be a plausible typo:
 /// at most a third of the word's length in edits (at least one). Ties keep the first.
 pub fn closest<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
-    let limit = (word.chars().count() / 3).max(1);
+    let length = word.chars().count();
+    let limit = (length / 3).max(1);
     let mut best: Option<(usize, &str)> = None;
-    for candidate in candidates {
+    for candidate in candidates.into_iter().filter(|c| within(length, c, limit)) {
         let d = distance(word, candidate);
         if d <= limit && best.is_none_or(|(bd, _)| d < bd) {
             best = Some((d, candidate));
@@ -39,13 +40,21 @@ pub fn closest<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) ->
     best.map(|(_, c)| c)
 }
 
+/// Whether `candidate` can be within `limit` edits of a word of `length` characters: the
+/// distance is at least the difference in length, so most candidates need no table.
+fn within(length: usize, candidate: &str, limit: usize) -> bool {
+    length.abs_diff(candidate.chars().count()) <= limit
+}
+
 /// The candidates within the typo limit of `word`, closest first (ties in the given
 /// order), at most `n`.
 pub fn ranked<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>, n: usize) -> Vec<&'a str> {
-    let limit = (word.chars().count() / 3).max(1);
+    let length = word.chars().count();
+    let limit = (length / 3).max(1);
     let mut close: Vec<(usize, usize, &str)> = candidates
         .into_iter()
         .enumerate()
+        .filter(|(_, c)| within(length, c, limit))
         .map(|(i, c)| (distance(word, c), i, c))
         .filter(|(d, ..)| *d <= limit)
         .collect();

@@ -6,6 +6,7 @@
 pub mod human;
 pub mod json;
 pub mod sarif;
+mod window;
 
 use crate::{FileId, Label};
 
