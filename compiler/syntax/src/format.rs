@@ -20,6 +20,10 @@ const INDENT: &str = "  ";
 pub fn format(src: &str) -> Result<String, Vec<Diagnostic>> {
     let parsed = parse(src);
     if parsed.has_errors() {
+        // what `check` calls something else is one error here too (E0007)
+        if let Some(not_tad) = crate::sniff::not_tad(src, &parsed.diagnostics) {
+            return Err(vec![not_tad]);
+        }
         return Err(parsed.diagnostics.into_iter().filter(Diagnostic::is_error).collect());
     }
     Ok(format_parsed(src, &parsed))

@@ -465,6 +465,26 @@ fn bench_runtime_reports_episodes_and_the_search() {
 }
 
 #[test]
+fn fmt_refuses_what_check_calls_non_tad_and_caps_its_errors() {
+    // prose is one E0007, as in `check`, not an error per word
+    let prose = "# Notes on the drive\n\nThe ego { waits } at the light: then [turns] left.\n".repeat(200);
+    let out = tadslc(&["fmt", "-"], &prose);
+    assert_eq!(code(&out), 1);
+    let err = stderr(&out);
+    assert_eq!(err.matches("error[").count(), 1, "{err}");
+    assert!(err.contains("error[E0007]"), "{err}");
+    // a TAD file with hundreds of syntax errors: the first 50, then how many more
+    let broken = format!("scenario demo {{\n{}}}\n", "  ego { speed: ] }\n".repeat(300));
+    let out = tadslc(&["fmt", "-"], &broken);
+    assert_eq!(code(&out), 1);
+    let err = stderr(&out);
+    assert_eq!(err.matches("error[").count(), 50, "{err}");
+    assert!(err.contains("<stdin>: and ") && err.contains("more errors"), "{err}");
+    let out = tadslc(&["fmt", "--max-diagnostics", "0", "-"], &broken);
+    assert!(stderr(&out).matches("error[").count() > 50);
+}
+
+#[test]
 fn fmt_canonicalize_applies_canonical_forms_and_then_checks_clean() {
     let dir = scratch("canonical");
     let path = dir.join("aliases.tad");

@@ -19,6 +19,10 @@ pub struct Args {
     /// canonical forms (the fixes of W0401, W0402 and W0403)
     #[arg(long)]
     pub canonicalize: bool,
+    /// Show at most this many syntax errors per file that cannot be formatted, then how
+    /// many more there are (0: all)
+    #[arg(long, value_name = "N", default_value_t = 50)]
+    pub max_diagnostics: usize,
 }
 
 /// The codes whose fixes `--canonicalize` applies (their machine-applicable ones).
@@ -45,7 +49,8 @@ pub fn canonicalize(db: &mut tad_db::Database, input: &files::Input) -> String {
 /// Format every `.tad` file `paths` name (directories are searched for `*.tad` only:
 /// YAML is not TAD, and is skipped).
 pub fn run(args: &Args, color: bool) -> Result<Status, CliError> {
-    let Args { paths, check, canonicalize: canonical } = args;
+    let Args { paths, check, canonicalize: canonical, max_diagnostics: limit } = args;
+    let limit = *limit;
     let (check, canonical) = (*check, *canonical);
     let mut db = tad_db::Database::new(tad_check::Options::default());
     // raised by files that cannot be formatted or written, and by unformatted ones with --check
@@ -64,8 +69,14 @@ pub fn run(args: &Args, color: bool) -> Result<Status, CliError> {
             Ok(formatted) => formatted,
             Err(diagnostics) => {
                 status = status.max(Status::Failed);
-                let report = FileReport::new(&input.name, &input.text, &diagnostics);
+                let shown =
+                    if limit > 0 && diagnostics.len() > limit { &diagnostics[..limit] } else { &diagnostics[..] };
+                let report = FileReport::new(&input.name, &input.text, shown);
                 err!("{}", human::render(&report, color))?;
+                if shown.len() < diagnostics.len() {
+                    let more = plural(diagnostics.len() - shown.len(), "more error");
+                    errln!("{}: and {more}; `--max-diagnostics 0` shows all\n", input.name)?;
+                }
                 errln!("error: `{}` has syntax errors; not formatted", input.name)?;
                 continue;
             }
