@@ -9,12 +9,14 @@
 //! instead (`bench --runtime`), [`lsp`] the language server (`--lsp`), [`llm`] the local
 //! model against llama-server (`--llm`), [`translate`] a model's faithfulness against
 //! hand-written ground truth (`--translate`); [`align`] runs the alignment recovery experiment
-//! (`--align`).
+//! (`--align`); [`hostile`] checks and formats files no one would write against a clean one
+//! (`--hostile`).
 //!
 //! Nothing here prints: each experiment returns a [`Report`], the text lines its host
 //! prints; long ones hand their progress lines to a callback as they go.
 
 pub mod align;
+pub mod hostile;
 pub mod llm;
 pub mod lsp;
 pub mod rl;

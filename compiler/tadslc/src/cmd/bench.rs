@@ -139,6 +139,16 @@ pub struct Args {
     /// Print the rows as JSON
     #[arg(long, requires = "align")]
     pub json: bool,
+    /// Check and format hostile files (a run of one bad character, deep nesting, 100k
+    /// fields, ...) against a clean file of the same size: time and peak memory
+    #[arg(long, conflicts_with_all = ["runtime", "lsp", "llm", "align", "translate", "rl"])]
+    pub hostile: bool,
+    /// Bytes per file
+    #[arg(long, value_name = "BYTES", default_value_t = 1_000_000, requires = "hostile")]
+    pub size: usize,
+    /// Measure one shape in this process and print it as JSON (what each child does)
+    #[arg(long, value_name = "I", requires = "hostile", hide = true)]
+    pub shape: Option<usize>,
 }
 
 pub fn run(args: &Args) -> Result<Status, CliError> {
@@ -147,6 +157,17 @@ pub fn run(args: &Args) -> Result<Status, CliError> {
     }
     if args.translate {
         return translate(args);
+    }
+    if args.hostile {
+        if let Some(shape) = args.shape {
+            let line = tad_bench::hostile::one(shape, args.size, args.runs)
+                .map_err(|e| CliError::usage(format!("bench --hostile: {e}")))?;
+            crate::outln!("{line}")?;
+            return Ok(Status::Ok);
+        }
+        return streamed("bench --hostile: ", |progress| {
+            tad_bench::hostile::run(&std::env::current_exe()?, args.size, args.runs, progress)
+        });
     }
     if args.lsp {
         return streamed("bench --lsp: ", |progress| {
