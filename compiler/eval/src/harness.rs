@@ -166,6 +166,8 @@ impl Plan {
                         trial: trial.index,
                         seed: trial.seed,
                         score,
+                        stop: None,
+                        index: None,
                     });
                 }
             }
@@ -201,6 +203,8 @@ pub fn held_out(kept: &[Kept], test: &[usize], drivers: &[(String, EgoSpec)]) ->
                         trial: 0,
                         seed: scene.seed,
                         score,
+                        stop: None,
+                        index: None,
                     })
                 })
                 .collect::<Vec<_>>()

@@ -144,6 +144,53 @@ pub fn picture(scene: &Scene, ego: &str, e: &Episode, format: tad_render::Format
 /// The table for people: one row per scenario and ego (aggregated over the seeds), then
 /// one per ego over all scenarios, in the paper's normalised values (value / max) and OS.
 pub fn table(scenarios: &[&str], egos: &[String], played: &[Played], mode: Mode) -> String {
+    let counted: Vec<Counted> = played
+        .iter()
+        .map(|d| Counted { scenario: d.scenario, ego: d.ego, score: &d.score, stop: d.episode.stop_reason.as_str() })
+        .collect();
+    table_of(scenarios, egos, &counted, mode)
+}
+
+/// The table of `run`'s results files merged (the shards of `run --shard --out`, each
+/// once): the table the unsharded run prints. `None` for another command's files.
+pub fn merged_table(all: &[Results]) -> Option<String> {
+    let setup = &all.first()?.setup;
+    if !setup.is_run() {
+        return None;
+    }
+    let mut rows: Vec<&Row> = all.iter().flat_map(|r| &r.rows).collect();
+    // the inputs' order, then the seed's: as the unsharded run plays them
+    rows.sort_by_key(|r| (r.index, r.seed));
+    let mut scenarios: Vec<(Option<usize>, &str)> = Vec::new();
+    for r in &rows {
+        if !scenarios.contains(&(r.index, r.scenario.as_str())) {
+            scenarios.push((r.index, r.scenario.as_str()));
+        }
+    }
+    let counted: Vec<Counted> = rows
+        .iter()
+        .filter_map(|r| {
+            Some(Counted {
+                scenario: scenarios.iter().position(|(i, name)| *i == r.index && *name == r.scenario)?,
+                ego: setup.egos.iter().position(|e| *e == r.ego)?,
+                score: &r.score,
+                stop: r.stop.as_deref().unwrap_or("-"),
+            })
+        })
+        .collect();
+    let names: Vec<&str> = scenarios.iter().map(|(_, name)| *name).collect();
+    Some(table_of(&names, &setup.egos, &counted, setup.mode()))
+}
+
+/// One episode as the table counts it.
+struct Counted<'a> {
+    scenario: usize,
+    ego: usize,
+    score: &'a EpisodeScore,
+    stop: &'a str,
+}
+
+fn table_of(scenarios: &[&str], egos: &[String], played: &[Counted], mode: Mode) -> String {
     use std::fmt::Write;
     let width = scenarios.iter().map(|s| s.len()).max().unwrap_or(8).clamp(8, 40);
     // an ego named by its file (`learned:PATH`) widens its column rather than the rows
@@ -153,7 +200,7 @@ pub fn table(scenarios: &[&str], egos: &[String], played: &[Played], mode: Mode)
         let _ = write!(out, " {:>6}", m.key);
     }
     let _ = writeln!(out, " {:>6}  stops", "OS");
-    let mut row = |label: &str, ego: &str, rows: &[&Played]| {
+    let mut row = |label: &str, ego: &str, rows: &[&Counted]| {
         let scores: Vec<EpisodeScore> = rows.iter().map(|d| d.score.clone()).collect();
         let Ok(agg) = tad_metrics::aggregate(&scores, mode) else { return };
         let _ = write!(out, "{label:<width$}  {ego:<ego_width$} {:>4}", rows.len());
@@ -165,7 +212,7 @@ pub fn table(scenarios: &[&str], egos: &[String], played: &[Played], mode: Mode)
         }
         let mut stops: Vec<(&str, usize)> = Vec::new();
         for d in rows {
-            let name = d.episode.stop_reason.as_str();
+            let name = d.stop;
             match stops.iter_mut().find(|(n, _)| *n == name) {
                 Some((_, k)) => *k += 1,
                 None => stops.push((name, 1)),
@@ -176,14 +223,14 @@ pub fn table(scenarios: &[&str], egos: &[String], played: &[Played], mode: Mode)
     };
     for (f, name) in scenarios.iter().enumerate() {
         for (e, ego) in egos.iter().enumerate() {
-            let rows: Vec<&Played> = played.iter().filter(|d| d.scenario == f && d.ego == e).collect();
+            let rows: Vec<&Counted> = played.iter().filter(|d| d.scenario == f && d.ego == e).collect();
             let name: String = name.chars().take(width).collect();
             row(&name, ego, &rows);
         }
     }
     if scenarios.len() > 1 {
         for (e, ego) in egos.iter().enumerate() {
-            let rows: Vec<&Played> = played.iter().filter(|d| d.ego == e).collect();
+            let rows: Vec<&Counted> = played.iter().filter(|d| d.ego == e).collect();
             row("all", ego, &rows);
         }
     }
@@ -198,14 +245,17 @@ pub fn table(scenarios: &[&str], egos: &[String], played: &[Played], mode: Mode)
 }
 
 /// The episodes as a results file of `eval`'s form (one region `all`, one generator
-/// `files`), for `tadslc merge`: `scenarios` named in order, `egos` as given, `seeds` the
-/// seeds each ran with.
+/// `files`), for `tadslc merge`: `scenarios` named in order, `egos` as the table names
+/// them, `seeds` the seeds each ran with; each row keeps its episode's stop and its
+/// scenario's place among all the command's inputs, so that the shards merge into the
+/// unsharded run's table.
 pub fn results(
     scenarios: &[&str],
     egos: &[String],
     seeds: std::ops::Range<u64>,
     shard: Shard,
     played: &[Played],
+    mode: Mode,
 ) -> Results {
     let rows: Vec<Row> = played
         .iter()
@@ -217,17 +267,21 @@ pub fn results(
             trial: 0,
             seed: d.episode.seed.unwrap_or(0),
             score: d.score.clone(),
+            stop: Some(d.episode.stop_reason.as_str().to_string()),
+            // the shard takes every count-th input from its index
+            index: Some(shard.index + d.scenario * shard.count),
         })
         .collect();
     let setup = Setup {
-        regions: vec!["all".into()],
-        generators: vec!["files".into()],
+        regions: vec![crate::results::RUN_REGION.into()],
+        generators: vec![crate::results::RUN_GENERATOR.into()],
         egos: egos.to_vec(),
         search_ego: String::new(),
         n: 0,
         samples: (seeds.end - seeds.start) as usize,
         keep: 0,
         seed: seeds.start,
+        compat: mode == Mode::Compat,
     };
     Results::new(setup, shard, [("all/files".to_string(), scenarios.len())].into_iter().collect(), rows)
 }

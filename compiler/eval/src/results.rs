@@ -28,7 +28,27 @@ pub struct Setup {
     pub samples: usize,
     pub keep: usize,
     pub seed: u64,
+    /// Scored as SafeBench's scorer does (`run --compat`) rather than with the fixed
+    /// formulas.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub compat: bool,
 }
+
+impl Setup {
+    /// How the rows are aggregated.
+    pub fn mode(&self) -> Mode {
+        if self.compat { Mode::Compat } else { Mode::Fixed }
+    }
+
+    /// Whether the file is `run`'s (its scenarios are files, not generated per region).
+    pub fn is_run(&self) -> bool {
+        self.regions == [RUN_REGION] && self.generators == [RUN_GENERATOR]
+    }
+}
+
+/// The region and generator of `run`'s rows: its scenarios are the files given.
+pub const RUN_REGION: &str = "all";
+pub const RUN_GENERATOR: &str = "files";
 
 /// One scored episode: an ego on one kept scene.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -41,6 +61,12 @@ pub struct Row {
     pub trial: usize,
     pub seed: u64,
     pub score: EpisodeScore,
+    /// Why the episode stopped (`run`'s rows).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stop: Option<String>,
+    /// The scenario's place among the command's inputs, whatever the shard (`run`'s rows).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub index: Option<usize>,
 }
 
 /// A results file (`results.json`, `results.I-of-N.json`).
@@ -162,7 +188,7 @@ pub fn lines(all: &[Results]) -> Vec<Line> {
                     .collect();
                 rows.sort_by(|a, b| (&a.scenario, a.trial, a.seed).cmp(&(&b.scenario, b.trial, b.seed)));
                 let scores: Vec<EpisodeScore> = rows.iter().map(|r| r.score.clone()).collect();
-                if let Ok(agg) = tad_metrics::aggregate(&scores, Mode::Fixed) {
+                if let Ok(agg) = tad_metrics::aggregate(&scores, setup.mode()) {
                     out.push(Line {
                         region: region.clone(),
                         generator: generator.clone(),
@@ -292,6 +318,7 @@ pub(crate) fn test_setup(seed: u64) -> Setup {
         samples: 1,
         keep: 1,
         seed,
+        compat: false,
     }
 }
 

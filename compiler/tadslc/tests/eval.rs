@@ -212,6 +212,17 @@ fn run_shards_write_results_that_merge() {
     assert_eq!(rows.len(), 2);
     // 8 safety scenarios × 2 seeds per ego
     assert!(rows.iter().all(|r| r["episodes"] == 16), "{}", stdout(&merged));
+    // the directory `--out` wrote merges, into the per-scenario table of the unsharded run
+    let whole = tadslc(&["run", "examples/safety", "--seeds", "0..2"], "");
+    assert_eq!(code(&whole), 0, "{}", stderr(&whole));
+    let merged = tadslc(&["merge", path(&dir)], "");
+    assert_eq!(code(&merged), 0, "{}", stderr(&merged));
+    assert_eq!(stdout(&merged), stdout(&whole), "the shards' table is the whole run's, row for row");
+    assert!(stdout(&merged).lines().filter(|l| l.contains(" idm ")).count() > 8, "{}", stdout(&merged));
+    let empty = scratch("run-shards-empty");
+    let out = tadslc(&["merge", path(&empty)], "");
+    assert_eq!(code(&out), 2);
+    assert!(stderr(&out).contains("no results files in"), "{}", stderr(&out));
 }
 
 #[test]

@@ -123,6 +123,7 @@ pub fn run(args: &EvalArgs) -> Result<Status, CliError> {
             samples: args.samples,
             keep: args.keep,
             seed: args.llm.seed,
+            compat: false,
         },
         egos,
         surrogate,

@@ -1,6 +1,7 @@
 //! `tadslc merge`: the table of several results files (`tadsl-eval/1`, the shards of one
-//! `eval --shard` or `run --shard --out` command), as the unsharded run prints it. Files
-//! of another command are refused; missing shards are a warning and status 1.
+//! `eval --shard` or `run --shard --out` command, or the directory they were written to),
+//! as the unsharded run prints it: `run`'s per-scenario table for `run`'s files. Files of
+//! another command are refused; missing shards are a warning and status 1.
 
 use std::path::{Path, PathBuf};
 
@@ -14,7 +15,7 @@ use crate::{Status, errln, out};
 /// `tadslc merge`'s arguments.
 #[derive(clap::Args)]
 pub struct Args {
-    /// The results files
+    /// The results files, or the directories `--out` wrote them in
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
     #[arg(long, value_enum, default_value_t = EvalFormat::Markdown)]
@@ -44,7 +45,8 @@ impl From<EvalFormat> for TableFormat {
 
 /// `tadslc merge FILES`: the table of several results files (the shards of one command).
 pub fn run(args: &Args) -> Result<Status, CliError> {
-    let (files, format, plot) = (&args.files, args.format, args.plot.as_deref());
+    let (format, plot) = (args.format, args.plot.as_deref());
+    let files = &results_files(&args.files)?;
     let all = files
         .iter()
         .map(|path| Results::read(path).map_err(|e| CliError::usage(format!("{}: {e}", path.display()))))
@@ -70,10 +72,49 @@ pub fn run(args: &Args) -> Result<Status, CliError> {
     Ok(status.max(print(&all, format, plot)?))
 }
 
+/// The results files `paths` name: a directory stands for those `--out` wrote in it
+/// (`results.json`, `results.I-of-N.json`), in name order.
+fn results_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>, CliError> {
+    let mut files = Vec::new();
+    for path in paths {
+        if !path.is_dir() {
+            files.push(path.clone());
+            continue;
+        }
+        let found: Vec<PathBuf> = tad_db::host::with_extension(path, "json")
+            .into_iter()
+            .filter(|p| p.parent() == Some(path.as_path()))
+            .filter(|p| p.file_name().and_then(|n| n.to_str()).is_some_and(is_results_name))
+            .collect();
+        if found.is_empty() {
+            return Err(CliError::usage(format!(
+                "no results files in `{}` (`results.json` or `results.I-of-N.json`)",
+                path.display()
+            )));
+        }
+        files.extend(found);
+    }
+    Ok(files)
+}
+
+/// `results.json` or `results.I-of-N.json`.
+fn is_results_name(name: &str) -> bool {
+    let Some(middle) = name.strip_prefix("results").and_then(|n| n.strip_suffix(".json")) else { return false };
+    middle.is_empty()
+        || middle
+            .strip_prefix('.')
+            .and_then(|m| m.split_once("-of-"))
+            .is_some_and(|(i, n)| i.parse::<usize>().is_ok() && n.parse::<usize>().is_ok())
+}
+
 /// The table of `all` on standard output, and its plot; a plot that cannot be written is
 /// reported (the table still printed) and makes the status 2.
 pub fn print(all: &[Results], format: EvalFormat, plot: Option<&Path>) -> Result<Status, Closed> {
-    out!("{}", results::table(all, format.into()))?;
+    // `run`'s shards: the per-scenario table the unsharded run prints
+    match (format, tad_eval::record::merged_table(all)) {
+        (EvalFormat::Markdown, Some(table)) => out!("{table}")?,
+        _ => out!("{}", results::table(all, format.into()))?,
+    }
     if let Some(path) = plot
         && let Err(e) = std::fs::write(path, results::plot(all))
     {

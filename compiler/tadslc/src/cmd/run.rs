@@ -169,8 +169,9 @@ pub fn run(args: &RunArgs, color: bool) -> Result<Status, CliError> {
     }
     let names: Vec<String> = policies.iter().map(|p| p.name().to_string()).collect();
     if let Some(dir) = &args.out {
-        let files: Vec<&str> = scenes.iter().map(|s| s.name.as_str()).collect();
-        if let Err(e) = record::results(&files, &egos, args.seeds.clone(), args.shard, &done).write(dir) {
+        // named as the table names them, so that `merge` prints the same table
+        let scenarios: Vec<&str> = scenes.iter().map(|s| s.scene.name.as_str()).collect();
+        if let Err(e) = record::results(&scenarios, &names, args.seeds.clone(), args.shard, &done, mode).write(dir) {
             status = Status::Usage;
             errln!("error: cannot write the results to `{}`: {e}", dir.display())?;
         }
