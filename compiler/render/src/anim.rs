@@ -1,14 +1,19 @@
-//! The animated GIF: the SVG's view fitted to the picture, one frame every `every` steps
-//! and one of the last step.
+//! The animated GIF: a title band (the scene's title, and the time), the map fitted to the
+//! same place as the SVG's, and a legend band (each kind of actor present in its colours,
+//! events, lights, and a scale bar in metres); one frame every `every` steps and one of the
+//! last step. It is [`palette::GIF_WIDTH`] pixels wide (at least
+//! [`palette::GIF_MIN_WIDTH`]), as high as the view's aspect asks unless told a height.
 //!
-//! The road (and the route) is rasterised once with `tiny-skia`; each frame copies it and
-//! adds the lights' current colours, the events that have happened, every actor present as
-//! a filled rotated rectangle (dark at its front) in its kind's colour, the time (`t = 4.2
-//! s`, in the built-in bitmap font of `font`) and a progress bar. Drawing without
-//! anti-aliasing keeps every pixel in the palette's colours, so frames index the GIF's one
-//! global colour table exactly. Each frame after the first holds only the rectangle that
-//! changed, unchanged pixels in it transparent: a 300-step episode at every second step is
-//! a few hundred kilobytes. The last frame is held a little longer.
+//! The road (and the route) is rasterised once with `tiny-skia`, the bands too; each frame
+//! copies that and adds the lights' current colours, the events that have happened (hollow
+//! rings), the ego's trail so far, every actor present as a filled rotated rectangle (dark
+//! at its front) in its kind's colour, the ego last with a white halo, at least
+//! [`palette::GIF_EGO_MIN_PX`] long and named, the time and a progress bar. Text is set in
+//! `font`'s bitmap. Drawing without anti-aliasing keeps every pixel in the palette's
+//! colours, so frames index the GIF's one global colour table exactly. Each frame after the
+//! first holds only the rectangle that changed, unchanged pixels in it transparent, and is
+//! encoded as soon as it is drawn: a 300-step episode at every second step is a few hundred
+//! kilobytes. The last frame is held a little longer.
 
 use crate::map::{self, Item};
 use crate::palette::{self, Colour};
@@ -25,8 +30,8 @@ const HOLD: f64 = 1.5;
 
 /// The animation of a scene: see the module's header.
 pub fn gif(scene: &Scene, options: GifOptions) -> Vec<u8> {
-    let (w, h) = size(options);
-    let frames = frames(scene, options);
+    let layout = layout(scene, options);
+    let (w, h) = (layout.width, layout.height);
     let table = palette::all();
     let index: HashMap<Colour, u8> = table.iter().enumerate().map(|(i, c)| (*c, i as u8)).collect();
     let transparent = table.len() as u8;
@@ -41,9 +46,13 @@ pub fn gif(scene: &Scene, options: GifOptions) -> Vec<u8> {
         return Vec::new();
     }
     let mut previous: Option<Vec<u8>> = None;
-    let count = frames.len();
+    let count = steps(scene, options).len().max(1);
     let mut nearest: HashMap<[u8; 3], u8> = HashMap::new();
-    for (k, pixmap) in frames.into_iter().enumerate() {
+    let mut failed = false;
+    each_frame(scene, options, |k, pixmap| {
+        if failed {
+            return;
+        }
         let indices: Vec<u8> = pixmap
             .pixels()
             .iter()
@@ -63,18 +72,38 @@ pub fn gif(scene: &Scene, options: GifOptions) -> Vec<u8> {
         };
         frame.delay = if k + 1 == count { hold } else { delay };
         frame.dispose = ::gif::DisposalMethod::Keep;
-        if encoder.write_frame(&frame).is_err() {
-            return Vec::new();
-        }
+        failed = encoder.write_frame(&frame).is_err();
         previous = Some(indices);
-    }
+    });
     drop(encoder);
-    out
+    if failed { Vec::new() } else { out }
 }
 
-/// The picture's size, clamped to what a GIF holds.
-fn size(options: GifOptions) -> (u32, u32) {
-    (options.width.clamp(16, MAX_SIDE), options.height.clamp(16, MAX_SIDE))
+/// Where the GIF's parts go: its size, px, the title band's and the legend band's height,
+/// and the map's view between them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Layout {
+    pub width: u32,
+    pub height: u32,
+    pub band: u32,
+    pub view: View,
+}
+
+/// The GIF's layout: `options.width` (at least [`palette::GIF_MIN_WIDTH`]) wide, and
+/// `options.height` high, or (0) as high as the view's aspect asks.
+pub fn layout(scene: &Scene, options: GifOptions) -> Layout {
+    let width = options.width.clamp(palette::GIF_MIN_WIDTH, MAX_SIDE);
+    let band = palette::GIF_BAND_PX;
+    let focus = view::focus(scene);
+    let aspect = (focus.width() / focus.height().max(1e-6)).clamp(1.0 / 1.25, palette::MAX_ASPECT);
+    let map = if options.height == 0 {
+        (width as f64 / aspect).round() as u32
+    } else {
+        options.height.saturating_sub(2 * band)
+    };
+    let map = map.clamp(16, MAX_SIDE - 2 * band);
+    let view = View::fit(focus, 0.0, band as f64, width as f64, map as f64);
+    Layout { width, height: map + 2 * band, band, view }
 }
 
 /// The palette entry nearest a colour.
@@ -129,13 +158,15 @@ fn changed(before: &[u8], now: &[u8], w: u32, h: u32, transparent: u8) -> ::gif:
 /// happened, the time.
 pub fn png(scene: &Scene, options: GifOptions) -> Vec<u8> {
     let last = GifOptions { every: usize::MAX, ..options };
-    frames(scene, last).pop().and_then(|pixmap| pixmap.encode_png().ok()).unwrap_or_default()
+    let mut picture = None;
+    each_frame(scene, last, |_, pixmap| picture = Some(pixmap));
+    picture.and_then(|pixmap| pixmap.encode_png().ok()).unwrap_or_default()
 }
 
-/// The view the GIF shows.
+/// The view the GIF's map shows.
+#[cfg(test)]
 pub fn view_of(scene: &Scene, options: GifOptions) -> View {
-    let (w, h) = size(options);
-    View::fit(view::focus(scene), 0.0, 0.0, w as f64, h as f64)
+    layout(scene, options).view
 }
 
 /// The steps drawn: every `every`th from the first, and the last.
@@ -148,27 +179,46 @@ pub fn steps(scene: &Scene, options: GifOptions) -> Vec<usize> {
     steps
 }
 
-/// Every frame of the animation as pixels; a scene without frames gives one of the road.
-/// Bodies are drawn at least [`palette::GIF_MIN_BODY_PX`] a side, so walkers seen from
-/// afar stay visible.
+/// Every frame of the animation as pixels (for tests; `gif` encodes each as it is drawn).
+#[cfg(test)]
 pub fn frames(scene: &Scene, options: GifOptions) -> Vec<Pixmap> {
-    let (w, h) = size(options);
-    let view = view_of(scene, options);
-    let Some(mut ground) = Pixmap::new(w, h) else { return Vec::new() };
-    let mut r = Raster { pixmap: &mut ground, view };
+    let mut out = Vec::new();
+    each_frame(scene, options, |_, pixmap| out.push(pixmap));
+    out
+}
+
+/// The picture without what changes: the bands, the road, the route.
+fn ground(scene: &Scene, layout: &Layout) -> Option<(Pixmap, map::Map)> {
+    let mut ground = Pixmap::new(layout.width, layout.height)?;
+    let mut r = Raster { pixmap: &mut ground, view: layout.view };
     r.pixmap.fill(colour(palette::BACKGROUND));
-    let map = map::draw(scene, &view.bounds);
+    let map = map::draw(scene, &layout.view.bounds);
     for item in &map.items {
         r.item(item);
     }
     let route: Vec<Vec2> =
         scene.route.iter().map(|p| Vec2::new(p[0], p[1])).filter(|p| p.x.is_finite() && p.y.is_finite()).collect();
     r.line(&route, palette::ROUTE, palette::ROUTE_WIDTH, Some(palette::ROUTE_DASH));
+    let (w, band) = (layout.width, layout.band);
+    r.rect(0, 0, w, band, palette::PAPER);
+    r.rect(0, layout.height - band, w, band, palette::PAPER);
+    r.rect(0, band - 1, w, 1, palette::FRAME);
+    r.rect(0, layout.height - band, w, 1, palette::FRAME);
+    r.text(palette::GIF_PAD_PX, (band - crate::font::HEIGHT) / 2, &scene.title, palette::INK);
+    legend(&mut r, scene, &map, layout);
+    Some((ground, map))
+}
 
+/// Calls `each` with every frame drawn (its number and pixels); a scene without frames
+/// gives one of the road. Bodies are drawn at least [`palette::GIF_MIN_BODY_PX`] a side, so
+/// walkers seen from afar stay visible.
+fn each_frame(scene: &Scene, options: GifOptions, mut each: impl FnMut(usize, Pixmap)) {
+    let layout = layout(scene, options);
+    let view = layout.view;
+    let Some((ground, map)) = ground(scene, &layout) else { return };
     let steps = steps(scene, options);
     let total = scene.frames.len().saturating_sub(1).max(1);
-    let mut out = Vec::new();
-    for &step in steps.iter().chain(steps.is_empty().then_some(&0)) {
+    for (k, &step) in steps.iter().chain(steps.is_empty().then_some(&0)).enumerate() {
         let mut pixmap = ground.clone();
         let mut r = Raster { pixmap: &mut pixmap, view };
         if let Some(frame) = scene.frames.get(step) {
@@ -179,33 +229,79 @@ pub fn frames(scene: &Scene, options: GifOptions) -> Vec<Pixmap> {
                 }
             }
         }
-        for e in scene.events.iter().filter(|e| e.step <= step) {
-            let p = Vec2::new(e.position[0], e.position[1]);
-            let s = palette::EVENT_RADIUS;
-            let diamond = |s: f64| {
-                vec![p + Vec2::new(s, 0.0), p + Vec2::new(0.0, s), p - Vec2::new(s, 0.0), p - Vec2::new(0.0, s)]
-            };
-            r.area(&diamond(s * 1.25), palette::EVENT_EDGE);
-            r.area(&diamond(s), palette::EVENT);
+        let trail: Vec<Vec2> = (0..=step).filter_map(|f| scene.pose(f, 0)).map(|[x, y, _]| Vec2::new(x, y)).collect();
+        if !scene.actors.is_empty() && trail.len() > 1 {
+            r.line(&trail, palette::kind(crate::Kind::Ego).fill, palette::kind(crate::Kind::Ego).trail, None);
         }
         // the ego last, on top
         for a in (1..scene.actors.len()).chain((!scene.actors.is_empty()).then_some(0)) {
             let Some(pose) = scene.pose(step, a) else { continue };
-            let least = palette::GIF_MIN_BODY_PX / view.scale;
-            let (length, width) = scene.size(a);
-            let (length, width) = (length.max(least), width.max(least));
-            let style = palette::kind(scene.kind(a));
-            let body = view::body(pose, length, width);
-            r.area(&body.corners(), style.fill);
-            r.area(&crate::svg::front(&body), style.dark);
+            r.actor(scene, a, pose);
+        }
+        for e in scene.events.iter().filter(|e| e.step <= step) {
+            let p = Vec2::new(e.position[0], e.position[1]);
+            r.ring(p, palette::EVENT_RADIUS, palette::EVENT_STROKE * 1.8, palette::EVENT_EDGE);
+            r.ring(p, palette::EVENT_RADIUS, palette::EVENT_STROKE, palette::EVENT);
+        }
+        if let Some(pose) = scene.pose(step, 0).filter(|_| !scene.actors.is_empty()) {
+            r.tag(Vec2::new(pose[0], pose[1]), &scene.actors[0].label);
         }
         let dt = scene.step();
-        let label = if dt > 0.0 { format!("t = {:.1} s", step as f64 * dt) } else { format!("{step}") };
-        r.label(&label);
-        r.progress(step as f64 / total as f64);
-        out.push(pixmap);
+        let label = if dt > 0.0 { format!("t = {:.1} s", step as f64 * dt) } else { format!("step {step}") };
+        let tw = crate::font::width(&label);
+        r.text(
+            layout.width.saturating_sub(tw + palette::GIF_PAD_PX),
+            (layout.band - crate::font::HEIGHT) / 2,
+            &label,
+            palette::INK,
+        );
+        r.progress(layout.height - layout.band, step as f64 / total as f64);
+        each(k, pixmap);
     }
-    out
+}
+
+/// The legend band: each kind present (a body in its colours and its name), events and
+/// lights when there are some, and a scale bar at the right end.
+fn legend(r: &mut Raster, scene: &Scene, map: &map::Map, layout: &Layout) {
+    let y = layout.height - layout.band;
+    let mid = y + layout.band / 2;
+    let text_y = y + (layout.band - crate::font::HEIGHT) / 2 + 1;
+    let mut x = palette::GIF_PAD_PX;
+    for k in crate::Kind::ALL {
+        if (0..scene.actors.len()).any(|a| scene.kind(a) == k) {
+            let st = palette::kind(k);
+            r.rect(x, mid - 4, 18, 9, st.fill);
+            r.rect(x + 14, mid - 4, 4, 9, st.dark);
+            x += 22;
+            r.text(x, text_y, st.name, palette::INK);
+            x += crate::font::width(st.name) + 14;
+        }
+    }
+    if !scene.events.is_empty() {
+        r.rect(x, mid - 6, 12, 12, palette::EVENT_EDGE);
+        r.rect(x + 2, mid - 4, 8, 8, palette::EVENT);
+        r.rect(x + 4, mid - 2, 4, 4, palette::PAPER);
+        x += 16;
+        r.text(x, text_y, "event", palette::INK);
+        x += crate::font::width("event") + 14;
+    }
+    if !map.signals.is_empty() && scene.frames.iter().any(|f| !f.lights.is_empty()) {
+        for l in crate::LIGHTS.iter().filter(|l| scene.frames.iter().any(|f| f.lights.iter().any(|(_, x)| x == *l))) {
+            r.rect(x, mid - 4, 9, 9, palette::light(*l));
+            x += 12;
+        }
+        x += 2;
+        r.text(x, text_y, "lights", palette::INK);
+    }
+    let metres = crate::svg::nice_length(palette::SCALE_BAR_PX / layout.view.scale.max(1e-9));
+    let len = (metres * layout.view.scale).round().max(1.0) as u32;
+    let words = format!("{metres} m");
+    let right = layout.width.saturating_sub(palette::GIF_PAD_PX + crate::font::width(&words));
+    r.text(right, text_y, &words, palette::INK);
+    let x0 = right.saturating_sub(len + 6);
+    r.rect(x0, mid + 2, len, 2, palette::INK);
+    r.rect(x0, mid - 4, 2, 8, palette::INK);
+    r.rect(x0 + len.saturating_sub(2), mid - 4, 2, 8, palette::INK);
 }
 
 fn colour(c: Colour) -> tiny_skia::Color {
@@ -285,22 +381,61 @@ impl Raster<'_> {
         }
     }
 
-    /// Text in the top left corner, on paper.
-    fn label(&mut self, text: &str) {
-        let k = palette::GIF_FONT_SCALE;
-        let pad = 3;
-        self.rect(0, 0, crate::font::width(text) * k + 2 * pad, crate::font::HEIGHT * k + 2 * pad, palette::PAPER);
-        for (x, y) in crate::font::pixels(text) {
-            self.rect(pad + x * k, pad + y * k, k, k, palette::INK);
+    /// Text in the font's bitmap, its top-left corner at `(x, y)`.
+    fn text(&mut self, x: u32, y: u32, text: &str, c: Colour) {
+        for (px, py) in crate::font::pixels(text) {
+            self.rect(x + px, y + py, 1, 1, c);
         }
     }
 
-    /// A bar along the bottom edge, `done` of it filled.
-    fn progress(&mut self, done: f64) {
-        let (w, h) = (self.pixmap.width(), self.pixmap.height());
-        let bar = palette::GIF_BAR_PX.min(h);
-        self.rect(0, h - bar, w, bar, palette::PAPER);
+    /// An actor's body at a pose, at least [`palette::GIF_MIN_BODY_PX`] a side; the ego at
+    /// least [`palette::GIF_EGO_MIN_PX`] long, with a halo.
+    fn actor(&mut self, scene: &Scene, a: usize, pose: [f64; 3]) {
+        let least = palette::GIF_MIN_BODY_PX / self.view.scale;
+        let (length, width) = scene.size(a);
+        let (mut length, width) = (length.max(least), width.max(least));
+        if a == 0 {
+            length = length.max(palette::GIF_EGO_MIN_PX / self.view.scale);
+            let halo = palette::GIF_HALO_PX as f64 / self.view.scale;
+            let around = view::body(pose, length + 2.0 * halo, width + 2.0 * halo);
+            self.area(&around.corners(), palette::PAPER);
+        }
+        let style = palette::kind(scene.kind(a));
+        let body = view::body(pose, length, width);
+        self.area(&body.corners(), style.fill);
+        self.area(&crate::svg::front(&body), style.dark);
+    }
+
+    /// A ring of `radius` m, `width` m wide.
+    fn ring(&mut self, centre: Vec2, radius: f64, width: f64, c: Colour) {
+        let (x, y) = self.view.px(centre);
+        let r = (radius * self.view.scale).max(2.0);
+        let Some(path) = PathBuilder::from_circle(x as f32, y as f32, r as f32) else { return };
+        let stroke = Stroke { width: (width * self.view.scale).max(1.0) as f32, ..Stroke::default() };
+        self.pixmap.stroke_path(&path, &paint(c), &stroke, Transform::identity(), None);
+    }
+
+    /// A name on paper above a point, kept inside the map.
+    fn tag(&mut self, at: Vec2, text: &str) {
+        let (x, y) = self.view.px(at);
+        let (w, h) = (crate::font::width(text) + 4, crate::font::HEIGHT + 2);
+        let top = self.view.top as u32;
+        let bottom = (self.view.top + self.view.height()) as u32;
+        let right = self.pixmap.width().saturating_sub(w);
+        let tx = ((x - w as f64 / 2.0).round().max(0.0) as u32).min(right);
+        let ring = (palette::EVENT_RADIUS + palette::EVENT_STROKE) * self.view.scale;
+        let lift = palette::GIF_EGO_MIN_PX.max(ring) + 2.0 + h as f64;
+        let ty = ((y - lift).round().max(top as f64) as u32).min(bottom.saturating_sub(h));
+        self.rect(tx, ty, w, h, palette::PAPER);
+        self.text(tx + 2, ty + 1, text, palette::INK);
+    }
+
+    /// A bar along the map's bottom edge (ending at row `bottom`), `done` of it filled.
+    fn progress(&mut self, bottom: u32, done: f64) {
+        let w = self.pixmap.width();
+        let bar = palette::GIF_BAR_PX.min(bottom);
+        self.rect(0, bottom - bar, w, bar, palette::PAPER);
         let filled = (done.clamp(0.0, 1.0) * w as f64).round() as u32;
-        self.rect(0, h - bar, filled, bar, palette::ROUTE);
+        self.rect(0, bottom - bar, filled, bar, palette::ROUTE);
     }
 }

@@ -4,8 +4,10 @@
 //! The input is plain data ([`Scene`]): the layout's abstract road, what each actor is, and
 //! one [`Frame`] of poses and light states per simulation step. Nothing here knows the
 //! runtime; whoever simulates fills a `Scene`. Both pictures are built from one list of
-//! shapes in metres (`map`: the road; `view`: the window onto it), then written as SVG
-//! elements or rasterised; colours and sizes come from [`palette`] only.
+//! shapes in metres (`map`: the road; `view`: the window onto it, fitted to where things
+//! happen), then written as SVG elements or rasterised; the SVG's labels are placed apart
+//! and inside the map by `label`, the GIF's text set in `font`'s bitmap; colours and sizes
+//! come from [`palette`] only.
 //!
 //! Rendering is total: missing poses, non-finite numbers, empty scenes and odd options give
 //! a picture (perhaps an empty road), never a panic. The SVG's numbers have fixed precision,
@@ -13,6 +15,7 @@
 
 mod anim;
 mod font;
+mod label;
 mod map;
 pub mod palette;
 mod svg;
@@ -122,8 +125,9 @@ pub struct Event {
     pub label: String,
 }
 
-/// How to animate: the picture's size in pixels, every how many frames one is drawn, and
-/// how many are shown per second.
+/// How to animate: the picture's width in pixels (at least [`palette::GIF_MIN_WIDTH`]) and
+/// height (0: as the view's aspect asks), every how many frames one is drawn, and how many
+/// are shown per second.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct GifOptions {
     pub width: u32,
@@ -134,7 +138,7 @@ pub struct GifOptions {
 
 impl Default for GifOptions {
     fn default() -> GifOptions {
-        GifOptions { width: 480, height: 480, every: 2, fps: 10 }
+        GifOptions { width: palette::GIF_WIDTH, height: 0, every: 2, fps: 10 }
     }
 }
 

@@ -117,32 +117,52 @@ pub const TICK_LONG: f64 = 2.2;
 pub const OUTLINE: f64 = 0.2;
 /// The share of a body's length painted dark at its front.
 pub const FRONT: f64 = 0.22;
-/// An event marker's radius.
-pub const EVENT_RADIUS: f64 = 1.3;
+/// An event's ring: its radius and its stroke (hollow, so what collided stays visible).
+pub const EVENT_RADIUS: f64 = 1.6;
+pub const EVENT_STROKE: f64 = 0.35;
 /// The smallest a body is drawn (walkers seen from afar), m.
 pub const MIN_BODY: f64 = 0.5;
 
 // --- the view
-/// The margin round what moved, m, and the view's least extent, m.
-pub const MARGIN: f64 = 8.0;
-pub const MIN_VIEW: f64 = 40.0;
+/// The margin round what happened, m, and the view's least extent, m.
+pub const MARGIN: f64 = 5.0;
+pub const MIN_VIEW: f64 = 20.0;
 /// The SVG map's longer side, px, and its greatest aspect ratio.
 pub const MAP_PX: f64 = 900.0;
-pub const MAX_ASPECT: f64 = 2.5;
-/// The SVG's title band, legend panel and padding, px.
+pub const MAX_ASPECT: f64 = 3.5;
+/// The SVG's title band and padding, px.
 pub const TITLE_PX: f64 = 36.0;
-pub const LEGEND_PX: f64 = 250.0;
 pub const PAD_PX: f64 = 12.0;
 pub const FONT_PX: f64 = 12.0;
 pub const TITLE_FONT_PX: f64 = 16.0;
-pub const LABEL_FONT_PX: f64 = 10.0;
-/// The scale bar's length, m.
-pub const SCALE_BAR: f64 = 10.0;
+pub const LABEL_FONT_PX: f64 = 11.0;
+/// Time marks' text ("4 s") and the least distance between two on a trajectory, px.
+pub const TIME_FONT_PX: f64 = 9.0;
+pub const TIME_GAP_PX: f64 = 48.0;
+/// Actors of one group (`parked[0]`, `parked[1]`…) this near each other share a label, m.
+pub const GROUP_M: f64 = 9.0;
+/// A text's width per character, in font sizes (wide enough for DejaVu Sans, the usual
+/// stand-in for Helvetica), for placing labels without measuring glyphs.
+pub const CHAR_EM: f64 = 0.62;
+/// The legend below the map: a row's height, a symbol's width, the gap between columns, px.
+pub const LEGEND_ROW_PX: f64 = 20.0;
+pub const LEGEND_SYMBOL_PX: f64 = 28.0;
+pub const LEGEND_GAP_PX: f64 = 24.0;
+/// Scale bars are this long at most, px; their lengths are 1, 2 or 5 times a power of ten, m.
+pub const SCALE_BAR_PX: f64 = 120.0;
 
 // --- the GIF
-/// The time label's glyph scale (pixels per font pixel) and the progress bar's height, px.
-pub const GIF_FONT_SCALE: u32 = 2;
+/// The picture's width and least width, px (its height follows the view's aspect).
+pub const GIF_WIDTH: u32 = 800;
+pub const GIF_MIN_WIDTH: u32 = 720;
+/// The title band's and the legend band's height, px, and text's padding in them.
+pub const GIF_BAND_PX: u32 = 24;
+pub const GIF_PAD_PX: u32 = 6;
+/// The progress bar's height, px.
 pub const GIF_BAR_PX: u32 = 4;
 /// The thinnest a line is drawn in the GIF, and the smallest a body, px.
 pub const GIF_MIN_PX: f32 = 1.0;
 pub const GIF_MIN_BODY_PX: f64 = 4.0;
+/// The ego is drawn at least this long, with a halo this wide round it, px.
+pub const GIF_EGO_MIN_PX: f64 = 12.0;
+pub const GIF_HALO_PX: f32 = 2.0;

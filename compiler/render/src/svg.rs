@@ -1,12 +1,21 @@
-//! The SVG figure: the title above, the map (road, route, trajectories with a tick each
-//! second, every actor at its first pose outlined and at its last filled, signals, events,
-//! a scale bar) and a legend panel to its right.
+//! The SVG figure: the title with a scale bar above, the map (road, route, trajectories
+//! with a tick each second, every actor at its first pose outlined and at its last filled,
+//! signals, events as hollow rings), the labels over it, and the legend below it.
+//!
+//! The map is fitted to where things happen (`view`); what leaves it is clipped at its
+//! frame. Labels are placed last, above everything, by `label`: events first, then each
+//! actor (the ego first; actors of one group standing together, like `parked[0]` to
+//! `parked[4]`, share one label `parked[0–4]`), then time marks (`4 s`) along the
+//! trajectories, which are dropped where there is no free room. No two labels overlap and
+//! each lies inside the map; each `<text>` carries its box as `data-box="x y w h"`.
 //!
 //! Coordinates are written in pixels (the `View` flips `y`), one decimal each, so text is
 //! never mirrored and the same scene gives the same bytes. Elements carry classes (`road`
-//! items by role, `actor-start`, `actor-end`, `trajectory`, `route`, `signal`, `event`) and
-//! each actor's group the id `actor-N`, for tests and for readers who restyle the figure.
+//! items by role, `actor-start`, `actor-end`, `trajectory`, `ticks`, `route`, `signal`,
+//! `event`, `label`, `event-label`, `time-label`, `leader`) and each actor's group the id
+//! `actor-N`, for tests and for readers who restyle the figure.
 
+use crate::label::{self, Placed, Rect, Request};
 use crate::map::{self, Item};
 use crate::palette;
 use crate::view::{self, Bounds, View};
@@ -95,8 +104,8 @@ impl Svg<'_> {
     }
 }
 
-/// The map's view: what moved, at most [`palette::MAX_ASPECT`] times as wide as high (or
-/// high as wide), its longer side [`palette::MAP_PX`] pixels.
+/// The map's view: where things happen, at most [`palette::MAX_ASPECT`] times as wide as
+/// high (or high as wide), its longer side [`palette::MAP_PX`] pixels.
 pub fn view_of(scene: &Scene) -> View {
     let bounds = view::focus(scene);
     let (w, h) = (bounds.width(), bounds.height());
@@ -108,10 +117,10 @@ pub fn view_of(scene: &Scene) -> View {
 /// The SVG figure of a scene: see the module's header.
 pub fn svg(scene: &Scene) -> String {
     let view = view_of(scene);
-    let legend = legend_entries(scene);
-    let legend_h = palette::PAD_PX * 2.0 + legend.len() as f64 * palette::FONT_PX * 1.8;
-    let width = palette::PAD_PX * 3.0 + view.width() + palette::LEGEND_PX;
-    let height = palette::TITLE_PX + view.height().max(legend_h) + palette::PAD_PX;
+    let (mx, my, mw, mh) = (view.left, view.top, view.width(), view.height());
+    let legend = Legend::new(legend_entries(scene), mw);
+    let width = palette::PAD_PX * 2.0 + mw;
+    let height = my + mh + legend.height + palette::PAD_PX;
 
     let mut s = Svg { out: String::new(), view, scene };
     s.push("<?xml version=\"1.0\" encoding=\"UTF-8\"?>");
@@ -131,7 +140,7 @@ pub fn svg(scene: &Scene) -> String {
         palette::INK.hex(),
         text(&scene.title)
     ));
-    let (mx, my, mw, mh) = (view.left, view.top, view.width(), view.height());
+    scale_bar(&mut s, mx + mw);
     s.push(&format!(
         "<defs><clipPath id=\"map-clip\"><rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\"/></clipPath></defs>",
         n(mx),
@@ -158,7 +167,6 @@ pub fn svg(scene: &Scene) -> String {
     actors(&mut s);
     signals(&mut s, &map.signals);
     events(&mut s);
-    scale_bar(&mut s);
     s.push("</g>");
     s.push(&format!(
         "<rect class=\"frame\" x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"1\"/>",
@@ -168,7 +176,8 @@ pub fn svg(scene: &Scene) -> String {
         n(mh),
         palette::FRAME.hex()
     ));
-    draw_legend(&mut s, &legend, mx + mw + palette::PAD_PX, my, legend_h);
+    labels(&mut s, &map.signals);
+    legend.draw(&mut s, mx, my + mh + palette::PAD_PX);
     s.push("</svg>");
     s.out
 }
@@ -211,7 +220,7 @@ fn runs(points: &[Vec2], window: &Bounds) -> Vec<Vec<Vec2>> {
 }
 
 /// Each actor's trajectory (a polyline per stretch it is present), its second ticks, its
-/// first pose outlined and its last filled, and its label; the ego last, on top.
+/// first pose outlined and its last filled; the ego last, on top. Labels come later.
 fn actors(s: &mut Svg) {
     let scene = s.scene;
     let dt = scene.step();
@@ -317,19 +326,6 @@ fn actors(s: &mut Svg) {
             style.dark.hex()
         );
         s.push(&line);
-        // the label beside the last pose
-        let (px, py) = s.view.px(end.pose.position);
-        let off = (length.max(width) / 2.0) * s.view.scale + 3.0;
-        let line = format!(
-            "<text class=\"label\" x=\"{}\" y=\"{}\" font-size=\"{}\" fill=\"{}\" stroke=\"{}\" stroke-width=\"3\" paint-order=\"stroke\" stroke-linejoin=\"round\">{}</text>",
-            n(px + off),
-            n(py - off),
-            n(palette::LABEL_FONT_PX),
-            style.dark.hex(),
-            palette::PAPER.hex(),
-            text(&scene.actors[a].label)
-        );
-        s.push(&line);
         s.push("</g>");
     }
     s.push("</g>");
@@ -382,60 +378,264 @@ fn signals(s: &mut Svg, places: &[(tad_road::Arm, Vec2)]) {
     s.push("</g>");
 }
 
-/// A diamond for each event, labelled with what happened and when.
+/// A hollow ring round each event (what collided stays visible inside it): dark under
+/// bright. Its words are a label.
 fn events(s: &mut Svg) {
     let scene = s.scene;
-    let dt = scene.step();
     s.push("<g class=\"events\">");
     for e in &scene.events {
         let p = Vec2::new(e.position[0], e.position[1]);
         if !(p.x.is_finite() && p.y.is_finite()) {
             continue;
         }
-        let r = palette::EVENT_RADIUS;
-        let diamond = [p + Vec2::new(r, 0.0), p + Vec2::new(0.0, r), p - Vec2::new(r, 0.0), p - Vec2::new(0.0, r)];
-        let line = format!(
-            "<polygon class=\"event\" points=\"{}\" fill=\"{}\" stroke=\"{}\" stroke-width=\"{}\"/>",
-            s.pts(&diamond),
-            palette::EVENT.hex(),
-            palette::EVENT_EDGE.hex(),
-            s.m(0.2)
-        );
-        s.push(&line);
-        let when = if dt > 0.0 { format!(" @ {:.1} s", e.step as f64 * dt) } else { format!(" @ step {}", e.step) };
         let (x, y) = s.view.px(p);
-        let off = r * s.view.scale + 3.0;
+        for (class, colour, width) in [
+            ("event-edge", palette::EVENT_EDGE, palette::EVENT_STROKE * 1.8),
+            ("event", palette::EVENT, palette::EVENT_STROKE),
+        ] {
+            let line = format!(
+                "<circle class=\"{class}\" cx=\"{}\" cy=\"{}\" r=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"{}\"/>",
+                n(x),
+                n(y),
+                s.m(palette::EVENT_RADIUS),
+                colour.hex(),
+                s.m(width)
+            );
+            s.push(&line);
+        }
+    }
+    s.push("</g>");
+}
+
+/// What an event's label says: what happened and when.
+fn event_text(scene: &Scene, e: &crate::Event) -> String {
+    let dt = scene.step();
+    if dt > 0.0 {
+        format!("{}, t = {:.1} s", e.label, e.step as f64 * dt)
+    } else {
+        format!("{}, step {}", e.label, e.step)
+    }
+}
+
+/// `name[3]` → (`name`, 3); other labels have no index.
+fn indexed(label: &str) -> Option<(&str, usize)> {
+    let (base, rest) = label.rsplit_once('[')?;
+    Some((base, rest.strip_suffix(']')?.parse().ok()?))
+}
+
+/// One actor label: what it says, in which kind's colour, and the box (px) it names.
+struct Named {
+    text: String,
+    kind: Kind,
+    anchor: Rect,
+    /// The first actor it names.
+    first: usize,
+}
+
+/// An actor, where its label would stand (px) and its body's box there.
+type Single = (usize, (f64, f64), Rect);
+
+/// The actors' labels: each at its last pose inside the view; actors of one group whose
+/// labels would stand within [`palette::GROUP_M`] of each other share one.
+fn actor_labels(s: &Svg) -> Vec<Named> {
+    let scene = s.scene;
+    let mut singles: Vec<Single> = Vec::new();
+    let mut order: Vec<usize> = (0..scene.actors.len()).collect();
+    order.sort_by_key(|&a| a != 0);
+    for a in order {
+        let Some(pose) = (0..scene.frames.len())
+            .rev()
+            .filter_map(|f| scene.pose(f, a))
+            .find(|p| s.view.bounds.contains(Vec2::new(p[0], p[1])))
+        else {
+            continue;
+        };
+        let (length, width) = scene.size(a);
+        let corners = view::body(pose, length, width).corners().map(|c| s.view.px(c));
+        let Some(body) = Rect::bounding(corners) else { continue };
+        singles.push((a, s.view.px(Vec2::new(pose[0], pose[1])), body));
+    }
+    let mut groups: Vec<Vec<Single>> = Vec::new();
+    for single in singles {
+        let (a, at, _) = single;
+        let key = indexed(&scene.actors[a].label).map(|(b, _)| b);
+        let joins = groups.iter_mut().find(|g| {
+            let (b, _, _) = g[0];
+            b != 0
+                && a != 0
+                && key.is_some()
+                && indexed(&scene.actors[b].label).map(|(k, _)| k) == key
+                && scene.kind(a) == scene.kind(b)
+                && g.iter().any(|m| (m.1.0 - at.0).hypot(m.1.1 - at.1) < palette::GROUP_M * s.view.scale)
+        });
+        match joins {
+            Some(g) => g.push(single),
+            None => groups.push(vec![single]),
+        }
+    }
+    groups
+        .into_iter()
+        .filter_map(|g| {
+            let corners = g.iter().flat_map(|m| [(m.2.x, m.2.y), (m.2.x + m.2.w, m.2.y + m.2.h)]);
+            let anchor = Rect::bounding(corners)?;
+            let text = group_text(scene, &g.iter().map(|m| m.0).collect::<Vec<_>>());
+            Some(Named { text, kind: scene.kind(g[0].0), anchor, first: g[0].0 })
+        })
+        .collect()
+}
+
+/// A group's label: `name[0–4]` for a run of indices, `name[0, 2]` otherwise.
+fn group_text(scene: &Scene, members: &[usize]) -> String {
+    let first = &scene.actors[members[0]].label;
+    let mut indices: Vec<usize> =
+        members.iter().filter_map(|&m| indexed(&scene.actors[m].label)).map(|x| x.1).collect();
+    let Some((base, _)) = indexed(first).filter(|_| members.len() > 1) else { return first.clone() };
+    indices.sort_unstable();
+    let (lo, hi) = (indices[0], indices[indices.len() - 1]);
+    if hi - lo + 1 == indices.len() {
+        format!("{base}[{lo}–{hi}]")
+    } else {
+        let list: Vec<String> = indices.iter().map(usize::to_string).collect();
+        format!("{base}[{}]", list.join(", "))
+    }
+}
+
+/// Time marks along the trajectories of `actors` that moved, the ego's first: whole
+/// seconds, every 1, 2, 5, 10… s, whichever puts them about [`palette::TIME_GAP_PX`] apart.
+fn time_marks(s: &Svg, actors: &[usize]) -> Vec<(Request, Kind)> {
+    let scene = s.scene;
+    let dt = scene.step();
+    let mut out = Vec::new();
+    if dt <= 0.0 {
+        return out;
+    }
+    let mut order: Vec<usize> = actors.to_vec();
+    order.sort_by_key(|&a| (a != 0, a));
+    for a in order {
+        let mut ticks: Vec<(i64, (f64, f64), f64)> = Vec::new();
+        let mut previous_second = 0i64;
+        for f in 0..scene.frames.len() {
+            let Some([x, y, yaw]) = scene.pose(f, a) else { continue };
+            let second = (f as f64 * dt + 1e-9).floor() as i64;
+            if f == 0 || second > previous_second {
+                ticks.push((second, s.view.px(Vec2::new(x, y)), yaw));
+            }
+            previous_second = second;
+        }
+        let mut steps: Vec<f64> = ticks.windows(2).map(|w| (w[1].1.0 - w[0].1.0).hypot(w[1].1.1 - w[0].1.1)).collect();
+        steps.sort_by(f64::total_cmp);
+        let Some(&median) = steps.get(steps.len() / 2).filter(|m| **m > 0.5) else { continue };
+        let every =
+            [1, 2, 5, 10, 20, 30, 60].into_iter().find(|k| median * *k as f64 >= palette::TIME_GAP_PX).unwrap_or(60);
+        let mut last = ticks[0].1;
+        let half = palette::TICK_LONG / 2.0 * s.view.scale;
+        for &(second, p, yaw) in &ticks[1..] {
+            if second % every == 0 && (p.0 - last.0).hypot(p.1 - last.1) >= palette::TIME_GAP_PX * 0.6 {
+                last = p;
+                let text = format!("{second} s");
+                let (anchor, along) = (Rect::around(p, half), Some((yaw.cos(), -yaw.sin())));
+                out.push((Request { text, font: palette::TIME_FONT_PX, anchor, optional: true, along }, scene.kind(a)));
+            }
+        }
+    }
+    out
+}
+
+/// Every label, placed by `label` over the map: events, actors, time marks.
+fn labels(s: &mut Svg, signals: &[(tad_road::Arm, Vec2)]) {
+    let scene = s.scene;
+    let view = s.view;
+    let frame = Rect { x: view.left, y: view.top, w: view.width(), h: view.height() };
+    let mut obstacles: Vec<Rect> = Vec::new();
+    for a in 0..scene.actors.len() {
+        let (length, width) = scene.size(a);
+        let present: Vec<[f64; 3]> = (0..scene.frames.len()).filter_map(|f| scene.pose(f, a)).collect();
+        for pose in present.first().into_iter().chain(present.last()) {
+            let corners = view::body(*pose, length, width).corners();
+            obstacles.extend(Rect::bounding(corners.iter().map(|c| view.px(*c))));
+        }
+    }
+    let ring = (palette::EVENT_RADIUS + palette::EVENT_STROKE) * view.scale;
+    for e in &scene.events {
+        obstacles.push(Rect::around(view.px(Vec2::new(e.position[0], e.position[1])), ring));
+    }
+    for (_, p) in signals {
+        obstacles.push(Rect::around(view.px(*p), palette::SIGNAL_RADIUS * 1.6 * view.scale));
+    }
+    let mut requests: Vec<(Request, &str, crate::palette::Colour)> = Vec::new();
+    for e in &scene.events {
+        let anchor = Rect::around(view.px(Vec2::new(e.position[0], e.position[1])), ring);
+        let r =
+            Request { text: event_text(scene, e), font: palette::LABEL_FONT_PX, anchor, optional: false, along: None };
+        requests.push((r, "event-label", palette::INK));
+    }
+    let named = actor_labels(s);
+    // one trajectory of a group that shares a label is marked, not every one
+    let marked: Vec<usize> = named.iter().map(|n| n.first).collect();
+    for named in named {
+        let colour = palette::kind(named.kind).dark;
+        let r = Request {
+            text: named.text,
+            font: palette::LABEL_FONT_PX,
+            anchor: named.anchor,
+            optional: false,
+            along: None,
+        };
+        requests.push((r, "label", colour));
+    }
+    for (r, kind) in time_marks(s, &marked) {
+        requests.push((r, "time-label", palette::kind(kind).dark));
+    }
+    let only: Vec<Request> = requests.iter().map(|r| r.0.clone()).collect();
+    let placed = label::place(&only, &obstacles, frame);
+    s.push("<g class=\"labels\">");
+    for ((r, class, colour), at) in requests.iter().zip(placed) {
+        let Some(Placed { rect, leader }) = at else { continue };
+        if leader {
+            let centre = |b: &Rect| (b.x + b.w / 2.0, b.y + b.h / 2.0);
+            let (x0, y0) = r.anchor.nearest(centre(&rect));
+            let (x1, y1) = rect.nearest(centre(&r.anchor));
+            let line = format!(
+                "<line class=\"leader\" x1=\"{}\" y1=\"{}\" x2=\"{}\" y2=\"{}\" stroke=\"{}\" stroke-width=\"1\"/>",
+                n(x0),
+                n(y0),
+                n(x1),
+                n(y1),
+                palette::INK.hex()
+            );
+            s.push(&line);
+        }
+        let weight = if *class == "event-label" { " font-weight=\"bold\"" } else { "" };
         let line = format!(
-            "<text class=\"event-label\" x=\"{}\" y=\"{}\" font-size=\"{}\" font-weight=\"bold\" fill=\"{}\" stroke=\"{}\" stroke-width=\"3\" paint-order=\"stroke\" stroke-linejoin=\"round\">{}{}</text>",
-            n(x + off),
-            n(y + off + palette::LABEL_FONT_PX),
-            n(palette::LABEL_FONT_PX),
-            palette::INK.hex(),
+            "<text class=\"{class}\" data-box=\"{} {} {} {}\" x=\"{}\" y=\"{}\" font-size=\"{}\"{weight} fill=\"{}\" stroke=\"{}\" stroke-width=\"3\" paint-order=\"stroke\" stroke-linejoin=\"round\">{}</text>",
+            n(rect.x),
+            n(rect.y),
+            n(rect.w),
+            n(rect.h),
+            n(rect.x + 2.0),
+            n(rect.y + r.font * 1.0),
+            n(r.font),
+            colour.hex(),
             palette::PAPER.hex(),
-            text(&e.label),
-            when
+            text(&r.text)
         );
         s.push(&line);
     }
     s.push("</g>");
 }
 
-/// A bar of [`palette::SCALE_BAR`] metres in the map's lower left corner.
-fn scale_bar(s: &mut Svg) {
-    let len = palette::SCALE_BAR * s.view.scale;
-    let x = s.view.left + palette::PAD_PX;
-    let y = s.view.top + s.view.height() - palette::PAD_PX;
+/// A scale bar at the title band's right end, ending at `right`: 1, 2 or 5 times a power
+/// of ten metres, at most [`palette::SCALE_BAR_PX`] long.
+fn scale_bar(s: &mut Svg, right: f64) {
+    let metres = nice_length(palette::SCALE_BAR_PX / s.view.scale.max(1e-9));
+    let len = metres * s.view.scale;
+    let words = format!("{metres} m");
+    let (tw, _) = label::size(&words, palette::FONT_PX);
+    let y = palette::TITLE_PX - 14.0;
+    let x = right - tw - 4.0 - len;
     let lines = [
         format!(
-            "<g class=\"scale\"><rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"{}\" fill-opacity=\"0.8\"/>",
-            n(x - 6.0),
-            n(y - 24.0),
-            n(len + 12.0),
-            n(32.0),
-            palette::PAPER.hex()
-        ),
-        format!(
-            "<path d=\"M{} {} V{} H{} V{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"2\"/>",
+            "<g class=\"scale\"><path d=\"M{} {} V{} H{} V{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"2\"/>",
             n(x),
             n(y - 5.0),
             n(y),
@@ -444,11 +644,11 @@ fn scale_bar(s: &mut Svg) {
             palette::INK.hex()
         ),
         format!(
-            "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\" fill=\"{}\">{} m</text></g>",
-            n(x + len / 2.0),
-            n(y - 9.0),
+            "<text x=\"{}\" y=\"{}\" fill=\"{}\">{}</text></g>",
+            n(x + len + 6.0),
+            n(y + 1.0),
             palette::INK.hex(),
-            palette::SCALE_BAR
+            words
         ),
     ];
     for l in lines {
@@ -456,7 +656,16 @@ fn scale_bar(s: &mut Svg) {
     }
 }
 
-/// What the legend shows, one row each.
+/// The longest of 1, 2 or 5 times a power of ten that is at most `most` (at least 1).
+pub fn nice_length(most: f64) -> f64 {
+    if !(most.is_finite() && most >= 1.0) {
+        return 1.0;
+    }
+    let p = 10f64.powf(most.log10().floor());
+    [5.0, 2.0, 1.0].into_iter().map(|k| k * p).find(|v| *v <= most).unwrap_or(p)
+}
+
+/// What the legend shows, one cell each.
 enum Entry {
     Kind(Kind),
     Start,
@@ -500,114 +709,152 @@ fn legend_entries(scene: &Scene) -> Vec<Entry> {
     entries
 }
 
-fn draw_legend(s: &mut Svg, entries: &[Entry], x: f64, y: f64, h: f64) {
-    s.push(&format!(
-        "<g class=\"legend\"><rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"{}\" stroke=\"{}\"/>",
-        n(x),
-        n(y),
-        n(palette::LEGEND_PX),
-        n(h),
-        palette::PAPER.hex(),
-        palette::FRAME.hex()
-    ));
-    let row = palette::FONT_PX * 1.8;
-    let (sx, tx) = (x + palette::PAD_PX, x + palette::PAD_PX + 34.0);
-    for (i, e) in entries.iter().enumerate() {
-        let cy = y + palette::PAD_PX + row * (i as f64 + 0.5);
+/// The legend below the map: its entries down as few rows as let their columns (each as
+/// wide as its widest entry) fit the map's width.
+struct Legend {
+    entries: Vec<Entry>,
+    rows: usize,
+    /// Each column's left edge from the legend's, px.
+    lefts: Vec<f64>,
+    height: f64,
+}
+
+impl Legend {
+    fn new(entries: Vec<Entry>, width: f64) -> Legend {
+        let widths: Vec<f64> = entries
+            .iter()
+            .map(|e| {
+                let (words, symbol) = e.words();
+                label::size(&words, palette::FONT_PX).0 + if symbol { palette::LEGEND_SYMBOL_PX + 8.0 } else { 0.0 }
+            })
+            .collect();
+        let n = entries.len().max(1);
+        let layout = |rows: usize| -> Vec<f64> {
+            let mut lefts = vec![0.0];
+            for column in widths.chunks(rows) {
+                let right =
+                    lefts[lefts.len() - 1] + column.iter().copied().fold(0.0, f64::max) + palette::LEGEND_GAP_PX;
+                lefts.push(right);
+            }
+            lefts
+        };
+        let rows =
+            (1..=n).find(|&r| layout(r).last().is_some_and(|w| w - palette::LEGEND_GAP_PX <= width)).unwrap_or(n);
+        let mut lefts = layout(rows);
+        lefts.pop();
+        let height = if entries.is_empty() { 0.0 } else { rows as f64 * palette::LEGEND_ROW_PX };
+        Legend { entries, rows, lefts, height }
+    }
+
+    fn draw(&self, s: &mut Svg, x: f64, y: f64) {
+        s.push("<g class=\"legend\">");
+        for (i, e) in self.entries.iter().enumerate() {
+            let (col, row) = (i / self.rows, i % self.rows);
+            let sx = x + self.lefts.get(col).copied().unwrap_or(0.0);
+            let cy = y + (row as f64 + 0.5) * palette::LEGEND_ROW_PX;
+            let symbol = e.symbol(sx, cy);
+            let (words, has_symbol) = e.words();
+            let tx = if has_symbol { sx + palette::LEGEND_SYMBOL_PX + 8.0 } else { sx };
+            s.push(&symbol);
+            s.push(&format!(
+                "<text x=\"{}\" y=\"{}\" dominant-baseline=\"central\" fill=\"{}\">{}</text>",
+                n(tx),
+                n(cy),
+                palette::INK.hex(),
+                text(&words)
+            ));
+        }
+        s.push("</g>");
+    }
+}
+
+impl Entry {
+    /// The entry's words, and whether it has a symbol.
+    fn words(&self) -> (String, bool) {
+        match self {
+            Entry::Kind(k) => (palette::kind(*k).name.to_string(), true),
+            Entry::Start => ("first pose".to_string(), true),
+            Entry::End => ("last pose (dark: front)".to_string(), true),
+            Entry::Trajectory => ("trajectory: a tick each second, marked in s".to_string(), true),
+            Entry::Route => ("ego's route".to_string(), true),
+            Entry::Event => ("event".to_string(), true),
+            Entry::Light(l) => (format!("light {}", tad_ir::ClosedSet::as_str(*l)), true),
+            Entry::Note(t) => (t.clone(), false),
+        }
+    }
+
+    /// The entry's symbol, its left edge at `sx`, centred on `cy`.
+    fn symbol(&self, sx: f64, cy: f64) -> String {
         let vehicle = palette::kind(Kind::Vehicle);
-        let (symbol, words) = match e {
+        let w = palette::LEGEND_SYMBOL_PX;
+        match self {
             Entry::Kind(k) => {
                 let st = palette::kind(*k);
-                (
-                    format!(
-                        "<rect x=\"{}\" y=\"{}\" width=\"24\" height=\"10\" fill=\"{}\" stroke=\"{}\"/>",
-                        n(sx),
-                        n(cy - 5.0),
-                        st.fill.hex(),
-                        st.dark.hex()
-                    ),
-                    st.name.to_string(),
+                format!(
+                    "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"10\" fill=\"{}\" stroke=\"{}\"/><rect x=\"{}\" y=\"{}\" width=\"5\" height=\"10\" fill=\"{}\"/>",
+                    n(sx),
+                    n(cy - 5.0),
+                    n(w),
+                    st.fill.hex(),
+                    st.dark.hex(),
+                    n(sx + w - 5.0),
+                    n(cy - 5.0),
+                    st.dark.hex()
                 )
             }
-            Entry::Start => (
-                format!(
-                    "<rect x=\"{}\" y=\"{}\" width=\"24\" height=\"10\" fill=\"none\" stroke=\"{}\" stroke-dasharray=\"3 2\"/>",
-                    n(sx),
-                    n(cy - 5.0),
-                    vehicle.dark.hex()
-                ),
-                "first pose".to_string(),
+            Entry::Start => format!(
+                "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"10\" fill=\"none\" stroke=\"{}\" stroke-dasharray=\"3 2\"/>",
+                n(sx),
+                n(cy - 5.0),
+                n(w),
+                vehicle.dark.hex()
             ),
-            Entry::End => (
-                format!(
-                    "<rect x=\"{}\" y=\"{}\" width=\"24\" height=\"10\" fill=\"{}\" stroke=\"{}\"/><rect x=\"{}\" y=\"{}\" width=\"5\" height=\"10\" fill=\"{}\"/>",
-                    n(sx),
-                    n(cy - 5.0),
-                    vehicle.fill.hex(),
-                    vehicle.dark.hex(),
-                    n(sx + 19.0),
-                    n(cy - 5.0),
-                    vehicle.dark.hex()
-                ),
-                "last pose (dark: front)".to_string(),
+            Entry::End => format!(
+                "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"10\" fill=\"{}\" stroke=\"{}\"/><rect x=\"{}\" y=\"{}\" width=\"5\" height=\"10\" fill=\"{}\"/>",
+                n(sx),
+                n(cy - 5.0),
+                n(w),
+                vehicle.fill.hex(),
+                vehicle.dark.hex(),
+                n(sx + w - 5.0),
+                n(cy - 5.0),
+                vehicle.dark.hex()
             ),
-            Entry::Trajectory => (
-                format!(
-                    "<path d=\"M{} {} H{} M{} {} V{} M{} {} V{}\" stroke=\"{}\" stroke-width=\"2\" fill=\"none\"/>",
-                    n(sx),
-                    n(cy),
-                    n(sx + 24.0),
-                    n(sx + 8.0),
-                    n(cy - 4.0),
-                    n(cy + 4.0),
-                    n(sx + 18.0),
-                    n(cy - 4.0),
-                    n(cy + 4.0),
-                    vehicle.fill.hex()
-                ),
-                "trajectory, tick = 1 s".to_string(),
+            Entry::Trajectory => format!(
+                "<path d=\"M{} {} H{} M{} {} V{} M{} {} V{}\" stroke=\"{}\" stroke-width=\"2\" fill=\"none\"/>",
+                n(sx),
+                n(cy),
+                n(sx + w),
+                n(sx + 9.0),
+                n(cy - 4.0),
+                n(cy + 4.0),
+                n(sx + 19.0),
+                n(cy - 4.0),
+                n(cy + 4.0),
+                vehicle.fill.hex()
             ),
-            Entry::Route => (
-                format!(
-                    "<path d=\"M{} {} H{}\" stroke=\"{}\" stroke-width=\"2\" stroke-dasharray=\"4 3\"/>",
-                    n(sx),
-                    n(cy),
-                    n(sx + 24.0),
-                    palette::ROUTE.hex()
-                ),
-                "ego's route".to_string(),
+            Entry::Route => format!(
+                "<path d=\"M{} {} H{}\" stroke=\"{}\" stroke-width=\"2\" stroke-dasharray=\"4 3\"/>",
+                n(sx),
+                n(cy),
+                n(sx + w),
+                palette::ROUTE.hex()
             ),
-            Entry::Event => (
-                format!(
-                    "<path d=\"M{} {} l7 -7 l7 7 l-7 7 z\" fill=\"{}\" stroke=\"{}\"/>",
-                    n(sx + 5.0),
-                    n(cy),
-                    palette::EVENT.hex(),
-                    palette::EVENT_EDGE.hex()
-                ),
-                "event".to_string(),
+            Entry::Event => format!(
+                "<circle cx=\"{x}\" cy=\"{y}\" r=\"6\" fill=\"none\" stroke=\"{}\" stroke-width=\"4\"/><circle cx=\"{x}\" cy=\"{y}\" r=\"6\" fill=\"none\" stroke=\"{}\" stroke-width=\"2\"/>",
+                palette::EVENT_EDGE.hex(),
+                palette::EVENT.hex(),
+                x = n(sx + w / 2.0),
+                y = n(cy)
             ),
-            Entry::Light(l) => (
-                format!(
-                    "<circle cx=\"{}\" cy=\"{}\" r=\"5\" fill=\"{}\" stroke=\"{}\"/>",
-                    n(sx + 12.0),
-                    n(cy),
-                    palette::light(*l).hex(),
-                    palette::INK.hex()
-                ),
-                format!("light {}", tad_ir::ClosedSet::as_str(*l)),
+            Entry::Light(l) => format!(
+                "<circle cx=\"{}\" cy=\"{}\" r=\"5\" fill=\"{}\" stroke=\"{}\"/>",
+                n(sx + w / 2.0),
+                n(cy),
+                palette::light(*l).hex(),
+                palette::INK.hex()
             ),
-            Entry::Note(t) => (String::new(), t.clone()),
-        };
-        let tx = if symbol.is_empty() { sx } else { tx };
-        s.push(&symbol);
-        s.push(&format!(
-            "<text x=\"{}\" y=\"{}\" dominant-baseline=\"central\" fill=\"{}\">{}</text>",
-            n(tx),
-            n(cy),
-            palette::INK.hex(),
-            text(&words)
-        ));
+            Entry::Note(_) => String::new(),
+        }
     }
-    s.push("</g>");
 }

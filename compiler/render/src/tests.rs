@@ -51,7 +51,7 @@ fn junction_scene(road: &Road) -> Scene<'_> {
             Frame {
                 poses: vec![
                     Some([8.0 * t, -1.75, 0.0]),
-                    Some([road.centre().x - 1.75, 20.0, -std::f64::consts::FRAC_PI_2]),
+                    Some([road.centre().x - 1.75, 14.0, -std::f64::consts::FRAC_PI_2]),
                     walker,
                 ],
                 lights: vec![(Arm::Ego, light), (Arm::Left, Light::Red)],
@@ -114,10 +114,10 @@ fn the_svg_is_well_formed_and_shows_the_road_and_the_actors() {
     assert!(class("stop-line") == 4, "a stop line on each arm of a four-way junction");
     assert!(class("crosswalk") >= 4 * 4, "crosswalk stripes across each arm");
     assert!(class("trajectory") >= 2, "the ego's and the walker's trajectories");
-    assert!(class("event") == 1 && text.contains("red light @ 3.0 s"));
+    assert!(class("event") == 1 && text.contains(">red light, t = 3.0 s</text>"));
     assert!(class("signal") == 2 && class("signal-end") == 1, "the ego's light changed; the left's did not");
     assert!(text.contains("red_light &lt;running&gt; &amp; co"), "the title is escaped");
-    assert!(text.contains(">10 m</text>"), "a scale bar");
+    assert!(class("scale") == 1 && text.contains(" m</text>"), "a scale bar");
     assert!(class("legend") == 1);
 }
 
@@ -131,7 +131,7 @@ fn the_view_is_fitted_to_what_moved() {
         f.poses.push(Some([150.0, 2.0, 0.0]));
     }
     let view = crate::view::focus(&scene);
-    assert!(view.min.x < -2.25 - 5.0 && view.max.x > 31.2 + 2.25 + 5.0, "{view:?}");
+    assert!(view.min.x <= -2.25 - 5.0 && view.max.x >= 31.2 + 2.25 + 5.0, "{view:?}");
     assert!(view.width() < 80.0, "{view:?}");
     // the road is drawn near the view only, not 200 m each way
     let map = crate::map::draw(&scene, &view);
@@ -190,16 +190,16 @@ fn the_same_scene_gives_the_same_bytes() {
 fn the_gif_decodes_with_one_frame_per_stride_and_the_ego_where_it_is() {
     let road = road(Shape::Junction { arms: 4, roundabout: false }, true);
     let scene = junction_scene(&road);
-    let options = GifOptions { width: 200, height: 150, every: 4, fps: 10 };
+    let options = GifOptions { width: 720, height: 400, every: 4, fps: 10 };
     let bytes = gif(&scene, options);
     let mut decoder = {
         let mut o = ::gif::DecodeOptions::new();
         o.set_color_output(::gif::ColorOutput::RGBA);
         o.read_info(bytes.as_slice()).expect("a GIF")
     };
-    assert_eq!((decoder.width(), decoder.height()), (200, 150));
+    assert_eq!((decoder.width(), decoder.height()), (720, 400));
     let first = decoder.read_next_frame().expect("decodes").expect("a first frame").clone();
-    assert_eq!((first.width, first.height), (200, 150), "the first frame is whole");
+    assert_eq!((first.width, first.height), (720, 400), "the first frame is whole");
     let mut count = 1;
     while decoder.read_next_frame().expect("decodes").is_some() {
         count += 1;
@@ -208,12 +208,12 @@ fn the_gif_decodes_with_one_frame_per_stride_and_the_ego_where_it_is() {
     // the ego's centre at step 0, (0, -1.75), in the ego's colour
     let view: View = anim::view_of(&scene, options);
     let (x, y) = view.px(Vec2::new(0.0, -1.75));
-    let i = (y.round() as usize * 200 + x.round() as usize) * 4;
+    let i = (y.round() as usize * 720 + x.round() as usize) * 4;
     let ego = palette::kind(Kind::Ego).fill;
     assert_eq!(&first.buffer[i..i + 3], &[ego.0, ego.1, ego.2]);
     // and the left arm's car in the vehicles' colour
-    let (x, y) = view.px(Vec2::new(road.centre().x - 1.75, 20.0));
-    let i = (y.round() as usize * 200 + x.round() as usize) * 4;
+    let (x, y) = view.px(Vec2::new(road.centre().x - 1.75, 14.0));
+    let i = (y.round() as usize * 720 + x.round() as usize) * 4;
     let car = palette::kind(Kind::Vehicle).fill;
     assert_eq!(&first.buffer[i..i + 3], &[car.0, car.1, car.2]);
 }
@@ -223,10 +223,10 @@ fn the_gif_decodes_with_one_frame_per_stride_and_the_ego_where_it_is() {
 fn the_png_is_the_last_frame() {
     let road = road(Shape::Junction { arms: 4, roundabout: false }, true);
     let scene = junction_scene(&road);
-    let options = GifOptions { width: 200, height: 150, every: 4, fps: 10 };
+    let options = GifOptions { width: 720, height: 300, every: 4, fps: 10 };
     let png = tiny_skia::Pixmap::decode_png(&png(&scene, options)).expect("a PNG");
     let last = anim::frames(&scene, options).pop().expect("frames");
-    assert_eq!((png.width(), png.height()), (200, 150));
+    assert_eq!((png.width(), png.height()), (720, 300));
     assert_eq!(png.data(), last.data());
 }
 
@@ -268,7 +268,8 @@ fn bad_input_still_gives_pictures() {
     roxmltree::Document::parse(&svg(&empty)).expect("well-formed");
     let bytes = gif(&empty, GifOptions { width: 0, height: 0, every: 0, fps: 0 });
     let decoder = ::gif::DecodeOptions::new().read_info(bytes.as_slice()).expect("a GIF");
-    assert_eq!((decoder.width(), decoder.height()), (16, 16));
+    assert_eq!(decoder.width() as u32, palette::GIF_MIN_WIDTH, "never narrower than that");
+    assert!(decoder.height() as u32 > 2 * palette::GIF_BAND_PX);
     let odd = Scene {
         road: &road,
         title: "\u{0}\u{7}<>".to_string(),
@@ -421,4 +422,168 @@ fn samples() {
             }
         }
     }
+}
+
+/// A crowded straight street: the ego drives 60 m to an event at the view's right edge,
+/// a row of five parked cars (one group) beside its lane, twelve walkers crossing in a
+/// block, and an oncoming car that starts 150 m away.
+fn crowded(road: &Road) -> Scene<'_> {
+    let mut actors = vec![actor("ego", Kind::Ego, 4.5, 2.0)];
+    actors.extend((0..5).map(|k| actor(&format!("parked[{k}]"), Kind::Vehicle, 4.5, 1.9)));
+    actors.extend((0..12).map(|k| actor(&format!("crowd[{k}]"), Kind::Walker, 0.6, 0.6)));
+    actors.push(actor("oncoming[0]", Kind::Vehicle, 4.5, 1.9));
+    let frames = (0..60)
+        .map(|f| {
+            let t = f as f64 * 0.1;
+            let mut poses = vec![Some([10.0 * t, -1.75, 0.0])];
+            poses.extend((0..5).map(|k| Some([8.0 + 6.0 * k as f64, -5.4, 0.0])));
+            poses.extend((0..12).map(|k| {
+                Some([40.0 + (k % 4) as f64 * 0.9, -8.0 + (k / 4) as f64 * 0.8 + 1.2 * t, std::f64::consts::FRAC_PI_2])
+            }));
+            poses.push(Some([150.0 - 12.0 * t, 1.75, std::f64::consts::PI]));
+            Frame { poses, lights: vec![] }
+        })
+        .collect();
+    Scene {
+        road,
+        title: "crowded".to_string(),
+        actors,
+        frames,
+        dt: 0.1,
+        route: vec![],
+        events: vec![Event { step: 59, position: [61.0, -1.75], label: "collision with crowd[3]".to_string() }],
+    }
+}
+
+/// Every label's box (`data-box`) and the map's rectangle.
+fn label_boxes(text: &str) -> (Vec<(String, [f64; 4])>, [f64; 4]) {
+    let doc = roxmltree::Document::parse(text).expect("well-formed XML");
+    let clip = doc.descendants().find(|n| n.attribute("id") == Some("map-clip")).expect("the map's clip");
+    let r = clip.first_element_child().expect("its rectangle");
+    let num = |a: &str| r.attribute(a).and_then(|v| v.parse::<f64>().ok()).expect("a number");
+    let map = [num("x"), num("y"), num("width"), num("height")];
+    let boxes = doc
+        .descendants()
+        .filter_map(|n| {
+            let v: Vec<f64> = n.attribute("data-box")?.split(' ').filter_map(|v| v.parse().ok()).collect();
+            Some((n.text().unwrap_or("").to_string(), [v[0], v[1], v[2], v[3]]))
+        })
+        .collect();
+    (boxes, map)
+}
+
+#[test]
+fn labels_neither_overlap_nor_leave_the_map() {
+    let road = road(Shape::Straight, true);
+    let scene = crowded(&road);
+    let text = svg(&scene);
+    let (boxes, map) = label_boxes(&text);
+    let names: Vec<&str> = boxes.iter().map(|(t, _)| t.as_str()).collect();
+    for wanted in ["ego", "parked[0–4]", "collision with crowd[3], t = 5.9 s"] {
+        assert!(names.contains(&wanted), "{wanted} is not among {names:?}");
+    }
+    assert!(names.iter().any(|n| n.starts_with("crowd[")), "the crowd is named: {names:?}");
+    assert!(names.iter().filter(|n| n.ends_with(" s") && n.len() <= 5).count() >= 3, "time marks: {names:?}");
+    for (i, (a, ra)) in boxes.iter().enumerate() {
+        let inside = ra[0] >= map[0] && ra[1] >= map[1] && ra[0] + ra[2] <= map[0] + map[2];
+        assert!(inside && ra[1] + ra[3] <= map[1] + map[3], "{a} at {ra:?} leaves the map {map:?}");
+        for (b, rb) in &boxes[i + 1..] {
+            let apart =
+                ra[0] + ra[2] <= rb[0] || rb[0] + rb[2] <= ra[0] || ra[1] + ra[3] <= rb[1] || rb[1] + rb[3] <= ra[1];
+            assert!(apart, "{a} {ra:?} overlaps {b} {rb:?}");
+        }
+    }
+    // labels come after (over) the signals and the event's ring, which is hollow
+    let labels_at = text.find("<g class=\"labels\">").expect("labels");
+    assert!(text.find("<g class=\"events\">").is_some_and(|e| e < labels_at));
+    assert!(text.contains("class=\"event\" ") && text.contains("fill=\"none\" stroke=\"#ffd700\""));
+}
+
+#[test]
+fn placement_keeps_apart_what_would_stack() {
+    use crate::label::{Rect, Request, place};
+    let frame = Rect { x: 0.0, y: 0.0, w: 300.0, h: 120.0 };
+    // ten labels on one spot near the right edge
+    let requests: Vec<Request> = (0..10)
+        .map(|k| Request {
+            text: format!("actor_{k}"),
+            font: 11.0,
+            anchor: Rect::around((290.0, 60.0), 3.0),
+            optional: false,
+            along: None,
+        })
+        .collect();
+    let placed = place(&requests, &[], frame);
+    let boxes: Vec<Rect> = placed.iter().flatten().map(|p| p.rect).collect();
+    assert!(boxes.len() >= 6, "most find a place: {boxes:?}");
+    for (i, a) in boxes.iter().enumerate() {
+        assert!(a.inside(&frame), "{a:?}");
+        assert!(boxes[i + 1..].iter().all(|b| a.overlap(b) == 0.0), "{a:?} overlaps");
+    }
+    assert!(placed.iter().flatten().any(|p| p.leader), "the far ones are led back");
+    // an optional label never covers an obstacle, and is dropped rather than moved away
+    let wall = Rect { x: 0.0, y: 0.0, w: 300.0, h: 120.0 };
+    let optional = Request {
+        text: "4 s".into(),
+        font: 9.0,
+        anchor: Rect::around((150.0, 60.0), 2.0),
+        optional: true,
+        along: None,
+    };
+    assert_eq!(place(&[optional], &[wall], frame), vec![None]);
+}
+
+#[test]
+fn the_view_holds_where_things_happen_and_not_more() {
+    let road = road(Shape::Straight, true);
+    let scene = crowded(&road);
+    let view = crate::svg::view_of(&scene);
+    let inside = |x: f64, y: f64| view.bounds.contains(Vec2::new(x, y));
+    for f in &scene.frames {
+        let [x, y, _] = f.poses[0].expect("the ego");
+        assert!(inside(x, y), "the ego at ({x}, {y}) is outside {:?}", view.bounds);
+        for p in f.poses[1..18].iter().flatten() {
+            assert!(inside(p[0], p[1]), "({}, {}) is outside {:?}", p[0], p[1], view.bounds);
+        }
+    }
+    assert!(inside(61.0, -1.75), "the event");
+    // the oncoming car's approach from 150 m does not stretch the view
+    assert!(view.bounds.max.x < 90.0, "{:?}", view.bounds);
+    // and the map is wide, not two thirds empty: the road's width fills a third of it
+    assert!(view.bounds.height() < 30.0, "{:?}", view.bounds);
+}
+
+#[test]
+fn the_gif_is_wide_titled_with_a_legend_and_a_scale_and_the_ego_stands_out() {
+    let road = road(Shape::Straight, true);
+    let scene = crowded(&road);
+    let options = GifOptions::default();
+    let layout = anim::layout(&scene, options);
+    assert!(layout.width >= 720, "{}", layout.width);
+    let frames = anim::frames(&scene, GifOptions { every: 30, ..options });
+    let first = &frames[0];
+    let at = |x: u32, y: u32| {
+        let p = first.pixel(x, y).expect("a pixel");
+        palette::Colour(p.red(), p.green(), p.blue())
+    };
+    let band = layout.band;
+    let ink_in = |x0: u32, x1: u32, y0: u32, y1: u32| {
+        (x0..x1).flat_map(|x| (y0..y1).map(move |y| (x, y))).filter(|&(x, y)| at(x, y) == palette::INK).count()
+    };
+    assert!(ink_in(0, 200, 0, band) > 50, "a title in the top band");
+    let h = layout.height;
+    assert!(ink_in(layout.width - 150, layout.width, h - band, h) > 40, "a scale bar and its metres");
+    let swatches = (0..400).flat_map(|x| (h - band..h).map(move |y| (x, y)));
+    for k in [Kind::Ego, Kind::Vehicle, Kind::Walker] {
+        assert!(swatches.clone().any(|(x, y)| at(x, y) == palette::kind(k).fill), "{k:?} in the legend");
+    }
+    // the ego: at least 12 px long, in its colour, with a white halo
+    let (x, y) = layout.view.px(Vec2::new(0.0, -1.75));
+    let (x, y) = (x.round() as u32, y.round() as u32);
+    let ego = palette::kind(Kind::Ego).fill;
+    let run = (x.saturating_sub(20)..x + 20)
+        .filter(|&i| at(i, y) == ego || at(i, y) == palette::kind(Kind::Ego).dark)
+        .count();
+    assert!(run >= 12, "the ego is {run} px long");
+    assert!((0..40).any(|d| at(x, y.saturating_sub(d)) == palette::PAPER), "a halo above the ego");
 }

@@ -1,17 +1,21 @@
 //! The window onto the road: what the picture shows and how metres become pixels.
 //!
 //! The road runs [`tad_road::road::RUN`] metres each way, far more than a scenario uses,
-//! so the window is fitted to what moved (every actor whose position changed by more than
-//! [`MOVED`] m, and the ego always), the events, and the junction when it is near; plus
-//! [`palette::MARGIN`] and at least [`palette::MIN_VIEW`] metres each way. A scene where
-//! nothing moved is fitted to every actor; an empty one to the ego's start.
-//! Pixels have `y` down, so the road's `y` (to the left of `x`) is flipped.
+//! so the window is fitted to where things happen: the ego's whole drive, the events, and
+//! every other actor while it is within [`NEAR_EGO`] m of the ego (so a parked van beside
+//! the ego's lane counts, an oncoming car's approach from 150 m away does not; what leaves
+//! the window is clipped at its edge), and the junction when it is near; plus
+//! [`palette::MARGIN`] and at least [`palette::MIN_VIEW`] metres each way. A scene without
+//! an ego is fitted to every actor that moved, else to every actor; an empty one to the
+//! origin. Pixels have `y` down, so the road's `y` (to the left of `x`) is flipped.
 
 use crate::{Scene, palette};
 use tad_road::geom::{Footprint, Pose, Vec2};
 
 /// Actors that moved less than this are "static" for the window, m.
 const MOVED: f64 = 0.5;
+/// Another actor is in the window while it is this near the ego, m.
+pub const NEAR_EGO: f64 = 20.0;
 /// A junction whose box is nearer than this to what moved is shown whole, m.
 const JUNCTION_NEAR: f64 = 40.0;
 
@@ -73,22 +77,31 @@ impl Bounds {
 /// The rectangle the pictures show: see the module's header.
 pub fn focus(scene: &Scene) -> Bounds {
     let n = scene.actors.len();
+    let ego: Vec<Option<[f64; 3]>> = (0..scene.frames.len()).map(|f| scene.pose(f, 0)).collect();
+    let mut near = if n > 0 { corners_of(scene, 0, |_| true) } else { Vec::new() };
     let mut moving = Vec::new();
     let mut everyone = Vec::new();
-    for actor in 0..n {
-        let corners = corners_of(scene, actor);
+    for actor in 1..n {
+        let close = |f: usize| {
+            let (Some(e), Some(p)) = (ego[f], scene.pose(f, actor)) else { return false };
+            (e[0] - p[0]).hypot(e[1] - p[1]) < NEAR_EGO
+        };
+        near.extend(corners_of(scene, actor, close));
         let positions: Vec<Vec2> =
             (0..scene.frames.len()).filter_map(|f| scene.pose(f, actor)).map(|[x, y, _]| Vec2::new(x, y)).collect();
-        let moved = positions.first().is_some_and(|a| positions.iter().any(|p| p.distance(*a) > MOVED));
-        if moved || actor == 0 {
+        let corners = corners_of(scene, actor, |_| true);
+        if positions.first().is_some_and(|a| positions.iter().any(|p| p.distance(*a) > MOVED)) {
             moving.extend(corners.iter().copied());
         }
         everyone.extend(corners);
     }
-    let events = scene.events.iter().map(|e| Vec2::new(e.position[0], e.position[1]));
-    let core = Bounds::around(moving.into_iter().chain(events))
-        .or_else(|| Bounds::around(everyone))
-        .unwrap_or(Bounds { min: Vec2::default(), max: Vec2::default() });
+    let events: Vec<Vec2> = scene.events.iter().map(|e| Vec2::new(e.position[0], e.position[1])).collect();
+    let core = if n > 0 && ego.iter().any(Option::is_some) {
+        Bounds::around(near.into_iter().chain(events))
+    } else {
+        Bounds::around(moving.into_iter().chain(events.iter().copied())).or_else(|| Bounds::around(everyone))
+    };
+    let core = core.unwrap_or(Bounds { min: Vec2::default(), max: Vec2::default() });
     let mut bounds = core;
     if let Some(j) = &scene.road.junction {
         let c = scene.road.centre();
@@ -101,10 +114,11 @@ pub fn focus(scene: &Scene) -> Bounds {
     bounds.grown(palette::MARGIN).at_least(palette::MIN_VIEW, palette::MIN_VIEW)
 }
 
-/// Every corner of an actor's body at each frame it is present.
-fn corners_of(scene: &Scene, actor: usize) -> Vec<Vec2> {
+/// Every corner of an actor's body at each frame it is present and `when` holds.
+fn corners_of(scene: &Scene, actor: usize, when: impl Fn(usize) -> bool) -> Vec<Vec2> {
     let (length, width) = scene.size(actor);
     (0..scene.frames.len())
+        .filter(|&f| when(f))
         .filter_map(|f| scene.pose(f, actor))
         .flat_map(|p| body(p, length, width).corners())
         .collect()

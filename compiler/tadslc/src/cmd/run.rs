@@ -46,9 +46,10 @@ pub struct RunArgs {
     /// Write every actor's pose at every step as JSON lines
     #[arg(long, value_name = "FILE")]
     pub trace: Option<PathBuf>,
-    /// Draw the first episode: `.svg` (a figure), `.png` (where it ended) or `.gif` (an
-    /// animation)
-    #[arg(long, value_name = "FILE", value_parser = picture_path)]
+    /// Draw the first episode to FILE: `.svg` (a figure), `.png` (where it ended) or `.gif`
+    /// (an animation); or, given a directory (or a path without an extension, made a
+    /// directory), every episode as DIR/SCENARIO.EGO.seedN.svg
+    #[arg(long, value_name = "FILE|DIR", value_parser = picture_path)]
     pub render: Option<PathBuf>,
     /// Score as SafeBench's scorer does, quirks included (TS 0 when nothing completes,
     /// yaw not unwrapped, off-road never ends an episode)
@@ -98,13 +99,50 @@ pub fn parse_seeds(text: &str) -> Result<Range<u64>, String> {
     Ok(range)
 }
 
-/// `--render`'s path: its extension must name a picture format.
+/// `--render`'s path: a picture whose extension names its format, or a directory.
 fn picture_path(path: &str) -> Result<PathBuf, String> {
     let path = PathBuf::from(path);
-    match tad_render::Format::of(&path) {
-        Some(_) => Ok(path),
-        None => Err("the picture's extension names its format: .svg, .png or .gif".into()),
+    if tad_render::Format::of(&path).is_some() || path.is_dir() || path.extension().is_none() {
+        return Ok(path);
     }
+    Err("the picture's extension names its format: .svg, .png or .gif (or give a directory, for one \
+         SVG per scenario, ego and seed)"
+        .into())
+}
+
+/// Where `--render` draws: one picture of the first episode, or every episode into a
+/// directory.
+enum Render<'a> {
+    File(&'a std::path::Path, tad_render::Format),
+    Dir(&'a std::path::Path),
+}
+
+impl Render<'_> {
+    fn of(path: &std::path::Path) -> Render<'_> {
+        match tad_render::Format::of(path) {
+            Some(format) if !path.is_dir() => Render::File(path, format),
+            _ => Render::Dir(path),
+        }
+    }
+}
+
+/// A name made safe for a file: letters, digits, `-`, `_` and `.` kept, the rest `_`.
+fn file_part(name: &str) -> String {
+    name.chars().map(|c| if c.is_ascii_alphanumeric() || "-_.".contains(c) { c } else { '_' }).collect()
+}
+
+/// An episode's figure in `--render DIR`: DIR/SCENARIO.EGO.seedN.svg.
+fn render_into(
+    dir: &std::path::Path,
+    loaded: &crate::scenes::Loaded,
+    ego: &str,
+    played: &Played,
+) -> Result<(), String> {
+    let seed = played.episode.seed.unwrap_or(0);
+    let name = format!("{}.{}.seed{seed}.svg", file_part(&loaded.scene.name), file_part(ego));
+    let path = dir.join(name);
+    let picture = record::picture(&loaded.scene, ego, &played.episode, tad_render::Format::Svg);
+    std::fs::write(&path, picture).map_err(|e| format!("cannot write `{}`: {e}", path.display()))
 }
 
 pub fn run(args: &RunArgs, color: bool) -> Result<Status, CliError> {
@@ -131,6 +169,12 @@ pub fn run(args: &RunArgs, color: bool) -> Result<Status, CliError> {
         )),
         None => None,
     };
+    let render = args.render.as_deref().map(Render::of);
+    if let Some(Render::Dir(dir)) = &render {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| CliError::usage(format!("cannot make the directory `{}`: {e}", dir.display())))?;
+    }
+    let mut rendered = 0usize;
     let mut done: Vec<Played> = Vec::new();
     for (f, loaded) in scenes.iter().enumerate() {
         for (e, policy) in policies.iter_mut().enumerate() {
@@ -151,11 +195,20 @@ pub fn run(args: &RunArgs, color: bool) -> Result<Status, CliError> {
                 if args.format == RunFormat::Json {
                     outln!("{}", record::episode_json(&loaded.name, policy.name(), &episode, &score))?;
                 }
-                let mut episode = episode;
-                if args.render.is_none() || !done.is_empty() {
-                    episode.frames = Vec::new();
+                let mut played = Played { scenario: f, ego: e, episode, score };
+                if let Some(Render::Dir(dir)) = &render {
+                    match render_into(dir, loaded, policy.name(), &played) {
+                        Ok(()) => rendered += 1,
+                        Err(err) => {
+                            status = Status::Usage;
+                            errln!("error: {err}")?;
+                        }
+                    }
                 }
-                done.push(Played { scenario: f, ego: e, episode, score });
+                if !matches!(render, Some(Render::File(..))) || !done.is_empty() {
+                    played.episode.frames = Vec::new();
+                }
+                done.push(played);
                 progress.inc(1);
             }
         }
@@ -191,9 +244,11 @@ pub fn run(args: &RunArgs, color: bool) -> Result<Status, CliError> {
         }
     }
     status = status.max(gate(args, &scenes, &names, &done)?);
-    if let (Some(path), Some(first)) = (&args.render, done.first()) {
+    if let Some(Render::Dir(dir)) = &render {
+        errln!("rendered {} to {}", crate::plural(rendered, "episode"), dir.display())?;
+    }
+    if let (Some(Render::File(path, format)), Some(first)) = (render, done.first()) {
         let loaded = &scenes[first.scenario];
-        let format = tad_render::Format::of(path).unwrap_or(tad_render::Format::Svg);
         if let Err(e) = std::fs::write(path, record::picture(&loaded.scene, &names[first.ego], &first.episode, format))
         {
             status = Status::Usage;
