@@ -295,14 +295,45 @@ pub fn table(all: &[Results], format: TableFormat) -> String {
     out
 }
 
-/// The OS of each line as an SVG bar chart, grouped by region and generator.
+/// The OS of each line as an SVG bar chart, grouped by region and generator: each bar with
+/// its 95 % bootstrap interval (the line's episodes resampled with replacement
+/// [`crate::interval::RESAMPLES`] times, OS aggregated as the table does, the 2.5 and 97.5
+/// percentiles; seeded by the setup's seed, so the plot is deterministic) and its episodes.
 pub fn plot(all: &[Results]) -> String {
+    use tad_ir::{Rng, SplitMix64};
+    let seed = all.first().map_or(0, |r| r.setup.seed);
+    let mut bars = Vec::new();
+    for (k, l) in lines(all).iter().enumerate() {
+        let mut rows: Vec<&Row> = all
+            .iter()
+            .flat_map(|r| &r.rows)
+            .filter(|r| r.region == l.region && r.generator == l.generator && r.ego == l.ego)
+            .collect();
+        rows.sort_by(|a, b| (&a.scenario, a.trial, a.seed).cmp(&(&b.scenario, b.trial, b.seed)));
+        let mut rng = SplitMix64::new(seed ^ 0x0051_A7E5 ^ (k as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
+        let mut draws: Vec<f64> = (0..crate::interval::RESAMPLES)
+            .filter_map(|_| {
+                let pick: Vec<EpisodeScore> =
+                    (0..rows.len()).map(|_| rows[rng.below(rows.len())].score.clone()).collect();
+                tad_metrics::aggregate(&pick, Mode::Fixed).ok().map(|a| a.normalised.os)
+            })
+            .filter(|v| v.is_finite())
+            .collect();
+        draws.sort_by(f64::total_cmp);
+        let at = |q: f64| draws.get(((draws.len() as f64 - 1.0) * q).round() as usize).copied();
+        let interval = at(0.025).zip(at(0.975));
+        bars.push(tad_stats::plot::Bar {
+            group: format!("{} · {}", l.region, l.generator),
+            series: l.ego.clone(),
+            value: l.agg.normalised.os,
+            interval,
+            n: l.agg.episodes,
+        });
+    }
     tad_stats::plot::grouped(
         "Overall score (OS) by generator and ego",
-        &lines(all)
-            .iter()
-            .map(|l| (format!("{} · {}", l.region, l.generator), l.ego.clone(), l.agg.normalised.os))
-            .collect::<Vec<_>>(),
+        ("region · generator", "overall score (OS, 1 is perfect)"),
+        &bars,
     )
 }
 

@@ -1,7 +1,14 @@
-//! Plots as standalone SVG: grouped bar charts of histograms, and a scatter of embeddings
-//! projected to two dimensions (PCA over the pooled points, like the paper's Figure 3,
-//! which uses UMAP). Colours are the Okabe–Ito palette (distinguishable with colour
-//! blindness); text is escaped; the output is deterministic.
+//! Plots as standalone SVG: grouped bar charts of histograms, bars of scores with their
+//! 95 % intervals as error bars and the number of episodes over each ([`grouped`]), and a
+//! scatter of embeddings projected to two dimensions (PCA over the pooled points, like the
+//! paper's Figure 3, which uses UMAP). Colours are the Okabe–Ito palette (distinguishable
+//! with colour blindness); text is escaped; the output is deterministic.
+//!
+//! Text is not measured: a character is taken as [`CHAR_EM`] font sizes wide, enough for
+//! the fonts viewers substitute for Helvetica, and every margin is sized from the longest
+//! text it holds (tick labels, slanted group names, legend entries), so nothing is clipped.
+//! Axes carry titles; data that would fall outside the frame (an interval past the axis,
+//! a non-finite point) is left out or the axis widened, never drawn over the edge.
 
 use std::fmt::Write;
 
@@ -9,6 +16,19 @@ use crate::stats::{Histogram, Stats};
 
 const COLOURS: &[&str] = &["#0072B2", "#E69F00", "#009E73", "#CC79A7", "#56B4E9", "#D55E00", "#F0E442", "#000000"];
 const FONT: &str = "font-family=\"Helvetica, Arial, sans-serif\"";
+
+/// A character's width in font sizes (see the module's header).
+const CHAR_EM: f64 = 0.62;
+
+/// A text's estimated width, px.
+fn text_width(text: &str, font: f64) -> f64 {
+    text.chars().count() as f64 * font * CHAR_EM
+}
+
+/// A legend's width, px: the swatch and the longest name.
+fn legend_width(names: &[&str]) -> f64 {
+    18.0 + names.iter().map(|n| text_width(n, 12.0)).fold(0.0, f64::max) + 12.0
+}
 
 fn escape(s: &str) -> String {
     s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
@@ -46,68 +66,153 @@ pub fn corpora(all: &[Stats]) -> Vec<(String, String)> {
     plots
 }
 
-/// Values in `[0, 1]` as bars: one cluster per group (the first item), one colour per
-/// series (the second), like the paper's bar charts of OS by method and agent.
-pub fn grouped(title: &str, bars: &[(String, String, f64)]) -> String {
+/// One bar of [`grouped`]: its cluster, its series (its colour), its value, its 95 %
+/// interval `(low, high)` when there is one, and how many episodes it stands for.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Bar {
+    pub group: String,
+    pub series: String,
+    pub value: f64,
+    pub interval: Option<(f64, f64)>,
+    pub n: usize,
+}
+
+/// Scores as bars: one cluster per group, one colour per series, like the paper's bar
+/// charts of OS by method and agent; each bar with its interval as an error bar and `n`
+/// over it. `axes` are the x and y axes' titles. The y axis runs from 0 to 1, widened to
+/// hold every finite value and interval.
+pub fn grouped(title: &str, axes: (&str, &str), bars: &[Bar]) -> String {
     let mut groups: Vec<&str> = Vec::new();
     let mut series: Vec<&str> = Vec::new();
-    for (g, s, _) in bars {
-        if !groups.contains(&g.as_str()) {
-            groups.push(g);
+    for b in bars {
+        if !groups.contains(&b.group.as_str()) {
+            groups.push(&b.group);
         }
-        if !series.contains(&s.as_str()) {
-            series.push(s);
+        if !series.contains(&b.series.as_str()) {
+            series.push(&b.series);
         }
     }
-    let (left, top, height, bar) = (50.0, 40.0, 240.0, 18.0);
-    let cluster = bar * series.len().max(1) as f64 + 24.0;
-    let width = left + cluster * groups.len().max(1) as f64 + 160.0;
+    let finite = bars.iter().flat_map(|b| [Some(b.value), b.interval.map(|i| i.0), b.interval.map(|i| i.1)]).flatten();
+    let finite: Vec<f64> = finite.filter(|v| v.is_finite()).collect();
+    let y0 = (finite.iter().copied().fold(0.0f64, f64::min) * 4.0).floor() / 4.0;
+    let y1 = (finite.iter().copied().fold(1.0f64, f64::max) * 4.0).ceil() / 4.0;
+    let (bar, plot_h, font) = (22.0, 260.0, 11.0);
+    let cluster = bar * series.len().max(1) as f64 + 28.0;
+    // slanted group names: (width, height) of each at -35°
+    let (sin, cos) = (35f64.to_radians().sin(), 35f64.to_radians().cos());
+    let slant = |g: &str| (text_width(g, font) * cos, text_width(g, font) * sin + font);
+    let first_reach = groups.first().map_or(0.0, |g| slant(g).0) - cluster / 2.0;
+    let left = (64.0f64).max(first_reach + 24.0);
+    let top = 56.0;
+    let below = groups.iter().map(|g| slant(g).1).fold(0.0, f64::max) + 48.0;
+    let plot_w = cluster * groups.len().max(1) as f64;
+    let legend_w = legend_width(&series).max(text_width("whiskers: 95 % interval", 11.0) + 12.0);
+    let width = left + plot_w + 24.0 + legend_w;
+    let height = top + plot_h + below;
+    let y_of = |v: f64| top + plot_h * (1.0 - (v - y0) / (y1 - y0).max(1e-9));
     let mut out = String::new();
     let _ = write!(
         out,
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{width}\" height=\"{}\" viewBox=\"0 0 {width} {}\"><rect width=\"100%\" height=\"100%\" fill=\"white\"/><text x=\"{left}\" y=\"22\" font-size=\"15\" {FONT}>{}</text>",
-        top + height + 110.0,
-        top + height + 110.0,
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{width:.0}\" height=\"{height:.0}\" viewBox=\"0 0 {width:.0} {height:.0}\" {FONT}>\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n<text x=\"{left:.1}\" y=\"24\" font-size=\"15\">{}</text>\n",
         escape(title)
     );
-    for k in 0..=4 {
-        let v = k as f64 / 4.0;
-        let y = top + height * (1.0 - v);
-        let _ = write!(
+    let ticks = ((y1 - y0) / 0.25).round().max(1.0) as usize;
+    for k in 0..=ticks {
+        let v = y0 + k as f64 * 0.25;
+        let y = y_of(v);
+        let _ = writeln!(
             out,
-            "<line x1=\"{left}\" y1=\"{y}\" x2=\"{}\" y2=\"{y}\" stroke=\"#ddd\"/><text x=\"{}\" y=\"{}\" font-size=\"11\" text-anchor=\"end\" {FONT}>{v:.2}</text>",
-            width - 160.0,
+            "<line x1=\"{left:.1}\" y1=\"{y:.1}\" x2=\"{:.1}\" y2=\"{y:.1}\" stroke=\"#ddd\"/><text x=\"{:.1}\" y=\"{:.1}\" font-size=\"{font}\" text-anchor=\"end\">{v:.2}</text>",
+            left + plot_w,
             left - 6.0,
             y + 4.0
         );
     }
+    let _ = writeln!(
+        out,
+        "<line x1=\"{left:.1}\" y1=\"{top:.1}\" x2=\"{left:.1}\" y2=\"{:.1}\" stroke=\"black\"/><line x1=\"{left:.1}\" y1=\"{:.1}\" x2=\"{:.1}\" y2=\"{:.1}\" stroke=\"black\"/>",
+        top + plot_h,
+        y_of(y0.max(0.0)),
+        left + plot_w,
+        y_of(y0.max(0.0))
+    );
+    let (ty, tx) = (top + plot_h / 2.0, left - 44.0);
+    let _ = writeln!(
+        out,
+        "<text class=\"axis-title\" x=\"{tx:.1}\" y=\"{ty:.1}\" font-size=\"12\" text-anchor=\"middle\" transform=\"rotate(-90 {tx:.1} {ty:.1})\">{}</text>",
+        escape(axes.1)
+    );
+    let _ = writeln!(
+        out,
+        "<text class=\"axis-title\" x=\"{:.1}\" y=\"{:.1}\" font-size=\"12\" text-anchor=\"middle\">{}</text>",
+        left + plot_w / 2.0,
+        height - 10.0,
+        escape(axes.0)
+    );
     for (gi, g) in groups.iter().enumerate() {
-        let x0 = left + 12.0 + gi as f64 * cluster;
+        let x0 = left + 14.0 + gi as f64 * cluster;
         for (si, s) in series.iter().enumerate() {
-            let Some(v) = bars.iter().find(|(a, b, _)| a == g && b == s).map(|b| b.2.clamp(0.0, 1.0)) else { continue };
-            let _ = write!(
-                out,
-                "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"{}\"><title>{}: {v:.3}</title></rect>",
-                x0 + si as f64 * bar,
-                top + height * (1.0 - v),
-                bar - 2.0,
-                height * v,
-                COLOURS[si % COLOURS.len()],
-                escape(&format!("{g} · {s}"))
-            );
+            let Some(b) = bars.iter().find(|b| b.group == *g && b.series == *s) else { continue };
+            bar_with_interval(&mut out, b, x0 + si as f64 * bar, bar - 3.0, COLOURS[si % COLOURS.len()], &y_of, y0);
         }
         let cx = x0 + bar * series.len() as f64 / 2.0;
+        let gy = top + plot_h + 16.0;
         let _ = write!(
             out,
-            "<text x=\"{cx}\" y=\"{}\" font-size=\"11\" text-anchor=\"end\" transform=\"rotate(-35 {cx} {})\" {FONT}>{}</text>",
-            top + height + 16.0,
-            top + height + 16.0,
+            "<text class=\"group\" x=\"{cx:.1}\" y=\"{gy:.1}\" font-size=\"{font}\" text-anchor=\"end\" transform=\"rotate(-35 {cx:.1} {gy:.1})\">{}</text>",
             escape(g)
         );
     }
-    legend(&mut out, &series, width - 140.0, top + 10.0);
+    legend(&mut out, &series, left + plot_w + 24.0, top + 10.0);
+    let _ = write!(
+        out,
+        "<text x=\"{:.1}\" y=\"{:.1}\" font-size=\"11\" fill=\"#444\">numbers: episodes</text><text x=\"{:.1}\" y=\"{:.1}\" font-size=\"11\" fill=\"#444\">whiskers: 95 % interval</text>",
+        left + plot_w + 24.0,
+        top + 10.0 + series.len() as f64 * 18.0 + 8.0,
+        left + plot_w + 24.0,
+        top + 10.0 + series.len() as f64 * 18.0 + 24.0
+    );
     out.push_str("</svg>\n");
     out
+}
+
+/// One bar of [`grouped`] at `x`, `w` wide: the bar, its error bar (whiskers capped), and
+/// its `n` (episodes) above both.
+fn bar_with_interval(out: &mut String, b: &Bar, x: f64, w: f64, colour: &str, y_of: &dyn Fn(f64) -> f64, y0: f64) {
+    if !b.value.is_finite() {
+        return;
+    }
+    let base = y_of(y0.max(0.0).min(b.value.max(y0)));
+    let (ya, yb) = (y_of(b.value).min(base), y_of(b.value).max(base));
+    let _ = write!(
+        out,
+        "<rect class=\"bar\" x=\"{x:.1}\" y=\"{ya:.1}\" width=\"{w:.1}\" height=\"{:.1}\" fill=\"{colour}\"><title>{}: {:.3}</title></rect>",
+        yb - ya,
+        escape(&format!("{} · {}", b.group, b.series)),
+        b.value
+    );
+    let mut over = y_of(b.value);
+    if let Some((lo, hi)) = b.interval.filter(|(lo, hi)| lo.is_finite() && hi.is_finite()) {
+        let (lo, hi) = (lo.min(hi), lo.max(hi));
+        let cx = x + w / 2.0;
+        let (yl, yh) = (y_of(lo), y_of(hi));
+        let _ = write!(
+            out,
+            "<g class=\"error-bar\" data-low=\"{lo:.4}\" data-high=\"{hi:.4}\" stroke=\"black\" stroke-width=\"1.2\"><line x1=\"{cx:.1}\" y1=\"{yl:.1}\" x2=\"{cx:.1}\" y2=\"{yh:.1}\"/><line x1=\"{:.1}\" y1=\"{yl:.1}\" x2=\"{:.1}\" y2=\"{yl:.1}\"/><line x1=\"{:.1}\" y1=\"{yh:.1}\" x2=\"{:.1}\" y2=\"{yh:.1}\"/></g>",
+            cx - 4.0,
+            cx + 4.0,
+            cx - 4.0,
+            cx + 4.0
+        );
+        over = over.min(yh);
+    }
+    let _ = write!(
+        out,
+        "<text class=\"n\" x=\"{:.1}\" y=\"{:.1}\" font-size=\"9\" text-anchor=\"middle\" fill=\"#444\">{}</text>",
+        x + w / 2.0,
+        over - 4.0,
+        b.n
+    );
 }
 
 /// Shares of each value per corpus, bars side by side; values by total share, at most
@@ -221,9 +326,35 @@ pub fn pca(points: &[Vec<f32>]) -> Vec<[f64; 2]> {
     (0..n).map(|i| [c1[i], c2[i]]).collect()
 }
 
-/// A scatter plot of labelled 2-D point sets.
+/// The first two principal components of `points` (as [`pca`]) and the share of the
+/// total variance each explains (0 for points without spread).
+pub fn pca_explained(points: &[Vec<f32>]) -> (Vec<[f64; 2]>, [f64; 2]) {
+    let projected = pca(points);
+    let n = points.len().max(1) as f64;
+    let d = points.first().map_or(0, |p| p.len());
+    let mut total = 0.0;
+    for j in 0..d {
+        let mean = points.iter().map(|p| p.get(j).copied().unwrap_or(0.0) as f64).sum::<f64>() / n;
+        total += points.iter().map(|p| (p.get(j).copied().unwrap_or(0.0) as f64 - mean).powi(2)).sum::<f64>();
+    }
+    let share = |k: usize| {
+        let v: f64 = projected.iter().map(|p| p[k] * p[k]).sum();
+        if total > 0.0 { v / total } else { 0.0 }
+    };
+    let explained = [share(0), share(1)];
+    (projected, explained)
+}
+
+/// A scatter plot of labelled 2-D point sets, its axes titled as a PCA's.
 pub fn scatter(title: &str, sets: &[(&str, Vec<[f64; 2]>)]) -> String {
-    let all: Vec<[f64; 2]> = sets.iter().flat_map(|(_, p)| p.iter().copied()).collect();
+    scatter_axes(title, ("PC1 (first principal component)", "PC2 (second principal component)"), sets)
+}
+
+/// A scatter plot of labelled 2-D point sets with the x and y axes' titles: every finite
+/// point inside the frame (non-finite ones are left out), ticks on both axes.
+pub fn scatter_axes(title: &str, axes: (&str, &str), sets: &[(&str, Vec<[f64; 2]>)]) -> String {
+    let finite = |p: &&[f64; 2]| p[0].is_finite() && p[1].is_finite();
+    let all: Vec<[f64; 2]> = sets.iter().flat_map(|(_, p)| p.iter().filter(finite).copied()).collect();
     let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
     for [x, y] in &all {
         x0 = x0.min(*x);
@@ -235,41 +366,92 @@ pub fn scatter(title: &str, sets: &[(&str, Vec<[f64; 2]>)]) -> String {
         (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
     }
     let (sx, sy) = ((x1 - x0).max(1e-9), (y1 - y0).max(1e-9));
-    let (size, margin, legend_w) = (480.0, 40.0, 170.0);
-    let width = size + 2.0 * margin + legend_w;
-    let height = size + 2.0 * margin;
+    let names: Vec<&str> = sets.iter().map(|(n, _)| *n).collect();
+    let (size, left, top, inset) = (480.0, 72.0, 44.0, 10.0);
+    let below = 56.0;
+    let width = left + size + 24.0 + legend_width(&names);
+    let height = top + size + below;
+    let px = |x: f64| left + inset + (size - 2.0 * inset) * (x - x0) / sx;
+    let py = |y: f64| top + inset + (size - 2.0 * inset) * (1.0 - (y - y0) / sy);
     let mut out = format!(
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{width}\" height=\"{height}\" viewBox=\"0 0 {width} {height}\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{width:.0}\" height=\"{height:.0}\" viewBox=\"0 0 {width:.0} {height:.0}\" {FONT}>\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
     );
-    let _ = writeln!(out, "<text x=\"{margin}\" y=\"24\" font-size=\"16\" {FONT}>{}</text>", escape(title));
+    let _ = writeln!(out, "<text x=\"{left}\" y=\"24\" font-size=\"15\">{}</text>", escape(title));
     let _ = writeln!(
         out,
-        "<rect x=\"{margin}\" y=\"{margin}\" width=\"{size}\" height=\"{size}\" fill=\"none\" stroke=\"#999\"/>"
+        "<rect class=\"plot-area\" x=\"{left}\" y=\"{top}\" width=\"{size}\" height=\"{size}\" fill=\"none\" stroke=\"#999\"/>"
     );
+    for vx in nice_ticks(x0, x1) {
+        let x = px(vx);
+        let _ = writeln!(
+            out,
+            "<line x1=\"{x:.1}\" y1=\"{top}\" x2=\"{x:.1}\" y2=\"{:.1}\" stroke=\"#eee\"/><text x=\"{x:.1}\" y=\"{:.1}\" font-size=\"10\" text-anchor=\"middle\">{}</text>",
+            top + size,
+            top + size + 14.0,
+            tick(vx)
+        );
+    }
+    for vy in nice_ticks(y0, y1) {
+        let y = py(vy);
+        let _ = writeln!(
+            out,
+            "<line x1=\"{left}\" y1=\"{y:.1}\" x2=\"{:.1}\" y2=\"{y:.1}\" stroke=\"#eee\"/><text x=\"{:.1}\" y=\"{:.1}\" font-size=\"10\" text-anchor=\"end\">{}</text>",
+            left + size,
+            left - 5.0,
+            y + 3.5,
+            tick(vy)
+        );
+    }
     for (c, (name, points)) in sets.iter().enumerate() {
         let _ = write!(
             out,
-            "<g fill=\"{}\" fill-opacity=\"0.6\"><title>{}</title>",
+            "<g class=\"points\" fill=\"{}\" fill-opacity=\"0.6\"><title>{}</title>",
             COLOURS[c % COLOURS.len()],
             escape(name)
         );
-        for [x, y] in points {
-            let px = margin + 8.0 + (size - 16.0) * (x - x0) / sx;
-            let py = margin + 8.0 + (size - 16.0) * (1.0 - (y - y0) / sy);
-            let _ = write!(out, "<circle cx=\"{px:.1}\" cy=\"{py:.1}\" r=\"4\"/>");
+        for [x, y] in points.iter().filter(finite) {
+            let _ = write!(out, "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"4\"/>", px(*x), py(*y));
         }
         out.push_str("</g>\n");
     }
+    let (ty, tx) = (top + size / 2.0, 16.0);
     let _ = writeln!(
         out,
-        "<text x=\"{}\" y=\"{}\" font-size=\"11\" text-anchor=\"middle\" {FONT}>first principal component</text>",
-        margin + size / 2.0,
-        height - 12.0
+        "<text class=\"axis-title\" x=\"{:.1}\" y=\"{:.1}\" font-size=\"12\" text-anchor=\"middle\">{}</text>\n<text class=\"axis-title\" x=\"{tx}\" y=\"{ty:.1}\" font-size=\"12\" text-anchor=\"middle\" transform=\"rotate(-90 {tx} {ty:.1})\">{}</text>",
+        left + size / 2.0,
+        height - 14.0,
+        escape(axes.0),
+        escape(axes.1)
     );
-    let names: Vec<&str> = sets.iter().map(|(n, _)| *n).collect();
-    legend(&mut out, &names, margin + size + 16.0, margin + 10.0);
+    legend(&mut out, &names, left + size + 24.0, top + 10.0);
     out.push_str("</svg>\n");
     out
+}
+
+/// Round values from `lo` to `hi`: multiples of 1, 2 or 5 times a power of ten, three to
+/// six of them (none for a range that is not finite and positive).
+fn nice_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    let range = hi - lo;
+    if !(range.is_finite() && range > 0.0) {
+        return Vec::new();
+    }
+    let p = 10f64.powf((range / 4.0).log10().floor());
+    let step = [1.0, 2.0, 5.0, 10.0].into_iter().map(|k| k * p).find(|s| range / s <= 5.0).unwrap_or(10.0 * p);
+    let first = (lo / step).ceil() as i64;
+    let last = (hi / step).floor() as i64;
+    (first..=last).map(|k| k as f64 * step).collect()
+}
+
+/// A tick's value, short: two significant decimals at most.
+fn tick(v: f64) -> String {
+    let s = if v.abs() >= 100.0 {
+        format!("{v:.0}")
+    } else if v.abs() >= 1.0 {
+        format!("{v:.1}")
+    } else {
+        format!("{v:.2}")
+    };
+    if s.starts_with('-') && s.trim_start_matches(['-', '0', '.']).is_empty() { s[1..].to_string() } else { s }
 }
 
 /// A panel of [`curves`]: its y label and its named series of (x, y) points.
@@ -381,5 +563,60 @@ mod tests {
         assert!(c.trim_end().ends_with("</svg>"));
         let s = scatter("t", &[("a", vec![[0.0, 0.0], [1.0, 2.0]]), ("b", vec![])]);
         assert_eq!(s.matches("<circle").count(), 2);
+    }
+
+    /// The numbers of an attribute `name="…"` in order of appearance.
+    fn numbers(svg: &str, name: &str) -> Vec<f64> {
+        let key = format!(" {name}=\"");
+        svg.split(&key).skip(1).filter_map(|rest| rest.split('"').next()?.parse().ok()).collect()
+    }
+
+    fn bar(group: &str, series: &str, value: f64, interval: Option<(f64, f64)>, n: usize) -> Bar {
+        Bar { group: group.into(), series: series.into(), value, interval, n }
+    }
+
+    #[test]
+    fn grouped_bars_have_error_bars_counts_and_titled_axes() {
+        let long = "a very long region name · generator";
+        let bars = [
+            bar(long, "idm", 0.8, Some((0.7, 0.9)), 24),
+            bar(long, "naive", 0.5, Some((0.41, 0.62)), 24),
+            bar("b", "idm", 0.95, Some((0.9, 1.2)), 7),
+            bar("b", "naive", 0.3, None, 3),
+        ];
+        let svg = grouped("OS", ("region · generator", "overall score"), &bars);
+        assert_eq!(svg.matches("class=\"bar\"").count(), 4);
+        assert_eq!(numbers(&svg, "data-low"), vec![0.7, 0.41, 0.9], "the intervals' values");
+        assert_eq!(numbers(&svg, "data-high"), vec![0.9, 0.62, 1.2]);
+        assert!(svg.contains(">24</text>") && svg.contains(">7</text>") && svg.contains(">3</text>"), "n per bar");
+        assert!(svg.contains(">overall score</text>") && svg.contains(">region · generator</text>"), "axis titles");
+        // the y axis grew to hold the interval past 1; the error bar stays inside the plot
+        assert!(svg.contains(">1.25</text>"));
+        let width = numbers(&svg, "width")[0];
+        // the slanted group name of the first cluster starts right of the picture's left edge
+        let xs = numbers(&svg, "x");
+        assert!(xs.iter().all(|x| *x >= 0.0 && *x <= width), "{xs:?}");
+        let first = svg.split("class=\"group\" x=\"").nth(1).and_then(|r| r.split('"').next()?.parse::<f64>().ok());
+        let reach = long.chars().count() as f64 * 11.0 * CHAR_EM * 35f64.to_radians().cos();
+        assert!(first.is_some_and(|x| x - reach >= 0.0), "{first:?} - {reach} clips the first group's name");
+    }
+
+    #[test]
+    fn scatter_keeps_every_point_inside_the_frame_and_titles_its_axes() {
+        let points: Vec<[f64; 2]> = (0..50).map(|i| [(i as f64).sin() * 1e3, (i as f64 * 0.7).cos() - 5.0]).collect();
+        let s = scatter_axes("t", ("PC1 (41 %)", "PC2 (12 %)"), &[("a", points), ("b", vec![[f64::NAN, 1.0]])]);
+        let area = s.split("class=\"plot-area\"").nth(1).expect("the plot area");
+        let n = |k: &str| numbers(area, k)[0];
+        let (x, y, w, h) = (n("x"), n("y"), n("width"), n("height"));
+        let (cx, cy) = (numbers(&s, "cx"), numbers(&s, "cy"));
+        assert_eq!(cx.len(), 50, "the non-finite point is left out");
+        for (px, py) in cx.iter().zip(&cy) {
+            assert!(*px - 4.0 >= x && *px + 4.0 <= x + w && *py - 4.0 >= y && *py + 4.0 <= y + h, "({px}, {py})");
+        }
+        assert!(s.contains(">PC1 (41 %)</text>") && s.contains(">PC2 (12 %)</text>"));
+        assert!(scatter("t", &[]).contains("PC1"));
+        let (p, explained) = pca_explained(&[vec![0.0, 0.0], vec![2.0, 0.1], vec![4.0, -0.1]]);
+        assert_eq!(p.len(), 3);
+        assert!(explained[0] > 0.99 && explained[0] + explained[1] <= 1.0 + 1e-9, "{explained:?}");
     }
 }

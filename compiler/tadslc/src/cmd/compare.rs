@@ -105,10 +105,12 @@ pub fn run(args: &Args) -> Result<Status, CliError> {
             return Err(CliError::usage("--plot needs embeddings (not --embedding none)"));
         };
         let pooled: Vec<Vec<f32>> = a.iter().chain(b).cloned().collect();
-        let projected = tad_stats::plot::pca(&pooled);
+        let (projected, [first, second]) = tad_stats::plot::pca_explained(&pooled);
         let (pa, pb) = projected.split_at(a.len());
-        let svg = tad_stats::plot::scatter(
+        let axis = |k: usize, share: f64| format!("PC{k} ({:.0} % of the variance)", share * 100.0);
+        let svg = tad_stats::plot::scatter_axes(
             &format!("{} embeddings, first two principal components", model),
+            (&axis(1, first), &axis(2, second)),
             &[(&corpora[0].name, pa.to_vec()), (&corpora[1].name, pb.to_vec())],
         );
         std::fs::write(path, svg).map_err(|e| CliError::usage(format!("cannot write {}: {e}", path.display())))?;
