@@ -9,6 +9,7 @@
 //! finishes, and units already there are not run again.
 
 use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use rayon::prelude::*;
 use tad_base::Shard;
@@ -81,6 +82,8 @@ pub struct Evaluated<'a> {
     /// Units this shard evaluated now, and those it found in the journal.
     pub run: usize,
     pub resumed: usize,
+    /// Units not started because the run was asked to stop (their rows are missing).
+    pub skipped: usize,
 }
 
 impl Plan {
@@ -106,42 +109,46 @@ impl Plan {
 
     /// Evaluate this shard's units: those in `done` (a journal's) are taken as they are, the
     /// others searched and played in parallel, each handed to `record` when it finishes;
-    /// `tick` is called after every episode.
+    /// `tick` is called after every episode. Once `stop` is set no unit is started (those
+    /// under way finish): the results hold the finished units only.
     pub fn evaluate<'u>(
         &self,
         units: &'u [Unit],
         done: &BTreeMap<usize, Entry>,
         record: &(dyn Fn(&Entry) + Sync),
         tick: &(dyn Fn() + Sync),
+        stop: &AtomicBool,
     ) -> Evaluated<'u> {
         let mine = self.mine(units);
-        let mut scenarios: BTreeMap<String, usize> = BTreeMap::new();
-        for (_, u) in &mine {
-            *scenarios.entry(format!("{}/{}", u.region, u.generator)).or_default() += 1;
-        }
         let resumed = mine.iter().filter(|(k, _)| done.contains_key(k)).count();
-        let entries: Vec<Entry> = mine
+        let entries: Vec<Option<Entry>> = mine
             .par_iter()
             .map(|&(k, u)| match done.get(&k) {
-                Some(entry) => entry.clone(),
+                Some(entry) => Some(entry.clone()),
+                None if stop.load(Ordering::SeqCst) => None,
                 None => {
                     let entry = self.unit(k, u, tick);
                     record(&entry);
-                    entry
+                    Some(entry)
                 }
             })
             .collect();
+        let mut scenarios: BTreeMap<String, usize> = BTreeMap::new();
         let mut rows = Vec::new();
         let mut kept = Vec::new();
-        for ((_, unit), entry) in mine.iter().zip(entries) {
-            rows.extend(entry.rows);
-            kept.extend(entry.kept.into_iter().map(|s| Kept { unit, params: s.params, seed: s.seed }));
+        for ((_, unit), entry) in mine.iter().zip(&entries) {
+            let Some(entry) = entry else { continue };
+            *scenarios.entry(format!("{}/{}", unit.region, unit.generator)).or_default() += 1;
+            rows.extend(entry.rows.iter().cloned());
+            kept.extend(entry.kept.iter().map(|s| Kept { unit, params: s.params.clone(), seed: s.seed }));
         }
+        let skipped = entries.iter().filter(|e| e.is_none()).count();
         Evaluated {
             results: Results::new(self.setup.clone(), self.shard, scenarios, rows),
             kept,
-            run: mine.len() - resumed,
+            run: mine.len() - resumed - skipped,
             resumed,
+            skipped,
         }
     }
 

@@ -14,6 +14,7 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
+use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use tad_base::Shard;
 
@@ -60,35 +61,40 @@ impl Journal {
     /// unit), or none when there was no journal or another command's.
     pub fn open(dir: &Path, setup: &Setup, shard: Shard) -> std::io::Result<(Journal, BTreeMap<usize, Entry>)> {
         std::fs::create_dir_all(dir)?;
-        let path = Journal::path(dir, shard);
         let head = Head { format: FORMAT.into(), setup: setup.clone(), shard };
-        let mut done = BTreeMap::new();
+        let (journal, entries) = Journal::open_at(Journal::path(dir, shard), &head)?;
+        Ok((journal, entries.into_iter().map(|e: Entry| (e.unit, e)).collect()))
+    }
+
+    /// Open the journal at `path` whose first line is `head`: the whole entries after a
+    /// head equal to it, or none (the file started afresh) when the head differs or there
+    /// is no file. A last line cut short is dropped, and the file cut back to the entries.
+    pub fn open_at<H, E>(path: PathBuf, head: &H) -> std::io::Result<(Journal, Vec<E>)>
+    where
+        H: Serialize + DeserializeOwned + PartialEq,
+        E: DeserializeOwned,
+    {
+        let mut done = Vec::new();
         let mut valid = 0;
         if let Ok(text) = std::fs::read_to_string(&path) {
             let mut lines = text.split_inclusive('\n');
-            let same = lines
-                .next()
-                .filter(|l| l.ends_with('\n'))
-                .and_then(|l| serde_json::from_str::<Head>(l).ok())
-                .is_some_and(|h| h == head);
-            if same {
+            if lines.next().is_some_and(|first| is_head(first, head)) {
                 valid = text.lines().next().map_or(0, |l| l.len() + 1);
                 for line in lines {
                     // a line the kill cut short has no newline, or does not parse: it and
                     // everything after it are dropped
-                    let Some(entry) = line.strip_suffix('\n').and_then(|l| serde_json::from_str::<Entry>(l).ok())
-                    else {
+                    let Some(entry) = line.strip_suffix('\n').and_then(|l| serde_json::from_str::<E>(l).ok()) else {
                         break;
                     };
                     valid += line.len();
-                    done.insert(entry.unit, entry);
+                    done.push(entry);
                 }
             }
         }
         let mut file = std::fs::OpenOptions::new().create(true).read(true).write(true).truncate(false).open(&path)?;
         if valid == 0 {
             file.set_len(0)?;
-            let line = serde_json::to_string(&head).map_err(std::io::Error::other)? + "\n";
+            let line = serde_json::to_string(head).map_err(std::io::Error::other)? + "\n";
             file.write_all(line.as_bytes())?;
         } else {
             file.set_len(valid as u64)?;
@@ -99,17 +105,34 @@ impl Journal {
         Ok((Journal { path, file: Mutex::new(file) }, done))
     }
 
+    /// Whether the journal at `path` has `head` for its first line (a run to resume).
+    pub fn holds<H: DeserializeOwned + PartialEq>(path: &Path, head: &H) -> bool {
+        let Ok(text) = std::fs::read_to_string(path) else { return false };
+        text.split_inclusive('\n').next().is_some_and(|first| is_head(first, head))
+    }
+
     pub fn file(&self) -> &Path {
         &self.path
     }
 
     /// Append one finished unit, durably.
-    pub fn append(&self, entry: &Entry) -> std::io::Result<()> {
+    pub fn append<E: Serialize>(&self, entry: &E) -> std::io::Result<()> {
         let line = serde_json::to_string(entry).map_err(std::io::Error::other)? + "\n";
         let mut file = self.file.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
         file.write_all(line.as_bytes())?;
         file.sync_data()
     }
+
+    /// Remove the journal: its run finished, and its results file says everything.
+    pub fn remove(self) -> std::io::Result<()> {
+        drop(self.file);
+        std::fs::remove_file(&self.path)
+    }
+}
+
+/// Whether a journal's first line, whole, is `head`.
+fn is_head<H: DeserializeOwned + PartialEq>(line: &str, head: &H) -> bool {
+    line.strip_suffix('\n').and_then(|l| serde_json::from_str::<H>(l).ok()).is_some_and(|h| h == *head)
 }
 
 #[cfg(test)]

@@ -2,9 +2,16 @@
 //! (`tad_search::fix`), under a name no other scene took, with a header saying where it
 //! came from; the scene run again with the same ego and seed (does it reproduce the
 //! searched outcome?); and `search.json` (format `tadsl-search/1`).
+//!
+//! While it runs, each finished search is appended to `search.jsonl` ([`Head`], then a
+//! [`Finished`] per scenario): a run interrupted (Ctrl-C, a kill) and started again with
+//! the same arguments and inputs searches only what had not finished, and writes the
+//! same files as an unbroken run.
 
 use std::collections::HashSet;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+
+use tad_base::Shard;
 
 use tad_db::Database;
 use tad_db::host::Input;
@@ -15,6 +22,40 @@ use tad_search::{Outcome, Trial};
 
 /// The search's result format.
 pub const FORMAT: &str = "tadsl-search/1";
+/// The format of its journal.
+pub const JOURNAL_FORMAT: &str = "tadsl-search-journal/1";
+
+/// What a search journal belongs to: a rerun resumes it only if all of this is the same.
+#[derive(Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Head {
+    pub format: String,
+    pub ego: String,
+    pub seed: u64,
+    pub samples: usize,
+    pub round: usize,
+    pub keep: usize,
+    pub compat: bool,
+    pub shard: Shard,
+    /// Each input of the shard: its name and a hash of its text.
+    pub inputs: Vec<(String, u64)>,
+}
+
+/// One finished search: the input's place in the shard and what it found.
+#[derive(serde::Serialize, serde::Deserialize)]
+pub struct Finished {
+    pub index: usize,
+    pub outcome: Outcome,
+}
+
+/// `DIR/search.jsonl`, or `DIR/search.I-of-N.jsonl` for a shard.
+pub fn journal_path(dir: &Path, shard: Shard) -> PathBuf {
+    dir.join(shard.file_name("search", "jsonl"))
+}
+
+/// The hash of an input's text that a [`Head`] keeps.
+pub fn input_hash(text: &str) -> u64 {
+    tad_base::fnv1a(text.bytes())
+}
 
 /// One chosen scene, as `search.json` lists it.
 #[derive(serde::Serialize)]

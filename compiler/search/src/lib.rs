@@ -52,7 +52,7 @@ impl Default for Config {
 }
 
 /// One sampled scene and how the ego fared.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Trial {
     pub index: usize,
     pub round: usize,
@@ -73,8 +73,9 @@ impl Trial {
     }
 }
 
-/// What a search found for one scenario.
-#[derive(Clone, Debug, PartialEq)]
+/// What a search found for one scenario (serialisable, so an interrupted run's finished
+/// searches can be kept and taken up again).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Outcome {
     pub trials: Vec<Trial>,
     /// The ranges each round drew from: `ranges[r][slot] = (low, high)`.

@@ -122,6 +122,32 @@ pub fn run(body: impl FnOnce(&mut Status) -> Result<(), Closed>) -> Status {
     }
 }
 
+/// Ctrl-C as a request to stop, for a command whose finished work is worth keeping: the
+/// first sets the flag returned (nothing new is started, what is under way finishes, and
+/// the command keeps what finished) and says so on standard error; a second exits at once
+/// with status 130.
+pub fn on_interrupt(under_way: &'static str) -> std::sync::Arc<AtomicBool> {
+    let stop = std::sync::Arc::new(AtomicBool::new(false));
+    let flag = stop.clone();
+    let watch = async move {
+        if tokio::signal::ctrl_c().await.is_ok() {
+            flag.store(true, Ordering::SeqCst);
+            let _ = crate::errln!("\ninterrupted: finishing the {under_way} under way (Ctrl-C again to abort)");
+            if tokio::signal::ctrl_c().await.is_ok() {
+                std::process::exit(130);
+            }
+        }
+    };
+    // a thread of its own, so that any command can be interrupted, async or not
+    let spawned = std::thread::Builder::new().name("ctrl-c".into()).spawn(move || {
+        if let Ok(runtime) = tokio::runtime::Builder::new_current_thread().enable_all().build() {
+            runtime.block_on(watch);
+        }
+    });
+    drop(spawned);
+    stop
+}
+
 /// The progress bar of every long command, on standard error, shown at a terminal only:
 /// `total` units named `unit` (`episodes`, `steps`); a message follows the count.
 pub fn progress(total: usize, unit: &str) -> indicatif::ProgressBar {

@@ -45,3 +45,26 @@ pub fn scratch(name: &str) -> PathBuf {
 pub fn tad_files(dir: &Path) -> Vec<PathBuf> {
     files(dir, "tad")
 }
+
+/// Run `tadslc` from the repository root and press Ctrl-C (SIGINT) once `file` has
+/// `lines` lines (a journal's head and its first finished unit); its output once it has
+/// stopped.
+pub fn interrupted_once(args: &[&str], file: &Path, lines: usize) -> Output {
+    let child = Command::new(env!("CARGO_BIN_EXE_tadslc"))
+        .args(args)
+        .current_dir(repo())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("tadslc runs");
+    let count = || std::fs::read_to_string(file).map_or(0, |t| t.lines().count());
+    for _ in 0..1200 {
+        if count() >= lines {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(25));
+    }
+    assert!(count() >= lines, "{} never had {lines} lines", file.display());
+    let _ = Command::new("kill").args(["-INT", &child.id().to_string()]).status();
+    child.wait_with_output().expect("tadslc finishes")
+}

@@ -467,3 +467,79 @@ fn eval_and_gen_work_from_any_directory_on_their_embedded_defaults() {
     assert_eq!(code(&generated), 0, "{}", stderr(&generated));
     assert!(stdout(&generated).contains("scenario "), "{}", stdout(&generated));
 }
+
+/// The files of `dir` (not its journals), with their contents, sorted.
+fn written(dir: &Path) -> Vec<(String, String)> {
+    let mut files: Vec<(String, String)> = std::fs::read_dir(dir)
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|name| !name.ends_with(".jsonl"))
+        .map(|name| {
+            let text = std::fs::read_to_string(dir.join(&name)).unwrap();
+            // the wall time is the one line that differs between runs
+            let text = text.lines().filter(|l| !l.contains("\"seconds\"")).collect::<Vec<_>>().join("\n");
+            (name, text)
+        })
+        .collect();
+    files.sort();
+    files
+}
+
+#[test]
+fn an_interrupted_search_keeps_what_finished_and_a_rerun_resumes_it() {
+    let dir = scratch("search-interrupt");
+    let (broken, whole) = (dir.join("broken"), dir.join("whole"));
+    let args = |out: &Path| -> Vec<String> {
+        ["search", "examples/safety", "--samples", "600", "-o", path(out)].iter().map(|a| a.to_string()).collect()
+    };
+    let first = args(&broken);
+    let first: Vec<&str> = first.iter().map(String::as_str).collect();
+    let out = interrupted_once(&first, &broken.join("search.jsonl"), 2);
+    assert_eq!(code(&out), 1, "{}", stderr(&out));
+    assert!(stderr(&out).contains("run the same command again"), "{}", stderr(&out));
+    let summary: Value = serde_json::from_str(&std::fs::read_to_string(broken.join("search.json")).unwrap()).unwrap();
+    assert_eq!(summary["interrupted"], true);
+    let finished = summary["scenarios"].as_array().unwrap().len();
+    assert!((1..8).contains(&finished), "{finished} of 8 searched before the interrupt");
+    // the same command again searches the rest, and writes what an unbroken run writes
+    let again = tadslc(&first, "");
+    assert_eq!(code(&again), 0, "{}", stderr(&again));
+    assert!(stderr(&again).contains(&format!("resumed {finished} of 8 scenarios")), "{}", stderr(&again));
+    assert!(!broken.join("search.jsonl").exists(), "a whole run leaves no journal");
+    let unbroken = args(&whole);
+    let unbroken = tadslc(&unbroken.iter().map(String::as_str).collect::<Vec<_>>(), "");
+    assert_eq!(code(&unbroken), 0, "{}", stderr(&unbroken));
+    assert_eq!(stdout(&again), stdout(&unbroken));
+    assert_eq!(written(&broken), written(&whole));
+    // a finished run's directory is refused again, as before
+    assert_eq!(code(&tadslc(&first, "")), 2);
+}
+
+#[test]
+fn an_interrupted_eval_keeps_what_finished_and_a_rerun_resumes_it() {
+    let dir = scratch("eval-interrupt");
+    let (broken, whole) = (dir.join("broken"), dir.join("whole"));
+    let args = |out: &Path| -> Vec<String> {
+        ["eval", "examples", "--region", "los_angeles", "-n", "3", "--samples", "200", "--out", path(out)]
+            .iter()
+            .map(|a| a.to_string())
+            .collect()
+    };
+    let first = args(&broken);
+    let first: Vec<&str> = first.iter().map(String::as_str).collect();
+    let out = interrupted_once(&first, &broken.join("results.jsonl"), 2);
+    assert_eq!(code(&out), 1, "{}", stderr(&out));
+    assert!(stderr(&out).contains("run the same command again"), "{}", stderr(&out));
+    assert!(!broken.join("results.json").exists(), "no results file for part of the work");
+    let again = tadslc(&first, "");
+    assert_eq!(code(&again), 0, "{}", stderr(&again));
+    assert!(stderr(&again).contains("resumed"), "{}", stderr(&again));
+    let unbroken = args(&whole);
+    let unbroken = tadslc(&unbroken.iter().map(String::as_str).collect::<Vec<_>>(), "");
+    assert_eq!(stdout(&again), stdout(&unbroken), "the resumed table is the unbroken run's");
+    assert_eq!(
+        std::fs::read_to_string(broken.join("results.json")).unwrap(),
+        std::fs::read_to_string(whole.join("results.json")).unwrap()
+    );
+}

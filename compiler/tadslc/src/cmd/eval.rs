@@ -173,13 +173,17 @@ pub fn run(args: &EvalArgs) -> Result<Status, CliError> {
     };
     let progress = crate::output::progress(todo * plan.episodes_per_unit(), "episodes");
     let started = std::time::Instant::now();
-    let evaluated = plan.evaluate(&units, &done, &record, &|| progress.inc(1));
+    let stop = crate::output::on_interrupt("scenarios");
+    let evaluated = plan.evaluate(&units, &done, &record, &|| progress.inc(1), &stop);
     progress.finish_and_clear();
     if let Some(e) = failed_journal.into_inner().unwrap_or_else(|p| p.into_inner()) {
         status = Status::Usage;
         errln!("error: cannot write the journal: {e}")?;
     }
     let results = evaluated.results;
+    if evaluated.skipped > 0 {
+        return interrupted(args, &results, evaluated.skipped, mine.len(), journal.as_ref());
+    }
     if let Some(dir) = &args.out {
         let path = results.write(dir).map_err(|e| {
             CliError::usage(format!("cannot write `{}`: {e}", Results::path(dir, args.shard).display()))
@@ -343,6 +347,29 @@ pub fn finetune(args: &EvalArgs, plan: &Plan, kept: &[Kept]) -> Result<Status, C
         std::fs::write(&path, text).map_err(|e| CliError::usage(format!("cannot write `{}`: {e}", path.display())))?;
     }
     Ok(status)
+}
+
+/// An interrupted evaluation: the table of the scenarios that finished, and how to go on.
+/// No results file is written (it would pass for the whole shard's); the journal keeps
+/// what finished for a rerun.
+fn interrupted(
+    args: &EvalArgs,
+    results: &Results,
+    skipped: usize,
+    all: usize,
+    journal: Option<&Journal>,
+) -> Result<Status, CliError> {
+    errln!("interrupted: {} of {} evaluated; the table covers those", all - skipped, plural(all, "scenario"))?;
+    super::merge::print(std::slice::from_ref(results), args.format, None)?;
+    match journal {
+        Some(journal) => errln!(
+            "{} kept in {}: run the same command again to evaluate the rest",
+            plural(all - skipped, "scenario"),
+            journal.file().display()
+        )?,
+        None => errln!("nothing was kept: with --out DIR, a rerun takes up what an interrupted run finished")?,
+    }
+    Ok(Status::Failed)
 }
 
 /// Episodes rolled out at once while fine-tuning (a setting, so results do not depend on

@@ -6,11 +6,12 @@
 //! written scene is compiled and run again with the same ego and seed; the summary says
 //! whether it reproduced the searched outcome. `--shard I/N` searches every N-th input.
 
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use rayon::prelude::*;
-use tad_eval::searched;
+use tad_eval::{Journal, searched};
 use tad_metrics::Mode;
 use tad_search::{Config, Outcome};
 
@@ -66,28 +67,70 @@ pub fn run(args: &SearchArgs, color: bool) -> Result<Status, CliError> {
         args.shard == tad_base::Shard::ALL
             && (name.ends_with(".tad") || (name.starts_with("search") && name.ends_with(".json")))
     };
-    crate::files::fresh_output(&args.out, args.force, &ours)?;
     let mode = if args.compat { Mode::Compat } else { Mode::Fixed };
     let config = Config { samples: args.samples, round: args.round, keep: args.keep, seed: args.seed, mode };
+    // an interrupted run of this very command is taken up again; its files are rewritten
+    let head = journal_head(args, &scenes);
+    let path = searched::journal_path(&args.out, args.shard);
+    let resuming = Journal::holds(&path, &head);
+    crate::files::fresh_output(&args.out, args.force || resuming, &ours)?;
+    let (journal, finished) = Journal::open_at::<_, searched::Finished>(path, &head)
+        .map_err(|e| CliError::usage(format!("cannot write the journal in `{}`: {e}", args.out.display())))?;
+    let done: BTreeMap<usize, Outcome> = finished.into_iter().map(|f| (f.index, f.outcome)).collect();
+    if !done.is_empty() {
+        errln!(
+            "resumed {} of {} from {}",
+            done.len(),
+            crate::plural(scenes.len(), "scenario"),
+            journal.file().display()
+        )?;
+    }
+    let episodes_of =
+        |l: &crate::scenes::Loaded| if l.scene.program.params.is_empty() { 1 } else { args.samples.max(1) };
     let total: usize =
-        scenes.iter().map(|s| if s.scene.program.params.is_empty() { 1 } else { args.samples.max(1) }).sum();
+        scenes.iter().enumerate().filter(|(k, _)| !done.contains_key(k)).map(|(_, l)| episodes_of(l)).sum();
     let progress = crate::output::progress(total, "episodes");
-    let done = AtomicUsize::new(0);
+    let episodes = AtomicUsize::new(0);
     let tick = || {
-        done.fetch_add(1, Ordering::Relaxed);
+        episodes.fetch_add(1, Ordering::Relaxed);
         progress.inc(1);
     };
     let make = || ego.make();
+    let stop = crate::output::on_interrupt("searches");
+    let unjournaled = std::sync::Mutex::new(None);
     let started = std::time::Instant::now();
-    let outcomes: Vec<Outcome> =
-        scenes.par_iter().map(|l| tad_search::search(&l.scene, &make, &config, &tick)).collect();
+    // each search from its own seed; a finished one goes to the journal at once
+    let outcomes: Vec<Option<Outcome>> = scenes
+        .par_iter()
+        .enumerate()
+        .map(|(k, l)| {
+            if let Some(outcome) = done.get(&k) {
+                return Some(outcome.clone());
+            }
+            if stop.load(Ordering::SeqCst) {
+                return None;
+            }
+            let outcome = tad_search::search(&l.scene, &make, &config, &tick);
+            if let Err(e) = journal.append(&searched::Finished { index: k, outcome: outcome.clone() }) {
+                *unjournaled.lock().unwrap_or_else(|p| p.into_inner()) = Some(e);
+            }
+            Some(outcome)
+        })
+        .collect();
     progress.finish_and_clear();
     let seconds = started.elapsed().as_secs_f64();
+    if let Some(e) = unjournaled.into_inner().unwrap_or_else(|p| p.into_inner()) {
+        status = Status::Usage;
+        errln!("error: cannot write the journal: {e}")?;
+    }
+    let searched_now = outcomes.iter().flatten().count() - done.len();
+    let interrupted = outcomes.iter().any(Option::is_none);
 
     let mut writer = searched::Writer::new(&args.out, &args.ego, &ego, mode);
     let mut summary = Vec::new();
     outln!("{}", searched::table_header())?;
     for (loaded, outcome) in scenes.iter().zip(&outcomes) {
+        let Some(outcome) = outcome else { continue };
         let mut written = Vec::new();
         for (k, &i) in outcome.chosen.iter().enumerate() {
             let (scene, error) = writer.write(loaded.source.as_ref(), &loaded.scene, outcome, (i, k));
@@ -100,9 +143,8 @@ pub fn run(args: &SearchArgs, color: bool) -> Result<Status, CliError> {
         outln!("{}", searched::table_line(&loaded.scene, outcome, &written))?;
         summary.push(searched::scenario_json(&loaded.name, &loaded.scene, outcome, &written));
     }
-    let episodes = done.load(Ordering::Relaxed);
     let file = args.out.join(args.shard.file_name("search", "json"));
-    let value = serde_json::json!({
+    let mut value = serde_json::json!({
         "format": searched::FORMAT,
         "ego": args.ego,
         "seed": args.seed,
@@ -110,20 +152,57 @@ pub fn run(args: &SearchArgs, color: bool) -> Result<Status, CliError> {
         "round": args.round,
         "keep": args.keep,
         "shard": args.shard.to_string(),
-        "episodes": episodes,
+        // every search's, resumed ones too, so a resumed run writes an unbroken one's file
+        "episodes": outcomes.iter().flatten().map(|o| o.trials.len()).sum::<usize>(),
         "seconds": searched::round(seconds),
         "scenarios": summary,
     });
+    if interrupted {
+        // the scenarios not searched are missing: a rerun searches them
+        value["interrupted"] = true.into();
+    }
     let text = serde_json::to_string_pretty(&value).unwrap_or_default();
     std::fs::write(&file, text + "\n")
         .map_err(|e| CliError::usage(format!("cannot write `{}`: {e}", file.display())))?;
     errln!(
-        "searched {} with {}: {episodes} episodes in {seconds:.1} s on {}; scenes and {} in {}",
-        crate::plural(scenes.len(), "scenario"),
+        "searched {} with {}: {} in {seconds:.1} s on {}; scenes and {} in {}",
+        crate::plural(searched_now, "scenario"),
         args.ego,
+        crate::plural(episodes.load(Ordering::Relaxed), "episode"),
         crate::plural(rayon::current_num_threads(), "thread"),
         file.file_name().map_or(String::new(), |f| f.to_string_lossy().into_owned()),
         args.out.display()
     )?;
+    if interrupted {
+        let left = outcomes.iter().filter(|o| o.is_none()).count();
+        errln!(
+            "interrupted: {} not searched; run the same command again to search {} and keep the rest",
+            crate::plural(left, "scenario"),
+            if left == 1 { "it" } else { "them" }
+        )?;
+        return Ok(status.max(Status::Failed));
+    }
+    // the run is whole: its files say everything
+    if let Err(e) = journal.remove() {
+        errln!("warning: cannot remove the journal: {e}")?;
+    }
     Ok(status)
+}
+
+/// What the journal of this search belongs to.
+fn journal_head(args: &SearchArgs, scenes: &[crate::scenes::Loaded]) -> searched::Head {
+    searched::Head {
+        format: searched::JOURNAL_FORMAT.into(),
+        ego: args.ego.clone(),
+        seed: args.seed,
+        samples: args.samples,
+        round: args.round,
+        keep: args.keep,
+        compat: args.compat,
+        shard: args.shard,
+        inputs: scenes
+            .iter()
+            .map(|l| (l.name.clone(), l.source.as_ref().map_or(0, |i| searched::input_hash(&i.text))))
+            .collect(),
+    }
 }

@@ -3,8 +3,6 @@
 //! resumable, `--shard I/N` for job arrays, Ctrl-C finishes the frames under way.
 
 use std::path::PathBuf;
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
 
 use tad_frontend::Summary;
 use tad_frontend::backend;
@@ -75,20 +73,8 @@ pub fn run(s: &Args) -> Result<Status, CliError> {
         ffprobe: std::env::var("TADSL_FFPROBE").unwrap_or_else(|_| "ffprobe".into()),
     };
     std::fs::create_dir_all(&s.out).map_err(|e| CliError::usage(format!("cannot create {}: {e}", s.out.display())))?;
-    let stop = Arc::new(AtomicBool::new(false));
+    let stop = crate::output::on_interrupt("frames");
     let runtime = backend::runtime().map_err(CliError::usage)?;
-    {
-        let stop = stop.clone();
-        runtime.spawn(async move {
-            if tokio::signal::ctrl_c().await.is_ok() {
-                stop.store(true, Ordering::SeqCst);
-                let _ = errln!("\ninterrupted: finishing the frames under way (Ctrl-C again to abort)");
-                if tokio::signal::ctrl_c().await.is_ok() {
-                    std::process::exit(130);
-                }
-            }
-        });
-    }
     let bar = crate::output::progress(0, "frames");
     let mut summary = Summary::default();
     let mut failed = 0usize;
