@@ -27,10 +27,10 @@ pub fn parse_extra(s: &str) -> Result<(String, String, PathBuf), String> {
 
 fn write_all(dir: &Path, texts: &[String], stem: &str) -> Result<(), String> {
     let _ = std::fs::remove_dir_all(dir);
-    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create `{}`: {e}", dir.display()))?;
     for (i, t) in texts.iter().enumerate() {
         let path = dir.join(format!("{stem}_{i:03}.tad"));
-        std::fs::write(&path, t).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        std::fs::write(&path, t).map_err(|e| format!("cannot write `{}`: {e}", path.display()))?;
     }
     Ok(())
 }

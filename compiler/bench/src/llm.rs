@@ -66,7 +66,7 @@ fn requests(args: &LlmArgs) -> Result<(Vec<Request>, String, String), String> {
     files.sort();
     if files.is_empty() {
         return Err(format!(
-            "no descriptions (*.txt) in {}: pass --descriptions DIR (the repository's tests/llm/descriptions)",
+            "no descriptions (*.txt) in `{}`: pass --descriptions DIR (the repository's tests/llm/descriptions)",
             args.descriptions.display()
         ));
     }
@@ -76,7 +76,7 @@ fn requests(args: &LlmArgs) -> Result<(Vec<Request>, String, String), String> {
     let gbnf = tad_grammar::export(tad_grammar::Format::Gbnf, &vocabulary, &modules, "TAD");
     let mut out = Vec::new();
     for path in files.iter().take(args.prompts.max(1)) {
-        let text = std::fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+        let text = std::fs::read_to_string(path).map_err(|e| format!("cannot read `{}`: {e}", path.display()))?;
         let mut request = Request::new(tad_frontend::translate_messages(text.trim(), &checker));
         request.max_tokens = args.max_tokens;
         request.temperature = 0.0;
@@ -94,7 +94,7 @@ pub fn run(args: &LlmArgs, progress: &mut dyn FnMut(&str)) -> Result<Report, Ben
     let gguf = model.require()?;
     let (requests, lark, gbnf) = requests(args)?;
     progress(&format!(
-        "bench --llm: {} prompts, answers of at most {} tokens, {} thread{}, {}",
+        "bench --llm: {} prompts, answers of at most {} tokens, {} thread{}, `{}`",
         requests.len(),
         args.max_tokens,
         args.threads,
@@ -202,7 +202,7 @@ fn measure_server(
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .spawn()
-        .map_err(|e| format!("cannot start {}: {e}", binary.display()))?;
+        .map_err(|e| format!("cannot start `{}`: {e}", binary.display()))?;
     let mut server = Server { child, port };
     let start = Instant::now();
     loop {

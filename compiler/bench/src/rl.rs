@@ -101,7 +101,7 @@ fn sb3(python: &PathBuf, algo: Algo, threads: usize, updates: usize) -> Result<f
         .args(["--rollout", &PPO_ROLLOUT.to_string(), "--epochs", &PPO_EPOCHS.to_string()])
         .env("OMP_NUM_THREADS", threads.to_string())
         .output()
-        .map_err(|e| format!("cannot run {}: {e}", python.display()))?;
+        .map_err(|e| format!("cannot run `{}`: {e}", python.display()))?;
     let _ = std::fs::remove_file(&script);
     if !output.status.success() {
         let err = String::from_utf8_lossy(&output.stderr);

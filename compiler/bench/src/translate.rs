@@ -34,7 +34,7 @@ pub struct Case {
 pub fn cases(descriptions: &Path, truth: &Path) -> Result<Vec<Case>, BenchError> {
     let files = tad_db::host::with_extension(descriptions, "txt");
     if files.is_empty() {
-        return Err(BenchError(format!("no descriptions (*.txt) in {}", descriptions.display())));
+        return Err(BenchError(format!("no descriptions (*.txt) in `{}`", descriptions.display())));
     }
     let mut cases = Vec::new();
     let mut missing = Vec::new();

@@ -261,7 +261,7 @@ fn uses(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
                             FileSpan { file: used.id(db), span: first.primary.span },
                             format!("the first: {}", first.message),
                         )
-                        .with_note(format!("its file is {}; its errors are reported there", used.path(db).display())),
+                        .with_note(format!("its file is `{}`; its errors are reported there", used.path(db).display())),
                     );
                 }
             }

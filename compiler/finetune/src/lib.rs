@@ -257,11 +257,11 @@ impl AdamW {
             tensors.insert(format!("{name}.m"), self.m[i].clone());
             tensors.insert(format!("{name}.v"), self.v[i].clone());
         }
-        candle_core::safetensors::save(&tensors, path).map_err(|e| format!("cannot write {}: {e}", path.display()))
+        candle_core::safetensors::save(&tensors, path).map_err(|e| format!("cannot write `{}`: {e}", path.display()))
     }
 
     fn load(&mut self, path: &Path, step: usize) -> Result<(), String> {
-        let bytes = std::fs::read(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+        let bytes = std::fs::read(path).map_err(|e| format!("cannot read `{}`: {e}", path.display()))?;
         let mut tensors = candle_core::safetensors::load_buffer(&bytes, &Device::Cpu)
             .map_err(|e| format!("{}: {e}", path.display()))?;
         for (i, (name, var)) in self.vars.iter().enumerate() {
@@ -305,7 +305,7 @@ fn save_checkpoint(
     let text = serde_json::to_string_pretty(state).map_err(err)?;
     std::fs::write(partial.join(STATE_FILE), text).map_err(|e| format!("cannot write the checkpoint: {e}"))?;
     let _ = std::fs::remove_dir_all(&dir);
-    std::fs::rename(&partial, &dir).map_err(|e| format!("cannot write {}: {e}", dir.display()))?;
+    std::fs::rename(&partial, &dir).map_err(|e| format!("cannot write `{}`: {e}", dir.display()))?;
     Ok(dir)
 }
 
@@ -319,7 +319,7 @@ pub fn train_samples(
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<Report, FinetuneError> {
     check(samples, config)?;
-    std::fs::create_dir_all(out).map_err(|e| FinetuneError::Io(format!("cannot create {}: {e}", out.display())))?;
+    std::fs::create_dir_all(out).map_err(|e| FinetuneError::Io(format!("cannot create `{}`: {e}", out.display())))?;
     let mut run = Run::start(weights, samples, config, out)?;
     let start = Instant::now();
     run.epochs(weights, samples, config, out, start, progress)?;
@@ -419,7 +419,7 @@ impl Run {
             let same = |s: &State| (s.seed, s.rank, s.alpha, s.targets.clone(), s.examples, s.accumulate);
             if same(&saved) != same(&state) {
                 return Err(setup(format!(
-                    "the checkpoint in {} is of another run (seed, rank, alpha, targets, examples or accumulation differ): remove it or train without --resume",
+                    "the checkpoint in `{}` is of another run (seed, rank, alpha, targets, examples or accumulation differ): remove it or train without --resume",
                     checkpoint.display()
                 )));
             }

@@ -94,7 +94,7 @@ impl Weights {
 
     /// Reads the GGUF file at `path`.
     pub fn load(path: &Path) -> Result<(Weights, Content), String> {
-        let mut file = std::fs::File::open(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+        let mut file = std::fs::File::open(path).map_err(|e| format!("cannot read `{}`: {e}", path.display()))?;
         let content = Content::read(&mut file).map_err(|e| format!("{} is not a GGUF file: {e}", path.display()))?;
         Ok((Weights::from_gguf(&content, &mut file)?, content))
     }

@@ -106,7 +106,7 @@ fn config_file(explicit: Option<&Path>) -> Result<Option<(String, String)>, Stri
         }),
     };
     let Some(path) = path else { return Ok(None) };
-    let text = std::fs::read_to_string(&path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let text = std::fs::read_to_string(&path).map_err(|e| format!("cannot read `{}`: {e}", path.display()))?;
     Ok(Some((path.display().to_string(), text)))
 }
 

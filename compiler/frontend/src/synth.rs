@@ -110,7 +110,7 @@ pub fn frames(spec: &Spec) -> Result<Vec<Frame>, Error> {
         }
         Input::Frames(dir) => {
             let mut images: Vec<PathBuf> = std::fs::read_dir(dir)
-                .map_err(|e| io(&format!("cannot read {}", dir.display()), e))?
+                .map_err(|e| io(&format!("cannot read `{}`", dir.display()), e))?
                 .filter_map(|e| e.ok().map(|e| e.path()))
                 .filter(|p| {
                     let ext = p.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
@@ -182,7 +182,7 @@ fn grab(ffmpeg: &str, video: &Path, t: f64) -> Result<Vec<u8>, Error> {
 fn image(spec: &Spec, frame: &Frame) -> Result<(String, Vec<u8>), Error> {
     match (&spec.input, &frame.image) {
         (_, Some(path)) => {
-            let bytes = std::fs::read(path).map_err(|e| io(&format!("cannot read {}", path.display()), e))?;
+            let bytes = std::fs::read(path).map_err(|e| io(&format!("cannot read `{}`", path.display()), e))?;
             let png = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"));
             Ok((if png { "image/png" } else { "image/jpeg" }.into(), bytes))
         }
@@ -373,7 +373,7 @@ async fn one(
         let dir = if status == "invalid" { spec.out.join("rejected") } else { spec.out.clone() };
         let path = store::inside(&dir, &frame.id, "tad");
         store::write_atomic(&path, crate::with_provenance(program, &provenance).as_bytes())
-            .map_err(|e| io(&format!("cannot write {}", path.display()), e))?;
+            .map_err(|e| io(&format!("cannot write `{}`", path.display()), e))?;
         file = Some(path.display().to_string());
     }
     Ok(Record {

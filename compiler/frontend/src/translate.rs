@@ -34,7 +34,7 @@ pub fn read_description(path: &Path) -> Result<String, String> {
             .map_err(|e| format!("cannot read standard input: {e}"))?;
         s
     } else {
-        std::fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?
+        std::fs::read_to_string(path).map_err(|e| format!("cannot read `{}`: {e}", path.display()))?
     };
     if text.trim().is_empty() {
         return Err(format!("{} is empty: there is nothing to translate", path.display()));
@@ -105,7 +105,7 @@ impl Translator<'_> {
                 let sub = if outcome.class == Some("invalid") { dir.join("rejected") } else { dir.to_path_buf() };
                 let target = store::inside(&sub, &stem, "tad");
                 store::write_atomic(&target, p.as_bytes())
-                    .map_err(|e| format!("cannot write {}: {e}", target.display()))?;
+                    .map_err(|e| format!("cannot write `{}`: {e}", target.display()))?;
                 file = Some(target.display().to_string());
             }
             unreachable += usize::from(outcome.unreachable());

@@ -148,7 +148,7 @@ impl Adapter {
     pub fn load(dir: &Path) -> Result<Adapter, String> {
         let config_path = dir.join(CONFIG_FILE);
         let text = std::fs::read_to_string(&config_path)
-            .map_err(|e| format!("cannot read the adapter's config {}: {e}", config_path.display()))?;
+            .map_err(|e| format!("cannot read the adapter's config `{}`: {e}", config_path.display()))?;
         let config: serde_json::Value =
             serde_json::from_str(&text).map_err(|e| format!("{}: not JSON: {e}", config_path.display()))?;
         let bad = |what: &str| format!("{}: {what}", config_path.display());
@@ -210,7 +210,7 @@ impl Adapter {
 
         let weights_path = dir.join(WEIGHTS_FILE);
         let bytes = std::fs::read(&weights_path)
-            .map_err(|e| format!("cannot read the adapter's weights {}: {e}", weights_path.display()))?;
+            .map_err(|e| format!("cannot read the adapter's weights `{}`: {e}", weights_path.display()))?;
         let tensors = candle_core::safetensors::load_buffer(&bytes, &Device::Cpu)
             .map_err(|e| format!("{}: not a safetensors file: {e}", weights_path.display()))?;
         let bad = |what: String| format!("{}: {what}", weights_path.display());
@@ -293,7 +293,7 @@ impl Adapter {
 
     /// Writes the adapter in PEFT's format into `dir` (created if needed).
     pub fn save(&self, dir: &Path) -> Result<(), String> {
-        std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+        std::fs::create_dir_all(dir).map_err(|e| format!("cannot create `{}`: {e}", dir.display()))?;
         let mut tensors = std::collections::HashMap::new();
         let tensor = |v: &[f32], rows: usize, cols: usize| {
             Tensor::from_slice(v, (rows, cols), &Device::Cpu).map_err(|e| e.to_string())
@@ -320,11 +320,11 @@ impl Adapter {
         let weights = dir.join(WEIGHTS_FILE);
         let partial = dir.join(format!("{WEIGHTS_FILE}.part"));
         candle_core::safetensors::save(&tensors, &partial)
-            .map_err(|e| format!("cannot write {}: {e}", partial.display()))?;
-        std::fs::rename(&partial, &weights).map_err(|e| format!("cannot write {}: {e}", weights.display()))?;
+            .map_err(|e| format!("cannot write `{}`: {e}", partial.display()))?;
+        std::fs::rename(&partial, &weights).map_err(|e| format!("cannot write `{}`: {e}", weights.display()))?;
         let text = serde_json::to_string_pretty(&config).map_err(|e| e.to_string())?;
         std::fs::write(dir.join(CONFIG_FILE), text + "\n")
-            .map_err(|e| format!("cannot write {}: {e}", dir.join(CONFIG_FILE).display()))
+            .map_err(|e| format!("cannot write `{}`: {e}", dir.join(CONFIG_FILE).display()))
     }
 }
 

@@ -133,7 +133,7 @@ impl Engine {
     /// As [`Engine::load`], with a LoRA adapter applied to the projections it targets.
     pub fn load_with(path: &std::path::Path, threads: usize, adapter: Option<&Adapter>) -> Result<Engine, Error> {
         let mut file =
-            std::fs::File::open(path).map_err(|e| failed(&format!("cannot be read from {}", path.display()), e))?;
+            std::fs::File::open(path).map_err(|e| failed(&format!("cannot be read from `{}`", path.display()), e))?;
         let content = gguf_file::Content::read(&mut file).map_err(|e| failed("is not a GGUF file", e))?;
         let tokenizer = tokenizer(&content).map_err(|e| failed("has no usable tokenizer", e))?;
         let mut model = Model::load(&content, &mut file, threads).map_err(|e| failed("cannot be loaded", e))?;

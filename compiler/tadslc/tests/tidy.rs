@@ -12,6 +12,8 @@
 //!   shrinks: a listed function that got shorter must leave the list;
 //! - no `too_many_arguments` allowance (each is a missing struct), but for [`MANY_ARGUMENTS`],
 //!   which only shrinks too;
+//! - a path inside a message is quoted in backticks (a single-placeholder line's
+//!   `X.display()`; a path that starts the message is a location, and bare);
 //! - subcommands return `Result<Status, CliError>`: no status raised by side effect
 //!   (`*status = …`), but in the files of [`STATUS_BY_SIDE_EFFECT`], which only shrinks.
 
@@ -111,6 +113,45 @@ fn only_the_output_module_prints() {
         }
     }
     assert!(found.is_empty(), "printing outside tadslc's output module (use outln!/errln!): {found:#?}");
+}
+
+/// A message's one placeholder for a path (`X.display()`, the line's last argument) inside
+/// a sentence, not quoted: `cannot write {}: …` where `cannot write `{}`: …` is the rule
+/// (spec/output.md, Paths). A path that starts the text (`{}: not formatted`) is a
+/// location, and a listing's field (`cache: {}`) a value: both bare.
+fn unquoted_path(line: &str) -> bool {
+    let Some(start) = line.find('"') else { return false };
+    let Some(end) = line[start + 1..].find('"').map(|e| start + 1 + e) else { return false };
+    let literal = &line[start + 1..end];
+    let rest = &line[end..];
+    let last = rest.rfind(".display()").map(|at| &rest[at + ".display()".len()..]);
+    let holders: Vec<usize> = literal.match_indices("{}").map(|(at, _)| at).collect();
+    let [at] = holders[..] else { return false };
+    // `cache: {}`: a listing's field, its value bare
+    let field = literal[..at].strip_suffix(": ").is_some_and(|k| k.chars().all(|c| c.is_ascii_lowercase() || c == ' '));
+    at > 0
+        && !field
+        && !literal[..at].ends_with(['`', '\'', '/', ':', '('])
+        && last.is_some_and(|after| after.chars().all(|c| ")?;, ".contains(c)))
+        && rest.matches(',').count() == 1
+}
+
+#[test]
+fn paths_in_messages_are_quoted() {
+    let mut found = Vec::new();
+    for path in rust_files().into_iter().filter(|p| production(p)) {
+        let text = read(&path);
+        let code = text.split("#[cfg(test)]").next().unwrap_or("");
+        for (i, line) in code.lines().enumerate() {
+            if !line.trim_start().starts_with("//") && unquoted_path(line) {
+                found.push(format!("{}:{}: {}", path.display(), i + 1, line.trim()));
+            }
+        }
+    }
+    assert!(found.is_empty(), "a path inside a message is written `{{}}` (in backticks): {found:#?}");
+    assert!(unquoted_path(r#"    errln!("rows in {}", path.display())?;"#));
+    assert!(!unquoted_path(r#"    errln!("rows in `{}`", path.display())?;"#));
+    assert!(!unquoted_path(r#"    errln!("{}: not formatted", path.display())?;"#));
 }
 
 /// Production dependencies on `tad-test-support` still to remove, with why they remain.

@@ -268,7 +268,7 @@ fn translate(args: &Args) -> Result<Status, CliError> {
     let mut manifest = match &args.out {
         Some(dir) => Some(
             store::Jsonl::append(&dir.join("faithfulness.jsonl"))
-                .map_err(|e| CliError::usage(format!("cannot write in {}: {e}", dir.display())))?,
+                .map_err(|e| CliError::usage(format!("cannot write in `{}`: {e}", dir.display())))?,
         ),
         None => None,
     };
@@ -319,7 +319,7 @@ fn answered(cases: &[tad_bench::translate::Case], dir: &std::path::Path) -> Resu
     }
     let cases: Vec<Case> =
         cases.iter().filter(|c| records.is_empty() || records.contains_key(&c.name)).cloned().collect();
-    let label = format!("the answers in {}", dir.display());
+    let label = format!("the answers in `{}`", dir.display());
     streamed("bench --translate: ", |progress| {
         let mut one = |case: &Case, _: &str| {
             let record = records.get(&case.name);

@@ -160,7 +160,7 @@ fn scenic(args: &BuildArgs, color: bool) -> Result<Status, CliError> {
                     continue;
                 };
                 errln!(
-                    "{}: wrote {} ({}, {}, {})",
+                    "{}: wrote `{}` ({}, {}, {})",
                     input.name,
                     target.display(),
                     emitted.map,
@@ -213,7 +213,7 @@ fn bytecode(args: &BuildArgs, color: bool) -> Result<Status, CliError> {
         };
         let actors = program.code.iter().filter(|i| matches!(i, tad_bytecode::Instr::Spawn { .. })).count();
         errln!(
-            "{}: wrote {} ({}, {}, {} bytes)",
+            "{}: wrote `{}` ({}, {}, {} bytes)",
             input.name,
             target.display(),
             plural(actors, "actor"),

@@ -113,7 +113,7 @@ pub fn run(args: &Args) -> Result<Status, CliError> {
             (&axis(1, first), &axis(2, second)),
             &[(&corpora[0].name, pa.to_vec()), (&corpora[1].name, pb.to_vec())],
         );
-        std::fs::write(path, svg).map_err(|e| CliError::usage(format!("cannot write {}: {e}", path.display())))?;
+        std::fs::write(path, svg).map_err(|e| CliError::usage(format!("cannot write `{}`: {e}", path.display())))?;
     }
     Ok(status)
 }

@@ -161,7 +161,7 @@ pub fn run(args: &EvalArgs) -> Result<Status, CliError> {
     if let Some(journal) = &journal
         && todo < mine.len()
     {
-        errln!("resumed {} of {} scenarios from {}", mine.len() - todo, mine.len(), journal.file().display())?;
+        errln!("resumed {} of {} scenarios from `{}`", mine.len() - todo, mine.len(), journal.file().display())?;
     }
     let failed_journal = std::sync::Mutex::new(None);
     let record = |entry: &tad_eval::Entry| {
@@ -188,7 +188,7 @@ pub fn run(args: &EvalArgs) -> Result<Status, CliError> {
         let path = results.write(dir).map_err(|e| {
             CliError::usage(format!("cannot write `{}`: {e}", Results::path(dir, args.shard).display()))
         })?;
-        errln!("rows in {}", path.display())?;
+        errln!("rows in `{}`", path.display())?;
     }
     errln!(
         "evaluated {} ({} of {}) in {:.1} s on {}",
@@ -233,7 +233,7 @@ fn scenarios(
             std::fs::create_dir_all(&dir)
                 .map_err(|e| CliError::usage(format!("cannot create `{}`: {e}", dir.display())))?;
             errln!(
-                "{region}: generating {} with the language model ({generator}) into {}",
+                "{region}: generating {} with the language model ({generator}) into `{}`",
                 plural(n, "scenario"),
                 dir.display()
             )?;
@@ -328,7 +328,7 @@ pub fn finetune(args: &EvalArgs, plan: &Plan, kept: &[Kept]) -> Result<Status, C
     }
     progress.finish_and_clear();
     if let Some(dir) = &args.out {
-        errln!("the fine-tuned egos in {}", dir.join("finetuned").display())?;
+        errln!("the fine-tuned egos in `{}`", dir.join("finetuned").display())?;
     }
     let held_out = finetune::held_out(plan, kept, &test, tuned, seed);
     if args.format == EvalFormat::Markdown {
@@ -363,7 +363,7 @@ fn interrupted(
     super::merge::print(std::slice::from_ref(results), args.format, None)?;
     match journal {
         Some(journal) => errln!(
-            "{} kept in {}: run the same command again to evaluate the rest",
+            "{} kept in `{}`: run the same command again to evaluate the rest",
             plural(all - skipped, "scenario"),
             journal.file().display()
         )?,

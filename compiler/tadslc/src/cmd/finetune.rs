@@ -97,7 +97,7 @@ pub fn run(args: &FinetuneArgs) -> Result<Status, CliError> {
     let config = args.config().map_err(CliError::usage)?;
     let file = data_file(&args.data);
     let text =
-        std::fs::read_to_string(&file).map_err(|e| CliError::usage(format!("cannot read {}: {e}", file.display())))?;
+        std::fs::read_to_string(&file).map_err(|e| CliError::usage(format!("cannot read `{}`: {e}", file.display())))?;
     let examples = tad_finetune::read_jsonl(&text).map_err(|e| CliError::usage(format!("{}: {e}", file.display())))?;
     if examples.is_empty() {
         return Err(CliError::usage(format!("{} holds no examples", file.display())));
@@ -119,7 +119,7 @@ pub fn run(args: &FinetuneArgs) -> Result<Status, CliError> {
     let first = report.losses.first().copied().unwrap_or(f32::NAN);
     let last = report.losses.last().copied().unwrap_or(f32::NAN);
     outln!(
-        "wrote the adapter to {}: {} examples, {} steps, loss {first:.4} -> {last:.4}, {:.1} tokens/s",
+        "wrote the adapter to `{}`: {} examples, {} steps, loss {first:.4} -> {last:.4}, {:.1} tokens/s",
         report.adapter.display(),
         report.examples,
         report.steps,
@@ -155,7 +155,7 @@ fn train(
             );
         }
         if let Some(dir) = &p.checkpoint {
-            bar.suspend(|| errln!("checkpoint: {}", dir.display())).ok();
+            bar.suspend(|| errln!("checkpoint: `{}`", dir.display())).ok();
         }
     });
     if let Some(bar) = progress {

@@ -23,9 +23,9 @@ pub fn run(args: &Args) -> Result<Status, CliError> {
     let (corpus, status) = corpus::load(paths)?;
     let (fitted, fitted_from) = tad_eval::generator::fit(corpus.items.iter());
     tad_frontend::store::write_atomic(output, fitted.to_json().as_bytes())
-        .map_err(|e| CliError::usage(format!("cannot write {}: {e}", output.display())))?;
+        .map_err(|e| CliError::usage(format!("cannot write `{}`: {e}", output.display())))?;
     errln!(
-        "fitted {} of {} ({} fields, region {}) into {}",
+        "fitted {} of {} ({} fields, region {}) into `{}`",
         plural(fitted_from, "scenario"),
         corpus.name,
         fitted.tables.len(),

@@ -203,7 +203,7 @@ pub struct FittedGen<'a> {
 /// checks without errors (at most `attempts` draws).
 fn fitted(g: &FittedGen) -> Result<Status, CliError> {
     let text = std::fs::read_to_string(g.model)
-        .map_err(|e| CliError::usage(format!("cannot read {}: {e}", g.model.display())))?;
+        .map_err(|e| CliError::usage(format!("cannot read `{}`: {e}", g.model.display())))?;
     let fitted =
         tad_fit::Fitted::from_json(&text).map_err(|e| CliError::usage(format!("{}: {e}", g.model.display())))?;
     let stem = fitted.region.clone().unwrap_or_else(|| tad_eval::corpus::name_of(g.model));
@@ -233,7 +233,7 @@ fn fitted(g: &FittedGen) -> Result<Status, CliError> {
             Some(dir) => {
                 let path = dir.join(format!("{}.tad", drawn.name));
                 tad_frontend::store::write_atomic(&path, program.as_bytes())
-                    .map_err(|e| CliError::usage(format!("cannot write {}: {e}", path.display())))?;
+                    .map_err(|e| CliError::usage(format!("cannot write `{}`: {e}", path.display())))?;
             }
             None => out!("{program}\n")?,
         }

@@ -97,7 +97,7 @@ pub(super) fn write_output(out: Option<&Path>, text: &str) -> Result<(), CliErro
         Some(path) => {
             std::fs::write(path, text)
                 .map_err(|e| CliError::usage(format!("cannot write `{}`: {e}", path.display())))?;
-            Ok(errln!("wrote {}", path.display())?)
+            Ok(errln!("wrote `{}`", path.display())?)
         }
     }
 }

@@ -101,7 +101,7 @@ pub fn run(args: &Args, command: clap::Command) -> Result<Status, CliError> {
     std::fs::create_dir_all(dir).map_err(|e| CliError::usage(format!("cannot create `{}`: {e}", dir.display())))?;
     let written = write_pages(&command, "tadslc", dir)
         .map_err(|e| CliError::usage(format!("cannot write the manual pages into `{}`: {e}", dir.display())))?;
-    errln!("wrote {} into {}", plural(written, "manual page"), dir.display())?;
+    errln!("wrote {} into `{}`", plural(written, "manual page"), dir.display())?;
     Ok(Status::Ok)
 }
 

@@ -245,7 +245,7 @@ pub fn run(args: &RunArgs, color: bool) -> Result<Status, CliError> {
     }
     status = status.max(gate(args, &scenes, &names, &done)?);
     if let Some(Render::Dir(dir)) = &render {
-        errln!("rendered {} to {}", crate::plural(rendered, "episode"), dir.display())?;
+        errln!("rendered {} to `{}`", crate::plural(rendered, "episode"), dir.display())?;
     }
     if let (Some(Render::File(path, format)), Some(first)) = (render, done.first()) {
         let loaded = &scenes[first.scenario];
@@ -255,7 +255,7 @@ pub fn run(args: &RunArgs, color: bool) -> Result<Status, CliError> {
             errln!("error: cannot write `{}`: {e}", path.display())?;
         } else {
             errln!(
-                "{}: rendered seed {} with {} to {}",
+                "{}: rendered seed {} with {} to `{}`",
                 loaded.name,
                 first.episode.seed.unwrap_or(0),
                 names[first.ego],

@@ -79,7 +79,7 @@ pub fn run(args: &SearchArgs, color: bool) -> Result<Status, CliError> {
     let done: BTreeMap<usize, Outcome> = finished.into_iter().map(|f| (f.index, f.outcome)).collect();
     if !done.is_empty() {
         errln!(
-            "resumed {} of {} from {}",
+            "resumed {} of {} from `{}`",
             done.len(),
             crate::plural(scenes.len(), "scenario"),
             journal.file().display()
@@ -165,7 +165,7 @@ pub fn run(args: &SearchArgs, color: bool) -> Result<Status, CliError> {
     std::fs::write(&file, text + "\n")
         .map_err(|e| CliError::usage(format!("cannot write `{}`: {e}", file.display())))?;
     errln!(
-        "searched {} with {}: {} in {seconds:.1} s on {}; scenes and {} in {}",
+        "searched {} with {}: {} in {seconds:.1} s on {}; scenes and {} in `{}`",
         crate::plural(searched_now, "scenario"),
         args.ego,
         crate::plural(episodes.load(Ordering::Relaxed), "episode"),

@@ -37,11 +37,11 @@ pub fn run(args: &Args) -> Result<Status, CliError> {
     for (name, text) in [("messages.jsonl", &export.messages), ("prompt_completion.jsonl", &export.prompt_completion)] {
         let path = output.join(name);
         tad_frontend::store::write_atomic(&path, text.as_bytes())
-            .map_err(|e| CliError::usage(format!("cannot write {}: {e}", path.display())))?;
+            .map_err(|e| CliError::usage(format!("cannot write `{}`: {e}", path.display())))?;
     }
     let total: usize = export.regions.values().sum();
     errln!(
-        "wrote {} to {} (messages.jsonl, prompt_completion.jsonl; prompt {}): {}",
+        "wrote {} to `{}` (messages.jsonl, prompt_completion.jsonl; prompt {}): {}",
         plural(total, "example"),
         output.display(),
         tad_frontend::prompt::GENERATE_TUNED.id,

@@ -60,13 +60,13 @@ pub fn run(args: &Args) -> Result<Status, CliError> {
         TableFormat::Json => outln!("{}", serde_json::to_string_pretty(&all).unwrap_or_default())?,
     }
     if let Some(dir) = args.plot.as_deref() {
-        std::fs::create_dir_all(dir).map_err(|e| CliError::usage(format!("cannot create {}: {e}", dir.display())))?;
+        std::fs::create_dir_all(dir).map_err(|e| CliError::usage(format!("cannot create `{}`: {e}", dir.display())))?;
         let plots = tad_stats::plot::corpora(&all);
         for (name, svg) in &plots {
             let path = dir.join(format!("{name}.svg"));
-            std::fs::write(&path, svg).map_err(|e| CliError::usage(format!("cannot write {}: {e}", path.display())))?;
+            std::fs::write(&path, svg).map_err(|e| CliError::usage(format!("cannot write `{}`: {e}", path.display())))?;
         }
-        errln!("wrote {} to {}", plural(plots.len(), "plot"), dir.display())?;
+        errln!("wrote {} to `{}`", plural(plots.len(), "plot"), dir.display())?;
     }
     Ok(status)
 }

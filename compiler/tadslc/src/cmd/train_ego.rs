@@ -156,7 +156,7 @@ fn no_learning_step(trainer: &Trainer, warm: bool, checkpoint: &Path) -> Result<
     if !warm {
         return Err(CliError::failed(format!(
             "no learning step was taken: the episodes ended early and stored {stored} transitions; learning starts \
-             at {needed}. The checkpoint is in {}: continue with --resume and more --episodes",
+             at {needed}. The checkpoint is in `{}`: continue with --resume and more --episodes",
             checkpoint.display()
         )));
     }
@@ -301,7 +301,7 @@ pub fn run(args: &TrainEgoArgs, color: bool) -> Result<Status, CliError> {
         judged.len()
     )?;
     errln!(
-        "actor in {} (use --ego learned:{}); checkpoint in {}",
+        "actor in `{}` (use `--ego learned:{}`); checkpoint in `{}`",
         args.out.display(),
         args.out.display(),
         checkpoint.display()
@@ -322,7 +322,7 @@ fn split(args: &TrainEgoArgs, scenes: &[Loaded]) -> Result<(Vec<usize>, Vec<usiz
     let path = tad_train::beside(&args.out, ".split.json");
     std::fs::write(&path, serde_json::to_string_pretty(&value).unwrap_or_default() + "\n")
         .map_err(|e| CliError::usage(format!("cannot write `{}`: {e}", path.display())))?;
-    errln!("split: {} for training, {} held out ({})", train.len(), test.len(), path.display())?;
+    errln!("split: {} for training, {} held out (`{}`)", train.len(), test.len(), path.display())?;
     Ok((train, test))
 }
 
@@ -343,7 +343,7 @@ fn trainer(args: &TrainEgoArgs, config: Config, checkpoint: &std::path::Path) ->
             checkpoint.display()
         )));
     }
-    errln!("resumed from {} after {}", checkpoint.display(), plural(t.episodes() as usize, "episode"))?;
+    errln!("resumed from `{}` after {}", checkpoint.display(), plural(t.episodes() as usize, "episode"))?;
     Ok(t)
 }
 

@@ -65,7 +65,7 @@ pub fn run(t: &Args) -> Result<Status, CliError> {
     };
     let mut transcript_file = match transcript {
         Some(p) => {
-            Some(store::Jsonl::append(p).map_err(|e| CliError::usage(format!("cannot write {}: {e}", p.display())))?)
+            Some(store::Jsonl::append(p).map_err(|e| CliError::usage(format!("cannot write `{}`: {e}", p.display())))?)
         }
         None => None,
     };
@@ -102,7 +102,7 @@ pub fn run(t: &Args) -> Result<Status, CliError> {
         let (outcome, program) = translator.one(&files[0], &text, &mut on_round);
         match (&program, output) {
             (Some(p), Some(path)) => store::write_atomic(path, p.as_bytes())
-                .map_err(|e| CliError::usage(format!("cannot write {}: {e}", path.display())))?,
+                .map_err(|e| CliError::usage(format!("cannot write `{}`: {e}", path.display())))?,
             (Some(p), None) => out!("{p}")?,
             (None, _) => {}
         }
