@@ -139,6 +139,12 @@ pub struct Conflict {
     pub spread: f64,
 }
 
+/// Half a conflict's spread, the most an agent's start is sampled either way: at least
+/// 0.5 m, at most 5 m.
+pub(crate) fn half_spread(spread: f64) -> f64 {
+    (spread * 0.5).clamp(0.5, 5.0)
+}
+
 /// What the layout could not do as the scenario says.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Finding {
@@ -204,7 +210,7 @@ impl Layout {
     /// spread (at most 5 m), never into the junction; 0 for an agent not timed.
     pub fn conflict_spread(&self, agent: &Agent) -> f64 {
         let Some(c) = agent.group.and_then(|g| self.conflict(g)) else { return 0.0 };
-        let half = (c.spread * 0.5).clamp(0.5, 5.0);
+        let half = half_spread(c.spread);
         match agent.station.arm {
             Arm::Ego => half,
             _ => half.min(agent.station.along - agent.length / 2.0 - 0.5).max(0.0),

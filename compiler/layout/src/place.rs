@@ -1306,6 +1306,12 @@ fn time_group(road: &Road, ego: &Agent, d: &Decision, g: &mut GroupLayout) -> Op
     }
     // move the whole group along its path by the difference, keeping its relation
     let mut shift = s_own - v * time; // > 0: start nearer the conflict point
+    if d.arm == Arm::Ego && d.longitudinal == Longitudinal::Behind && same_way {
+        // catching the ego up from behind: later than the first overlap it ends up behind
+        // the ego and follows it, so it starts nearer by what it gains on the ego in half
+        // a second, and its sampled spread lies mostly on the early side of that time
+        shift += crate::half_spread(v - ego.speed);
+    }
     // not inside the junction; not past the ego when in front of it, nor ahead when behind
     let room = first.station.along.abs() - first.length / 2.0 - ego.length / 2.0 - 0.5;
     let (floor, limit) = match d.arm {

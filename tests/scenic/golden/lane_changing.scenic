@@ -668,12 +668,12 @@ behavior TadYield(speed):
         take SetThrottleAction(0), SetBrakeAction(1.0)
 # ---- end of the prelude ----
 
-# The road around the ego vehicle: 4 lanes in the ego's direction, 4 lanes in the other direction, a straight stretch of 79 m.
+# The road around the ego vehicle: 4 lanes in the ego's direction, 4 lanes in the other direction, a straight stretch of 76 m.
 # The ego is placed where the lane layout holds from `behind` metres behind it to `ahead` metres
 # in front (and, with `approach`, that many metres before the junction its lane ends at).
 tadRoad = dict(same=4, other=4, minSame=3, minOther=0, index=3, sidewalk=False,
                junction=None, signalised=None, maneuver=None, signs=(),
-               shape='straight', ahead=50.0, behind=29.0, approach=None, arms=(),
+               shape='straight', ahead=50.0, behind=26.0, approach=None, arms=(),
                armLanes=None, armReach=None)
 tadAnchor = Uniform(*tadFind(network, tadRoad))
 
@@ -698,7 +698,7 @@ merging_suv = new Car at tadAt2[0], facing tadAt2[1],
 
 # group `fast_sedan`: 1 sedan, move_forward, 116 km/h, left_behind of ego, lane 2
 tadJitter3 = Range(-5.0, 5.0)
-tadAt3 = tadSpot(tadAnchor, -15.264 + tadJitter3, 2)
+tadAt3 = tadSpot(tadAnchor, -12.584 + tadJitter3, 2)
 fast_sedan = new Car at tadAt3[0], facing tadAt3[1],
     with blueprint 'vehicle.tesla.model3', with width 1.85, with length 4.8,
     with regionContainedIn None, with tadAdversary True, with speed 32.194, with behavior TadDrive(32.194)
