@@ -96,8 +96,8 @@ impl FinetuneArgs {
 pub fn run(args: &FinetuneArgs) -> Result<Status, CliError> {
     let config = args.config().map_err(CliError::usage)?;
     let file = data_file(&args.data);
-    let text =
-        std::fs::read_to_string(&file).map_err(|e| CliError::usage(format!("cannot read `{}`: {e}", file.display())))?;
+    let text = std::fs::read_to_string(&file)
+        .map_err(|e| CliError::usage(format!("cannot read `{}`: {e}", file.display())))?;
     let examples = tad_finetune::read_jsonl(&text).map_err(|e| CliError::usage(format!("{}: {e}", file.display())))?;
     if examples.is_empty() {
         return Err(CliError::usage(format!("{} holds no examples", file.display())));

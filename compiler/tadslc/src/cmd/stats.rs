@@ -64,7 +64,8 @@ pub fn run(args: &Args) -> Result<Status, CliError> {
         let plots = tad_stats::plot::corpora(&all);
         for (name, svg) in &plots {
             let path = dir.join(format!("{name}.svg"));
-            std::fs::write(&path, svg).map_err(|e| CliError::usage(format!("cannot write `{}`: {e}", path.display())))?;
+            std::fs::write(&path, svg)
+                .map_err(|e| CliError::usage(format!("cannot write `{}`: {e}", path.display())))?;
         }
         errln!("wrote {} to `{}`", plural(plots.len(), "plot"), dir.display())?;
     }

@@ -72,7 +72,8 @@ pub fn run(s: &Args) -> Result<Status, CliError> {
         ffmpeg: std::env::var("TADSL_FFMPEG").unwrap_or_else(|_| "ffmpeg".into()),
         ffprobe: std::env::var("TADSL_FFPROBE").unwrap_or_else(|_| "ffprobe".into()),
     };
-    std::fs::create_dir_all(&s.out).map_err(|e| CliError::usage(format!("cannot create `{}`: {e}", s.out.display())))?;
+    std::fs::create_dir_all(&s.out)
+        .map_err(|e| CliError::usage(format!("cannot create `{}`: {e}", s.out.display())))?;
     let stop = crate::output::on_interrupt("frames");
     let runtime = backend::runtime().map_err(CliError::usage)?;
     let bar = crate::output::progress(0, "frames");
