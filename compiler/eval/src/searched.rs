@@ -52,9 +52,9 @@ pub fn journal_path(dir: &Path, shard: Shard) -> PathBuf {
     dir.join(shard.file_name("search", "jsonl"))
 }
 
-/// The hash of an input's text that a [`Head`] keeps.
-pub fn input_hash(text: &str) -> u64 {
-    tad_base::fnv1a(text.bytes())
+/// The hash of an input (its text, or a `.tadc` file's program) that a [`Head`] keeps.
+pub fn input_hash(bytes: &[u8]) -> u64 {
+    tad_base::fnv1a(bytes.iter().copied())
 }
 
 /// One chosen scene, as `search.json` lists it.

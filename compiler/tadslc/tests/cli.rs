@@ -465,6 +465,16 @@ fn bench_runtime_reports_episodes_and_the_search() {
 }
 
 #[test]
+fn a_broken_module_is_reported_once_under_the_path_the_input_named() {
+    let out = tadslc(&["check", "tests/ui/check/modules.tad"], "");
+    assert_eq!(code(&out), 1);
+    let err = stderr(&out);
+    // its own report, after the input's, under the relative path the `use` resolved to
+    assert_eq!(err.matches("┌─ tests/ui/check/modules/broken_vocabulary.tad:4:3").count(), 2, "{err}");
+    assert!(!err.contains(&repo().display().to_string()), "{err}");
+}
+
+#[test]
 fn fmt_refuses_what_check_calls_non_tad_and_caps_its_errors() {
     // prose is one E0007, as in `check`, not an error per word
     let prose = "# Notes on the drive\n\nThe ego { waits } at the light: then [turns] left.\n".repeat(200);

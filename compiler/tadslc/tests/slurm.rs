@@ -362,7 +362,7 @@ fn a_cancelled_shard_resubmitted_redoes_only_what_it_had_not_written() {
         words.len() == 7 && words[2] == "of" && words[4] == "scenarios" && words[5] == "from",
         "`resumed K of M scenarios from PATH`: {resumed}"
     );
-    assert!(words[6].ends_with("results.1-of-2.jsonl"), "{resumed}");
+    assert!(words[6].starts_with('`') && words[6].ends_with("results.1-of-2.jsonl`"), "{resumed}");
     let (k, m): (usize, usize) = (words[1].parse().unwrap(), words[3].parse().unwrap());
     assert!(0 < k && k < m, "some but not all of the shard's scenarios were done: {resumed}");
     assert_eq!(k, written, "every scenario the journal had is taken: {resumed}");

@@ -170,8 +170,9 @@ pub fn run(args: &Args, color: bool) -> Result<Status, CliError> {
         out!("{}", sarif::Stream::HEAD)?;
     }
     let inputs: std::collections::HashSet<PathBuf> = paths.iter().map(|p| canonical(p)).collect();
-    // local modules used by an input and having errors of their own, each once
-    let mut modules: Vec<PathBuf> = Vec::new();
+    // local modules used by an input and having errors of their own, each once: the file
+    // (to tell it from the others) and its path as the input named it (to show)
+    let mut modules: Vec<(PathBuf, PathBuf)> = Vec::new();
     let mut db = Database::new(options.clone());
     for (i, path) in paths.iter().enumerate() {
         if i > 0 && i % BATCH == 0 {
@@ -190,10 +191,10 @@ pub fn run(args: &Args, color: bool) -> Result<Status, CliError> {
         for m in db.local_modules(file) {
             let at = canonical(m.path(&db));
             if !inputs.contains(&at)
-                && !modules.contains(&at)
+                && !modules.iter().any(|(known, _)| *known == at)
                 && tad_db::check(&db, m).diagnostics.iter().any(Diagnostic::is_error)
             {
-                modules.push(at);
+                modules.push((at, m.path(&db).clone()));
             }
         }
         reporter.files += 1;
@@ -201,7 +202,7 @@ pub fn run(args: &Args, color: bool) -> Result<Status, CliError> {
     }
     // each in its own file, after the inputs
     let mut db = Database::new(options);
-    for path in &modules {
+    for (_, path) in &modules {
         let Ok(input) = files::read(path) else { continue };
         let file = register(&mut db, &input);
         let result = tad_db::check(&db, file).clone();

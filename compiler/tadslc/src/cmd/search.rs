@@ -202,7 +202,14 @@ fn journal_head(args: &SearchArgs, scenes: &[crate::scenes::Loaded]) -> searched
         shard: args.shard,
         inputs: scenes
             .iter()
-            .map(|l| (l.name.clone(), l.source.as_ref().map_or(0, |i| searched::input_hash(&i.text))))
+            .map(|l| {
+                // a `.tadc` input has no source: its program's bytes stand for it
+                let hash = match &l.source {
+                    Some(input) => searched::input_hash(input.text.as_bytes()),
+                    None => searched::input_hash(&tad_bytecode::encode(&l.scene.program)),
+                };
+                (l.name.clone(), hash)
+            })
             .collect(),
     }
 }
