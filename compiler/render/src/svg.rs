@@ -787,21 +787,22 @@ impl Entry {
     fn symbol(&self, sx: f64, cy: f64) -> String {
         let vehicle = palette::kind(Kind::Vehicle);
         let w = palette::LEGEND_SYMBOL_PX;
+        // a body in a kind's colours, its front (right) dark: as actors are drawn
+        let body = |st: palette::KindStyle| {
+            format!(
+                "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"10\" fill=\"{}\" stroke=\"{}\"/><rect x=\"{}\" y=\"{}\" width=\"5\" height=\"10\" fill=\"{}\"/>",
+                n(sx),
+                n(cy - 5.0),
+                n(w),
+                st.fill.hex(),
+                st.dark.hex(),
+                n(sx + w - 5.0),
+                n(cy - 5.0),
+                st.dark.hex()
+            )
+        };
         match self {
-            Entry::Kind(k) => {
-                let st = palette::kind(*k);
-                format!(
-                    "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"10\" fill=\"{}\" stroke=\"{}\"/><rect x=\"{}\" y=\"{}\" width=\"5\" height=\"10\" fill=\"{}\"/>",
-                    n(sx),
-                    n(cy - 5.0),
-                    n(w),
-                    st.fill.hex(),
-                    st.dark.hex(),
-                    n(sx + w - 5.0),
-                    n(cy - 5.0),
-                    st.dark.hex()
-                )
-            }
+            Entry::Kind(k) => body(palette::kind(*k)),
             Entry::Start => format!(
                 "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"10\" fill=\"none\" stroke=\"{}\" stroke-dasharray=\"3 2\"/>",
                 n(sx),
@@ -809,17 +810,7 @@ impl Entry {
                 n(w),
                 vehicle.dark.hex()
             ),
-            Entry::End => format!(
-                "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"10\" fill=\"{}\" stroke=\"{}\"/><rect x=\"{}\" y=\"{}\" width=\"5\" height=\"10\" fill=\"{}\"/>",
-                n(sx),
-                n(cy - 5.0),
-                n(w),
-                vehicle.fill.hex(),
-                vehicle.dark.hex(),
-                n(sx + w - 5.0),
-                n(cy - 5.0),
-                vehicle.dark.hex()
-            ),
+            Entry::End => body(vehicle),
             Entry::Trajectory => format!(
                 "<path d=\"M{} {} H{} M{} {} V{} M{} {} V{}\" stroke=\"{}\" stroke-width=\"2\" fill=\"none\"/>",
                 n(sx),
