@@ -345,9 +345,12 @@ pub fn pca_explained(points: &[Vec<f32>]) -> (Vec<[f64; 2]>, [f64; 2]) {
     (projected, explained)
 }
 
-/// A scatter plot of labelled 2-D point sets, its axes titled as a PCA's.
-pub fn scatter(title: &str, sets: &[(&str, Vec<[f64; 2]>)]) -> String {
-    scatter_axes(title, ("PC1 (first principal component)", "PC2 (second principal component)"), sets)
+/// A scatter plot of labelled point sets projected on their first two principal
+/// components, each axis titled with the share of the variance it explains
+/// ([`pca_explained`]).
+pub fn scatter(title: &str, explained: [f64; 2], sets: &[(&str, Vec<[f64; 2]>)]) -> String {
+    let axis = |k: usize| format!("PC{} ({:.0} % of the variance)", k + 1, explained[k] * 100.0);
+    scatter_axes(title, (&axis(0), &axis(1)), sets)
 }
 
 /// A scatter plot of labelled 2-D point sets with the x and y axes' titles: every finite
@@ -561,7 +564,7 @@ mod tests {
         let c = curves("r & c", "episode", &[("return", vec![("a<", vec![[0.0, 1.0], [10.0, 2.0]])]), ("CR", vec![])]);
         assert!(c.contains("a&lt;") && c.contains("r &amp; c") && c.matches("<polyline").count() == 1);
         assert!(c.trim_end().ends_with("</svg>"));
-        let s = scatter("t", &[("a", vec![[0.0, 0.0], [1.0, 2.0]]), ("b", vec![])]);
+        let s = scatter("t", [0.5, 0.25], &[("a", vec![[0.0, 0.0], [1.0, 2.0]]), ("b", vec![])]);
         assert_eq!(s.matches("<circle").count(), 2);
     }
 
@@ -614,7 +617,7 @@ mod tests {
             assert!(*px - 4.0 >= x && *px + 4.0 <= x + w && *py - 4.0 >= y && *py + 4.0 <= y + h, "({px}, {py})");
         }
         assert!(s.contains(">PC1 (41 %)</text>") && s.contains(">PC2 (12 %)</text>"));
-        assert!(scatter("t", &[]).contains("PC1"));
+        assert!(scatter("t", [0.5, 0.25], &[]).contains("PC1"));
         let (p, explained) = pca_explained(&[vec![0.0, 0.0], vec![2.0, 0.1], vec![4.0, -0.1]]);
         assert_eq!(p.len(), 3);
         assert!(explained[0] > 0.99 && explained[0] + explained[1] <= 1.0 + 1e-9, "{explained:?}");

@@ -105,12 +105,11 @@ pub fn run(args: &Args) -> Result<Status, CliError> {
             return Err(CliError::usage("--plot needs embeddings (not --embedding none)"));
         };
         let pooled: Vec<Vec<f32>> = a.iter().chain(b).cloned().collect();
-        let (projected, [first, second]) = tad_stats::plot::pca_explained(&pooled);
+        let (projected, explained) = tad_stats::plot::pca_explained(&pooled);
         let (pa, pb) = projected.split_at(a.len());
-        let axis = |k: usize, share: f64| format!("PC{k} ({:.0} % of the variance)", share * 100.0);
-        let svg = tad_stats::plot::scatter_axes(
+        let svg = tad_stats::plot::scatter(
             &format!("{} embeddings, first two principal components", model),
-            (&axis(1, first), &axis(2, second)),
+            explained,
             &[(&corpora[0].name, pa.to_vec()), (&corpora[1].name, pb.to_vec())],
         );
         std::fs::write(path, svg).map_err(|e| CliError::usage(format!("cannot write `{}`: {e}", path.display())))?;
