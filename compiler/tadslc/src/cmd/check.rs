@@ -147,6 +147,11 @@ pub fn report<'a>(
         .with_related(related.iter().map(|(name, text, file)| Source { file: *file, name, text }).collect())
 }
 
+/// The diagnostics `--max-diagnostics N` shows of a file's: the first `limit`, all with 0.
+pub fn capped(all: &[Diagnostic], limit: usize) -> &[Diagnostic] {
+    if limit > 0 { &all[..all.len().min(limit)] } else { all }
+}
+
 /// Files one database holds before the next one is started: a check of a large directory
 /// holds this many files' analyses at a time, and reads the prelude once per batch. Each
 /// file's result does not depend on the batch it is in.
@@ -261,7 +266,7 @@ impl Reporter {
             self.tally.classes[class as usize] += 1;
         }
         // a file with hundreds of problems: the first ones, and how many more
-        let shown = if self.limit > 0 && all.len() > self.limit { &all[..self.limit] } else { &all[..] };
+        let shown = capped(all, self.limit);
         let hidden = &all[shown.len()..];
         let related = related(db, file, shown);
         let report = report(name, text, shown, &related);

@@ -69,8 +69,7 @@ pub fn run(args: &Args, color: bool) -> Result<Status, CliError> {
             Ok(formatted) => formatted,
             Err(diagnostics) => {
                 status = status.max(Status::Failed);
-                let shown =
-                    if limit > 0 && diagnostics.len() > limit { &diagnostics[..limit] } else { &diagnostics[..] };
+                let shown = super::check::capped(&diagnostics, limit);
                 let report = FileReport::new(&input.name, &input.text, shown);
                 err!("{}", human::render(&report, color))?;
                 if shown.len() < diagnostics.len() {
