@@ -133,16 +133,16 @@ impl Plan {
                 }
             })
             .collect();
+        let skipped = entries.iter().filter(|e| e.is_none()).count();
         let mut scenarios: BTreeMap<String, usize> = BTreeMap::new();
         let mut rows = Vec::new();
         let mut kept = Vec::new();
-        for ((_, unit), entry) in mine.iter().zip(&entries) {
+        for ((_, unit), entry) in mine.iter().zip(entries) {
             let Some(entry) = entry else { continue };
             *scenarios.entry(format!("{}/{}", unit.region, unit.generator)).or_default() += 1;
-            rows.extend(entry.rows.iter().cloned());
-            kept.extend(entry.kept.iter().map(|s| Kept { unit, params: s.params.clone(), seed: s.seed }));
+            rows.extend(entry.rows);
+            kept.extend(entry.kept.into_iter().map(|s| Kept { unit, params: s.params, seed: s.seed }));
         }
-        let skipped = entries.iter().filter(|e| e.is_none()).count();
         Evaluated {
             results: Results::new(self.setup.clone(), self.shard, scenarios, rows),
             kept,

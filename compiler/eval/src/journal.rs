@@ -49,6 +49,8 @@ pub struct KeptScene {
 pub struct Journal {
     path: PathBuf,
     file: Mutex<std::fs::File>,
+    /// The last failure of [`Journal::record`], for the end of the run.
+    failed: Mutex<Option<std::io::Error>>,
 }
 
 impl Journal {
@@ -102,7 +104,7 @@ impl Journal {
         use std::io::Seek as _;
         file.seek(std::io::SeekFrom::End(0))?;
         file.sync_data()?;
-        Ok((Journal { path, file: Mutex::new(file) }, done))
+        Ok((Journal { path, file: Mutex::new(file), failed: Mutex::new(None) }, done))
     }
 
     /// Whether the journal at `path` has `head` for its first line (a run to resume).
@@ -121,6 +123,19 @@ impl Journal {
         let mut file = self.file.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
         file.write_all(line.as_bytes())?;
         file.sync_data()
+    }
+
+    /// Append one finished unit from a worker that goes on whatever happens: a failure is
+    /// kept for [`Journal::failure`] (the unit's result is not lost, only its resumption).
+    pub fn record<E: Serialize>(&self, entry: &E) {
+        if let Err(e) = self.append(entry) {
+            *self.failed.lock().unwrap_or_else(|poisoned| poisoned.into_inner()) = Some(e);
+        }
+    }
+
+    /// The last failure of [`Journal::record`], if any.
+    pub fn failure(&self) -> Option<std::io::Error> {
+        self.failed.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).take()
     }
 
     /// Remove the journal: its run finished, and its results file says everything.

@@ -139,12 +139,12 @@ pub fn on_interrupt(under_way: &'static str) -> std::sync::Arc<AtomicBool> {
         }
     };
     // a thread of its own, so that any command can be interrupted, async or not
-    let spawned = std::thread::Builder::new().name("ctrl-c".into()).spawn(move || {
+    // without the thread (none could be made), Ctrl-C stops the command as it always did
+    let _ = std::thread::Builder::new().name("ctrl-c".into()).spawn(move || {
         if let Ok(runtime) = tokio::runtime::Builder::new_current_thread().enable_all().build() {
             runtime.block_on(watch);
         }
     });
-    drop(spawned);
     stop
 }
 

@@ -163,12 +163,9 @@ pub fn run(args: &EvalArgs) -> Result<Status, CliError> {
     {
         errln!("resumed {} of {} scenarios from `{}`", mine.len() - todo, mine.len(), journal.file().display())?;
     }
-    let failed_journal = std::sync::Mutex::new(None);
     let record = |entry: &tad_eval::Entry| {
-        if let Some(journal) = &journal
-            && let Err(e) = journal.append(entry)
-        {
-            *failed_journal.lock().unwrap_or_else(|p| p.into_inner()) = Some(e);
+        if let Some(journal) = &journal {
+            journal.record(entry);
         }
     };
     let progress = crate::output::progress(todo * plan.episodes_per_unit(), "episodes");
@@ -176,7 +173,7 @@ pub fn run(args: &EvalArgs) -> Result<Status, CliError> {
     let stop = crate::output::on_interrupt("scenarios");
     let evaluated = plan.evaluate(&units, &done, &record, &|| progress.inc(1), &stop);
     progress.finish_and_clear();
-    if let Some(e) = failed_journal.into_inner().unwrap_or_else(|p| p.into_inner()) {
+    if let Some(e) = journal.as_ref().and_then(Journal::failure) {
         status = Status::Usage;
         errln!("error: cannot write the journal: {e}")?;
     }

@@ -97,7 +97,6 @@ pub fn run(args: &SearchArgs, color: bool) -> Result<Status, CliError> {
     };
     let make = || ego.make();
     let stop = crate::output::on_interrupt("searches");
-    let unjournaled = std::sync::Mutex::new(None);
     let started = std::time::Instant::now();
     // each search from its own seed; a finished one goes to the journal at once
     let outcomes: Vec<Option<Outcome>> = scenes
@@ -111,20 +110,19 @@ pub fn run(args: &SearchArgs, color: bool) -> Result<Status, CliError> {
                 return None;
             }
             let outcome = tad_search::search(&l.scene, &make, &config, &tick);
-            if let Err(e) = journal.append(&searched::Finished { index: k, outcome: outcome.clone() }) {
-                *unjournaled.lock().unwrap_or_else(|p| p.into_inner()) = Some(e);
-            }
+            journal.record(&searched::Finished { index: k, outcome: outcome.clone() });
             Some(outcome)
         })
         .collect();
     progress.finish_and_clear();
     let seconds = started.elapsed().as_secs_f64();
-    if let Some(e) = unjournaled.into_inner().unwrap_or_else(|p| p.into_inner()) {
+    if let Some(e) = journal.failure() {
         status = Status::Usage;
         errln!("error: cannot write the journal: {e}")?;
     }
-    let searched_now = outcomes.iter().flatten().count() - done.len();
-    let interrupted = outcomes.iter().any(Option::is_none);
+    let left = outcomes.iter().filter(|o| o.is_none()).count();
+    let searched_now = outcomes.len() - left - done.len();
+    let interrupted = left > 0;
 
     let mut writer = searched::Writer::new(&args.out, &args.ego, &ego, mode);
     let mut summary = Vec::new();
@@ -174,7 +172,6 @@ pub fn run(args: &SearchArgs, color: bool) -> Result<Status, CliError> {
         args.out.display()
     )?;
     if interrupted {
-        let left = outcomes.iter().filter(|o| o.is_none()).count();
         errln!(
             "interrupted: {} not searched; run the same command again to search {} and keep the rest",
             crate::plural(left, "scenario"),
