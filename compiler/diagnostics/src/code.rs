@@ -114,6 +114,7 @@ codes! {
     // OpenSCENARIO backend
     W0710 => Warning,
     W0711 => Warning,
+    W0712 => Warning,
     W0720 => Warning,
 }
 

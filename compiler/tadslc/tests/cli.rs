@@ -1132,3 +1132,46 @@ fn the_runtime_says_where_it_does_not_model_the_weather_or_the_night() {
         tadslc(&["build", "--target", "openscenario", file.to_str().unwrap(), "-o", out_dir.to_str().unwrap()], "");
     assert!(!stderr(&out).contains("W0720"), "{}", stderr(&out));
 }
+
+#[test]
+fn openscenario_on_a_town_names_its_file_and_says_what_it_lacks() {
+    let Some(maps) = tad_test_support::shared().map(|s| s.join("maps/CARLA")).filter(|d| d.is_dir()) else {
+        assert!(std::env::var("TAD_REQUIRE_MAPS").as_deref() != Ok("1"), "../shared/maps/CARLA is not there");
+        return;
+    };
+    let dir = scratch("xosc-town");
+    let file = repo().join("examples/safety/crossing_negotiation.tad");
+    let (f, m) = (file.to_str().unwrap(), maps.to_str().unwrap());
+    let out_dir = dir.join("out");
+    let o = out_dir.to_str().unwrap();
+    let out = tadslc(&["build", "--target", "openscenario", f, "--map", "Town10HD", "--map-dir", m, "-o", o], "");
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    // the town's lanes and lights, said; no road of its own
+    assert!(stderr(&out).contains("warning[W0712]: the ego's road has 2 + 2 lanes"), "{}", stderr(&out));
+    assert!(!out_dir.join("crossing_negotiation.xodr").exists());
+    let xosc = std::fs::read_to_string(out_dir.join("crossing_negotiation.xosc")).unwrap();
+    let town = std::path::absolute(maps.join("Town10HD.xodr")).unwrap();
+    assert!(xosc.contains(&format!("<LogicFile filepath=\"{}\"/>", town.display())), "{xosc}");
+    // the same output twice
+    let again = tadslc(&["build", "--target", "openscenario", f, "--map", "Town10HD", "--map-dir", m, "-o", o], "");
+    assert_eq!(code(&again), 0);
+    assert_eq!(std::fs::read_to_string(out_dir.join("crossing_negotiation.xosc")).unwrap(), xosc);
+    // without --map-dir the town is looked for beside the output, and its absence is a usage error
+    let out = tadslc(&["build", "--target", "openscenario", f, "--map", "Town10HD", "-o", o], "");
+    assert_eq!(code(&out), 2);
+    assert!(stderr(&out).contains("--map-dir DIR"), "{}", stderr(&out));
+    // a town file that is not OpenDRIVE: a usage error naming it
+    let bad = dir.join("maps");
+    std::fs::create_dir_all(&bad).unwrap();
+    std::fs::write(bad.join("Town04.xodr"), "<OpenDRIVE><road id=\"1\" length=\"x\" junction=\"-1\"/></OpenDRIVE>")
+        .unwrap();
+    let out = tadslc(
+        &["build", "--target", "openscenario", f, "--map", "Town04", "--map-dir", bad.to_str().unwrap(), "-o", o],
+        "",
+    );
+    assert_eq!(code(&out), 2);
+    assert!(stderr(&out).contains("<road> `length` is `x`, not a number"), "{}", stderr(&out));
+    // --map-dir alone
+    let out = tadslc(&["build", "--target", "openscenario", f, "--map-dir", m, "-o", o], "");
+    assert_eq!(code(&out), 2);
+}

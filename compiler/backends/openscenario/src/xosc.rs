@@ -18,6 +18,7 @@ use tad_road::{Arm, Body, Turn};
 use crate::attrs;
 use crate::mapping::{self, Category};
 use crate::network::{Network, arm_road};
+use crate::site::{self, Site};
 use crate::xml::{Xml, num};
 
 /// The OpenSCENARIO version written.
@@ -33,8 +34,10 @@ pub struct Context<'a> {
     pub layout: &'a Layout,
     pub program: &'a Program,
     pub net: &'a Network,
-    /// The generated road's file name.
+    /// The road's file: the generated road's name, or the town's path.
     pub xodr_file: &'a str,
+    /// With `--map`: where the layout lies on the town (`net` is then unused).
+    pub site: Option<&'a Site<'a>>,
 }
 
 /// A parameter's name: the slot's `group.what` as `group_what`.
@@ -94,6 +97,9 @@ impl Position {
 /// Where a pose of an arm is, on the generated road; `along` (the slot of the station's
 /// `along`) moves `s` with it.
 fn locate(c: &Context, arm: Arm, pose: Pose, along: Option<Value>) -> Position {
+    if let Some(site) = c.site {
+        return locate_on_town(c, site, arm, pose, along);
+    }
     let Some((road_id, s, t)) = c.net.locate(arm, pose.position) else { return Position::World(pose) };
     let Some(road) = c.net.road(road_id) else { return Position::World(pose) };
     let Some((lane, offset)) = road.lane_at(t) else { return Position::World(pose) };
@@ -104,6 +110,34 @@ fn locate(c: &Context, arm: Arm, pose: Pose, along: Option<Value>) -> Position {
         _ => num(s),
     };
     Position::Lane { road: road_id, lane, s: s_text, offset, heading }
+}
+
+/// [`locate`] on a town: the same distance from the arm's origin, the same lane from the
+/// centre (`site::Site::place`).
+fn locate_on_town(c: &Context, site: &Site, arm: Arm, pose: Pose, along: Option<Value>) -> Position {
+    let road = &c.layout.road;
+    let (out, lateral, traffic) = site::frame(road, arm, pose.position);
+    let lane = site.place(road, arm, out, lateral, wrap(pose.yaw - traffic)).and_then(|place| {
+        let (lane, offset) = site.town.road(place.road)?.lane_at(place.s, place.t)?;
+        Some((place, lane, offset))
+    });
+    let Some((place, lane, offset)) = lane else {
+        let yaw = site.direction(Vec2::from_yaw(pose.yaw)).yaw();
+        return Position::World(Pose { position: site.world(road, pose.position), yaw });
+    };
+    // s moves with `along`: with it on the ego's arm, against it on the others, as the road runs
+    let dir = site.arm(arm).map_or(1.0, |a| a.dir);
+    let rate = if arm == Arm::Ego { dir } else { -dir };
+    let s_text = match along {
+        Some(v @ Value { slot: Some(_), .. }) => value(c.program, Value { base: 0.0, ..v }, rate, place.s),
+        _ => num(place.s),
+    };
+    Position::Lane { road: place.road, lane, s: s_text, offset, heading: place.heading }
+}
+
+/// A layout point in the road file's world.
+fn world(c: &Context, p: Vec2) -> Vec2 {
+    c.site.map_or(p, |site| site.world(&c.layout.road, p))
 }
 
 /// One start condition of an event.
@@ -155,7 +189,7 @@ pub fn print(c: &Context, file: &str) -> Output {
     );
     parameters(&mut x, c.program);
     x.empty("CatalogLocations", &[]);
-    road_network(&mut x, c);
+    road_network(&mut x, c, &mut diagnostics);
     let actors = entities(&mut x, c, &mut diagnostics);
     storyboard(&mut x, c, &actors, &mut diagnostics);
     let distribution = (!c.program.params.is_empty()).then(|| print_distribution(c.program, file));
@@ -176,7 +210,7 @@ fn parameters(x: &mut Xml, program: &Program) {
     x.close();
 }
 
-fn road_network(x: &mut Xml, c: &Context) {
+fn road_network(x: &mut Xml, c: &Context, diagnostics: &mut Vec<Diagnostic>) {
     x.open("RoadNetwork", &[]);
     x.empty("LogicFile", attrs!("filepath" => c.xodr_file));
     let controllers: Vec<(Arm, &[tad_bytecode::Phase])> = c
@@ -191,14 +225,32 @@ fn road_network(x: &mut Xml, c: &Context) {
     if !controllers.is_empty() {
         x.open("TrafficSignals", &[]);
         for (arm, phases) in controllers {
-            let Some(signal) = c.net.controllers.iter().find(|k| k.arm == arm).and_then(|k| k.signals.first()) else {
-                continue;
+            let signals: Vec<u32> = match c.site {
+                Some(site) => site.signals(arm),
+                None => c
+                    .net
+                    .controllers
+                    .iter()
+                    .find(|k| k.arm == arm)
+                    .and_then(|k| k.signals.first())
+                    .into_iter()
+                    .copied()
+                    .collect(),
             };
+            if signals.is_empty() {
+                if let Some(site) = c.site {
+                    let what = format!("the town's junction has no traffic lights for the {} road", arm.as_str());
+                    diagnostics.push(misfit(c, site, &what, false, "its lights keep the town's own phases"));
+                }
+                continue;
+            }
             x.open("TrafficSignalController", attrs!("name" => format!("{}_lights", arm.as_str())));
             for (k, phase) in phases.iter().enumerate() {
                 let light = phase.light.as_str();
                 x.open("Phase", attrs!("name" => format!("{light}{}", k + 1), "duration" => num(phase.seconds)));
-                x.empty("TrafficSignalState", attrs!("trafficSignalId" => signal, "state" => light));
+                for signal in &signals {
+                    x.empty("TrafficSignalState", attrs!("trafficSignalId" => signal, "state" => light));
+                }
                 x.close();
             }
             x.close();
@@ -206,6 +258,21 @@ fn road_network(x: &mut Xml, c: &Context) {
         x.close();
     }
     x.close();
+}
+
+/// W0712: what of the scenario the town does not have, and what is done instead; on the
+/// road's `lanes` when it is about lanes, else on its `type`.
+pub fn misfit(c: &Context, site: &Site, what: &str, lanes: bool, instead: &str) -> Diagnostic {
+    let message = format!("{what} on `{}`", site.town.name);
+    let payload = Payload::Unsupported {
+        backend: "openscenario".into(),
+        construct: what.to_string(),
+        instead: Some(instead.to_string()),
+    };
+    let road = &c.scenario.road;
+    let field = if lanes { road.lanes.span() } else { road.road_type.span() };
+    let span = field.or(road.span).unwrap_or(c.scenario.span);
+    Diagnostic::new(Code::W0712, message, span, format!("placed on `{}`", site.town.name)).with_payload(payload)
 }
 
 /// An actor of the program: its entity's name and how it starts.
@@ -334,6 +401,9 @@ fn group_span(c: &Context, group: &str) -> tad_diagnostics::Span {
 /// The route of a vehicle in `lane` of `arm` taking `turn`: its start, then a point on its
 /// exit road's lane; `None` without a junction.
 fn route(c: &Context, start: &Position, arm: Arm, lane: i64, turn: Turn) -> Option<Vec<Position>> {
+    if let Some(site) = c.site {
+        return route_on_town(site, start, arm, lane, turn);
+    }
     let connecting = c.net.connecting(arm, lane, turn)?;
     let (_, out) = connecting.turn.map(|(a, _, t)| (a, t.exit(a)))?;
     let exit_lane = connecting.right.first()?.successor?;
@@ -342,6 +412,21 @@ fn route(c: &Context, start: &Position, arm: Arm, lane: i64, turn: Turn) -> Opti
     let heading = if exit_lane > 0 { PI } else { 0.0 };
     let end = Position::Lane { road: exit_road.id, lane: exit_lane, s: num(s), offset: 0.0, heading };
     Some(vec![start.clone(), end])
+}
+
+/// [`route`] on a town: its start, the middle of the town's connecting road for the lane and
+/// turn (which pins the way through the junction), and a point on the exit road's lane.
+fn route_on_town(site: &Site, start: &Position, arm: Arm, lane: i64, turn: Turn) -> Option<Vec<Position>> {
+    let (connecting, via, exit) = site.route(arm, lane, turn)?;
+    let length = site.town.road(connecting)?.length;
+    let along_via = if via > 0 { PI } else { 0.0 };
+    let middle = Position::Lane { road: connecting, lane: via, s: num(length / 2.0), offset: 0.0, heading: along_via };
+    let exit_lane = site.exit_lane(exit, lane, turn)?;
+    let exit_road = site.town.road(exit.road)?;
+    let s = (exit.s0 - exit.dir * ROUTE_BEYOND).clamp(0.0, exit_road.length);
+    let heading = if exit.dir > 0.0 { PI } else { 0.0 };
+    let end = Position::Lane { road: exit.road, lane: exit_lane, s: num(s), offset: 0.0, heading };
+    Some(vec![start.clone(), middle, end])
 }
 
 /// Each actor's events, in its script's order.
@@ -377,7 +462,14 @@ fn events(c: &Context, actor: &Actor, diagnostics: &mut Vec<Diagnostic>) -> Vec<
                     flush(&mut events, &mut current);
                 }
                 let point = Vec2::new(point[0], point[1]);
-                current.starts.push(Start::Meet { point, travel: value(p, *travel, 1.0, 0.0) });
+                // on a town, its own way to the point is as much longer as the straight line
+                let (from, to) = (actor.pose.position, world(c, actor.pose.position));
+                let ratio = match from.distance(point) {
+                    d if d > 1.0 => to.distance(c.site.map_or(point, |site| site.conflict(&c.layout.road, point))) / d,
+                    _ => 1.0,
+                };
+                let point = c.site.map_or(point, |site| site.conflict(&c.layout.road, point));
+                current.starts.push(Start::Meet { point, travel: value(p, *travel, ratio, 0.0) });
             }
             Instr::WaitNear { actor: a, distance } if mine(a) => {
                 if !current.actions.is_empty() {
@@ -396,13 +488,15 @@ fn events(c: &Context, actor: &Actor, diagnostics: &mut Vec<Diagnostic>) -> Vec<
             Instr::Follow { actor: a, path, speed } if mine(a) => {
                 current.actions.push(("speed".into(), Action::Speed(value(p, *speed, 1.0, 0.0))));
                 if let Some(line) = p.paths.get(usize::from(*path)) {
-                    let points: Vec<Vec2> = line.0.iter().map(|q| Vec2::new(q[0], q[1])).collect();
-                    current.actions.push(("path".into(), Action::Trajectory(ahead_of(&points, actor.pose.position))));
+                    let points: Vec<Vec2> = line.0.iter().map(|q| world(c, Vec2::new(q[0], q[1]))).collect();
+                    let from = world(c, actor.pose.position);
+                    current.actions.push(("path".into(), Action::Trajectory(ahead_of(&points, from))));
                 }
             }
             Instr::Cross { actor: a, speed } if mine(a) => {
                 current.actions.push(("speed".into(), Action::Speed(value(p, *speed, 1.0, 0.0))));
                 let d = Vec2::from_yaw(actor.pose.yaw);
+                let d = c.site.map_or(d, |site| site.direction_on(&c.layout.road, actor.arm, actor.pose.position, d));
                 current.actions.push(("cross".into(), Action::Across(d * crossing_length(c, actor))));
             }
             Instr::ChangeLane { actor: a, lanes } if mine(a) => {

@@ -35,7 +35,12 @@ fn examples() -> Vec<Example> {
         .iter()
         .map(|path| {
             let (stem, scenario, emitted) = common::emit_file(path);
-            Example { stem, layout: tad_layout::lay_out(&scenario), xosc: emitted.xosc, xodr: emitted.xodr }
+            Example {
+                stem,
+                layout: tad_layout::lay_out(&scenario),
+                xosc: emitted.xosc,
+                xodr: emitted.xodr.expect("a generated road"),
+            }
         })
         .collect()
 }

@@ -16,17 +16,36 @@ fn build(text: &str) -> tad_openscenario::Emitted {
 #[test]
 fn every_openscenario_code_is_produced_by_its_example() {
     let codes: Vec<Code> = Code::ALL.iter().copied().filter(|c| c.as_str()[1..].starts_with("071")).collect();
-    assert_eq!(codes, [Code::W0710, Code::W0711]);
+    assert_eq!(codes, [Code::W0710, Code::W0711, Code::W0712]);
     for code in codes {
         let text = tad_test_support::fixtures::tad_block(code.explanation())
             .unwrap_or_else(|| panic!("{code}: no tad example"));
-        let emitted = build(&text);
+        let emitted = match code {
+            Code::W0712 => {
+                let Some(town) = town10hd() else { continue };
+                let (scenario, _) = common::emit(Path::new("/nonexistent/example.tad"), &text, "example");
+                let options = tad_openscenario::EmitOptions { stem: "example".into(), source: "example".into() };
+                tad_openscenario::emit_on_town(&scenario, &options, &town, "Town10HD.xodr").expect("a site")
+            }
+            _ => build(&text),
+        };
         assert!(
             emitted.diagnostics.iter().any(|d| d.code == code),
             "{code}: the example gives {:#?}",
             emitted.diagnostics
         );
     }
+}
+
+/// CARLA's Town10HD, when `../shared/maps/CARLA` is there.
+fn town10hd() -> Option<tad_openscenario::town::Town> {
+    let path = tad_test_support::shared()?.join("maps/CARLA/Town10HD.xodr");
+    let Ok(text) = std::fs::read_to_string(&path) else {
+        assert!(std::env::var("TAD_REQUIRE_MAPS").as_deref() != Ok("1"), "`{}` is not there", path.display());
+        eprintln!("SKIPPED: W0712's example: `{}` is not there", path.display());
+        return None;
+    };
+    Some(tad_openscenario::town::Town::parse("Town10HD", &text).unwrap())
 }
 
 /// The rows of §3.2's table: (actor types, category cell).

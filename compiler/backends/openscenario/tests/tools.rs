@@ -101,3 +101,52 @@ fn asam_checkers_netconvert_and_scenariogeneration_pass_every_example() {
     assert!(problems.is_empty(), "{} problems:\n{}", problems.len(), problems.join("\n"));
     assert!(out.status.success(), "the checker's status: {}", out.status);
 }
+
+/// `--map Town10HD`: every example placed on the town, which its `.xosc` names by absolute
+/// path. The `.xosc` bundle and the read-back pass; the town's own `.xodr` is CARLA's, not
+/// checked here.
+#[test]
+fn asam_checker_and_scenariogeneration_pass_every_example_on_a_town() {
+    let Some(python) = python() else { return };
+    let Some(maps) = tad_test_support::shared().map(|s| s.join("maps/CARLA")).filter(|d| d.is_dir()) else {
+        assert!(std::env::var("TAD_REQUIRE_OPENSCENARIO").as_deref() != Ok("1"), "../shared/maps/CARLA is not there");
+        return;
+    };
+    let town_file = std::path::absolute(maps.join("Town10HD.xodr")).unwrap();
+    let town = tad_openscenario::town::Town::parse("Town10HD", &std::fs::read_to_string(&town_file).unwrap()).unwrap();
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("openscenario-town");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut stems = 0;
+    for path in common::scenarios() {
+        let text = std::fs::read_to_string(&path).unwrap();
+        let stem = path.file_stem().unwrap().to_string_lossy().into_owned();
+        let (scenario, _) = common::emit(&path, &text, &stem);
+        let options = tad_openscenario::EmitOptions { stem: stem.clone(), source: stem.clone() };
+        let emitted =
+            tad_openscenario::emit_on_town(&scenario, &options, &town, &town_file.to_string_lossy()).expect("a site");
+        for (ext, text) in emitted.files() {
+            std::fs::write(dir.join(format!("{stem}.{ext}")), text).unwrap();
+        }
+        stems += 1;
+    }
+    let script = tad_test_support::repo().join("tools/openscenario_check.py");
+    let out = Command::new(&python).arg(&script).arg(&dir).arg("--json").output().expect("the checker runs");
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
+        panic!("{e}: {}\n{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr))
+    });
+    let files = report["files"].as_array().expect("files");
+    let mut problems = Vec::new();
+    for f in files {
+        let name = f["file"].as_str().unwrap();
+        for issue in f["issues"].as_array().unwrap() {
+            problems.push(format!("{name}: {issue}"));
+        }
+        if let Some(rb) = f["readback"].as_object().filter(|rb| rb["ok"] != true) {
+            problems.push(format!("{name}: read-back failed: {}", rb["error"]));
+        }
+    }
+    assert!(files.iter().filter(|f| f["kind"] == "xosc").count() >= stems, "every .xosc checked");
+    assert!(problems.is_empty(), "{} problems:\n{}", problems.len(), problems.join("\n"));
+    assert!(out.status.success(), "the checker's status: {}", out.status);
+}

@@ -1,6 +1,7 @@
 //! `tadslc build`: a Scenic 3 program per scenario (`--target scenic`), a bytecode
 //! program for the runtime (`--target bytecode`, `spec/bytecode.md`), or OpenSCENARIO on a
-//! generated OpenDRIVE road (`--target openscenario`, `spec/backends/openscenario.md`).
+//! generated OpenDRIVE road or, with `--map`, a CARLA town (`--target openscenario`,
+//! `spec/backends/openscenario.md`).
 //!
 //! Each file is checked first: a file with errors is refused (its errors are printed and
 //! the status is 1); the others are resolved (`tad_db::resolve`, the typed IR) and emitted
@@ -36,10 +37,11 @@ pub struct BuildArgs {
     #[arg(short, long)]
     pub output: Option<PathBuf>,
     /// Directory of the CARLA OpenDRIVE maps (`TownNN.xodr`); default: the map
-    /// next to the program
+    /// next to the program (or, for openscenario, in the output directory)
     #[arg(long)]
     pub map_dir: Option<PathBuf>,
-    /// The town to use, e.g. `Town10HD` (default: the first map with the road's features)
+    /// The town to use, e.g. `Town10HD` (scenic default: the first map with the road's
+    /// features; openscenario default: a road generated from the layout)
     #[arg(long, value_parser = |s: &str| tad_scenic::maps::town(s).map(String::from))]
     pub map: Option<String>,
     /// Which simulator the behaviors are written for
@@ -55,7 +57,8 @@ pub enum Target {
     /// Bytecode for the runtime (`NAME.tadc`, `spec/bytecode.md`)
     Bytecode,
     /// OpenSCENARIO XML 1.2 on a generated OpenDRIVE 1.7 road (`NAME.xosc`, `NAME.xodr`,
-    /// `NAME.distribution.xosc`; `spec/backends/openscenario.md`)
+    /// `NAME.distribution.xosc`), or with `--map` on a CARLA town
+    /// (`spec/backends/openscenario.md`)
     Openscenario,
 }
 
@@ -227,16 +230,20 @@ fn bytecode(args: &BuildArgs, color: bool) -> Result<Status, CliError> {
 /// `--target openscenario`: `NAME.xosc`, `NAME.xodr` and (with parameters)
 /// `NAME.distribution.xosc` per scenario into the `-o` directory, which it requires.
 fn openscenario(args: &BuildArgs, color: bool) -> Result<Status, CliError> {
-    if args.map_dir.is_some() || args.map.is_some() {
-        return Err(CliError::usage(
-            "the openscenario target generates its road: `--map` and `--map-dir` are options of the scenic target",
-        ));
-    }
     let dir = args.output.as_deref().ok_or_else(|| {
         CliError::usage(
             "the openscenario target writes two or three files per scenario: give an output directory with -o",
         )
     })?;
+    let town = match &args.map {
+        Some(name) => Some(read_town(name, args.map_dir.as_deref(), dir)?),
+        None if args.map_dir.is_some() => {
+            return Err(CliError::usage(
+                "`--map-dir` goes with `--map TownNN`: the openscenario target generates its road otherwise",
+            ));
+        }
+        None => None,
+    };
     let mut status = Status::Ok;
     let (inputs, read) = files::load(&args.paths, Search::Tad)?;
     status = status.max(read);
@@ -256,7 +263,17 @@ fn openscenario(args: &BuildArgs, color: bool) -> Result<Status, CliError> {
             }
         };
         let options = tad_openscenario::EmitOptions { stem: stem(input), source: input.name.clone() };
-        let emitted = tad_openscenario::emit(&scenario, &options);
+        let emitted = match &town {
+            Some((town, file)) => match tad_openscenario::emit_on_town(&scenario, &options, town, file) {
+                Ok(emitted) => emitted,
+                Err(why) => {
+                    errln!("error: {}: not built: {why}", input.name)?;
+                    status = status.max(Status::Failed);
+                    continue;
+                }
+            },
+            None => tad_openscenario::emit(&scenario, &options),
+        };
         err!("{}", human::render(&FileReport::new(&input.name, &input.text, &emitted.diagnostics), color))?;
         let mut names = Vec::new();
         for (ext, text) in emitted.files() {
@@ -272,6 +289,32 @@ fn openscenario(args: &BuildArgs, color: bool) -> Result<Status, CliError> {
         errln!("{}: wrote {} ({warnings})", input.name, names.join(", "))?;
     }
     Ok(status)
+}
+
+/// `--map TOWN` of the openscenario target: the town's OpenDRIVE file read from `--map-dir`
+/// (else the output directory, where the scenario then names it beside itself), and the path
+/// the scenario names it by.
+fn read_town(
+    name: &str,
+    map_dir: Option<&Path>,
+    out: &Path,
+) -> Result<(tad_openscenario::town::Town, String), CliError> {
+    let file = format!("{name}.xodr");
+    let (path, named) = match map_dir {
+        Some(d) => {
+            let path = std::path::absolute(d.join(&file)).unwrap_or_else(|_| d.join(&file));
+            let named = path.to_string_lossy().into_owned();
+            (path, named)
+        }
+        None => (out.join(&file), file.clone()),
+    };
+    let text = std::fs::read_to_string(&path).map_err(|e| {
+        let hint = if map_dir.is_none() { ": give the directory of the CARLA maps with `--map-dir DIR`" } else { "" };
+        CliError::usage(format!("cannot read `{}` ({e}){hint}", path.display()))
+    })?;
+    let town = tad_openscenario::town::Town::parse(name, &text)
+        .map_err(|e| CliError::usage(format!("`{}`: {e}", path.display())))?;
+    Ok((town, named))
 }
 
 /// The stem of an input's outputs: its file's (`stdin` without a path).
