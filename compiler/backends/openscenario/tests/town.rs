@@ -133,6 +133,11 @@ fn check(town: &Town, path: &std::path::Path, problems: &mut Vec<String>) -> Che
     );
     let starts = starts(&doc);
     let name = format!("{stem} on {}", town.name);
+    let w0712 = emitted.diagnostics.iter().filter(|d| d.code == tad_diagnostics::Code::W0712).count();
+    let ego_at = starts.get("ego").map_or("-".to_string(), |p| format!("road {} lane {}", p.road, p.lane));
+    let route = ego_route(&doc);
+    let via = route.get(1).map_or("-".to_string(), |p| format!("road {}", p.road));
+    println!("| {stem} | {} | {ego_at} | {via} | {w0712} |", town.name);
     let mut checked = Checked::default();
     let Some(ego) = starts.get("ego") else {
         problems.push(format!("{name}: the ego has no lane position"));
@@ -274,6 +279,7 @@ fn every_example_keeps_its_lanes_gaps_and_turns_on_each_town() {
     let towns = towns();
     let mut problems = Vec::new();
     let mut total = Checked::default();
+    println!("| example | town | ego starts on | through | W0712 |\n|---|---|---|---|---|");
     for town in &towns {
         for path in common::scenarios() {
             let c = check(town, &path, &mut problems);
