@@ -1,5 +1,5 @@
-//! `--map TownNN` (`spec/backends/openscenario.md` §4): every example placed on CARLA's
-//! towns (`../shared/maps/CARLA`), the written `.xosc` read back as XML and resolved on the
+//! `--map TownNN` (`spec/backends/openscenario.md` §4): every example placed on each of
+//! CARLA's six towns (`../shared/maps/CARLA`), the written `.xosc` read back as XML and resolved on the
 //! town's `.xodr`:
 //!
 //! - every start is a lane of the town at an `s` within its road, a vehicle's a driving lane;
@@ -29,9 +29,8 @@ const WAY_TOLERANCE: f64 = 0.75;
 const CROSS_TOLERANCE: f64 = 20.0 * PI / 180.0;
 /// A turn's heading change within this of its nominal, rad.
 const TURN_TOLERANCE: f64 = 35.0 * PI / 180.0;
-/// The towns tried: the smallest with four-way junctions and two lanes, the highway town with
-/// up to four lanes each way.
-const TOWNS: [&str; 2] = ["Town10HD", "Town04"];
+/// The towns tried: CARLA's six of `../shared/maps/CARLA`.
+const TOWNS: [&str; 6] = ["Town10HD", "Town04", "Town07", "Town06", "Town01", "Town02"];
 
 fn towns() -> Vec<Town> {
     let dir = tad_test_support::shared().map(|s| s.join("maps/CARLA"));
