@@ -1150,7 +1150,7 @@ fn openscenario_on_a_town_names_its_file_and_says_what_it_lacks() {
     assert!(stderr(&out).contains("warning[W0712]: the ego's road has 2 + 2 lanes"), "{}", stderr(&out));
     assert!(!out_dir.join("crossing_negotiation.xodr").exists());
     let xosc = std::fs::read_to_string(out_dir.join("crossing_negotiation.xosc")).unwrap();
-    let town = std::path::absolute(maps.join("Town10HD.xodr")).unwrap();
+    let town = std::fs::canonicalize(maps.join("Town10HD.xodr")).unwrap();
     assert!(xosc.contains(&format!("<LogicFile filepath=\"{}\"/>", town.display())), "{xosc}");
     // the same output twice
     let again = tadslc(&["build", "--target", "openscenario", f, "--map", "Town10HD", "--map-dir", m, "-o", o], "");

@@ -105,11 +105,14 @@ fn needs(layout: &Layout) -> Needs {
             (arm, lo - MARGIN, hi + MARGIN)
         })
         .collect();
-    let turns = layout
-        .agents()
-        .filter(|a| a.lane > 0 && a.body == tad_road::Body::Vehicle && road.junction.is_some())
-        .map(|a| (a.station.arm, a.lane, a.turn))
-        .collect();
+    let mut turns: Vec<(Arm, i64, Turn)> = Vec::new();
+    let vehicles =
+        layout.agents().filter(|a| a.lane > 0 && a.body == tad_road::Body::Vehicle && road.junction.is_some());
+    for turn in vehicles.map(|a| (a.station.arm, a.lane, a.turn)) {
+        if !turns.contains(&turn) {
+            turns.push(turn);
+        }
+    }
     Needs { arms, lanes, reach, turns, signalised: road.junction.as_ref().is_some_and(|j| j.signalised) }
 }
 
@@ -296,24 +299,14 @@ fn junction_candidates(town: &Town, j: u32, needs: &Needs) -> Vec<Candidate> {
             let words = if signalised { "has traffic lights" } else { "has no traffic lights" };
             misfits.push((5.0, Misfit { what: format!("the town's junction {words}"), lanes: false }));
         }
-        let candidate = Candidate { arms, junction: Some(j), misfits };
-        let missing: Vec<(f64, Misfit)> = needs
-            .turns
-            .iter()
-            .filter(|t| route_of(town, &candidate.arms, j, t.0, t.1, t.2).is_none())
-            .map(|t| {
-                let what = format!(
-                    "the junction has no {} turn from lane {} of the {} road",
-                    crate::network::turn_name(t.2),
-                    t.1,
-                    arm_words(t.0)
-                );
-                (20.0, Misfit { what, lanes: true })
-            })
-            .collect();
-        let mut candidate = candidate;
-        candidate.misfits.extend(missing);
-        out.push(candidate);
+        for &(arm, lane, turn) in &needs.turns {
+            if route_of(town, &arms, j, arm, lane, turn).is_none() {
+                let turn = crate::network::turn_name(turn);
+                let what = format!("the junction has no {turn} turn from lane {lane} of the {} road", arm_words(arm));
+                misfits.push((20.0, Misfit { what, lanes: true }));
+            }
+        }
+        out.push(Candidate { arms, junction: Some(j), misfits });
     }
     out
 }

@@ -225,18 +225,7 @@ fn road_network(x: &mut Xml, c: &Context, diagnostics: &mut Vec<Diagnostic>) {
     if !controllers.is_empty() {
         x.open("TrafficSignals", &[]);
         for (arm, phases) in controllers {
-            let signals: Vec<u32> = match c.site {
-                Some(site) => site.signals(arm),
-                None => c
-                    .net
-                    .controllers
-                    .iter()
-                    .find(|k| k.arm == arm)
-                    .and_then(|k| k.signals.first())
-                    .into_iter()
-                    .copied()
-                    .collect(),
-            };
+            let signals = signals_facing(c, arm);
             if signals.is_empty() {
                 if let Some(site) = c.site {
                     let what = format!("the town's junction has no traffic lights for the {} road", arm.as_str());
@@ -258,6 +247,23 @@ fn road_network(x: &mut Xml, c: &Context, diagnostics: &mut Vec<Diagnostic>) {
         x.close();
     }
     x.close();
+}
+
+/// The traffic lights facing an arm's incoming traffic: the generated road's first one, or
+/// the town's (`Site::signals`).
+fn signals_facing(c: &Context, arm: Arm) -> Vec<u32> {
+    match c.site {
+        Some(site) => site.signals(arm),
+        None => c
+            .net
+            .controllers
+            .iter()
+            .find(|k| k.arm == arm)
+            .and_then(|k| k.signals.first())
+            .into_iter()
+            .copied()
+            .collect(),
+    }
 }
 
 /// W0712: what of the scenario the town does not have, and what is done instead; on the

@@ -302,7 +302,8 @@ fn read_town(
     let file = format!("{name}.xodr");
     let (path, named) = match map_dir {
         Some(d) => {
-            let path = std::path::absolute(d.join(&file)).unwrap_or_else(|_| d.join(&file));
+            let path = d.join(&file);
+            let path = std::fs::canonicalize(&path).or_else(|_| std::path::absolute(&path)).unwrap_or(path);
             let named = path.to_string_lossy().into_owned();
             (path, named)
         }
