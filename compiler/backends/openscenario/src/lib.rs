@@ -74,8 +74,8 @@ pub fn emit(scenario: &Scenario, options: &EmitOptions) -> Emitted {
     let net = network::network(&layout);
     let name = program.name.clone();
     let xodr_file = format!("{}.{XODR}", options.stem);
-    let context =
-        xosc::Context { scenario, layout: &layout, program: &program, net: &net, xodr_file: &xodr_file, site: None };
+    let ground = xosc::Ground::Generated(&net);
+    let context = xosc::Context { scenario, layout: &layout, program: &program, ground, xodr_file: &xodr_file };
     let out = xosc::print(&context, &format!("{}.{XOSC}", options.stem));
     Emitted {
         xosc: out.text,
@@ -100,15 +100,8 @@ pub fn emit_on_town(
         Some(_) => format!("`{}` has no junction to place the scenario at", town.name),
         None => format!("`{}` has no road with driving lanes", town.name),
     })?;
-    let net = network::Network::default();
-    let context = xosc::Context {
-        scenario,
-        layout: &layout,
-        program: &program,
-        net: &net,
-        xodr_file: town_file,
-        site: Some(&site),
-    };
+    let ground = xosc::Ground::Town(&site);
+    let context = xosc::Context { scenario, layout: &layout, program: &program, ground, xodr_file: town_file };
     let out = xosc::print(&context, &format!("{}.{XOSC}", options.stem));
     let mut diagnostics = out.diagnostics;
     for m in &site.misfits {

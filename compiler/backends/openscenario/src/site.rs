@@ -22,7 +22,7 @@ use std::f64::consts::PI;
 
 use tad_layout::Layout;
 use tad_road::geom::{Pose, Vec2, wrap};
-use tad_road::road::CURVE_RADIUS;
+use tad_road::road::{CURVE_RADIUS, Station};
 use tad_road::{Arm, Road, Shape, Turn};
 
 use crate::town::{Connection, Town};
@@ -47,6 +47,23 @@ pub struct ArmSite {
     /// The town's driving lanes each way at the origin, innermost first: incoming, outgoing.
     pub incoming: Vec<i32>,
     pub outgoing: Vec<i32>,
+}
+
+impl ArmSite {
+    /// `s` on the arm's road `out` metres out from its origin (within the road).
+    fn s_at(&self, road: &crate::town::Road, out: f64) -> f64 {
+        (self.s0 - self.dir * out).clamp(0.0, road.length)
+    }
+
+    /// The heading of the arm's incoming traffic on its road at `s`.
+    fn traffic_yaw(&self, road: &crate::town::Road, s: f64) -> f64 {
+        along_dir(road.pose(s).yaw, self.dir)
+    }
+}
+
+/// A reference line's heading turned to the way traffic going `dir` drives.
+fn along_dir(yaw: f64, dir: f64) -> f64 {
+    if dir > 0.0 { yaw } else { yaw + PI }
 }
 
 /// The layout's place on a town.
@@ -117,13 +134,9 @@ fn needs(layout: &Layout) -> Needs {
 }
 
 /// A station's distance out from its arm's origin: from the junction's edge outwards, or
-/// (the ego's road without a junction) backwards from the ego's start.
+/// (the ego's road without a junction, whose `approach` is 0) backwards from the ego's start.
 fn outward(road: &Road, arm: Arm, along: f64) -> f64 {
-    match (arm, road.junction.is_some()) {
-        (Arm::Ego, true) => road.approach - along,
-        (Arm::Ego, false) => -along,
-        _ => along,
-    }
+    road.before_stop_line(Station { arm, along })
 }
 
 /// A candidate and its cost.
@@ -262,7 +275,7 @@ fn junction_candidates(town: &Town, j: u32, needs: &Needs) -> Vec<Candidate> {
     let roads = incoming_roads(town, j);
     let into = |(id, dir, s): (u32, f64, f64)| -> Option<Pose> {
         let p = town.road(id)?.pose(s);
-        Some(Pose { yaw: if dir > 0.0 { p.yaw } else { p.yaw + PI }, ..p })
+        Some(Pose { yaw: along_dir(p.yaw, dir), ..p })
     };
     let signalised = town.junctions.get(&j).is_some_and(|jn| {
         jn.connections.iter().any(|c| town.road(c.connecting).is_some_and(|r| !r.signals.is_empty()))
@@ -323,13 +336,11 @@ fn route_of(town: &Town, arms: &[ArmSite], j: u32, arm: Arm, lane: i64, turn: Tu
 /// between them.
 fn centre(layout: &Layout, town: &Town, c: &Candidate) -> (Vec2, Vec2, f64) {
     let origin = Vec2::new(0.0, 0.0);
-    let edge = |a: &ArmSite| town.road(a.road).map(|r| r.pose(a.s0));
-    let Some(ego_pose) = c.arms.iter().find(|a| a.arm == Arm::Ego).and_then(|a| edge(a).map(|p| (p, a.dir))) else {
+    let ego = c.arms.iter().find(|a| a.arm == Arm::Ego);
+    let Some(yaw) = ego.and_then(|a| town.road(a.road).map(|r| a.traffic_yaw(r, a.s0))) else {
         return (origin, origin, 0.0);
     };
-    let (pose, dir) = ego_pose;
-    let yaw = if dir > 0.0 { pose.yaw } else { pose.yaw + PI };
-    let edges: Vec<Vec2> = c.arms.iter().filter_map(|a| edge(a).map(|p| p.position)).collect();
+    let edges: Vec<Vec2> = c.arms.iter().filter_map(|a| town.road(a.road).map(|r| r.pose(a.s0).position)).collect();
     let mean = edges.iter().fold(origin, |acc, p| acc + *p) * (1.0 / edges.len().max(1) as f64);
     (layout.road.centre(), mean, yaw)
 }
@@ -360,7 +371,7 @@ impl Site<'_> {
     pub fn place(&self, road: &Road, arm: Arm, out: f64, lateral: f64, yaw: f64) -> Option<Place> {
         let a = self.arm(arm)?;
         let town_road = self.town.road(a.road)?;
-        let s = (a.s0 - a.dir * out).clamp(0.0, town_road.length);
+        let s = a.s_at(town_road, out);
         // the nearest layout lane, and how far from its centre
         let w = road.lane_width;
         let (incoming, outgoing) = road.arm_lanes(arm);
@@ -375,7 +386,7 @@ impl Site<'_> {
         let town_offset =
             if offset.abs() > w / 2.0 { offset.signum() * (half + offset.abs() - w / 2.0) } else { offset };
         let t = centre + a.dir * town_offset;
-        let heading = wrap(yaw + if a.dir > 0.0 { 0.0 } else { PI });
+        let heading = wrap(along_dir(yaw, a.dir));
         Some(Place { road: a.road, s, t, heading })
     }
 
@@ -454,16 +465,14 @@ impl Site<'_> {
         exit.outgoing.get(usize::try_from(k - 1).ok()?).copied()
     }
 
-    /// A layout direction at a point of an arm, on the town: the same angle to the arm's
-    /// incoming traffic there.
-    pub fn direction_on(&self, road: &Road, arm: Arm, p: Vec2, d: Vec2) -> Vec2 {
+    /// A layout heading at a point of an arm, on the town: the unit vector at the same angle
+    /// to the arm's incoming traffic there.
+    pub fn direction_on(&self, road: &Road, arm: Arm, p: Vec2, yaw: f64) -> Vec2 {
         let (out, _, traffic) = frame(road, arm, p);
         let Some((a, r)) = self.arm(arm).and_then(|a| self.town.road(a.road).map(|r| (a, r))) else {
-            return self.direction(d);
+            return self.direction(Vec2::from_yaw(yaw));
         };
-        let s = (a.s0 - a.dir * out).clamp(0.0, r.length);
-        let town_traffic = r.pose(s).yaw + if a.dir > 0.0 { 0.0 } else { PI };
-        Vec2::from_yaw(town_traffic + d.yaw() - traffic) * d.length()
+        Vec2::from_yaw(a.traffic_yaw(r, a.s_at(r, out)) + yaw - traffic)
     }
 
     /// Points every metre of a lane of an arm from `from` to `to` metres out.
@@ -471,8 +480,7 @@ impl Site<'_> {
         let Some(r) = self.town.road(a.road) else { return };
         let n = (from - to).abs().ceil().max(1.0) as usize;
         for k in 0..=n {
-            let out = from + (to - from) * k as f64 / n as f64;
-            let s = (a.s0 - a.dir * out).clamp(0.0, r.length);
+            let s = a.s_at(r, from + (to - from) * k as f64 / n as f64);
             points.extend(r.lane_centre(s, id).map(|t| r.point(s, t)));
         }
     }
@@ -496,18 +504,19 @@ impl Site<'_> {
 /// A layout point in an arm's frame: its distance out from the arm's origin, its offset left
 /// of the centre line (as the arm's incoming traffic sees it) and that traffic's heading there.
 pub fn frame(road: &Road, arm: Arm, p: Vec2) -> (f64, f64, f64) {
-    match (arm, road.junction.as_ref()) {
-        (Arm::Ego, None) => {
+    let (along, lateral, yaw) = match arm {
+        Arm::Ego => {
             let (along, lateral) = ego_road_inverse(road, p);
-            (-along, lateral, road.ego_road(along, 0.0).yaw)
+            (along, lateral, road.ego_road(along, 0.0).yaw)
         }
-        (Arm::Ego, Some(_)) => (road.approach - p.x, p.y, 0.0),
-        (arm, j) => {
+        arm => {
             let u = arm.outward();
             let q = p - road.centre();
-            (q.dot(u) - j.map_or(0.0, |j| j.half), q.dot((-u).left()), (-u).yaw())
+            let half = road.junction.as_ref().map_or(0.0, |j| j.half);
+            (q.dot(u) - half, q.dot((-u).left()), (-u).yaw())
         }
-    }
+    };
+    (outward(road, arm, along), lateral, yaw)
 }
 
 /// The arm a layout point lies on (outside the junction), its distance out from the arm's

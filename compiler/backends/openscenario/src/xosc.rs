@@ -33,11 +33,17 @@ pub struct Context<'a> {
     pub scenario: &'a Scenario,
     pub layout: &'a Layout,
     pub program: &'a Program,
-    pub net: &'a Network,
+    pub ground: Ground<'a>,
     /// The road's file: the generated road's name, or the town's path.
     pub xodr_file: &'a str,
-    /// With `--map`: where the layout lies on the town (`net` is then unused).
-    pub site: Option<&'a Site<'a>>,
+}
+
+/// What the scenario stands on: the road generated from the layout, or (`--map`) the
+/// layout's place on a town.
+#[derive(Clone, Copy)]
+pub enum Ground<'a> {
+    Generated(&'a Network),
+    Town(&'a Site<'a>),
 }
 
 /// A parameter's name: the slot's `group.what` as `group_what`.
@@ -97,11 +103,12 @@ impl Position {
 /// Where a pose of an arm is, on the generated road; `along` (the slot of the station's
 /// `along`) moves `s` with it.
 fn locate(c: &Context, arm: Arm, pose: Pose, along: Option<Value>) -> Position {
-    if let Some(site) = c.site {
-        return locate_on_town(c, site, arm, pose, along);
-    }
-    let Some((road_id, s, t)) = c.net.locate(arm, pose.position) else { return Position::World(pose) };
-    let Some(road) = c.net.road(road_id) else { return Position::World(pose) };
+    let net = match c.ground {
+        Ground::Generated(net) => net,
+        Ground::Town(site) => return locate_on_town(c, site, arm, pose, along),
+    };
+    let Some((road_id, s, t)) = net.locate(arm, pose.position) else { return Position::World(pose) };
+    let Some(road) = net.road(road_id) else { return Position::World(pose) };
     let Some((lane, offset)) = road.lane_at(t) else { return Position::World(pose) };
     let heading = wrap(pose.yaw - road.pose(s).yaw);
     let s_text = match along {
@@ -137,7 +144,10 @@ fn locate_on_town(c: &Context, site: &Site, arm: Arm, pose: Pose, along: Option<
 
 /// A layout point in the road file's world.
 fn world(c: &Context, p: Vec2) -> Vec2 {
-    c.site.map_or(p, |site| site.world(&c.layout.road, p))
+    match c.ground {
+        Ground::Generated(_) => p,
+        Ground::Town(site) => site.world(&c.layout.road, p),
+    }
 }
 
 /// One start condition of an event.
@@ -227,7 +237,7 @@ fn road_network(x: &mut Xml, c: &Context, diagnostics: &mut Vec<Diagnostic>) {
         for (arm, phases) in controllers {
             let signals = signals_facing(c, arm);
             if signals.is_empty() {
-                if let Some(site) = c.site {
+                if let Ground::Town(site) = c.ground {
                     let what = format!("the town's junction has no traffic lights for the {} road", arm.as_str());
                     diagnostics.push(misfit(c, site, &what, false, "its lights keep the town's own phases"));
                 }
@@ -252,17 +262,11 @@ fn road_network(x: &mut Xml, c: &Context, diagnostics: &mut Vec<Diagnostic>) {
 /// The traffic lights facing an arm's incoming traffic: the generated road's first one, or
 /// the town's (`Site::signals`).
 fn signals_facing(c: &Context, arm: Arm) -> Vec<u32> {
-    match c.site {
-        Some(site) => site.signals(arm),
-        None => c
-            .net
-            .controllers
-            .iter()
-            .find(|k| k.arm == arm)
-            .and_then(|k| k.signals.first())
-            .into_iter()
-            .copied()
-            .collect(),
+    match c.ground {
+        Ground::Town(site) => site.signals(arm),
+        Ground::Generated(net) => {
+            net.controllers.iter().find(|k| k.arm == arm).and_then(|k| k.signals.first()).into_iter().copied().collect()
+        }
     }
 }
 
@@ -407,13 +411,14 @@ fn group_span(c: &Context, group: &str) -> tad_diagnostics::Span {
 /// The route of a vehicle in `lane` of `arm` taking `turn`: its start, then a point on its
 /// exit road's lane; `None` without a junction.
 fn route(c: &Context, start: &Position, arm: Arm, lane: i64, turn: Turn) -> Option<Vec<Position>> {
-    if let Some(site) = c.site {
-        return route_on_town(site, start, arm, lane, turn);
-    }
-    let connecting = c.net.connecting(arm, lane, turn)?;
+    let net = match c.ground {
+        Ground::Generated(net) => net,
+        Ground::Town(site) => return route_on_town(site, start, arm, lane, turn),
+    };
+    let connecting = net.connecting(arm, lane, turn)?;
     let (_, out) = connecting.turn.map(|(a, _, t)| (a, t.exit(a)))?;
     let exit_lane = connecting.right.first()?.successor?;
-    let exit_road = c.net.road(arm_road(out))?;
+    let exit_road = net.road(arm_road(out))?;
     let s = if out == Arm::Ego { (exit_road.length() - ROUTE_BEYOND).max(0.0) } else { ROUTE_BEYOND };
     let heading = if exit_lane > 0 { PI } else { 0.0 };
     let end = Position::Lane { road: exit_road.id, lane: exit_lane, s: num(s), offset: 0.0, heading };
@@ -467,14 +472,16 @@ fn events(c: &Context, actor: &Actor, diagnostics: &mut Vec<Diagnostic>) -> Vec<
                 if !current.actions.is_empty() {
                     flush(&mut events, &mut current);
                 }
-                let point = Vec2::new(point[0], point[1]);
+                let laid = Vec2::new(point[0], point[1]);
+                let point = match c.ground {
+                    Ground::Generated(_) => laid,
+                    Ground::Town(site) => site.conflict(&c.layout.road, laid),
+                };
                 // on a town, its own way to the point is as much longer as the straight line
-                let (from, to) = (actor.pose.position, world(c, actor.pose.position));
-                let ratio = match from.distance(point) {
-                    d if d > 1.0 => to.distance(c.site.map_or(point, |site| site.conflict(&c.layout.road, point))) / d,
+                let ratio = match actor.pose.position.distance(laid) {
+                    d if d > 1.0 => world(c, actor.pose.position).distance(point) / d,
                     _ => 1.0,
                 };
-                let point = c.site.map_or(point, |site| site.conflict(&c.layout.road, point));
                 current.starts.push(Start::Meet { point, travel: value(p, *travel, ratio, 0.0) });
             }
             Instr::WaitNear { actor: a, distance } if mine(a) => {
@@ -501,8 +508,11 @@ fn events(c: &Context, actor: &Actor, diagnostics: &mut Vec<Diagnostic>) -> Vec<
             }
             Instr::Cross { actor: a, speed } if mine(a) => {
                 current.actions.push(("speed".into(), Action::Speed(value(p, *speed, 1.0, 0.0))));
-                let d = Vec2::from_yaw(actor.pose.yaw);
-                let d = c.site.map_or(d, |site| site.direction_on(&c.layout.road, actor.arm, actor.pose.position, d));
+                let (road, arm, at) = (&c.layout.road, actor.arm, actor.pose.position);
+                let d = match c.ground {
+                    Ground::Generated(_) => Vec2::from_yaw(actor.pose.yaw),
+                    Ground::Town(site) => site.direction_on(road, arm, at, actor.pose.yaw),
+                };
                 current.actions.push(("cross".into(), Action::Across(d * crossing_length(c, actor))));
             }
             Instr::ChangeLane { actor: a, lanes } if mine(a) => {

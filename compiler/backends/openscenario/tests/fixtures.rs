@@ -15,15 +15,8 @@ fn run(path: &Path) -> Result<(), String> {
     let (scenario, mut emitted) = common::emit(path, &text, "fixture");
     // `// map: TownNN`: built on that CARLA town (`--map`)
     if let Some(name) = text.lines().find_map(|l| l.strip_prefix("// map: ")) {
-        let Some(maps) = tad_test_support::shared().map(|s| s.join("maps/CARLA")).filter(|d| d.is_dir()) else {
-            assert!(std::env::var("TAD_REQUIRE_MAPS").as_deref() != Ok("1"), "../shared/maps/CARLA is not there");
-            eprintln!("SKIPPED: {}: ../shared/maps/CARLA is not there", path.display());
-            return Ok(());
-        };
-        let odr = std::fs::read_to_string(maps.join(format!("{name}.xodr"))).unwrap();
-        let town = tad_openscenario::town::Town::parse(name, &odr).unwrap();
-        let options = tad_openscenario::EmitOptions { stem: "fixture".into(), source: "fixture".into() };
-        emitted = tad_openscenario::emit_on_town(&scenario, &options, &town, "town.xodr").map_err(|e| e.to_string())?;
+        let Some((town, _)) = common::town(name) else { return Ok(()) };
+        emitted = common::on_town(&scenario, "fixture", &town, "town.xodr")?;
     }
     tad_test_support::fixtures::judge(path, &text, &emitted.diagnostics)
 }

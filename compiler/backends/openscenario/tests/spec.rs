@@ -22,10 +22,9 @@ fn every_openscenario_code_is_produced_by_its_example() {
             .unwrap_or_else(|| panic!("{code}: no tad example"));
         let emitted = match code {
             Code::W0712 => {
-                let Some(town) = town10hd() else { continue };
+                let Some((town, _)) = common::town("Town10HD") else { continue };
                 let (scenario, _) = common::emit(Path::new("/nonexistent/example.tad"), &text, "example");
-                let options = tad_openscenario::EmitOptions { stem: "example".into(), source: "example".into() };
-                tad_openscenario::emit_on_town(&scenario, &options, &town, "Town10HD.xodr").expect("a site")
+                common::on_town(&scenario, "example", &town, "Town10HD.xodr").expect("a site")
             }
             _ => build(&text),
         };
@@ -35,17 +34,6 @@ fn every_openscenario_code_is_produced_by_its_example() {
             emitted.diagnostics
         );
     }
-}
-
-/// CARLA's Town10HD, when `../shared/maps/CARLA` is there.
-fn town10hd() -> Option<tad_openscenario::town::Town> {
-    let path = tad_test_support::shared()?.join("maps/CARLA/Town10HD.xodr");
-    let Ok(text) = std::fs::read_to_string(&path) else {
-        assert!(std::env::var("TAD_REQUIRE_MAPS").as_deref() != Ok("1"), "`{}` is not there", path.display());
-        eprintln!("SKIPPED: W0712's example: `{}` is not there", path.display());
-        return None;
-    };
-    Some(tad_openscenario::town::Town::parse("Town10HD", &text).unwrap())
 }
 
 /// The rows of §3.2's table: (actor types, category cell).

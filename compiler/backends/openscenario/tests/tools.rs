@@ -21,19 +21,46 @@ fn python() -> Option<PathBuf> {
     python
 }
 
-/// Every example built into `dir`; returns the stems.
-fn build_examples(dir: &Path) -> Vec<String> {
+/// Every example built into `dir`, on the generated road or on `town` (the town and the path
+/// its `.xosc` names it by); returns the stems.
+fn build_examples(dir: &Path, town: Option<(&tad_openscenario::town::Town, &str)>) -> Vec<String> {
     let _ = std::fs::remove_dir_all(dir);
     std::fs::create_dir_all(dir).unwrap();
     let mut stems = Vec::new();
     for path in common::scenarios() {
-        let (stem, _, emitted) = common::emit_file(&path);
+        let (stem, scenario, emitted) = common::emit_file(&path);
+        let emitted = match town {
+            None => emitted,
+            Some((town, file)) => common::on_town(&scenario, &stem, town, file).expect("a site"),
+        };
         for (ext, text) in emitted.files() {
             std::fs::write(dir.join(format!("{stem}.{ext}")), text).unwrap();
         }
         stems.push(stem);
     }
     stems
+}
+
+/// `tools/openscenario_check.py DIR --json`: its report's files, the problems it found in
+/// them (the bundles' issues, failed read-backs), and whether it exited 0.
+fn check_dir(python: &Path, dir: &Path) -> (Vec<serde_json::Value>, Vec<String>, bool) {
+    let script = tad_test_support::repo().join("tools/openscenario_check.py");
+    let out = Command::new(python).arg(&script).arg(dir).arg("--json").output().expect("the checker runs");
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
+        panic!("{e}: {}\n{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr))
+    });
+    let files = report["files"].as_array().expect("files").clone();
+    let mut problems = Vec::new();
+    for f in &files {
+        let name = f["file"].as_str().unwrap();
+        for issue in f["issues"].as_array().unwrap() {
+            problems.push(format!("{name}: {issue}"));
+        }
+        if let Some(rb) = f["readback"].as_object().filter(|rb| rb["ok"] != true) {
+            problems.push(format!("{name}: read-back failed: {}", rb["error"]));
+        }
+    }
+    (files, problems, out.status.success())
 }
 
 /// The lanes of a type on the roads outside the junction, and the junction's connections.
@@ -53,23 +80,11 @@ fn xodr_counts(text: &str) -> (usize, usize, usize) {
 fn asam_checkers_netconvert_and_scenariogeneration_pass_every_example() {
     let Some(python) = python() else { return };
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("openscenario-tools");
-    let stems = build_examples(&dir);
-    let script = tad_test_support::repo().join("tools/openscenario_check.py");
-    let out = Command::new(&python).arg(&script).arg(&dir).arg("--json").output().expect("the checker runs");
-    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
-        panic!("{e}: {}\n{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr))
-    });
-    let files = report["files"].as_array().expect("files");
-    let mut problems = Vec::new();
+    let stems = build_examples(&dir, None);
+    let (files, mut problems, success) = check_dir(&python, &dir);
     println!("| example | edges | driving lanes | sidewalks | connections (xodr / SUMO) |\n|---|---|---|---|---|");
-    for f in files {
+    for f in &files {
         let name = f["file"].as_str().unwrap();
-        for issue in f["issues"].as_array().unwrap() {
-            problems.push(format!("{name}: {issue}"));
-        }
-        if let Some(rb) = f["readback"].as_object().filter(|rb| rb["ok"] != true) {
-            problems.push(format!("{name}: read-back failed: {}", rb["error"]));
-        }
         let Some(nc) = f["netconvert"].as_object() else { continue };
         if nc["ok"] != true {
             problems.push(format!("{name}: netconvert failed: {:?}", nc.get("errors")));
@@ -99,7 +114,7 @@ fn asam_checkers_netconvert_and_scenariogeneration_pass_every_example() {
     assert_eq!(xodr, stems.len(), "one .xodr per example");
     assert!(xosc >= stems.len(), "{xosc} .xosc files");
     assert!(problems.is_empty(), "{} problems:\n{}", problems.len(), problems.join("\n"));
-    assert!(out.status.success(), "the checker's status: {}", out.status);
+    assert!(success, "the checker's status is not 0");
 }
 
 /// `--map Town10HD`: every example placed on the town, which its `.xosc` names by absolute
@@ -108,45 +123,11 @@ fn asam_checkers_netconvert_and_scenariogeneration_pass_every_example() {
 #[test]
 fn asam_checker_and_scenariogeneration_pass_every_example_on_a_town() {
     let Some(python) = python() else { return };
-    let Some(maps) = tad_test_support::shared().map(|s| s.join("maps/CARLA")).filter(|d| d.is_dir()) else {
-        assert!(std::env::var("TAD_REQUIRE_OPENSCENARIO").as_deref() != Ok("1"), "../shared/maps/CARLA is not there");
-        return;
-    };
-    let town_file = std::path::absolute(maps.join("Town10HD.xodr")).unwrap();
-    let town = tad_openscenario::town::Town::parse("Town10HD", &std::fs::read_to_string(&town_file).unwrap()).unwrap();
+    let Some((town, path)) = common::town("Town10HD") else { return };
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("openscenario-town");
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    let mut stems = 0;
-    for path in common::scenarios() {
-        let text = std::fs::read_to_string(&path).unwrap();
-        let stem = path.file_stem().unwrap().to_string_lossy().into_owned();
-        let (scenario, _) = common::emit(&path, &text, &stem);
-        let options = tad_openscenario::EmitOptions { stem: stem.clone(), source: stem.clone() };
-        let emitted =
-            tad_openscenario::emit_on_town(&scenario, &options, &town, &town_file.to_string_lossy()).expect("a site");
-        for (ext, text) in emitted.files() {
-            std::fs::write(dir.join(format!("{stem}.{ext}")), text).unwrap();
-        }
-        stems += 1;
-    }
-    let script = tad_test_support::repo().join("tools/openscenario_check.py");
-    let out = Command::new(&python).arg(&script).arg(&dir).arg("--json").output().expect("the checker runs");
-    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
-        panic!("{e}: {}\n{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr))
-    });
-    let files = report["files"].as_array().expect("files");
-    let mut problems = Vec::new();
-    for f in files {
-        let name = f["file"].as_str().unwrap();
-        for issue in f["issues"].as_array().unwrap() {
-            problems.push(format!("{name}: {issue}"));
-        }
-        if let Some(rb) = f["readback"].as_object().filter(|rb| rb["ok"] != true) {
-            problems.push(format!("{name}: read-back failed: {}", rb["error"]));
-        }
-    }
+    let stems = build_examples(&dir, Some((&town, &path.to_string_lossy()))).len();
+    let (files, problems, success) = check_dir(&python, &dir);
     assert!(files.iter().filter(|f| f["kind"] == "xosc").count() >= stems, "every .xosc checked");
     assert!(problems.is_empty(), "{} problems:\n{}", problems.len(), problems.join("\n"));
-    assert!(out.status.success(), "the checker's status: {}", out.status);
+    assert!(success, "the checker's status is not 0");
 }

@@ -33,16 +33,7 @@ const TURN_TOLERANCE: f64 = 35.0 * PI / 180.0;
 const TOWNS: [&str; 6] = ["Town10HD", "Town04", "Town07", "Town06", "Town01", "Town02"];
 
 fn towns() -> Vec<Town> {
-    let dir = tad_test_support::shared().map(|s| s.join("maps/CARLA"));
-    let Some(dir) = dir.filter(|d| d.is_dir()) else {
-        assert!(std::env::var("TAD_REQUIRE_MAPS").as_deref() != Ok("1"), "../shared/maps/CARLA is not there");
-        eprintln!("SKIPPED: the town tests: ../shared/maps/CARLA is not there");
-        return Vec::new();
-    };
-    TOWNS
-        .iter()
-        .map(|name| Town::parse(name, &std::fs::read_to_string(dir.join(format!("{name}.xodr"))).unwrap()).unwrap())
-        .collect()
+    TOWNS.iter().map_while(|name| common::town(name).map(|(town, _)| town)).collect()
 }
 
 /// A `LanePosition` read back.
@@ -114,10 +105,9 @@ fn check(town: &Town, path: &std::path::Path, problems: &mut Vec<String>) -> Che
     let text = std::fs::read_to_string(path).unwrap();
     let stem = path.file_stem().unwrap().to_string_lossy().into_owned();
     let (scenario, _) = common::emit(path, &text, &stem);
-    let options = tad_openscenario::EmitOptions { stem: stem.clone(), source: stem.clone() };
     let file = format!("{}.xodr", town.name);
-    let emitted = tad_openscenario::emit_on_town(&scenario, &options, town, &file)
-        .unwrap_or_else(|e| panic!("{stem} on {}: {e}", town.name));
+    let emitted =
+        common::on_town(&scenario, &stem, town, &file).unwrap_or_else(|e| panic!("{stem} on {}: {e}", town.name));
     assert!(emitted.xodr.is_none(), "no road of its own on a town");
     let warned = |what: &str| {
         emitted.diagnostics.iter().any(|d| d.code == tad_diagnostics::Code::W0712 && d.message.contains(what))
@@ -300,7 +290,7 @@ fn every_example_keeps_its_lanes_gaps_and_turns_on_each_town() {
 /// do not exist, or whose lanes have no width places every example or refuses it in words.
 #[test]
 fn a_broken_town_places_or_refuses_never_panics() {
-    let Some(dir) = tad_test_support::shared().map(|s| s.join("maps/CARLA")).filter(|d| d.is_dir()) else { return };
+    let Some(dir) = common::maps() else { return };
     let text = std::fs::read_to_string(dir.join("Town10HD.xodr")).unwrap();
     let no_lanes = {
         let mut out = String::new();
@@ -322,8 +312,7 @@ fn a_broken_town_places_or_refuses_never_panics() {
         for path in common::scenarios() {
             let source = std::fs::read_to_string(&path).unwrap();
             let (scenario, _) = common::emit(&path, &source, "x");
-            let options = tad_openscenario::EmitOptions { stem: "x".into(), source: "x".into() };
-            if let Err(e) = tad_openscenario::emit_on_town(&scenario, &options, &town, "Broken.xodr") {
+            if let Err(e) = common::on_town(&scenario, "x", &town, "Broken.xodr") {
                 assert!(e.contains("`Broken` has no"), "{what}: {e}");
             }
         }

@@ -31,3 +31,32 @@ pub fn emit_file(path: &Path) -> (String, tad_ir::Scenario, tad_openscenario::Em
     let (scenario, emitted) = emit(path, &text, &stem);
     (stem, scenario, emitted)
 }
+
+/// CARLA's maps (`../shared/maps/CARLA`); `None`, said on standard error, when they are not
+/// there, which fails the test instead when `TAD_REQUIRE_MAPS=1`.
+pub fn maps() -> Option<PathBuf> {
+    let dir = tad_test_support::shared().map(|s| s.join("maps/CARLA")).filter(|d| d.is_dir());
+    if dir.is_none() {
+        assert!(std::env::var("TAD_REQUIRE_MAPS").as_deref() != Ok("1"), "../shared/maps/CARLA is not there");
+        eprintln!("SKIPPED: a test on CARLA's towns: ../shared/maps/CARLA is not there");
+    }
+    dir
+}
+
+/// The town `name` read from CARLA's maps, and the absolute path of its file.
+pub fn town(name: &str) -> Option<(tad_openscenario::town::Town, PathBuf)> {
+    let path = std::path::absolute(maps()?.join(format!("{name}.xodr"))).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    Some((tad_openscenario::town::Town::parse(name, &text).unwrap(), path))
+}
+
+/// `scenario` emitted on `town`, whose file it names `file`, with the files named `stem`.
+pub fn on_town(
+    scenario: &tad_ir::Scenario,
+    stem: &str,
+    town: &tad_openscenario::town::Town,
+    file: &str,
+) -> Result<tad_openscenario::Emitted, String> {
+    let options = tad_openscenario::EmitOptions { stem: stem.to_string(), source: stem.to_string() };
+    tad_openscenario::emit_on_town(scenario, &options, town, file)
+}
