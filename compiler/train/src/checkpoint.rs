@@ -4,7 +4,8 @@
 //! (`Learned`'s file: `learned:DIR/actor.safetensors` drives with it), `critics.safetensors`
 //! (each critic under its name: `q1.`, `q2.`, `q1_target.`, `q2_target.`, TD3's
 //! `actor_target.`, PPO's `v.`), `optimizer.safetensors` (each parameter's `.m` and `.v`
-//! under `actor.` or `critic.`), `replay.safetensors` (`transitions`, one row each) and,
+//! under `actor.` or `critic.`), `replay.safetensors` (`transitions`, one row each, and
+//! `collisions` when colliding steps are kept apart) and,
 //! after a warm start, `demos.safetensors` (`demos`: obs and the teacher's action).
 //! Everything the next step reads is in it, so N episodes, a stop and a resume to 2N give
 //! the same bytes as 2N at once.
@@ -42,6 +43,11 @@ struct State {
     rng: u64,
     replay_len: usize,
     replay_next: usize,
+    /// The colliding steps' ring (none: no `collisions` tensor).
+    #[serde(default)]
+    collisions_len: usize,
+    #[serde(default)]
+    collisions_next: usize,
     /// Rows in `demos.safetensors` (none: no file).
     #[serde(default)]
     demos: usize,
@@ -79,9 +85,13 @@ impl Trainer {
         self.critic_opt.tensors("critic.", &mut moments);
         save(OPTIMIZER_FILE, &moments)?;
         let rows = self.replay.len();
-        let transitions = Tensor::from_vec(self.replay.data.clone(), (rows, self.replay.width), &Device::Cpu)
-            .map_err(tensor_error)?;
-        save(REPLAY_FILE, &HashMap::from([("transitions".to_string(), transitions)]))?;
+        let ring =
+            |r: &Replay| Tensor::from_vec(r.data.clone(), (r.len(), r.width), &Device::Cpu).map_err(tensor_error);
+        let mut rings = HashMap::from([("transitions".to_string(), ring(&self.replay)?)]);
+        if self.collisions.len() > 0 {
+            rings.insert("collisions".to_string(), ring(&self.collisions)?);
+        }
+        save(REPLAY_FILE, &rings)?;
         let demo_width = self.config.observation.width() + crate::nets::ACT;
         let demos = self.demos.len() / demo_width;
         if demos > 0 {
@@ -99,6 +109,8 @@ impl Trainer {
             rng: self.rng.0,
             replay_len: rows,
             replay_next: self.replay.next,
+            collisions_len: self.collisions.len(),
+            collisions_next: self.collisions.next,
             demos,
             note: self.note.clone(),
         };
@@ -163,26 +175,35 @@ impl Trainer {
         let replay_path = dir.join(REPLAY_FILE);
         let width = trainer.replay.width;
         let replay = read(REPLAY_FILE)?;
-        let transitions =
-            replay.get("transitions").filter(|t| t.dims() == [state.replay_len, width]).ok_or_else(|| {
-                broken(&replay_path, format!("no `transitions` of shape [{}, {width}]", state.replay_len))
-            })?;
-        let data = transitions
-            .to_dtype(DType::F32)
-            .and_then(|t| t.flatten_all()?.to_vec1::<f32>())
-            .map_err(|e| broken(&replay_path, e.to_string()))?;
-        // filling, the next write appends; full, it overwrites the oldest (PPO's rollout
-        // only fills)
-        let capacity = state.config.replay_capacity();
-        let valid = match state.replay_len.cmp(&capacity) {
-            std::cmp::Ordering::Less => state.replay_next == state.replay_len % capacity,
-            std::cmp::Ordering::Equal => state.replay_next < state.replay_len,
-            std::cmp::Ordering::Greater => false,
+        let ring = |name: &str, len: usize, next: usize, capacity: usize| -> Result<Replay, TrainError> {
+            if len == 0 && next == 0 {
+                return Ok(Replay::new(obs));
+            }
+            let t = replay.get(name).filter(|t| t.dims() == [len, width]);
+            let t = t.ok_or_else(|| broken(&replay_path, format!("no `{name}` of shape [{len}, {width}]")))?;
+            let data = t
+                .to_dtype(DType::F32)
+                .and_then(|t| t.flatten_all()?.to_vec1::<f32>())
+                .map_err(|e| broken(&replay_path, e.to_string()))?;
+            // filling, the next write appends; full, it overwrites the oldest (PPO's
+            // rollout only fills)
+            let valid = match len.cmp(&capacity) {
+                std::cmp::Ordering::Less => next == len % capacity,
+                std::cmp::Ordering::Equal => next < len,
+                std::cmp::Ordering::Greater => false,
+            };
+            if !valid {
+                return Err(broken(
+                    &state_path,
+                    format!("the `{name}` ring's length or position does not fit its capacity"),
+                ));
+            }
+            Ok(Replay { width, data, next })
         };
-        if !valid {
-            return Err(broken(&state_path, "the replay's length or position does not fit its capacity".into()));
-        }
-        trainer.replay = Replay { width, data, next: state.replay_next };
+        let config = &state.config;
+        trainer.replay = ring("transitions", state.replay_len, state.replay_next, config.replay_capacity())?;
+        trainer.collisions =
+            ring("collisions", state.collisions_len, state.collisions_next, config.collision_capacity())?;
 
         if state.demos > 0 {
             let demos_path = dir.join(DEMOS_FILE);

@@ -64,6 +64,12 @@ pub struct Config {
     pub episodes: usize,
     /// Off-policy learning steps per finished episode (ChatScene: 1).
     pub updates_per_episode: usize,
+    /// ChatScene's replay split (`RouteReplayBuffer`): the transitions of colliding steps
+    /// go to a ring of their own (`buffer / 100` rows) and make up this share of every
+    /// off-policy batch, drawn without replacement (ChatScene: 1/5); fewer held, all of
+    /// them. 0: one ring, as SafeBench. A setting read without it is 0.
+    #[serde(default)]
+    pub collision_share: f64,
     /// Episodes rolled out at once with the same actor, in parallel over the cores; a
     /// setting of the run, never the thread count, so results do not depend on the machine.
     pub envs: usize,
@@ -113,6 +119,7 @@ impl Default for Config {
             start_training: 1000,
             episodes: 600,
             updates_per_episode: 1,
+            collision_share: 0.0,
             envs: 1,
             critic_warmup: 0,
             bc_weight: 0.0,
@@ -169,7 +176,9 @@ impl Config {
     /// settings, PPO and TD3 with SafeBench's. The fresh critics learn alone for their
     /// first 200 steps (PPO: 2 updates), and the model's own actions on the training
     /// scenes stay in the actor's loss at weight 1: without both, SAC and TD3 learned to
-    /// stop (collisions down 32-53 %, route completion from 0.55 to 0.04-0.16).
+    /// stop (collisions down 32-53 %, route completion from 0.55 to 0.04-0.16). SAC and
+    /// TD3 keep colliding steps apart as ChatScene's fine-tuning does (a fifth of each
+    /// batch, [`Config::collision_share`]).
     pub fn finetune(algo: Algo) -> Config {
         let base = match algo {
             Algo::Sac => Config::default(),
@@ -180,7 +189,12 @@ impl Config {
                 ..Config::safebench(algo)
             },
         };
-        Config { critic_warmup: if algo == Algo::Ppo { 2 } else { 200 }, bc_weight: 1.0, ..base }
+        Config {
+            critic_warmup: if algo == Algo::Ppo { 2 } else { 200 },
+            bc_weight: 1.0,
+            collision_share: CHATSCENE_COLLISION_SHARE,
+            ..base
+        }
     }
 
     /// Why these settings cannot train, if they cannot.
@@ -207,7 +221,12 @@ impl Config {
         if !(self.alpha.is_finite() && self.alpha >= 0.0) {
             return bad(format!("alpha must be a number ≥ 0 (got {})", self.alpha));
         }
-        for (name, v) in [("gamma", self.gamma), ("polyak", self.polyak), ("lambda", self.lambda)] {
+        for (name, v) in [
+            ("gamma", self.gamma),
+            ("polyak", self.polyak),
+            ("lambda", self.lambda),
+            ("the collisions' share", self.collision_share),
+        ] {
             if !(0.0..=1.0).contains(&v) {
                 return bad(format!("{name} must be within 0..=1 (got {v})"));
             }
@@ -250,10 +269,23 @@ impl Config {
         if self.algo == Algo::Ppo { usize::MAX } else { self.buffer }
     }
 
+    /// The colliding steps' ring's capacity (ChatScene: 1/100 of the replay's).
+    pub(crate) fn collision_capacity(&self) -> usize {
+        (self.buffer / 100).max(1)
+    }
+
+    /// Whether colliding steps have a ring of their own: an off-policy run with a share.
+    pub(crate) fn splits_collisions(&self) -> bool {
+        self.algo != Algo::Ppo && self.collision_share > 0.0
+    }
+
     pub(crate) fn options(&self) -> Options {
         Options { mode: if self.compat { Mode::Compat } else { Mode::Fixed }, ..Options::default() }
     }
 }
+
+/// ChatScene's share of colliding steps in a fine-tuning batch (`batch_size // 5`).
+pub const CHATSCENE_COLLISION_SHARE: f64 = 0.2;
 
 /// The widest hidden layer a run may ask for.
 pub const MAX_WIDTH: usize = 4096;

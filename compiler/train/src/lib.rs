@@ -293,6 +293,8 @@ pub struct Trainer {
     critics: Critics,
     critic_opt: Adam,
     replay: Replay,
+    /// Colliding steps, apart ([`Config::collision_share`]; empty without it).
+    collisions: Replay,
     /// The warm start's labelled states: rows of obs and the teacher's action.
     demos: Vec<f32>,
     rng: SplitMix64,
@@ -329,6 +331,7 @@ impl Trainer {
             critics,
             critic_opt,
             replay: Replay::new(obs),
+            collisions: Replay::new(obs),
             demos: Vec::new(),
             rng,
             episodes: 0,
@@ -391,6 +394,11 @@ impl Trainer {
     /// Transitions in the replay (PPO: in the rollout not yet learned from).
     pub fn replay_len(&self) -> usize {
         self.replay.len()
+    }
+
+    /// Colliding steps held apart ([`Config::collision_share`]).
+    pub fn collisions_len(&self) -> usize {
+        self.collisions.len()
     }
 
     /// Why `episodes` more episodes of at most `steps` steps each cannot reach a first
@@ -466,9 +474,14 @@ impl Trainer {
             .collect();
         let mut all = Vec::with_capacity(collected.len());
         let capacity = self.config.replay_capacity();
+        let apart = self.config.splits_collisions();
         for c in collected {
-            for row in c.rows.chunks_exact(self.replay.width) {
-                self.replay.push(capacity, row);
+            for (k, row) in c.rows.chunks_exact(self.replay.width).enumerate() {
+                if apart && c.collided.contains(&k) {
+                    self.collisions.push(self.config.collision_capacity(), row);
+                } else {
+                    self.replay.push(capacity, row);
+                }
             }
             self.episodes += 1;
             all.push(c.stats);

@@ -148,6 +148,8 @@ pub fn evaluate(
 /// An exploring episode's replay rows and statistics.
 pub(crate) struct Collected {
     pub rows: Vec<f32>,
+    /// The rows whose step collided.
+    pub collided: Vec<usize>,
     pub stats: EpisodeStats,
 }
 
@@ -161,7 +163,7 @@ pub(crate) fn explore(actor: &PlainActor, config: &Config, job: &Job, noise: Spl
     let obs_width = config.observation.width();
     let width = row_width(obs_width);
     let mut rewarder = Rewarder::new(job.scene, desired);
-    let (mut total, mut rows) = (0.0, Vec::with_capacity(n * width));
+    let (mut total, mut rows, mut collided) = (0.0, Vec::with_capacity(n * width), Vec::new());
     for k in 0..n {
         let r = rewarder.step(&episode.records[k], Action::from_unit(driver.applied[k]).steer).total();
         total += r;
@@ -172,6 +174,9 @@ pub(crate) fn explore(actor: &PlainActor, config: &Config, job: &Job, noise: Spl
             _ if config.algo == Algo::Ppo => (&driver.obs[k], 0.0),
             _ => continue,
         };
+        if episode.records[k].collision {
+            collided.push(rows.len() / width);
+        }
         rows.extend(driver.obs[k].iter().map(|&v| v as f32));
         rows.extend_from_slice(&driver.stored[k]);
         rows.push(r as f32);
@@ -180,5 +185,5 @@ pub(crate) fn explore(actor: &PlainActor, config: &Config, job: &Job, noise: Spl
         rows.push(if k + 1 == n { 1.0 } else { 0.0 });
     }
     let stored = rows.len() / width;
-    Collected { stats: stats(&episode, total, stored), rows }
+    Collected { stats: stats(&episode, total, stored), rows, collided }
 }

@@ -20,8 +20,8 @@ struct Batch {
 }
 
 impl Trainer {
-    /// The replay's rows `rows` as tensors.
-    fn batch(&self, rows: &[usize]) -> candle_core::Result<Batch> {
+    /// Replay rows as tensors.
+    fn batch(&self, rows: &[&[f32]]) -> candle_core::Result<Batch> {
         let o = self.config.observation.width();
         let b = rows.len();
         let (mut obs, mut act, mut rew, mut next, mut done) = (
@@ -31,8 +31,7 @@ impl Trainer {
             Vec::with_capacity(b * o),
             Vec::with_capacity(b),
         );
-        for &i in rows {
-            let t = self.replay.row(i);
+        for t in rows {
             obs.extend_from_slice(&t[..o]);
             act.extend_from_slice(&t[o..o + ACT]);
             rew.push(t[o + ACT]);
@@ -49,10 +48,24 @@ impl Trainer {
         })
     }
 
-    /// A batch drawn with replacement.
+    /// A batch: drawn with replacement from the replay, then, with colliding steps apart,
+    /// their share of it drawn without replacement from theirs (all of them, if fewer).
     fn draw(&mut self) -> candle_core::Result<Batch> {
+        let b = self.config.batch;
+        let held = self.collisions.len();
+        let apart = ((b as f64 * self.config.collision_share) as usize).min(held);
         let len = self.replay.len();
-        let rows: Vec<usize> = (0..self.config.batch).map(|_| self.rng.below(len)).collect();
+        let rows: Vec<usize> = (0..b - apart).map(|_| self.rng.below(len)).collect();
+        let mut pool: Vec<usize> = (0..held).collect();
+        for i in 0..apart {
+            let j = i + self.rng.below(held - i);
+            pool.swap(i, j);
+        }
+        let rows: Vec<&[f32]> = rows
+            .iter()
+            .map(|&i| self.replay.row(i))
+            .chain(pool[..apart].iter().map(|&i| self.collisions.row(i)))
+            .collect();
         self.batch(&rows)
     }
 
@@ -187,7 +200,8 @@ impl Trainer {
     pub(crate) fn ppo_update(&mut self) -> candle_core::Result<Losses> {
         let n = self.replay.len();
         let all: Vec<usize> = (0..n).collect();
-        let Batch { obs, act, rew, next, done } = self.batch(&all)?;
+        let rows: Vec<&[f32]> = all.iter().map(|&i| self.replay.row(i)).collect();
+        let Batch { obs, act, rew, next, done } = self.batch(&rows)?;
         let v = self.critics.get("v");
         let values = v.forward(&obs)?.remove(0).flatten_all()?.to_vec1::<f32>()?;
         let next_values = v.forward(&next)?.remove(0).flatten_all()?.to_vec1::<f32>()?;
@@ -244,5 +258,48 @@ impl Trainer {
         self.refresh_plain()?;
         self.updates += 1;
         Ok(last)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::{Config, Trainer};
+
+    /// A trainer whose replay holds `plain` rows (first value `i`) and whose colliding
+    /// steps' ring holds `collided` (first value `−1 − i`).
+    fn filled(share: f64, plain: usize, collided: usize) -> Trainer {
+        let config = Config { hidden: vec![4], batch: 20, buffer: 1000, collision_share: share, ..Config::default() };
+        let mut t = Trainer::new(config).expect("a trainer");
+        let w = t.replay.width;
+        for i in 0..plain {
+            t.replay.push(1000, &[vec![i as f32], vec![0.0; w - 1]].concat());
+        }
+        for i in 0..collided {
+            t.collisions.push(10, &[vec![-1.0 - i as f32], vec![0.0; w - 1]].concat());
+        }
+        t
+    }
+
+    /// The colliding rows of a drawn batch, by their first value.
+    fn colliding(t: &mut Trainer) -> Vec<i64> {
+        let obs = t.draw().expect("a batch").obs.to_vec2::<f32>().expect("values");
+        assert_eq!(obs.len(), 20);
+        let mut hits: Vec<i64> = obs.iter().map(|r| r[0] as i64).filter(|&v| v < 0).collect();
+        hits.sort_unstable();
+        hits
+    }
+
+    #[test]
+    fn a_fifth_of_each_batch_is_colliding_steps_each_drawn_once() {
+        let mut t = filled(0.2, 50, 6);
+        for _ in 0..20 {
+            let hits = colliding(&mut t);
+            assert_eq!(hits.len(), 4, "20 / 5 colliding rows");
+            assert!(hits.windows(2).all(|w| w[0] < w[1]), "without replacement: {hits:?}");
+        }
+        // fewer held than the share: all of them
+        assert_eq!(colliding(&mut filled(0.2, 50, 2)), vec![-2, -1]);
+        // without a share, one ring
+        assert!(colliding(&mut filled(0.0, 50, 6)).is_empty());
     }
 }

@@ -9,7 +9,7 @@ use tad_train::{Config, Trainer, split};
 
 mod common;
 
-use common::{mean_return, params, scene, small, temp, train};
+use common::{blocked, mean_return, params, scene, small, temp, train};
 
 #[test]
 fn training_improves_the_return_on_two_scenes_with_a_parameter() {
@@ -69,6 +69,48 @@ fn a_resumed_run_ends_with_the_same_bytes() {
     train(&mut other, &scenes, 8);
     other.save_actor(dir.join("other.safetensors")).expect("saved");
     assert_ne!(read("whole.safetensors"), read("other.safetensors"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn colliding_steps_are_kept_apart_and_resume_exactly() {
+    let scenes = [blocked(40), scene(30, false)];
+    let config = Config { start_training: 40, updates_per_episode: 2, batch: 30, collision_share: 0.2, ..small(4) };
+    let dir = temp("collisions");
+    let mut whole = Trainer::new(config.clone()).expect("a trainer");
+    train(&mut whole, &scenes, 10);
+    assert!(whole.collisions_len() > 0, "the blocked road's collisions are kept apart");
+    assert!(whole.collisions_len() <= config.buffer / 100, "the ring holds 1/100 of the replay");
+    whole.save_checkpoint(dir.join("whole.ckpt")).expect("saved");
+
+    let mut first = Trainer::new(config.clone()).expect("a trainer");
+    train(&mut first, &scenes, 5);
+    first.save_checkpoint(dir.join("half.ckpt")).expect("saved");
+    let mut second = Trainer::load_checkpoint(dir.join("half.ckpt")).expect("loaded");
+    assert_eq!(second.collisions_len(), first.collisions_len());
+    train(&mut second, &scenes, 10);
+    second.save_checkpoint(dir.join("resumed.ckpt")).expect("saved");
+    let read = |name: &str| std::fs::read(dir.join(name)).expect("written");
+    for file in ["actor.safetensors", "critics.safetensors", "replay.safetensors"] {
+        assert_eq!(read(&format!("whole.ckpt/{file}")), read(&format!("resumed.ckpt/{file}")), "{file}");
+    }
+
+    // one ring, as SafeBench: the same episodes learn otherwise
+    let mut one = Trainer::new(Config { collision_share: 0.0, ..config }).expect("a trainer");
+    train(&mut one, &scenes, 10);
+    assert_eq!(one.collisions_len(), 0);
+    one.save_checkpoint(dir.join("one.ckpt")).expect("saved");
+    assert_ne!(read("one.ckpt/actor.safetensors"), read("whole.ckpt/actor.safetensors"));
+
+    // a ring that does not fit its capacity is a damaged checkpoint
+    let state = std::fs::read_to_string(dir.join("whole.ckpt/state.json")).expect("read");
+    std::fs::write(
+        dir.join("whole.ckpt/state.json"),
+        state.replace("\"collisions_next\": ", "\"collisions_next\": 999"),
+    )
+    .expect("written");
+    let e = Trainer::load_checkpoint(dir.join("whole.ckpt")).err().expect("an error");
+    assert!(e.to_string().contains("collisions"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -214,6 +256,7 @@ fn bad_settings_are_errors() {
         Config { gamma: 1.5, ..Config::default() },
         Config { batch: 0, ..Config::default() },
         Config { desired_speed: Some(-1.0), ..Config::default() },
+        Config { collision_share: 1.5, ..Config::default() },
     ] {
         assert!(Trainer::new(config.clone()).is_err(), "{config:?}");
     }

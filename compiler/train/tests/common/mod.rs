@@ -15,6 +15,16 @@ const CAR: Size = Size { length: 4.5, width: 1.8, height: 1.5 };
 /// ±1 m/s), alone or with a car ahead at 4 m/s (40 m ahead: within the observation's 15 m
 /// only near the end of a long episode).
 pub fn scene(max_steps: u32, lead: bool) -> Scene {
+    on_road(max_steps, lead.then_some((40.0, 4.0)))
+}
+
+/// The same road with a car stopped 12 m ahead of the ego: an exploring actor hits it.
+pub fn blocked(max_steps: u32) -> Scene {
+    on_road(max_steps, Some((12.0, 0.0)))
+}
+
+/// The straight road, with a car in the ego's lane `(along, speed)`.
+fn on_road(max_steps: u32, lead: Option<(f64, f64)>) -> Scene {
     let road = Road {
         shape: Shape::Straight,
         lanes: 2,
@@ -42,7 +52,7 @@ pub fn scene(max_steps: u32, lead: bool) -> Scene {
             speed: Value { base: 8.0, slot: Some(0) },
         },
     ];
-    if lead {
+    if let Some((along, speed)) = lead {
         code.push(Instr::Spawn {
             actor: 0,
             group: "lead".into(),
@@ -53,16 +63,20 @@ pub fn scene(max_steps: u32, lead: bool) -> Scene {
             arm: Arm::Ego,
             lane: 1,
             place: Place::Lane,
-            along: Value::lit(40.0),
+            along: Value::lit(along),
             lateral: -0.5 * LANE_WIDTH,
             facing: Facing::Along,
             yaw: 0.0,
-            speed: 4.0,
+            speed,
         });
-        code.push(Instr::Drive { actor: 0, speed: Value::lit(4.0), turn: Turn::Straight });
+        code.push(Instr::Drive { actor: 0, speed: Value::lit(speed), turn: Turn::Straight });
     }
     let program = Program {
-        name: if lead { "lead".into() } else { "alone".into() },
+        name: match lead {
+            None => "alone".into(),
+            Some((_, speed)) if speed > 0.0 => "lead".into(),
+            Some(_) => "blocked".into(),
+        },
         source: "hand.tad".into(),
         params: vec![ParamSlot { name: "ego.speed".into(), min: -1.0, max: 1.0, default: 0.0 }],
         paths: vec![Polyline(path.points().iter().map(|p| [p.x, p.y]).collect())],
