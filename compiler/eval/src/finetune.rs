@@ -5,6 +5,11 @@
 //! (`tad_train::Config::finetune`); then every ego, before and after, on the held-out 2/5,
 //! with paired bootstrap intervals of each model's change ([`crate::interval`]).
 //!
+//! TrafficAlign evaluates every 50 epochs and reports the best. Here the actor is scored
+//! every [`SELECT_EVERY`] episodes (and at the start and the end) by its overall score on
+//! the scenes it trains on, never the held-out ones, and the best is kept: so fine-tuning
+//! may keep its start.
+//!
 //! With `--finetune-from` (a checkpoint or an actor file) or without any learned ego, one
 //! ego called `learned` is tuned instead, from that start or from scratch.
 
@@ -101,6 +106,11 @@ pub struct Tuned {
     /// Learning steps this fine-tuning took (0: it was too short to learn anything, and
     /// `after_name` says so).
     pub updates: u64,
+    /// Episodes into fine-tuning when the kept actor was taken (0: the start).
+    pub kept_at: usize,
+    /// Its overall score on the scenes it trained on, and the start's (none from scratch).
+    pub kept_os: f64,
+    pub start_os: Option<f64>,
     pub after: Learned,
     pub before: Option<Learned>,
 }
@@ -114,16 +124,43 @@ pub fn split(kept: &[Kept], seed: u64) -> (Vec<usize>, Vec<usize>) {
 /// Episodes of the model before fine-tuning whose states and actions anchor it.
 const ANCHOR_EPISODES: usize = 64;
 
+/// Episodes between two scorings of the actor (TrafficAlign's "every 50 epochs").
+pub const SELECT_EVERY: usize = 50;
+
+/// The best actor offered so far by its overall score on the training scenes; the
+/// earlier on a tie.
+struct Best<'k> {
+    kept: &'k [Kept<'k>],
+    train: &'k [usize],
+    best: Option<(Learned, usize, f64)>,
+    start: Option<f64>,
+}
+
+impl Best<'_> {
+    fn offer(&mut self, actor: Learned, at: usize) {
+        let rows = crate::harness::held_out(self.kept, self.train, &[(String::new(), EgoSpec::Learned(actor.clone()))]);
+        let scores: Vec<&tad_metrics::EpisodeScore> = rows.iter().map(|r| &r.score).collect();
+        let (_, os) = crate::interval::cr_os(&scores);
+        if at == 0 {
+            self.start = Some(os);
+        }
+        if self.best.as_ref().is_none_or(|(_, _, best)| os > *best) {
+            self.best = Some((actor, at, os));
+        }
+    }
+}
+
 /// The kept scenes of `train` that `generator` made.
 pub fn of_generator(kept: &[Kept], train: &[usize], generator: &str) -> Vec<usize> {
     train.iter().copied().filter(|&i| kept[i].unit.generator == generator).collect()
 }
 
 /// `tuning`'s ego trained for `config.episodes` more episodes on the kept scenes `train`,
-/// each with its kept parameters and seed; `on_episode` after each.
-pub fn tune(
-    kept: &[Kept],
-    train: &[usize],
+/// each with its kept parameters and seed; `on_episode` after each. The actor kept is the
+/// best scored on those scenes (see the module's header).
+pub fn tune<'k>(
+    kept: &'k [Kept<'k>],
+    train: &'k [usize],
     tuning: Tuning,
     mut on_episode: impl FnMut(),
 ) -> Result<Tuned, FinetuneError> {
@@ -142,17 +179,29 @@ pub fn tune(
         let drive = || -> Box<dyn tad_policy::EgoPolicy> { Box::new(model.clone()) };
         trainer.imitate(&scenes, &drive, &anchor, |_| {}).map_err(FinetuneError::Training)?;
     }
-    crate::train::train(&mut trainer, first + episodes, &scenes, |_, stats| -> Result<(), TrainError> {
+    let mut best = Best { kept, train, best: None, start: None };
+    if let Some(start) = &before {
+        best.offer(start.clone(), 0);
+    }
+    crate::train::train(&mut trainer, first + episodes, &scenes, |trainer, stats| -> Result<(), TrainError> {
         stats.iter().for_each(|_| on_episode());
+        let done = trainer.episodes() as usize - first;
+        if done / SELECT_EVERY > (done - stats.len()) / SELECT_EVERY || done == episodes {
+            best.offer(trainer.actor()?, done);
+        }
         Ok(())
     })
     .map_err(FinetuneError::Training)?;
-    let after = trainer.actor().map_err(FinetuneError::Actor)?;
+    let start_os = best.start;
+    let (after, kept_at, kept_os) = match best.best {
+        Some(best) => best,
+        None => (trainer.actor().map_err(FinetuneError::Actor)?, 0, f64::NAN),
+    };
     // an actor that learned nothing here is not labelled fine-tuned
     let updates = trainer.updates() - learned;
     let ego = if before_name == BEFORE { LEARNED } else { before_name.as_str() };
     let after_name = if updates == 0 { untuned_name(ego, &generator) } else { after_name };
-    Ok(Tuned { before_name, after_name, updates, after, before })
+    Ok(Tuned { before_name, after_name, updates, kept_at, kept_os, start_os, after, before })
 }
 
 /// The held-out table, and each tuned ego's change (with a start to change from).

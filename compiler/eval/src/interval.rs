@@ -56,7 +56,7 @@ pub struct Change {
 }
 
 /// CR and OS of some episodes.
-fn cr_os(scores: &[&EpisodeScore]) -> (f64, f64) {
+pub(crate) fn cr_os(scores: &[&EpisodeScore]) -> (f64, f64) {
     let owned: Vec<EpisodeScore> = scores.iter().map(|s| (*s).clone()).collect();
     match tad_metrics::aggregate(&owned, Mode::Fixed) {
         Ok(agg) => (agg.raw.cr, agg.normalised.os),

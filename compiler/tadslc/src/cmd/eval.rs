@@ -69,7 +69,8 @@ pub struct EvalArgs {
     pub shard: tad_base::Shard,
     /// Also the "after fine-tuning" table: each learned ego (`ppo`, `sac`, `td3`,
     /// `learned:PATH`) fine-tuned for this many episodes with its algorithm on 3/5 of each
-    /// behaviour's kept scenes of each generator (the paper: 500), every ego on the other 2/5
+    /// behaviour's kept scenes of each generator (the paper: 500), keeping the actor that
+    /// scores best on those scenes every 50 episodes; every ego on the other 2/5
     #[arg(long, value_name = "EPISODES", default_value_t = 0)]
     pub finetune: usize,
     /// Off-policy learning steps per fine-tuning episode (default: the algorithm's; ChatScene's SAC: 1)
@@ -313,6 +314,16 @@ pub fn finetune(args: &EvalArgs, plan: &Plan, kept: &[Kept]) -> Result<Status, C
                 "warning: `{after}` took no learning step (its episodes stored too few transitions to start \
                  learning): its row is `{}`, the ego as it started",
                 t.after_name
+            )?;
+        } else {
+            let start = t.start_os.map(|os| format!("; {os:.3} at the start")).unwrap_or_default();
+            errln!(
+                "`{}`: kept the actor of episode {} of {} (OS {:.3} on the {} it trained on{start})",
+                t.after_name,
+                t.kept_at,
+                args.finetune,
+                t.kept_os,
+                plural(subset.len(), "scene")
             )?;
         }
         if let Some(dir) = &args.out {
