@@ -1,4 +1,4 @@
-//! LoRA fine-tuning of the local model (SmolLM2-135M) in candle, on the CPU: TrafficAlign
+//! LoRA fine-tuning of a local model (SmolLM2-135M, Qwen2.5-Coder) in candle, on the CPU: TrafficAlign
 //! aligns a small model to each region's validated scenarios this way.
 //!
 //! ```text
@@ -51,6 +51,9 @@ pub struct Config {
     pub checkpoint_every: usize,
     /// Continue from the checkpoint in the output directory, if there is one.
     pub resume: bool,
+    /// The adapter's `base_model_name_or_path`: the model's upstream name
+    /// (`tad_models::Model::upstream`).
+    pub base_model: String,
 }
 
 impl Default for Config {
@@ -68,6 +71,7 @@ impl Default for Config {
             seed: 0,
             checkpoint_every: 0,
             resume: false,
+            base_model: tad_local::model(tad_local::DEFAULT).map_or("", |m| m.upstream).to_string(),
         }
     }
 }
@@ -294,13 +298,14 @@ fn save_checkpoint(
     out: &Path,
     lora: &LoraSet,
     shape: &tad_local::Shape,
+    base_model: &str,
     optimizer: &AdamW,
     state: &State,
 ) -> Result<PathBuf, String> {
     let dir = out.join(CHECKPOINT);
     let partial = out.join(format!("{CHECKPOINT}.part"));
     let _ = std::fs::remove_dir_all(&partial);
-    lora.to_adapter(shape)?.save(&partial)?;
+    lora.to_adapter(shape, base_model)?.save(&partial)?;
     optimizer.save(&partial.join(OPTIMIZER_FILE))?;
     let text = serde_json::to_string_pretty(state).map_err(err)?;
     std::fs::write(partial.join(STATE_FILE), text).map_err(|e| format!("cannot write the checkpoint: {e}"))?;
@@ -325,10 +330,10 @@ pub fn train_samples(
     run.epochs(weights, samples, config, out, start, progress)?;
     let Run { lora, optimizer, state, resumed_at, counts, .. } = run;
     let shape = weights.shape;
-    let adapter = lora.to_adapter(&shape).map_err(FinetuneError::Training)?;
+    let adapter = lora.to_adapter(&shape, &config.base_model).map_err(FinetuneError::Training)?;
     adapter.save(out).map_err(FinetuneError::Io)?;
     if config.checkpoint_every > 0 {
-        save_checkpoint(out, &lora, &shape, &optimizer, &state).map_err(FinetuneError::Io)?;
+        save_checkpoint(out, &lora, &shape, &config.base_model, &optimizer, &state).map_err(FinetuneError::Io)?;
     }
     let seconds = start.elapsed().as_secs_f64();
     Ok(Report {
@@ -507,7 +512,7 @@ impl Run {
                     && state.step < steps
                 {
                     written = Some(
-                        save_checkpoint(out, &self.lora, &weights.shape, &self.optimizer, state)
+                        save_checkpoint(out, &self.lora, &weights.shape, &config.base_model, &self.optimizer, state)
                             .map_err(FinetuneError::Io)?,
                     );
                 }

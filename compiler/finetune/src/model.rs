@@ -1,11 +1,13 @@
-//! A differentiable llama forward pass in candle, f32 on the CPU: the base weights
-//! dequantized from the GGUF as plain tensors (frozen: no gradient is kept for them), the
-//! LoRA pairs as `Var`s in a [`VarMap`].
+//! A differentiable llama or qwen2 forward pass in candle, f32 on the CPU: the base
+//! weights dequantized from the GGUF as plain tensors (frozen: no gradient is kept for
+//! them), the LoRA pairs as `Var`s in a [`VarMap`]. qwen2 adds biases to q, k and v.
 //!
-//! The weights stay in the GGUF's layout: q and k rows interleaved per head, so rope
-//! rotates adjacent pairs, as candle's `quantized_llama` and tad-local's decoder do. The
-//! LoRA `B` of q and k is therefore in the GGUF's row order while training, and converted
-//! to Hugging Face's (PEFT's) when written and back when read ([`tad_local::Adapter`]).
+//! The weights stay in the GGUF's layout. For llama, q and k rows are interleaved per head
+//! and rope rotates adjacent pairs, as candle's `quantized_llama` and tad-local's decoder
+//! do; the LoRA `B` of q and k is then in the GGUF's row order while training, and
+//! converted to Hugging Face's (PEFT's) when written and back when read
+//! ([`tad_local::hf_to_gguf_rows`]). qwen2's GGUF keeps Hugging Face's order and rope
+//! rotates each head's halves.
 //! Only candle operations with a backward pass are used (rope, RMSNorm and softmax are
 //! written out from them; candle-nn's fused kernels have none).
 
@@ -35,6 +37,8 @@ struct Block {
     ffn_norm: Tensor,
     /// `[out, in]` per [`Target`], in the GGUF's row order.
     proj: [Tensor; 7],
+    /// qwen2's biases of q, k and v.
+    bias: Option<[Tensor; 3]>,
 }
 
 /// The frozen base model, f32.
@@ -51,9 +55,6 @@ impl Weights {
     /// Dequantizes the GGUF's tensors (the llama.cpp names), each checked against the shape.
     pub fn from_gguf(content: &Content, file: &mut std::fs::File) -> Result<Weights, String> {
         let shape = Shape::from_gguf(content)?;
-        if shape.arch != Arch::Llama {
-            return Err(format!("a {:?} model: LoRA fine-tuning reads the llama architecture only", shape.arch));
-        }
         let device = Device::Cpu;
         let mut load = |name: &str, dims: &[usize]| -> Result<Tensor, String> {
             let q = content.tensor(file, name, &device).map_err(|e| format!("tensor `{name}`: {e}"))?;
@@ -83,10 +84,18 @@ impl Weights {
                 let (inputs, outputs) = t.dims(&shape);
                 proj.push(load(&name(part), &[outputs, inputs])?);
             }
+            let bias = match shape.arch {
+                Arch::Llama => None,
+                Arch::Qwen2 => {
+                    let mut bias = |part: &str, t: Target| load(&format!("blk.{i}.{part}.bias"), &[t.dims(&shape).1]);
+                    Some([bias("attn_q", Target::Q)?, bias("attn_k", Target::K)?, bias("attn_v", Target::V)?])
+                }
+            };
             blocks.push(Block {
                 attn_norm: load(&name("attn_norm"), &[shape.dim])?,
                 ffn_norm: load(&name("ffn_norm"), &[shape.dim])?,
                 proj: proj.try_into().map_err(|_| "seven projections")?,
+                bias,
             });
         }
         Ok(Weights { shape, vocab, embedding, output, norm, blocks })
@@ -99,7 +108,8 @@ impl Weights {
         Ok((Weights::from_gguf(&content, &mut file)?, content))
     }
 
-    /// A random model of `shape` (tests): weights uniform in ±1/√in, norms 1, tied embedding.
+    /// A random model of `shape` (tests): weights uniform in ±1/√in, norms 1, tied
+    /// embedding; qwen2's biases uniform in ±1/2.
     pub fn random(shape: Shape, vocab: usize, seed: u64) -> Result<Weights, String> {
         let mut rng = Rng(seed);
         let device = Device::Cpu;
@@ -115,11 +125,20 @@ impl Weights {
                 let (inputs, outputs) = t.dims(&shape);
                 proj.push(matrix(outputs, inputs, 1.0 / (inputs as f32).sqrt())?);
             }
+            let bias = match shape.arch {
+                Arch::Llama => None,
+                Arch::Qwen2 => {
+                    let mut bias =
+                        |t: Target| matrix(t.dims(&shape).1, 1, 0.5).and_then(|b| b.flatten_all().map_err(err));
+                    Some([bias(Target::Q)?, bias(Target::K)?, bias(Target::V)?])
+                }
+            };
             let ones = Tensor::ones(shape.dim, DType::F32, &device).map_err(err)?;
             blocks.push(Block {
                 attn_norm: ones.clone(),
                 ffn_norm: ones,
                 proj: proj.try_into().map_err(|_| "seven projections")?,
+                bias,
             });
         }
         let norm = Tensor::ones(shape.dim, DType::F32, &device).map_err(err)?;
@@ -160,16 +179,16 @@ impl LoraSet {
         alpha: f32,
         targets: &[Target],
         pairs: BTreeMap<(usize, Target), Lora>,
-        head_dim: Option<usize>,
+        from_hf: Option<&Shape>,
     ) -> Result<LoraSet, String> {
         let vars = VarMap::new();
         let mut out = BTreeMap::new();
         {
             let mut data = vars.data().lock().map_err(err)?;
             for ((layer, t), lora) in pairs {
-                let b = match (head_dim, t.roped()) {
-                    (Some(hd), true) => hf_to_gguf_rows(&lora.b, rank, hd),
-                    _ => lora.b,
+                let b = match from_hf {
+                    Some(shape) => hf_to_gguf_rows(&lora.b, rank, t, shape),
+                    None => lora.b,
                 };
                 let a = Var::from_vec(lora.a, (rank, lora.inputs), &Device::Cpu).map_err(err)?;
                 let b = Var::from_vec(b, (lora.outputs, rank), &Device::Cpu).map_err(err)?;
@@ -191,20 +210,19 @@ impl LoraSet {
         if adapter.rslora {
             return Err("rank-stabilised (rsLoRA) adapters cannot be trained on".into());
         }
-        LoraSet::from_pairs(adapter.rank, adapter.alpha, &adapter.targets, adapter.layers.clone(), Some(shape.head_dim))
+        LoraSet::from_pairs(adapter.rank, adapter.alpha, &adapter.targets, adapter.layers.clone(), Some(shape))
     }
 
-    /// The adapter in PEFT's layout (q and k rows of `B` in Hugging Face's order).
-    pub fn to_adapter(&self, shape: &Shape) -> Result<Adapter, String> {
+    /// The adapter in PEFT's layout (q and k rows of `B` in Hugging Face's order), for the
+    /// upstream model `base_model`.
+    pub fn to_adapter(&self, shape: &Shape, base_model: &str) -> Result<Adapter, String> {
         let mut layers = BTreeMap::new();
         for (&(layer, t), (a, b)) in &self.pairs {
             let values = |v: &Var| -> Result<Vec<f32>, String> {
                 v.as_tensor().flatten_all().and_then(|t| t.to_vec1()).map_err(err)
             };
-            let (a, mut b) = (values(a)?, values(b)?);
-            if t.roped() {
-                b = gguf_to_hf_rows(&b, self.rank, shape.head_dim);
-            }
+            let a = values(a)?;
+            let b = gguf_to_hf_rows(&values(b)?, self.rank, t, shape);
             let (inputs, outputs) = t.dims(shape);
             layers.insert((layer, t), Lora { a, b, inputs, outputs });
         }
@@ -213,7 +231,7 @@ impl LoraSet {
             alpha: self.alpha,
             rslora: false,
             targets: self.targets.clone(),
-            base_model: tad_local::BASE_MODEL.to_string(),
+            base_model: base_model.to_string(),
             layers,
         })
     }
@@ -238,10 +256,12 @@ impl LoraSet {
     }
 }
 
-/// cos and sin of each position's angle per pair, `[positions, head_dim / 2]`.
+/// cos and sin of each position's angle per pair, `[positions, head_dim / 2]`, and
+/// which values pair up ([`Arch::interleaved`]: adjacent ones, else each head's halves).
 pub struct Rope {
     cos: Tensor,
     sin: Tensor,
+    interleaved: bool,
 }
 
 impl Rope {
@@ -257,19 +277,24 @@ impl Rope {
             }
         }
         let t = |v| Tensor::from_vec(v, (positions, pairs), &Device::Cpu).map_err(err);
-        Ok(Rope { cos: t(cos)?, sin: t(sin)? })
+        Ok(Rope { cos: t(cos)?, sin: t(sin)?, interleaved: shape.arch.interleaved() })
     }
 
-    /// Rotates adjacent pairs of `x` (`[heads, t, head_dim]`).
+    /// Rotates the pairs of `x` (`[heads, t, head_dim]`): `(x[2i], x[2i+1])` interleaved,
+    /// else `(x[i], x[i + head_dim/2])`.
     fn apply(&self, x: &Tensor) -> candle_core::Result<Tensor> {
         let (heads, t, hd) = x.dims3()?;
-        let x = x.reshape((heads, t, hd / 2, 2))?;
-        let (x0, x1) = (x.narrow(3, 0, 1)?, x.narrow(3, 1, 1)?);
-        let cos = self.cos.narrow(0, 0, t)?.reshape((1, t, hd / 2, 1))?;
-        let sin = self.sin.narrow(0, 0, t)?.reshape((1, t, hd / 2, 1))?;
+        // the pair's members side by side in the last dimension (interleaved), or in two halves
+        let (x, axis, angles) = match self.interleaved {
+            true => (x.reshape((heads, t, hd / 2, 2))?, 3, (1, t, hd / 2, 1)),
+            false => (x.reshape((heads, t, 2, hd / 2))?, 2, (1, t, 1, hd / 2)),
+        };
+        let (x0, x1) = (x.narrow(axis, 0, 1)?, x.narrow(axis, 1, 1)?);
+        let cos = self.cos.narrow(0, 0, t)?.reshape(angles)?;
+        let sin = self.sin.narrow(0, 0, t)?.reshape(angles)?;
         let y0 = (x0.broadcast_mul(&cos)? - x1.broadcast_mul(&sin)?)?;
         let y1 = (x0.broadcast_mul(&sin)? + x1.broadcast_mul(&cos)?)?;
-        Tensor::cat(&[y0, y1], 3)?.reshape((heads, t, hd))
+        Tensor::cat(&[y0, y1], axis)?.reshape((heads, t, hd))
     }
 }
 
@@ -303,9 +328,16 @@ impl Weights {
         for (li, block) in self.blocks.iter().enumerate() {
             let h = rms_norm(&x, &block.attn_norm, eps)?;
             let split = |y: Tensor, count: usize| y.reshape((n, count, head_dim))?.transpose(0, 1)?.contiguous();
-            let q = rope.apply(&split(self.linear(&h, li, Target::Q, lora)?, heads)?)?;
-            let k = rope.apply(&split(self.linear(&h, li, Target::K, lora)?, kv_heads)?)?;
-            let v = split(self.linear(&h, li, Target::V, lora)?, kv_heads)?;
+            let qkv = |k: usize, t: Target| -> candle_core::Result<Tensor> {
+                let y = self.linear(&h, li, t, lora)?;
+                match &block.bias {
+                    Some(bias) => y.broadcast_add(&bias[k]),
+                    None => Ok(y),
+                }
+            };
+            let q = rope.apply(&split(qkv(0, Target::Q)?, heads)?)?;
+            let k = rope.apply(&split(qkv(1, Target::K)?, kv_heads)?)?;
+            let v = split(qkv(2, Target::V)?, kv_heads)?;
             // query heads h = kv·group + g read key/value head kv: [kv, group·t, hd]
             let q = q.reshape((kv_heads, group * n, head_dim))?;
             let scores = (q.matmul(&k.t()?)? * scale)?.reshape((heads, n, n))?.broadcast_add(&mask)?;

@@ -1,8 +1,9 @@
-//! LoRA training: on a tiny random llama built in memory (the loss falls, the adapter
-//! round-trips, B = 0 is the base model, gradients match finite differences, malformed
-//! adapters are errors), and on the real local model when it is installed (or
-//! `TAD_REQUIRE_MODEL=1`): the f32 training forward pass against tad-local's quantized
-//! decoder, with and without an adapter, and a few steps of training.
+//! LoRA training: on tiny random llama and qwen2 models built in memory (the loss falls,
+//! the adapter round-trips, B = 0 is the base model, gradients match finite differences,
+//! malformed adapters are errors), and on the real local models when they are installed
+//! (or `TAD_REQUIRE_MODEL=1`: SmolLM2-135M, a llama, and Qwen2.5-Coder-0.5B, a qwen2): the
+//! f32 training forward pass against tad-local's quantized decoder, with and without an
+//! adapter, and a few steps of training.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -13,8 +14,12 @@ use tad_finetune::{
 use tad_local::{Arch, Lora, Shape};
 
 fn tiny_shape() -> Shape {
+    tiny(Arch::Llama)
+}
+
+fn tiny(arch: Arch) -> Shape {
     Shape {
-        arch: Arch::Llama,
+        arch,
         layers: 2,
         dim: 32,
         hidden: 64,
@@ -61,20 +66,25 @@ fn random_adapter(shape: &Shape, rank: usize, targets: &[Target], seed: u64, bou
         alpha: 2.0 * rank as f32,
         rslora: false,
         targets: targets.to_vec(),
-        base_model: tad_local::BASE_MODEL.into(),
+        base_model: Config::default().base_model,
         layers,
     }
 }
 
 #[test]
 fn the_loss_falls_on_a_repeated_example_and_the_adapter_reloads() {
-    let shape = tiny_shape();
+    for arch in [Arch::Llama, Arch::Qwen2] {
+        the_loss_falls_and_the_adapter_reloads(tiny(arch));
+    }
+}
+
+fn the_loss_falls_and_the_adapter_reloads(shape: Shape) {
     let weights = Weights::random(shape, 40, 7).unwrap();
     let sample = Sample { tokens: vec![1, 5, 9, 3, 12, 30, 2, 8, 17, 25, 4, 33, 6, 21, 11, 39], answer: 6 };
     let samples = vec![sample.clone(); 4];
     let config =
         Config { rank: 4, alpha: 8.0, learning_rate: 1e-2, epochs: 6, max_len: 64, seed: 3, ..Config::default() };
-    let out = scratch("tiny");
+    let out = scratch(&format!("tiny-{:?}", shape.arch));
     let mut seen = Vec::new();
     let report =
         tad_finetune::train_samples(&weights, &samples, &config, &out, &mut |p: &Progress| seen.push(p.clone()))
@@ -83,7 +93,7 @@ fn the_loss_falls_on_a_repeated_example_and_the_adapter_reloads() {
     assert_eq!(seen.len(), 24);
     assert_eq!(seen.last().unwrap().epoch, 5);
     let (first, last) = (report.losses[0], *report.losses.last().unwrap());
-    assert!(last < 0.5 * first, "the loss went from {first} to {last}: {:?}", report.losses);
+    assert!(last < 0.5 * first, "{:?}: the loss went from {first} to {last}: {:?}", shape.arch, report.losses);
 
     // the files hold what was trained: reloaded, the loss is the trained one
     let adapter = Adapter::load(&out).unwrap();
@@ -96,8 +106,8 @@ fn the_loss_falls_on_a_repeated_example_and_the_adapter_reloads() {
     assert!((base - first).abs() < 1e-4, "step 1's loss {first} is the base model's {base}");
     assert!(reloaded < last * 1.01 + 1e-3, "reloaded {reloaded}, trained {last}");
     // and written again, the same tensors
-    let again = scratch("tiny-again");
-    lora.to_adapter(&shape).unwrap().save(&again).unwrap();
+    let again = scratch(&format!("tiny-again-{:?}", shape.arch));
+    lora.to_adapter(&shape, &config.base_model).unwrap().save(&again).unwrap();
     assert_eq!(Adapter::load(&again).unwrap(), adapter);
     let raw = candle_core::safetensors::load(out.join("adapter_model.safetensors"), &candle_core::Device::Cpu).unwrap();
     assert_eq!(raw.len(), 2 * 7 * shape.layers);
@@ -110,7 +120,7 @@ fn the_loss_falls_on_a_repeated_example_and_the_adapter_reloads() {
     assert_eq!(config["peft_type"], "LORA");
     assert_eq!(config["task_type"], "CAUSAL_LM");
     assert_eq!(config["r"], 4);
-    assert_eq!(config["base_model_name_or_path"], "HuggingFaceTB/SmolLM2-135M-Instruct");
+    assert_eq!(config["base_model_name_or_path"], tad_local::model(tad_local::DEFAULT).unwrap().upstream);
 }
 
 #[test]
@@ -170,7 +180,12 @@ fn a_resumed_run_ends_where_an_uninterrupted_one_does() {
 
 #[test]
 fn with_b_zero_the_adapter_is_the_base_model_and_gradients_match_finite_differences() {
-    let shape = tiny_shape();
+    for arch in [Arch::Llama, Arch::Qwen2] {
+        b_zero_is_the_base_model_and_gradients_match(tiny(arch));
+    }
+}
+
+fn b_zero_is_the_base_model_and_gradients_match(shape: Shape) {
     let weights = Weights::random(shape, 40, 5).unwrap();
     let tokens = [3u32, 14, 15, 9, 26, 5, 35, 8, 9, 7];
     let zero = LoraSet::new(&shape, 4, 8.0, &Target::ALL, 1).unwrap();
@@ -200,7 +215,11 @@ fn with_b_zero_the_adapter_is_the_base_model_and_gradients_match_finite_differen
         let numeric = (at(h) - at(-h)) / (2.0 * h as f64);
         at(0.0);
         let a = analytic[index] as f64;
-        assert!((a - numeric).abs() < 0.02 * a.abs().max(numeric.abs()) + 1e-4, "{name}[{index}]: {a} vs {numeric}");
+        let arch = shape.arch;
+        assert!(
+            (a - numeric).abs() < 0.02 * a.abs().max(numeric.abs()) + 1e-4,
+            "{arch:?} {name}[{index}]: {a} vs {numeric}"
+        );
         assert!(a.abs() > 1e-5, "{name}[{index}]: a zero gradient proves nothing");
     }
 }
@@ -312,8 +331,13 @@ fn a_malformed_adapter_is_an_error() {
 
 #[test]
 fn examples_are_tokenized_as_the_engine_reads_them() {
-    let Some(path) = gguf() else { return };
-    let mut file = std::fs::File::open(&path).unwrap();
+    for path in ggufs() {
+        examples_are_tokenized_on(&path);
+    }
+}
+
+fn examples_are_tokenized_on(path: &Path) {
+    let mut file = std::fs::File::open(path).unwrap();
     let content = candle_core::quantized::gguf_file::Content::read(&mut file).unwrap();
     let tokenizer = tad_local::tokenizer(&content).unwrap();
     let example = Example {
@@ -340,8 +364,9 @@ fn examples_are_tokenized_as_the_engine_reads_them() {
     assert!(none.is_none() && warning.unwrap().contains("dropped"));
 }
 
-fn gguf() -> Option<PathBuf> {
-    tad_local::for_tests(tad_local::DEFAULT)
+/// The real models installed (all of them with `TAD_REQUIRE_MODEL=1`): a llama and a qwen2.
+fn ggufs() -> Vec<PathBuf> {
+    [tad_local::DEFAULT, "qwen2.5-coder-0.5b"].into_iter().filter_map(tad_local::for_tests).collect()
 }
 
 fn prompt_tokens(path: &Path) -> Vec<u32> {
@@ -353,37 +378,49 @@ fn prompt_tokens(path: &Path) -> Vec<u32> {
 
 #[test]
 fn the_training_forward_pass_agrees_with_the_quantized_decoder() {
-    let Some(path) = gguf() else { return };
-    let tokens = prompt_tokens(&path);
-    let (weights, _) = Weights::load(&path).unwrap();
+    for path in ggufs() {
+        the_training_forward_pass_agrees_on(&path);
+    }
+}
+
+fn the_training_forward_pass_agrees_on(path: &Path) {
+    let tokens = prompt_tokens(path);
+    let (weights, _) = Weights::load(path).unwrap();
     let ours = weights.logits(&tokens, None).unwrap();
-    let mut engine = tad_local::Engine::load(&path, 1).unwrap();
+    let mut engine = tad_local::Engine::load(path, 1).unwrap();
     let theirs = engine.logits(&tokens);
     assert_eq!(ours.len(), theirs.len());
-    assert_eq!(argmax(&ours), argmax(&theirs));
-    assert!(cosine(&ours, &theirs) > 0.99, "cosine {}", cosine(&ours, &theirs));
+    assert_eq!(argmax(&ours), argmax(&theirs), "{}", path.display());
+    assert!(cosine(&ours, &theirs) > 0.99, "{}: cosine {}", path.display(), cosine(&ours, &theirs));
 }
 
 #[test]
 fn an_adapter_in_the_decoder_agrees_with_the_training_forward_pass() {
-    let Some(path) = gguf() else { return };
-    let tokens = prompt_tokens(&path);
-    let (weights, _) = Weights::load(&path).unwrap();
+    for path in ggufs() {
+        an_adapter_agrees_on(&path);
+    }
+}
+
+fn an_adapter_agrees_on(path: &Path) {
+    let tokens = prompt_tokens(path);
+    let (weights, _) = Weights::load(path).unwrap();
     let shape = weights.shape;
     let base = weights.logits(&tokens, None).unwrap();
     // q and k alone first: a wrong row order between HF's layout and the GGUF's shows here
-    for (targets, bound) in [(vec![Target::Q, Target::K], 2.0), (Target::ALL.to_vec(), 0.5)] {
+    // adapters that change the model without wrecking it: Qwen2.5 takes smaller ones
+    let (qk, all) = if shape.arch.interleaved() { (2.0, 0.5) } else { (0.3, 0.05) };
+    for (targets, bound) in [(vec![Target::Q, Target::K], qk), (Target::ALL.to_vec(), all)] {
         let adapter = random_adapter(&shape, 8, &targets, 4, bound);
-        let dir = scratch(&format!("real-{}", targets.len()));
+        let dir = scratch(&format!("real-{:?}-{}", shape.arch, targets.len()));
         adapter.save(&dir).unwrap();
         let adapter = Adapter::load(&dir).unwrap();
         let lora = LoraSet::from_adapter(&adapter, &shape).unwrap();
         let trained = weights.logits(&tokens, Some(&lora)).unwrap();
         let changed = cosine(&trained, &base);
-        let mut engine = tad_local::Engine::load_with(&path, 1, Some(&adapter)).unwrap();
+        let mut engine = tad_local::Engine::load_with(path, 1, Some(&adapter)).unwrap();
         let decoded = engine.logits(&tokens);
         let c = cosine(&trained, &decoded);
-        eprintln!("{targets:?}: cosine with the base {changed}, with the decoder {c}");
+        eprintln!("{:?} {targets:?}: cosine with the base {changed}, with the decoder {c}", shape.arch);
         assert!(changed < 0.995, "the adapter barely changes the model: {changed}");
         assert!(c > 0.995, "{targets:?}: cosine {c}");
         // The decoder keeps its KV cache in half precision. The q/k stress adapter makes the
@@ -398,14 +435,15 @@ fn an_adapter_in_the_decoder_agrees_with_the_training_forward_pass() {
             assert_eq!(best, chosen, "{targets:?}");
         }
         if targets.len() == 2 {
-            // the control: B's q/k rows in the other order disagree clearly
+            // the control: B's q/k rows interleaved once more than the model's order (llama:
+            // twice; qwen2, whose GGUF keeps Hugging Face's order: once) disagree clearly
             let mut wrong = adapter.clone();
             for ((_, t), lora) in wrong.layers.iter_mut() {
                 if t.roped() {
-                    lora.b = tad_local::hf_to_gguf_rows(&lora.b, 8, shape.head_dim);
+                    lora.b = tad_local::interleave_rows(&lora.b, 8, shape.head_dim);
                 }
             }
-            let mut engine = tad_local::Engine::load_with(&path, 1, Some(&wrong)).unwrap();
+            let mut engine = tad_local::Engine::load_with(path, 1, Some(&wrong)).unwrap();
             let w = cosine(&trained, &engine.logits(&tokens));
             eprintln!("rows in the wrong order: cosine {w}");
             assert!(1.0 - w > 4.0 * (1.0 - c), "the wrong order agrees as well: {w} vs {c}");
@@ -415,7 +453,12 @@ fn an_adapter_in_the_decoder_agrees_with_the_training_forward_pass() {
 
 #[test]
 fn a_few_steps_on_the_real_model() {
-    let Some(path) = gguf() else { return };
+    for path in ggufs() {
+        a_few_steps_on(&path);
+    }
+}
+
+fn a_few_steps_on(path: &Path) {
     let example = |region: &str| Example {
         prompt: vec![
             Message { role: "system".into(), content: "You write TAD scenarios.".into() },
@@ -425,12 +468,17 @@ fn a_few_steps_on_the_real_model() {
     };
     let examples = vec![example("urban"), example("highway")];
     let config = Config { rank: 4, alpha: 8.0, epochs: 2, max_len: 128, learning_rate: 1e-3, ..Config::default() };
-    let out = scratch("real-train");
-    let report = tad_finetune::train(&path, &examples, &config, &out, &mut |_| {}).unwrap();
+    let out = scratch(&format!("real-train-{}", path.file_name().unwrap().to_string_lossy()));
+    let report = tad_finetune::train(path, &examples, &config, &out, &mut |_| {}).unwrap();
+    eprintln!("{}: losses {:?}, {:.1} tokens/s", path.display(), report.losses, report.tokens_per_s);
     assert_eq!(report.steps, 4);
     assert!(report.losses.iter().all(|l| l.is_finite()));
     assert!(report.losses[3] < report.losses[0], "{:?}", report.losses);
+    // the adapter drives the decoder: the same vocabulary, other logits
     let adapter = Adapter::load(&out).unwrap();
-    let mut engine = tad_local::Engine::load_with(&path, 1, Some(&adapter)).unwrap();
-    assert_eq!(engine.logits(&prompt_tokens(&path)).len(), 49_152);
+    let tokens = prompt_tokens(path);
+    let tuned = tad_local::Engine::load_with(path, 1, Some(&adapter)).unwrap().logits(&tokens);
+    let base = tad_local::Engine::load(path, 1).unwrap().logits(&tokens);
+    assert_eq!(tuned.len(), base.len());
+    assert_ne!(tuned, base, "the adapter changes nothing");
 }

@@ -8,10 +8,11 @@
 //! the model; neither panics on any file.
 //!
 //! Hugging Face's q and k rows are in the order its rotary embedding wants (each head's
-//! first halves, then its second halves); llama.cpp's converter interleaves them per head
-//! so that rope rotates adjacent pairs, which is the order of the GGUF's `attn_q`/`attn_k`
-//! rows and of this crate's decoder. An adapter is kept in Hugging Face's order (as it is
-//! on disk); [`hf_to_gguf_rows`] and [`gguf_to_hf_rows`] convert `lora_B` of q and k.
+//! first halves, then its second halves); for llama, llama.cpp's converter interleaves them
+//! per head so that rope rotates adjacent pairs, which is the order of the GGUF's
+//! `attn_q`/`attn_k` rows and of this crate's decoder; qwen2's GGUF keeps Hugging Face's
+//! ([`crate::Arch::interleaved`]). An adapter is kept in Hugging Face's order (as it is on
+//! disk); [`hf_to_gguf_rows`] and [`gguf_to_hf_rows`] convert a `lora_B` to the model's.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -126,9 +127,6 @@ pub struct Adapter {
     pub base_model: String,
     pub layers: BTreeMap<(usize, Target), Lora>,
 }
-
-/// The base model adapters are trained for.
-pub const BASE_MODEL: &str = "HuggingFaceTB/SmolLM2-135M-Instruct";
 
 /// The adapter's files.
 pub const CONFIG_FILE: &str = "adapter_config.json";
@@ -337,8 +335,26 @@ fn gguf_row(row: usize, head_dim: usize) -> usize {
     head * head_dim + 2 * i + s
 }
 
-/// `b`'s rows (`[out, cols]`) from Hugging Face's order to the GGUF's.
-pub fn hf_to_gguf_rows(b: &[f32], cols: usize, head_dim: usize) -> Vec<f32> {
+/// `b`'s rows (`[out, cols]`) of `target` from Hugging Face's order to the GGUF's of a
+/// model of `shape`: interleaved for llama's q and k, else the same.
+pub fn hf_to_gguf_rows(b: &[f32], cols: usize, target: Target, shape: &Shape) -> Vec<f32> {
+    match target.roped() && shape.arch.interleaved() {
+        true => interleave_rows(b, cols, shape.head_dim),
+        false => b.to_vec(),
+    }
+}
+
+/// `b`'s rows of `target` from the GGUF's order of a model of `shape` to Hugging Face's.
+pub fn gguf_to_hf_rows(b: &[f32], cols: usize, target: Target, shape: &Shape) -> Vec<f32> {
+    match target.roped() && shape.arch.interleaved() {
+        true => deinterleave_rows(b, cols, shape.head_dim),
+        false => b.to_vec(),
+    }
+}
+
+/// `b`'s rows (`[out, cols]`) from Hugging Face's order to llama.cpp's per-head
+/// interleaving, for heads of `head_dim`.
+pub fn interleave_rows(b: &[f32], cols: usize, head_dim: usize) -> Vec<f32> {
     let mut out = vec![0f32; b.len()];
     for (row, values) in b.chunks_exact(cols).enumerate() {
         let to = gguf_row(row, head_dim);
@@ -347,8 +363,8 @@ pub fn hf_to_gguf_rows(b: &[f32], cols: usize, head_dim: usize) -> Vec<f32> {
     out
 }
 
-/// `b`'s rows (`[out, cols]`) from the GGUF's order to Hugging Face's.
-pub fn gguf_to_hf_rows(b: &[f32], cols: usize, head_dim: usize) -> Vec<f32> {
+/// The inverse of [`interleave_rows`].
+fn deinterleave_rows(b: &[f32], cols: usize, head_dim: usize) -> Vec<f32> {
     let mut out = vec![0f32; b.len()];
     for (row, values) in out.chunks_exact_mut(cols).enumerate() {
         let from = gguf_row(row, head_dim);
@@ -364,9 +380,9 @@ mod tests {
     #[test]
     fn row_orders_round_trip() {
         let b: Vec<f32> = (0..16 * 3).map(|x| x as f32).collect();
-        let g = hf_to_gguf_rows(&b, 3, 8);
+        let g = interleave_rows(&b, 3, 8);
         assert_ne!(g, b);
-        assert_eq!(gguf_to_hf_rows(&g, 3, 8), b);
+        assert_eq!(deinterleave_rows(&g, 3, 8), b);
         // HF's row 4 (the second half's first) of head 0 is GGUF's row 1
         assert_eq!(&g[3..6], &b[12..15]);
     }

@@ -176,6 +176,15 @@ pub enum Arch {
     Qwen2,
 }
 
+impl Arch {
+    /// Whether the GGUF's query and key rows are llama.cpp's per-head interleaving of
+    /// Hugging Face's, so that rope rotates adjacent pairs (llama). qwen2's are Hugging
+    /// Face's own, and rope rotates each head's halves.
+    pub fn interleaved(self) -> bool {
+        self == Arch::Llama
+    }
+}
+
 /// The shape of the model, from the GGUF metadata.
 #[derive(Clone, Copy, Debug)]
 pub struct Shape {
@@ -350,20 +359,10 @@ impl Model {
     /// Applies `adapter` from now on (in f32, beside the quantized products); checked
     /// against the model's shape first.
     pub fn attach(&mut self, adapter: &Adapter) -> Result<(), String> {
-        // the query and key rows are reordered for llama's rotary layout, not qwen2's
-        if self.shape.arch != Arch::Llama {
-            return Err(format!(
-                "a {:?} model: LoRA adapters are applied to the llama architecture only",
-                self.shape.arch
-            ));
-        }
         adapter.check(&self.shape)?;
         let mut layers: Vec<[Option<LoraPair>; 7]> = (0..self.shape.layers).map(|_| Default::default()).collect();
         for (&(layer, target), lora) in &adapter.layers {
-            let b = match target.roped() {
-                true => hf_to_gguf_rows(&lora.b, adapter.rank, self.shape.head_dim),
-                false => lora.b.clone(),
-            };
+            let b = hf_to_gguf_rows(&lora.b, adapter.rank, target, &self.shape);
             layers[layer][target as usize] = Some(LoraPair { a: lora.a.clone(), b, rank: adapter.rank });
         }
         self.lora = Some((layers, adapter.scale()));
@@ -462,10 +461,7 @@ impl Model {
                     }
                 }
             }
-            let rotate = match self.shape.arch {
-                Arch::Llama => rotate_pairs,
-                Arch::Qwen2 => rotate_halves,
-            };
+            let rotate = if self.shape.arch.interleaved() { rotate_pairs } else { rotate_halves };
             for t in 0..n {
                 let angles = &self.rope[(start + t) * pairs..(start + t + 1) * pairs];
                 for h in 0..heads {

