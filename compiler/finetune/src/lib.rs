@@ -71,7 +71,7 @@ impl Default for Config {
             seed: 0,
             checkpoint_every: 0,
             resume: false,
-            base_model: tad_local::model(tad_local::DEFAULT).map_or("", |m| m.upstream).to_string(),
+            base_model: tad_local::model(tad_local::ALIGN_DEFAULT).map_or("", |m| m.upstream).to_string(),
         }
     }
 }

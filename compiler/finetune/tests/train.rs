@@ -120,7 +120,7 @@ fn the_loss_falls_and_the_adapter_reloads(shape: Shape) {
     assert_eq!(config["peft_type"], "LORA");
     assert_eq!(config["task_type"], "CAUSAL_LM");
     assert_eq!(config["r"], 4);
-    assert_eq!(config["base_model_name_or_path"], tad_local::model(tad_local::DEFAULT).unwrap().upstream);
+    assert_eq!(config["base_model_name_or_path"], tad_local::model(tad_local::ALIGN_DEFAULT).unwrap().upstream);
 }
 
 #[test]
@@ -366,7 +366,7 @@ fn examples_are_tokenized_on(path: &Path) {
 
 /// The real models installed (all of them with `TAD_REQUIRE_MODEL=1`): a llama and a qwen2.
 fn ggufs() -> Vec<PathBuf> {
-    [tad_local::DEFAULT, "qwen2.5-coder-0.5b"].into_iter().filter_map(tad_local::for_tests).collect()
+    [tad_local::SMALLEST, "qwen2.5-coder-0.5b"].into_iter().filter_map(tad_local::for_tests).collect()
 }
 
 fn prompt_tokens(path: &Path) -> Vec<u32> {

@@ -50,7 +50,7 @@ impl Choice {
             }
             Some(config) => Ok(Backend::Server(Client::new(config).map_err(|e| e.to_string())?)),
             None => self.local(
-                tad_local::DEFAULT,
+                None,
                 Some(" (no server is configured: set TADSL_LLM_BASE_URL, e.g. http://127.0.0.1:8080/v1, or pass --base-url to use one)"),
             ),
         }
@@ -76,18 +76,24 @@ impl Choice {
             .map_err(|e| e.to_string())
     }
 
-    /// The local model `--model` names (`local`, `local:NAME`), if it names one.
-    fn local_name(&self) -> Option<&str> {
+    /// Whether `--model` names the local model (`local`, `local:NAME`), and which
+    /// (`None`: the default).
+    fn local_name(&self) -> Option<Option<&str>> {
         let name = self.model.as_deref()?.strip_prefix("local")?;
-        Some(name.strip_prefix(':').filter(|n| !n.is_empty()).unwrap_or(tad_local::DEFAULT))
+        Some(name.strip_prefix(':').filter(|n| !n.is_empty()))
     }
 
-    fn local(&self, name: &str, why: Option<&str>) -> Result<Backend, String> {
+    /// The local model `name`; without one, the model `--adapter` was trained on (its
+    /// `base_model_name_or_path`, when it is one of ours), else the default.
+    fn local(&self, name: Option<&str>, why: Option<&str>) -> Result<Backend, String> {
+        let adapter = self.adapter.as_deref().map(tad_local::Adapter::load).transpose()?;
+        let trained_on =
+            || tad_local::MODELS.iter().find(|m| Some(m.upstream) == adapter.as_ref().map(|a| &*a.base_model));
+        let name = name.or_else(|| trained_on().map(|m| m.name)).unwrap_or(tad_local::DEFAULT);
         let model = tad_local::model(name).ok_or_else(|| {
             let names: Vec<&str> = tad_local::MODELS.iter().map(|m| m.name).collect();
             format!("unknown local model `{name}` (the local models are: {})", names.join(", "))
         })?;
-        let adapter = self.adapter.as_deref().map(tad_local::Adapter::load).transpose()?;
         let chat = tad_local::LocalChat::load_with(model, self.threads, adapter.as_ref())
             .map_err(|e| format!("{e}{}", why.unwrap_or("")))?;
         Ok(Backend::Local(chat))

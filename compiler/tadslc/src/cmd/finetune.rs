@@ -48,7 +48,7 @@ pub struct FinetuneArgs {
     #[arg(long)]
     pub resume: bool,
     /// The local model to adapt
-    #[arg(long, default_value = tad_local::DEFAULT)]
+    #[arg(long, default_value = tad_local::ALIGN_DEFAULT)]
     pub model: String,
 }
 
