@@ -634,7 +634,7 @@ mod tests {
     use candle_transformers::models::quantized_llama::ModelWeights;
 
     fn gguf() -> Option<std::path::PathBuf> {
-        tad_models::for_tests(crate::DEFAULT)
+        tad_models::for_tests(crate::SMALLEST)
     }
 
     fn cosine(a: &[f32], b: &[f32]) -> f32 {
