@@ -138,6 +138,7 @@ struct Best<'k> {
 
 impl Best<'_> {
     fn offer(&mut self, actor: Learned, at: usize) {
+        // the held-out table's runner, on the training scenes (its rows' labels go unread)
         let rows = crate::harness::held_out(self.kept, self.train, &[(String::new(), EgoSpec::Learned(actor.clone()))]);
         let scores: Vec<&tad_metrics::EpisodeScore> = rows.iter().map(|r| &r.score).collect();
         let (_, os) = crate::interval::cr_os(&scores);

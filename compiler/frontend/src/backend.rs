@@ -87,9 +87,8 @@ impl Choice {
     /// `base_model_name_or_path`, when it is one of ours), else the default.
     fn local(&self, name: Option<&str>, why: Option<&str>) -> Result<Backend, String> {
         let adapter = self.adapter.as_deref().map(tad_local::Adapter::load).transpose()?;
-        let trained_on =
-            || tad_local::MODELS.iter().find(|m| Some(m.upstream) == adapter.as_ref().map(|a| &*a.base_model));
-        let name = name.or_else(|| trained_on().map(|m| m.name)).unwrap_or(tad_local::DEFAULT);
+        let trained_on = adapter.as_ref().and_then(|a| tad_local::MODELS.iter().find(|m| m.upstream == a.base_model));
+        let name = name.or(trained_on.map(|m| m.name)).unwrap_or(tad_local::DEFAULT);
         let model = tad_local::model(name).ok_or_else(|| {
             let names: Vec<&str> = tad_local::MODELS.iter().map(|m| m.name).collect();
             format!("unknown local model `{name}` (the local models are: {})", names.join(", "))
