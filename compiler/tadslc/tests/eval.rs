@@ -357,30 +357,7 @@ fn eval_adds_the_after_fine_tuning_table_when_asked() {
     expected.extend(["idm".to_string(), "naive".to_string()]);
     assert_eq!(egos, expected, "{}", stdout(&out));
     assert!(learned > 0, "some fine-tuning learns: {}", stderr(&out));
-    // the actor kept is the best scored on its training scenes, from the start (episode
-    // 0, then it drives as before) or the end (episode 6)
-    let row = |ego: &str| held.iter().find(|r| r["ego"] == ego).map(|r| r["metrics"].clone());
-    for model in ["ppo", "sac", "td3"] {
-        for generator in ["chatscene", "fitted", "baseline"] {
-            let tuned = format!("{model} (fine-tuned on {generator})");
-            let Some(line) =
-                stderr(&out).lines().find(|l| l.starts_with(&format!("`{tuned}`: kept"))).map(String::from)
-            else {
-                continue;
-            };
-            let number = |after: &str| -> f64 {
-                let rest = &line[line.find(after).unwrap_or_else(|| panic!("{line}")) + after.len()..];
-                rest.split(|c: char| !(c.is_ascii_digit() || c == '.')).next().unwrap().parse().unwrap()
-            };
-            let (at, kept, start) = (number("episode "), number("(OS "), number("; "));
-            assert!(kept >= start, "the kept actor scores no worse than the start: {line}");
-            match at as usize {
-                0 => assert_eq!(row(&tuned), row(model), "the start kept drives as before: {line}"),
-                6 => {}
-                _ => panic!("kept at neither end: {line}"),
-            }
-        }
-    }
+    kept_actors_are_the_best_and_the_start_drives_as_before(&stderr(&out), &held);
     // the held-out scenes are 2/5 of the kept ones, the same for every ego
     let kept: u64 = rows
         .iter()
@@ -466,6 +443,32 @@ fn eval_adds_the_after_fine_tuning_table_when_asked() {
     let sharded = tadslc(&["eval", "examples", "--finetune", "5", "--shard", "0/2"], "");
     assert_eq!(code(&sharded), 2);
     assert!(stderr(&sharded).contains("without --shard"), "{}", stderr(&sharded));
+}
+
+/// Each tuned run's line: the actor kept is the best scored on its training scenes, from
+/// the start (episode 0, then it drives as before) or the end (episode 6).
+fn kept_actors_are_the_best_and_the_start_drives_as_before(stderr: &str, held: &[&Value]) {
+    let row = |ego: &str| held.iter().find(|r| r["ego"] == ego).map(|r| r["metrics"].clone());
+    for model in ["ppo", "sac", "td3"] {
+        for generator in ["chatscene", "fitted", "baseline"] {
+            let tuned = format!("{model} (fine-tuned on {generator})");
+            let Some(line) = stderr.lines().find(|l| l.starts_with(&format!("`{tuned}`: kept"))).map(String::from)
+            else {
+                continue;
+            };
+            let number = |after: &str| -> f64 {
+                let rest = &line[line.find(after).unwrap_or_else(|| panic!("{line}")) + after.len()..];
+                rest.split(|c: char| !(c.is_ascii_digit() || c == '.')).next().unwrap().parse().unwrap()
+            };
+            let (at, kept, start) = (number("episode "), number("(OS "), number("; "));
+            assert!(kept >= start, "the kept actor scores no worse than the start: {line}");
+            match at as usize {
+                0 => assert_eq!(row(&tuned), row(model), "the start kept drives as before: {line}"),
+                6 => {}
+                _ => panic!("kept at neither end: {line}"),
+            }
+        }
+    }
 }
 
 #[test]
