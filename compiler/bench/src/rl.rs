@@ -145,8 +145,9 @@ pub fn run(args: &RlArgs, progress: &mut dyn FnMut(&str)) -> Result<Report, Benc
         }
     }
     report.notes.push(format!(
-        "networks 2 × {HIDDEN}; batches: SAC, TD3 {OFF_POLICY_BATCH}; PPO minibatches of {PPO_BATCH} over {PPO_ROLLOUT} transitions, {PPO_EPOCHS} passes; {} scenes",
-        units.len()
+        "networks 2 × {HIDDEN}; batches: SAC, TD3 {OFF_POLICY_BATCH}; PPO minibatches of {PPO_BATCH} over {PPO_ROLLOUT} transitions, {PPO_EPOCHS} passes; {} scenes; tad-train's products on {}",
+        units.len(),
+        tad_train::kernel_name()
     ));
     Ok(report)
 }

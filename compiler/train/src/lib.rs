@@ -61,8 +61,10 @@
 //! the thread count. Every other random choice (initialisation, batches, the update's
 //! noise) draws from one `tad_ir::SplitMix64` seeded by [`Config::seed`]. The `n`-th
 //! episode's scenario and seed ([`Trainer::task_at`]) are a function of the seed and `n`.
-//! Same seed, scenes and settings ⇒ the same file bytes on the same machine (candle's CPU
-//! matmul splits work by output block, so its sums do not depend on the thread count).
+//! Same seed, scenes and settings ⇒ the same file bytes, whatever the thread count and the
+//! vector width: every layer is one op of candle's graph whose products are this crate's
+//! own (`gemm`: each output one chain of fused multiply-adds in a fixed order, vectorised
+//! across outputs only), so AVX-512, AVX2 and the scalar fallback sum alike.
 //!
 //! # Warm start
 //!
@@ -76,6 +78,7 @@
 
 mod checkpoint;
 mod config;
+mod gemm;
 mod imitate;
 mod nets;
 pub mod reward;
@@ -93,6 +96,7 @@ use tad_policy::{EgoPolicy, Learned, PolicyError};
 use tad_runtime::Scene;
 
 pub use config::{Algo, Config, MAX_BUFFER, MAX_WIDTH};
+pub use gemm::kernel_name;
 pub use imitate::{Imitation, ImitationRound};
 pub use reward::{Reward, Rewarder};
 pub use rollout::evaluate;

@@ -1,13 +1,15 @@
 //! The networks as candle `Var`s (for gradients), their plain `f32` copy (for acting), Adam
 //! with its moments kept by name (for checkpoints), and the seeded draws (initialisation,
-//! Gaussian noise).
+//! Gaussian noise). A layer is one op of candle's graph ([`Linear`]: the product, the bias
+//! and ReLU, with a backward pass of its own), its products [`gemm`]'s.
 
 use std::collections::HashMap;
 
-use candle_core::{CpuStorage, CustomOp2, D, DType, Device, Layout, Shape, Tensor, Var};
+use candle_core::{CpuStorage, CustomOp2, CustomOp3, D, DType, Device, Layout, Shape, Tensor, Var};
 use tad_ir::{Rng, SplitMix64};
 
 use crate::TrainError;
+use crate::gemm::{self, View};
 
 /// The action's length (SafeBench's `ego_action_dim`).
 pub(crate) const ACT: usize = 2;
@@ -41,15 +43,11 @@ impl Layer {
         })
     }
 
-    /// `x Wᵀ + b`; `fixed`, the parameters as constants, so that a backward pass computes
-    /// no gradient of theirs.
-    fn forward(&self, x: &Tensor, fixed: bool) -> candle_core::Result<Tensor> {
+    /// `x Wᵀ + b`, with ReLU after when `relu`; `fixed`, the parameters as constants, so
+    /// that a backward pass computes no gradient of theirs.
+    fn forward(&self, x: &Tensor, fixed: bool, relu: bool) -> candle_core::Result<Tensor> {
         let (w, b) = (self.weight.as_tensor(), self.bias.as_tensor());
-        if fixed {
-            x.matmul(&w.detach().t()?)?.broadcast_add(&b.detach())
-        } else {
-            x.matmul(&w.t()?)?.apply_op2(b, AddBias)
-        }
+        if fixed { x.apply_op3(&w.detach(), &b.detach(), Linear { relu }) } else { x.apply_op3(w, b, Linear { relu }) }
     }
 
     fn outputs(&self) -> usize {
@@ -57,16 +55,84 @@ impl Layer {
     }
 }
 
-/// `x + b` row by row (`x` `[B, H]`, `b` `[H]`, both `f32`): candle's `broadcast_add`, with
-/// a faster backward pass. candle sums the bias's gradient over the batch with an integer
-/// division per element (its reduction over a leading dimension), a tenth of a learning
-/// step; this one adds the rows in the same order from the same `+0`, so the same bits
-/// (`add_bias_is_broadcast_add`).
-struct AddBias;
+/// An `f32` slice of a contiguous operand.
+fn contiguous<'s>(s: &'s CpuStorage, l: &Layout, what: &str) -> candle_core::Result<&'s [f32]> {
+    let Some((from, to)) = l.contiguous_offsets() else { candle_core::bail!("linear: {what} must be contiguous") };
+    Ok(&s.as_slice::<f32>()?[from..to])
+}
 
-impl CustomOp2 for AddBias {
+/// One `nn.Linear` (`x` `[B, in]`, `W` `[out, in]`, `b` `[out]`, all `f32`), optionally
+/// followed by ReLU, as one op of candle's graph: every output's sum is [`gemm`]'s chain
+/// started from its bias. Its backward pass computes only what the graph tracks: no `dW`,
+/// `db` for a layer held fixed, no `dx` for the batch itself; a ReLU's gradient is masked
+/// by the layer's output as it is packed.
+struct Linear {
+    relu: bool,
+}
+
+impl CustomOp3 for Linear {
     fn name(&self) -> &'static str {
-        "add-bias"
+        "linear"
+    }
+
+    fn cpu_fwd(
+        &self,
+        s1: &CpuStorage,
+        l1: &Layout,
+        s2: &CpuStorage,
+        l2: &Layout,
+        s3: &CpuStorage,
+        l3: &Layout,
+    ) -> candle_core::Result<(CpuStorage, Shape)> {
+        let (rows, inputs) = l1.shape().dims2()?;
+        let (outputs, width) = l2.shape().dims2()?;
+        if width != inputs || l3.shape().dims() != [outputs] {
+            candle_core::bail!("linear: {:?} through {:?} plus {:?}", l1.shape(), l2.shape(), l3.shape())
+        }
+        let (x, w, b) = (contiguous(s1, l1, "the input")?, contiguous(s2, l2, "W")?, contiguous(s3, l3, "b")?);
+        let mut out = Vec::with_capacity(rows * outputs);
+        (0..rows).for_each(|_| out.extend_from_slice(b));
+        gemm::gemm(View::rows(x, rows, inputs), View::rows(w, outputs, inputs).t(), &mut out);
+        if self.relu {
+            // NaN stays NaN: a diverged loss is seen as one
+            out.iter_mut().for_each(|v| *v = if *v < 0.0 { 0.0 } else { *v });
+        }
+        Ok((CpuStorage::F32(out), Shape::from((rows, outputs))))
+    }
+
+    fn bwd(
+        &self,
+        x: &Tensor,
+        w: &Tensor,
+        b: &Tensor,
+        res: &Tensor,
+        grad: &Tensor,
+    ) -> candle_core::Result<(Option<Tensor>, Option<Tensor>, Option<Tensor>)> {
+        let grad = grad.contiguous()?;
+        // through ReLU: the gradient where the output is positive (the pre-activation was)
+        let grad = if self.relu { grad.apply_op2_no_bwd(res, &ReluGrad)? } else { grad };
+        let of = |wrt: Wrt, other: &Tensor| grad.apply_op2_no_bwd(other, &LinearGrad(wrt));
+        let dx = if x.track_op() { Some(of(Wrt::Input, w)?) } else { None };
+        let dw = if w.track_op() { Some(of(Wrt::Weight, x)?) } else { None };
+        let db = if b.track_op() { Some(grad.apply_op1_no_bwd(&BiasGrad)?) } else { None };
+        Ok((dx, dw, db))
+    }
+}
+
+#[derive(Clone, Copy)]
+enum Wrt {
+    Input,
+    Weight,
+}
+
+/// A [`Linear`]'s gradient product from `(g, other)`, `g` the output's gradient `[B, out]`:
+/// `g·W` for the input (other: `W` `[out, in]`), `gᵀ·x` for the weight (other: `x`
+/// `[B, in]`).
+struct LinearGrad(Wrt);
+
+impl CustomOp2 for LinearGrad {
+    fn name(&self) -> &'static str {
+        "linear-grad"
     }
 
     fn cpu_fwd(
@@ -76,35 +142,62 @@ impl CustomOp2 for AddBias {
         s2: &CpuStorage,
         l2: &Layout,
     ) -> candle_core::Result<(CpuStorage, Shape)> {
-        let (rows, cols) = l1.shape().dims2()?;
-        let (Some((x0, x1)), Some((b0, b1))) = (l1.contiguous_offsets(), l2.contiguous_offsets()) else {
-            candle_core::bail!("add-bias: the operands must be contiguous")
+        let (rows, outputs) = l1.shape().dims2()?;
+        let (n0, n1) = l2.shape().dims2()?;
+        let g = View::rows(contiguous(s1, l1, "the gradient")?, rows, outputs);
+        let other = View::rows(contiguous(s2, l2, "the operand")?, n0, n1);
+        let (g, shape) = match self.0 {
+            Wrt::Input => (g, (rows, n1)),
+            Wrt::Weight => (g.t(), (outputs, n1)),
         };
-        let (x, b) = (&s1.as_slice::<f32>()?[x0..x1], &s2.as_slice::<f32>()?[b0..b1]);
-        if l2.shape().dims() != [cols] {
-            candle_core::bail!("add-bias: a bias of {:?} for rows of {cols}", l2.shape())
+        if g.cols != other.rows {
+            candle_core::bail!("linear-grad: {:?} against {:?}", l1.shape(), l2.shape())
         }
-        let mut out = Vec::with_capacity(rows * cols);
-        for row in x.chunks_exact(cols) {
-            out.extend(row.iter().zip(b).map(|(v, c)| v + c));
-        }
-        Ok((CpuStorage::F32(out), l1.shape().clone()))
+        let mut out = vec![0.0f32; shape.0 * shape.1];
+        gemm::gemm(g, other, &mut out);
+        Ok((CpuStorage::F32(out), Shape::from(shape)))
+    }
+}
+
+/// `g` where ReLU's output `y` is positive, else 0, from `(g, y)`.
+struct ReluGrad;
+
+impl CustomOp2 for ReluGrad {
+    fn name(&self) -> &'static str {
+        "relu-grad"
     }
 
-    fn bwd(
+    fn cpu_fwd(
         &self,
-        _x: &Tensor,
-        _b: &Tensor,
-        _sum: &Tensor,
-        grad: &Tensor,
-    ) -> candle_core::Result<(Option<Tensor>, Option<Tensor>)> {
-        let (_, cols) = grad.dims2()?;
-        let rows = grad.contiguous()?.flatten_all()?.to_vec1::<f32>()?;
+        s1: &CpuStorage,
+        l1: &Layout,
+        s2: &CpuStorage,
+        l2: &Layout,
+    ) -> candle_core::Result<(CpuStorage, Shape)> {
+        let (g, y) = (contiguous(s1, l1, "the gradient")?, contiguous(s2, l2, "the output")?);
+        if g.len() != y.len() {
+            candle_core::bail!("relu-grad: {:?} against {:?}", l1.shape(), l2.shape())
+        }
+        let out = g.iter().zip(y).map(|(g, y)| if *y > 0.0 { *g } else { 0.0 }).collect();
+        Ok((CpuStorage::F32(out), l1.shape().clone()))
+    }
+}
+
+/// A [`Linear`]'s bias gradient: the gradient's rows added in order from `+0`.
+struct BiasGrad;
+
+impl candle_core::CustomOp1 for BiasGrad {
+    fn name(&self) -> &'static str {
+        "bias-grad"
+    }
+
+    fn cpu_fwd(&self, s1: &CpuStorage, l1: &Layout) -> candle_core::Result<(CpuStorage, Shape)> {
+        let (_, cols) = l1.shape().dims2()?;
         let mut sum = vec![0.0f32; cols];
-        for row in rows.chunks_exact(cols) {
+        for row in contiguous(s1, l1, "the gradient")?.chunks_exact(cols) {
             sum.iter_mut().zip(row).for_each(|(s, v)| *s += v);
         }
-        Ok((Some(grad.clone()), Some(Tensor::from_vec(sum, cols, grad.device())?)))
+        Ok((CpuStorage::F32(sum), Shape::from(cols)))
     }
 }
 
@@ -155,9 +248,9 @@ impl Net {
     fn forward_as(&self, x: &Tensor, fixed: bool) -> candle_core::Result<Vec<Tensor>> {
         let mut x = x.clone();
         for layer in &self.hidden {
-            x = layer.forward(&x, fixed)?.relu()?;
+            x = layer.forward(&x, fixed, true)?;
         }
-        self.heads.iter().map(|h| h.forward(&x, fixed)).collect()
+        self.heads.iter().map(|h| h.forward(&x, fixed, false)).collect()
     }
 
     fn layers(&self) -> impl Iterator<Item = &Layer> {
@@ -237,6 +330,16 @@ impl Net {
         }
         Ok(())
     }
+}
+
+/// `f` of a CPU `f32` tensor's values in place (a copy only when it is not contiguous).
+fn read<R>(t: &Tensor, f: impl FnOnce(&[f32]) -> R) -> candle_core::Result<R> {
+    let (storage, layout) = t.storage_and_layout();
+    if let (candle_core::Storage::Cpu(cpu), Some((from, to))) = (&*storage, layout.contiguous_offsets()) {
+        return Ok(f(&cpu.as_slice::<f32>()?[from..to]));
+    }
+    drop(storage);
+    Ok(f(&t.flatten_all()?.to_vec1::<f32>()?))
 }
 
 /// One layer as plain numbers, row-major `[out, in]`.
@@ -403,9 +506,8 @@ impl Adam {
         let k = Step::new(self.lr, step);
         for (i, (_, theta)) in self.vars.iter().enumerate() {
             let Some(g) = grads.get(theta.as_tensor()) else { continue };
-            let g = g.flatten_all()?.to_vec1::<f32>()?;
-            let mut values = theta.as_tensor().flatten_all()?.to_vec1::<f32>()?;
-            k.apply(&mut values, &mut self.m[i], &mut self.v[i], &g);
+            let mut values = read(theta.as_tensor(), <[f32]>::to_vec)?;
+            read(g, |g| k.apply(&mut values, &mut self.m[i], &mut self.v[i], g))?;
             theta.set(&Tensor::from_vec(values, theta.shape(), theta.device())?)?;
         }
         Ok(())
@@ -496,29 +598,42 @@ mod tests {
         Ok(((theta - (adjusted * lr)?)?, m, v))
     }
 
+    /// `relu(x Wᵀ + b)`'s value and gradients, as candle's own operations write it
+    /// (close, not equal: candle's matmul sums in another order), and a fixed layer's
+    /// backward pass gives no gradient of its parameters.
     #[test]
-    fn add_bias_is_broadcast_add() {
+    fn linear_is_candles_expression() {
         let mut rng = SplitMix64::new(3);
         let device = Device::Cpu;
         let (rows, cols, inputs) = (37, 19, 5);
         let mut values = |n: usize| -> Vec<f32> { (0..n).map(|_| (rng.unit() as f32 - 0.5) * 4.0).collect() };
-        let x = Tensor::from_vec(values(rows * inputs), (rows, inputs), &device).unwrap();
+        let x = Var::from_vec(values(rows * inputs), (rows, inputs), &device).unwrap();
         let w = Var::from_vec(values(cols * inputs), (cols, inputs), &device).unwrap();
-        let mut bias = values(cols);
-        bias[..2].copy_from_slice(&[0.0, -0.0]);
-        let b = Var::from_vec(bias, cols, &device).unwrap();
+        let b = Var::from_vec(values(cols), cols, &device).unwrap();
         let scale = Tensor::from_vec(values(rows * cols), (rows, cols), &device).unwrap();
-        let grads = |fused: bool| {
-            let xw = x.matmul(&w.as_tensor().t().unwrap()).unwrap();
-            let y = if fused { xw.apply_op2(b.as_tensor(), AddBias) } else { xw.broadcast_add(b.as_tensor()) }.unwrap();
-            let loss = (y.relu().unwrap() * &scale).unwrap().sum_all().unwrap();
-            let grads = loss.backward().unwrap();
-            let bits = |t: &Tensor| -> Vec<u32> {
-                t.flatten_all().unwrap().to_vec1::<f32>().unwrap().iter().map(|v| v.to_bits()).collect()
+        let run = |ours: bool, relu: bool| {
+            let (xt, wt, bt) = (x.as_tensor(), w.as_tensor(), b.as_tensor());
+            let y = if ours {
+                xt.apply_op3(wt, bt, Linear { relu }).unwrap()
+            } else {
+                let y = xt.matmul(&wt.t().unwrap()).unwrap().broadcast_add(bt).unwrap();
+                if relu { y.relu().unwrap() } else { y }
             };
-            (bits(&y), bits(grads.get(w.as_tensor()).unwrap()), bits(grads.get(b.as_tensor()).unwrap()))
+            let grads = (&y * &scale).unwrap().sum_all().unwrap().backward().unwrap();
+            let flat = |t: &Tensor| t.flatten_all().unwrap().to_vec1::<f32>().unwrap();
+            [flat(&y), flat(grads.get(xt).unwrap()), flat(grads.get(wt).unwrap()), flat(grads.get(bt).unwrap())]
         };
-        assert_eq!(grads(true), grads(false));
+        for relu in [false, true] {
+            for (i, (ours, theirs)) in run(true, relu).iter().zip(run(false, relu)).enumerate() {
+                for (a, b) in ours.iter().zip(&theirs) {
+                    assert!((a - b).abs() <= 1e-4 * (1.0 + b.abs()), "part {i}, relu {relu}: {a} against {b}");
+                }
+            }
+        }
+        let fixed = x.as_tensor().apply_op3(&w.as_tensor().detach(), &b.as_tensor().detach(), Linear { relu: true });
+        let grads = (fixed.unwrap() * &scale).unwrap().sum_all().unwrap().backward().unwrap();
+        assert!(grads.get(x.as_tensor()).is_some());
+        assert!(grads.get(w.as_tensor()).is_none() && grads.get(b.as_tensor()).is_none());
     }
 
     #[test]

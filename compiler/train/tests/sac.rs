@@ -59,13 +59,14 @@ fn training_improves_the_return() {
     let scene = scene(ALONE);
     let mut trainer = Trainer::new(small(1)).unwrap();
     let before = mean_return(&trainer, &scene);
-    for _ in 0..30 {
+    // 60 episodes: at 30, 4 of 10 seeds had not yet improved; at 60 all 10 had, by 150 or more
+    for _ in 0..60 {
         let task = trainer.task(1);
         trainer.step(&scene, Vec::new(), task.seed).unwrap();
     }
     assert!(trainer.updates() > 0);
     let after = mean_return(&trainer, &scene);
-    assert!(after > before + 20.0, "return {before:.1} before training, {after:.1} after");
+    assert!(after > before + 100.0, "return {before:.1} before training, {after:.1} after");
 }
 
 #[test]
