@@ -1,6 +1,6 @@
 """TADSL's traffic scenarios as Gymnasium environments.
 
-``gymnasium.make("tadsl/Scenario-v0", scenarios=[...], observation="safebench" | "state",
+``gymnasium.make("tadsl/Scenario-v0", scenarios=[...], observation="safebench" | "state" | "kinematics",
 seed=...)`` drives the ego through TADSL scenario files (``.tad``, ``.yaml``, ``.tadc``) on
 TADSL's runtime, with SafeBench's observation, action and reward. ``gymnasium.make_vec(
 "tadsl/Scenario-v0", num_envs=8, vectorization_mode="vector_entry_point", scenarios=...)``

@@ -3,7 +3,7 @@
 //! (two hidden layers of 256), batch sizes and threads.
 //!
 //! - **Environment steps per second**: rounds of exploring episodes of ordinary scenes
-//!   (`tad_eval::pretrain::scenes`, the `state` observation), no learning, rolled out on
+//!   (`tad_eval::pretrain::scenes`, the `kinematics` observation), no learning, rolled out on
 //!   `threads` cores; reported also per core.
 //! - **Gradient updates per second**: SAC and TD3, learning steps on a batch of 256 from a
 //!   filled replay; PPO, minibatches of 64 over a rollout of 2,048 for 2 passes. SB3's side
@@ -34,6 +34,8 @@ pub struct RlArgs {
 }
 
 const HIDDEN: usize = 256;
+/// The shipped models' observation, on both sides.
+const OBSERVATION: tad_policy::Observation = tad_policy::Observation::Kinematics;
 const OFF_POLICY_BATCH: usize = 256;
 const PPO_BATCH: usize = 64;
 const PPO_ROLLOUT: usize = 2048;
@@ -42,7 +44,7 @@ const PPO_EPOCHS: usize = 2;
 fn config(algo: Algo) -> Config {
     Config {
         algo,
-        observation: tad_policy::Observation::State,
+        observation: OBSERVATION,
         hidden: vec![HIDDEN, HIDDEN],
         batch: if algo == Algo::Ppo { PPO_BATCH } else { OFF_POLICY_BATCH },
         start_training: 1,
@@ -97,7 +99,14 @@ fn sb3(python: &PathBuf, algo: Algo, threads: usize, updates: usize) -> Result<f
     let output = Command::new(python)
         .arg(&script)
         .args(["--algo", algo.name(), "--threads", &threads.to_string(), "--updates", &updates.to_string()])
-        .args(["--batch", &batch.to_string(), "--hidden", &HIDDEN.to_string(), "--obs", "13"])
+        .args([
+            "--batch",
+            &batch.to_string(),
+            "--hidden",
+            &HIDDEN.to_string(),
+            "--obs",
+            &OBSERVATION.width().to_string(),
+        ])
         .args(["--rollout", &PPO_ROLLOUT.to_string(), "--epochs", &PPO_EPOCHS.to_string()])
         .env("OMP_NUM_THREADS", threads.to_string())
         .output()

@@ -2,13 +2,14 @@
 //! (the shipped `ppo`, `sac`, `td3`, or `learned:PATH`) fine-tuned from its own weights with
 //! its own algorithm (`learned:PATH` with SAC) through [`crate::train`], on 3/5 of each
 //! behaviour's kept scenes (ChatScene's split) at the paper's learning rate
-//! (`tad_train::Config::finetune`); then every ego, before and after, on the held-out 2/5,
-//! with paired bootstrap intervals of each model's change ([`crate::interval`]).
+//! (`tad_train::Config::finetune`); a shipped model from its checkpoint, the critics it was
+//! kept with included; then every ego, before and after, on the held-out 2/5, with paired
+//! bootstrap intervals of each model's change ([`crate::interval`]).
 //!
 //! TrafficAlign evaluates every 50 epochs and reports the best. Here the actor is scored
-//! every [`SELECT_EVERY`] episodes (and at the start and the end) by its overall score on
-//! the scenes it trains on, never the held-out ones, and the best is kept: so fine-tuning
-//! may keep its start.
+//! every [`SELECT_EVERY`] episodes (and at the start and the end) on the scenes it trains
+//! on, never the held-out ones, and the best by OS among those that keep [`KEEP_ROUTE`] of
+//! the start's route completion is kept: so fine-tuning may keep its start.
 //!
 //! With `--finetune-from` (a checkpoint or an actor file) or without any learned ego, one
 //! ego called `learned` is tuned instead, from that start or from scratch.
@@ -85,13 +86,15 @@ pub fn tunings<'a>(plan: &Plan, from: Option<&'a Path>, settings: impl Fn(Algo) 
             continue;
         }
         for (name, actor) in &learned {
-            let algo = tad_policy::pretrained::find(name).and_then(|m| Algo::parse(m.name)).unwrap_or(Algo::Sac);
+            // a shipped model goes on from its checkpoint: its algorithm, its critics
+            let shipped = tad_policy::pretrained::find(name);
+            let algo = shipped.and_then(|m| Algo::parse(m.name)).unwrap_or(Algo::Sac);
             let observation = Observation::of_inputs(actor.inputs()).unwrap_or_default();
             out.push(Tuning {
                 before: (*name).clone(),
                 after: tuned_name(name, generator),
                 generator: generator.clone(),
-                start: Start::Learned((*actor).clone()),
+                start: Start::Learned { actor: (*actor).clone(), critics: shipped.map(|m| (m.name, m.critics)) },
                 config: Config { observation, ..settings(algo) },
             });
         }
@@ -108,9 +111,9 @@ pub struct Tuned {
     pub updates: u64,
     /// Episodes into fine-tuning when the kept actor was taken (0: the start).
     pub kept_at: usize,
-    /// Its overall score on the scenes it trained on, and the start's (none from scratch).
-    pub kept_os: f64,
-    pub start_os: Option<f64>,
+    /// Its score on the scenes it trained on, and the start's (none from scratch).
+    pub kept_score: Score,
+    pub start_score: Option<Score>,
     pub after: Learned,
     pub before: Option<Learned>,
 }
@@ -127,13 +130,25 @@ const ANCHOR_EPISODES: usize = 64;
 /// Episodes between two scorings of the actor (TrafficAlign's "every 50 epochs").
 pub const SELECT_EVERY: usize = 50;
 
-/// The best actor offered so far by its overall score on the training scenes; the
-/// earlier on a tie.
+/// The share of its start's route completion an actor must keep on the training scenes to
+/// be kept: below it, fewer collisions come from standing still (the adversaries wait for
+/// the ego), not from driving better. The shipped models' bar against idm is the same 0.9.
+pub const KEEP_ROUTE: f64 = 0.9;
+
+/// An actor as judged on the training scenes: OS, and the mean route completion (0..=1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Score {
+    pub os: f64,
+    pub route: f64,
+}
+
+/// The best actor offered so far: the highest OS among those that keep [`KEEP_ROUTE`] of
+/// the start's route completion (the start always does), the earlier on a tie.
 struct Best<'k> {
     kept: &'k [Kept<'k>],
     train: &'k [usize],
-    best: Option<(Learned, usize, f64)>,
-    start: Option<f64>,
+    best: Option<(Learned, usize, Score)>,
+    start: Option<Score>,
 }
 
 impl Best<'_> {
@@ -142,11 +157,14 @@ impl Best<'_> {
         let rows = crate::harness::held_out(self.kept, self.train, &[(String::new(), EgoSpec::Learned(actor.clone()))]);
         let scores: Vec<&tad_metrics::EpisodeScore> = rows.iter().map(|r| &r.score).collect();
         let (_, os) = crate::interval::cr_os(&scores);
+        let route = scores.iter().map(|s| s.metrics.comp).sum::<f64>() / scores.len().max(1) as f64;
+        let score = Score { os, route };
         if at == 0 {
-            self.start = Some(os);
+            self.start = Some(score);
         }
-        if self.best.as_ref().is_none_or(|(_, _, best)| os > *best) {
-            self.best = Some((actor, at, os));
+        let drives = self.start.is_none_or(|start| route >= KEEP_ROUTE * start.route);
+        if drives && self.best.as_ref().is_none_or(|(_, _, best)| os > best.os) {
+            self.best = Some((actor, at, score));
         }
     }
 }
@@ -193,16 +211,16 @@ pub fn tune<'k>(
         Ok(())
     })
     .map_err(FinetuneError::Training)?;
-    let start_os = best.start;
-    let (after, kept_at, kept_os) = match best.best {
+    let start_score = best.start;
+    let (after, kept_at, kept_score) = match best.best {
         Some(best) => best,
-        None => (trainer.actor().map_err(FinetuneError::Actor)?, 0, f64::NAN),
+        None => (trainer.actor().map_err(FinetuneError::Actor)?, 0, Score { os: f64::NAN, route: f64::NAN }),
     };
     // an actor that learned nothing here is not labelled fine-tuned
     let updates = trainer.updates() - learned;
     let ego = if before_name == BEFORE { LEARNED } else { before_name.as_str() };
     let after_name = if updates == 0 { untuned_name(ego, &generator) } else { after_name };
-    Ok(Tuned { before_name, after_name, updates, kept_at, kept_os, start_os, after, before })
+    Ok(Tuned { before_name, after_name, updates, kept_at, kept_score, start_score, after, before })
 }
 
 /// The held-out table, and each tuned ego's change (with a start to change from).

@@ -1,6 +1,7 @@
 //! The recipe of the shipped driving models (`tad_policy::pretrained`), written once:
 //! `tadslc train-ego --pretrained ALGO` runs it and reproduces the shipped file byte for
-//! byte (same seed; candle's sums do not depend on the thread count).
+//! byte (same seed; `tad-train`'s sums depend neither on the thread count nor on the
+//! vector width).
 //!
 //! 1. **Corpus**: for every region the embedded examples name, [`PER_REGION`] scenarios of
 //!    the `fitted` generator (fitted on that region's examples) and as many of the
@@ -9,8 +10,9 @@
 //!    default, and are searched to collide).
 //! 2. **Warm start** ([`imitation`]): DAgger from the idm driver ([`TEACHER`]).
 //! 3. **Training** ([`config`]): the algorithm's SafeBench settings at the learning rate
-//!    1e-4, the `state` observation (SafeBench's four values cannot see a red light or a
-//!    stop line: a driver on them cannot meet the idm bar), SafeBench's episode rules
+//!    1e-4, the `kinematics` observation (SafeBench's four values cannot see a red light or
+//!    a stop line: a driver on them cannot meet the idm bar; the actors around the ego are
+//!    what a fine-tuned model can learn to avoid), SafeBench's episode rules
 //!    (`compat`: leaving the road is no escape from the penalties), critics warmed up
 //!    before the actor moves, and the demonstrations kept in the actor's loss.
 //! 4. **Selection**, as the paper reports its models: the actor every
@@ -79,7 +81,7 @@ pub fn config(algo: Algo) -> Config {
     let off_policy =
         Config { updates_per_episode: 20, batch: 256, critic_warmup: 1000, start_training: 1000, ..base.clone() };
     Config {
-        observation: Observation::State,
+        observation: Observation::Kinematics,
         actor_lr: 1e-4,
         critic_lr: 1e-4,
         episodes: 200,

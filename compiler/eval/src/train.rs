@@ -1,8 +1,8 @@
 //! The one driver of training (PPO, SAC, TD3) on the runtime's scenes, for `tadslc train-ego` and the
 //! fine-tuning stage of `tadslc eval`.
 //!
-//! A trainer starts from scratch, from an actor alone (its critics fresh), or from a
-//! `train-ego` checkpoint (actor, critics, optimisers and replay: as ChatScene goes on from
+//! A trainer starts from scratch, from an actor (its critics fresh, or a shipped model's
+//! own), or from a `train-ego` checkpoint (actor, critics, optimisers and replay: as ChatScene goes on from
 //! SafeBench's). Episode `n` runs scene `task_at(n)` of the list, with the scene's fixed
 //! parameters and seed, or parameters sampled from the task's seed; so a run is a function
 //! of its seed and scenes, and resuming a checkpoint gives the unbroken run.
@@ -15,8 +15,12 @@ use tad_train::{Config, EpisodeStats, TrainError, Trainer};
 /// Where training starts.
 pub enum Start<'a> {
     Scratch,
-    /// An actor already read (a shipped model), with fresh critics.
-    Learned(Learned),
+    /// An actor already read, with the critics of a shipped model (its name and their
+    /// bytes), else fresh ones.
+    Learned {
+        actor: Learned,
+        critics: Option<(&'static str, &'static [u8])>,
+    },
     /// An actor (safetensors, as `learned:PATH` reads), with fresh critics.
     Actor(&'a Path),
     /// A `train-ego` checkpoint directory.
@@ -34,9 +38,12 @@ impl<'a> Start<'a> {
     pub fn trainer(&self, config: Config) -> Result<(Trainer, Option<Learned>), TrainError> {
         match self {
             Start::Scratch => Ok((Trainer::new(config)?, None)),
-            Start::Learned(actor) => {
+            Start::Learned { actor, critics } => {
                 let mut trainer = Trainer::new(config)?;
                 trainer.init_actor(actor)?;
+                if let Some((name, bytes)) = critics {
+                    trainer.init_critics(bytes, &format!("the critics of `{name}`"))?;
+                }
                 Ok((trainer, Some(actor.clone())))
             }
             Start::Actor(path) => {

@@ -18,8 +18,9 @@
 //! episodes `i, i + n, i + 2n, …`, so no two run the same seed, and what each environment
 //! does never depends on how many threads step them.
 //!
-//! **Observation** ([`Observation`]): SafeBench's four features or the 13-value `state`
-//! ([`tad_policy::EgoView::state`]), as `f32`. **Action**: `[acc, steer]` in `[−1, 1]²`,
+//! **Observation** ([`Observation`]): SafeBench's four features, the 13-value `state`
+//! ([`tad_policy::EgoView::state`]) or the `kinematics` (the `state` and the six actors
+//! nearest the ego, [`tad_policy::EgoView::kinematics`]), as `f32`. **Action**: `[acc, steer]` in `[−1, 1]²`,
 //! scaled as SafeBench scales its actors' ([`tad_policy::Action::from_unit`]), so a policy
 //! trained here drives under `tadslc run --ego learned:`. **Reward**: SafeBench's
 //! ([`tad_train::Rewarder`]). **End**: a collision, off road, the route completed or a

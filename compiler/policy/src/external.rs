@@ -7,11 +7,13 @@
 //!
 //! ```json
 //! {"obs":[0.1,-0.02,8.3,0],"speed":8.3,"desired_speed":8.3,"target":[6.0,0.2],"lookahead":6.0,
-//!  "wheelbase":2.9,"leader":[14.2,5.0],"stop":null,"curve_speed":null,"dt":0.1}
+//!  "wheelbase":2.9,"leader":[14.2,5.0],"stop":null,"curve_speed":null,"dt":0.1,
+//!  "around":[[14.9,0.1,-3.3,0,0,4.6,1.8]]}
 //! ```
 //!
 //! (`leader` is `[gap m, speed m/s]` or `null`, `stop` metres or `null`, `curve_speed`
-//! `null` where the route is straight) and answers one line, the action: `[accel, steer]`
+//! `null` where the route is straight, `around` the nearest actors, nearest first, each
+//! `[x, y, vx, vy, yaw, length, width]` in the ego's frame relative to the ego) and answers one line, the action: `[accel, steer]`
 //! (Gymnasium's two-number action) or `{"accel": A, "steer": S}`, accel in m/s², steer in
 //! `[-1, 1]`, positive to the right. Everything it writes is untrusted: a line that is not
 //! JSON or longer than 64 KiB, an action of another size or a number that is not finite, no
@@ -174,8 +176,17 @@ fn number(x: f64) -> String {
 fn request(view: &EgoView) -> String {
     let pair = |p: Option<(f64, f64)>| p.map_or("null".to_string(), |(a, b)| format!("[{},{}]", number(a), number(b)));
     let obs: Vec<String> = view.obs.iter().map(|x| number(*x)).collect();
+    let around: Vec<String> = view
+        .around
+        .iter()
+        .flatten()
+        .map(|n| {
+            let values = [n.position[0], n.position[1], n.velocity[0], n.velocity[1], n.yaw, n.size[0], n.size[1]];
+            format!("[{}]", values.map(number).join(","))
+        })
+        .collect();
     format!(
-        "{{\"obs\":[{}],\"speed\":{},\"desired_speed\":{},\"target\":[{},{}],\"lookahead\":{},\"wheelbase\":{},\"leader\":{},\"stop\":{},\"curve_speed\":{},\"dt\":{}}}",
+        "{{\"obs\":[{}],\"speed\":{},\"desired_speed\":{},\"target\":[{},{}],\"lookahead\":{},\"wheelbase\":{},\"leader\":{},\"stop\":{},\"curve_speed\":{},\"dt\":{},\"around\":[{}]}}",
         obs.join(","),
         number(view.speed),
         number(view.desired_speed),
@@ -187,6 +198,7 @@ fn request(view: &EgoView) -> String {
         view.stop.map_or("null".into(), number),
         number(view.curve_speed),
         number(view.dt),
+        around.join(","),
     )
 }
 
@@ -229,6 +241,7 @@ mod tests {
             stop: None,
             curve_speed: f64::INFINITY,
             dt: 0.1,
+            around: [None; crate::NEAR],
         }
     }
 

@@ -24,8 +24,8 @@
 //!
 //! The file's metadata key `activation` (`relu` or `tanh`) overrides the hidden layers'
 //! default. The first layer's width tells the observation: 4, SafeBench's; 13,
-//! [`crate::STATE_DIM`]'s `state` (what `tadsl`'s Gymnasium environment calls
-//! `observation="state"`). The environment's action space is `[−1, 1]²`, scaled as above.
+//! [`crate::STATE_DIM`]'s `state`; 67, [`crate::KINEMATICS_DIM`]'s `kinematics` (what
+//! `tadsl`'s Gymnasium environment calls `observation="state"` and `"kinematics"`). The environment's action space is `[−1, 1]²`, scaled as above.
 //!
 //! A SafeBench checkpoint converts from PyTorch with
 //! `safetensors.torch.save_file(torch.load(f)['policy_net'], 'actor.safetensors')`; names
@@ -37,7 +37,7 @@
 //! step against a few µs for the 17 k multiply-adds themselves. The tests check this
 //! forward pass against candle's.
 
-use crate::{Action, EgoPolicy, EgoView, OBS_DIM, Observation, PolicyError, STATE_DIM};
+use crate::{Action, EgoPolicy, EgoView, Observation, PolicyError};
 use candle_core::{DType, Device, Tensor};
 use std::collections::HashMap;
 use std::path::Path;
@@ -218,7 +218,7 @@ impl Learned {
         self.format
     }
 
-    /// The observation's length it reads: [`OBS_DIM`] or [`STATE_DIM`].
+    /// The observation's length it reads (one [`Observation::width`]).
     pub fn inputs(&self) -> usize {
         self.hidden.first().unwrap_or(&self.mu).inputs
     }
@@ -237,7 +237,7 @@ impl Learned {
             Dense { inputs, weight: draw(outputs * inputs), bias: draw(outputs) }
         };
         let mut layers = Vec::new();
-        let mut width = OBS_DIM;
+        let mut width = crate::OBS_DIM;
         for &h in hidden {
             layers.push(layer(h, width));
             width = h;
@@ -312,19 +312,22 @@ impl Reader<'_> {
         self.tensors.contains_key(&format!("{}{name}", self.prefix))
     }
 
-    /// The observation a first layer `name` reads: its weight's columns, which must be
-    /// [`OBS_DIM`] or [`STATE_DIM`].
+    /// The observation a first layer `name` reads: its weight's columns, which must be one
+    /// observation's length.
     fn inputs(&self, name: &str) -> Result<usize, PolicyError> {
         let full = format!("{}{name}.weight", self.prefix);
         let dims = self.tensor(&full)?.dims().to_vec();
         match dims.as_slice() {
-            [rows, cols] if *rows > 0 && (*cols == OBS_DIM || *cols == STATE_DIM) => Ok(*cols),
-            _ => Err(PolicyError::WrongShape {
-                path: self.path.to_string(),
-                name: full,
-                expected: format!("[n, {OBS_DIM}] or [n, {STATE_DIM}] (the observation's length)"),
-                found: dims,
-            }),
+            [rows, cols] if *rows > 0 && Observation::of_inputs(*cols).is_some() => Ok(*cols),
+            _ => {
+                let widths: Vec<String> = Observation::ALL.iter().map(|(_, o)| format!("[n, {}]", o.width())).collect();
+                Err(PolicyError::WrongShape {
+                    path: self.path.to_string(),
+                    name: full,
+                    expected: format!("{} (the observation's length)", widths.join(" or ")),
+                    found: dims,
+                })
+            }
         }
     }
 

@@ -98,7 +98,34 @@ pub struct EgoView {
     pub curve_speed: f64,
     /// Step length, s.
     pub dt: f64,
+    /// The other actors nearest the ego, nearest first: those within [`NEAR_RANGE`] of its
+    /// centre, at most [`NEAR`].
+    pub around: [Option<Near>; NEAR],
 }
+
+/// Another actor as the ego sees it, in the ego's frame (`x` forward, `y` left).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Near {
+    /// Its centre, m.
+    pub position: [f64; 2],
+    /// Its velocity less the ego's, m/s.
+    pub velocity: [f64; 2],
+    /// Its heading less the ego's, rad.
+    pub yaw: f64,
+    /// Its length and width, m.
+    pub size: [f64; 2],
+}
+
+/// How many other actors [`EgoView::around`] holds (highway-env's `Kinematics` shows five
+/// besides the ego; a junction's adversary and the cars around it need one more).
+pub const NEAR: usize = 6;
+/// How far from the ego's centre an actor is seen in [`EgoView::around`], m; also the
+/// `kinematics` observation's unit of position.
+pub const NEAR_RANGE: f64 = 50.0;
+/// The values each actor adds to the `kinematics` observation ([`EgoView::kinematics`]).
+pub const NEAR_FEATURES: usize = 9;
+/// The `kinematics` observation's length.
+pub const KINEMATICS_DIM: usize = STATE_DIM + NEAR * NEAR_FEATURES;
 
 /// What the driver does: `accel` in m/s² (the runtime clamps it to
 /// [`ACCEL_MIN`]..=[`ACCEL_MAX`]), `steer` normalised to `[-1, 1]` of
@@ -144,9 +171,34 @@ impl EgoView {
         let curve = self.curve_speed.min(STATE_FAR) / STATE_UNIT;
         [a, b, c, d, self.desired_speed / STATE_UNIT, x, y, leader, gap, leader_speed, stop, stop_at, curve]
     }
+
+    /// The `kinematics` observation: the [`EgoView::state`], then each of the
+    /// [`EgoView::around`] as highway-env's `Kinematics` shows a vehicle (presence, then
+    /// where it is and how it moves relative to the ego, its heading as cosine and sine),
+    /// with its size; an empty place is all zeros:
+    ///
+    /// | offset in the actor's 9 | value |
+    /// |---|---|
+    /// | 0 | 1 (present) |
+    /// | 1, 2 | its centre, ego frame, ÷ [`NEAR_RANGE`] (within ±1) |
+    /// | 3, 4 | its velocity less the ego's, ego frame, ÷ 10 m/s |
+    /// | 5, 6 | cosine and sine of its heading less the ego's |
+    /// | 7, 8 | its length and width ÷ 10 m |
+    pub fn kinematics(&self) -> [f64; KINEMATICS_DIM] {
+        let mut out = [0.0; KINEMATICS_DIM];
+        out[..STATE_DIM].copy_from_slice(&self.state());
+        for (near, slot) in self.around.iter().zip(out[STATE_DIM..].chunks_exact_mut(NEAR_FEATURES)) {
+            let Some(n) = near else { continue };
+            let [x, y] = n.position.map(|v| (v / NEAR_RANGE).clamp(-1.0, 1.0));
+            let [vx, vy] = n.velocity.map(|v| v / STATE_UNIT);
+            let [length, width] = n.size.map(|v| v / STATE_UNIT);
+            slot.copy_from_slice(&[1.0, x, y, vx, vy, n.yaw.cos(), n.yaw.sin(), length, width]);
+        }
+        out
+    }
 }
 
-/// What a learned driver sees: SafeBench's four values or the `state`.
+/// What a learned driver sees: SafeBench's four values, the `state`, or the `kinematics`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Observation {
@@ -155,14 +207,16 @@ pub enum Observation {
     SafeBench,
     /// [`EgoView::state`].
     State,
+    /// [`EgoView::kinematics`]: the `state` and the actors nearest the ego.
+    Kinematics,
 }
 
 impl Observation {
     /// Every observation by its name.
-    pub const ALL: [(&'static str, Observation); 2] =
-        [("safebench", Observation::SafeBench), ("state", Observation::State)];
+    pub const ALL: [(&'static str, Observation); 3] =
+        [("safebench", Observation::SafeBench), ("state", Observation::State), ("kinematics", Observation::Kinematics)];
 
-    /// The observation a name means (`safebench`, `state`).
+    /// The observation a name means (`safebench`, `state`, `kinematics`).
     pub fn parse(name: &str) -> Option<Observation> {
         Observation::ALL.iter().find(|(n, _)| *n == name).map(|&(_, o)| o)
     }
@@ -176,6 +230,7 @@ impl Observation {
         match self {
             Observation::SafeBench => OBS_DIM,
             Observation::State => STATE_DIM,
+            Observation::Kinematics => KINEMATICS_DIM,
         }
     }
 
@@ -184,6 +239,7 @@ impl Observation {
         match self {
             Observation::SafeBench => f(&view.obs),
             Observation::State => f(&view.state()),
+            Observation::Kinematics => f(&view.kinematics()),
         }
     }
 

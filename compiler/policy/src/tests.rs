@@ -20,6 +20,7 @@ fn view(speed: f64, desired_speed: f64) -> EgoView {
         stop: None,
         curve_speed: f64::INFINITY,
         dt: 0.1,
+        around: [None; NEAR],
     }
 }
 
@@ -276,7 +277,7 @@ fn learned_bad_files_are_errors() {
     let err = Learned::from_tensors(&t, "x").unwrap_err();
     assert_eq!(
         err.to_string(),
-        "x: tensor `fc1.weight` has shape [3, 5], expected [n, 4] or [n, 13] (the observation's length)"
+        "x: tensor `fc1.weight` has shape [3, 5], expected [n, 4] or [n, 13] or [n, 67] (the observation's length)"
     );
 
     let mut t = tiny();
@@ -476,6 +477,25 @@ fn unit_actions_round_trip_through_the_ranges() {
 }
 
 #[test]
+fn the_kinematics_observation_is_the_state_then_each_near_actor() {
+    let mut v = view(8.0, 10.0);
+    v.around[0] = Some(Near { position: [12.0, -3.5], velocity: [-8.0, 0.5], yaw: 0.5, size: [4.6, 1.8] });
+    v.around[1] = Some(Near { position: [80.0, 0.0], velocity: [0.0; 2], yaw: 0.0, size: [0.5, 0.5] });
+    let k = v.kinematics();
+    assert_eq!(k.len(), KINEMATICS_DIM);
+    assert_eq!(k[..STATE_DIM], v.state());
+    let first = &k[STATE_DIM..STATE_DIM + NEAR_FEATURES];
+    let expected = [1.0, 0.24, -0.07, -0.8, 0.05, 0.5f64.cos(), 0.5f64.sin(), 0.46, 0.18];
+    for (a, b) in first.iter().zip(expected) {
+        assert!((a - b).abs() < 1e-12, "{first:?}");
+    }
+    // beyond the unit the position is clamped; empty places are zeros
+    assert_eq!(k[STATE_DIM + NEAR_FEATURES + 1], 1.0);
+    assert!(k[STATE_DIM + 2 * NEAR_FEATURES..].iter().all(|&x| x == 0.0));
+    assert_eq!(Observation::Kinematics.of(&v), k.to_vec());
+}
+
+#[test]
 fn observations_by_name_and_width() {
     for (name, observation) in Observation::ALL {
         assert_eq!(Observation::parse(name), Some(observation));
@@ -495,7 +515,11 @@ fn the_shipped_models_load_by_name() {
     for model in pretrained::ALL {
         let actor = model.load().unwrap();
         assert_eq!(actor.name(), model.name);
-        assert_eq!(actor.inputs(), STATE_DIM, "{} reads the state", model.name);
+        assert_eq!(actor.inputs(), KINEMATICS_DIM, "{} reads the kinematics", model.name);
+        // its critics are a safetensors file beside it, with the first critic's layers
+        let critics = candle_core::safetensors::load_buffer(model.critics, &Device::Cpu).unwrap();
+        let first = if model.name == "ppo" { "v.fc1.weight" } else { "q1.fc1.weight" };
+        assert!(critics.contains_key(first), "{}: {:?}", model.name, critics.keys().collect::<Vec<_>>());
     }
     assert!(pretrained::find("ddpg").is_none());
 }

@@ -184,6 +184,37 @@ impl Seen {
     }
 }
 
+/// The actors nearest the ego (within [`tad_policy::NEAR_RANGE`] of its centre, nearest
+/// first, the earlier on a tie) as it sees them: in its frame, relative to it.
+fn around(ego: &Kinematics, others: &[Seen]) -> [Option<tad_policy::Near>; tad_policy::NEAR] {
+    // the nearest few by insertion, without allocating (this runs every step)
+    let mut near = [(f64::INFINITY, usize::MAX); tad_policy::NEAR];
+    for (i, o) in others.iter().enumerate() {
+        let d = o.position.distance(ego.position);
+        if d <= tad_policy::NEAR_RANGE && d < near[tad_policy::NEAR - 1].0 {
+            let at = near.iter().position(|&(e, _)| d < e).unwrap_or(tad_policy::NEAR - 1);
+            near.copy_within(at..tad_policy::NEAR - 1, at + 1);
+            near[at] = (d, i);
+        }
+    }
+    let near = near.iter().take_while(|(_, i)| *i != usize::MAX);
+    let frame = Pose { position: ego.position, yaw: ego.yaw };
+    let forward = Vec2::from_yaw(ego.yaw);
+    let mut out = [None; tad_policy::NEAR];
+    for (slot, &(_, i)) in out.iter_mut().zip(near) {
+        let o = &others[i];
+        let local = frame.local(o.position);
+        let relative = o.heading * o.speed - forward * ego.speed;
+        *slot = Some(tad_policy::Near {
+            position: [local.x, local.y],
+            velocity: [relative.dot(forward), relative.dot(forward.left())],
+            yaw: wrap(o.yaw - ego.yaw),
+            size: [o.length, o.width],
+        });
+    }
+    out
+}
+
 /// Run one episode of `scene` with parameters `params` (see [`crate::sample`]), `policy`
 /// driving the ego: [`Sim`]'s steps, the policy asked at each.
 pub fn run(scene: &Scene, seed: Option<u64>, params: Vec<f64>, policy: &mut dyn EgoPolicy, opts: &Options) -> Episode {
@@ -595,6 +626,7 @@ impl<S: Deref<Target = Scene>> Runner<S> {
             stop,
             curve_speed: models::curve_speed_knowing(route, self.route_bend, s, ego.speed),
             dt: scene.limits.dt,
+            around: around(ego, before),
         }
     }
 

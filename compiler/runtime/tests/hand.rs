@@ -315,3 +315,28 @@ fn mobil_does_not_cut_in_front_of_a_close_follower() {
     let (car, follower) = (e.frames[step].poses[2], e.frames[step].poses[3]);
     assert!(follower.0 > car.0, "it cut in {:.1} m ahead of the follower at step {step}", car.0 - follower.0);
 }
+
+/// The view's nearby actors: nearest first, in the ego's frame, relative to it, within
+/// reach only.
+#[test]
+fn the_ego_sees_the_nearest_actors_in_its_frame() {
+    // two parked cars ahead in lane 1 and one in lane 2, one beyond reach
+    let cars = vec![parked(0, 30.0, 1), parked(1, 12.0, 2), parked(2, 20.0, 1), parked(3, 90.0, 1)];
+    let scene = Scene::new(&program(straight(), 10.0, cars)).unwrap();
+    let mut sim = tad_runtime::Sim::start(&scene, None, vec![], Options::default());
+    let view = sim.view().expect("a first view").clone();
+    let seen: Vec<_> = view.around.iter().flatten().collect();
+    assert_eq!(seen.len(), 3, "the car 90 m on is out of reach: {seen:?}");
+    let ahead: Vec<f64> = seen.iter().map(|n| n.position[0]).collect();
+    assert!(ahead.windows(2).all(|w| w[0] <= w[1]), "nearest first: {ahead:?}");
+    for n in &seen {
+        // standing cars come at the ego at its own speed; they face its way
+        assert!((n.velocity[0] + view.speed).abs() < 1e-9 && n.velocity[1].abs() < 1e-9, "{n:?}");
+        assert!(n.yaw.abs() < 1e-9 && n.size == [CAR.length, CAR.width], "{n:?}");
+    }
+    // lane 2 is a lane's width to the ego's right (y is left); lane 1 is its own
+    assert!((seen[0].position[1] + LANE_WIDTH).abs() < 0.2, "{:?}", seen[0]);
+    assert!(seen[1].position[1].abs() < 0.2 && seen[2].position[1].abs() < 0.2);
+    assert!((seen[1].position[0] - seen[0].position[0] - 8.0).abs() < 1e-6);
+    assert!(view.around[3].is_none());
+}

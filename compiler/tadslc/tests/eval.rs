@@ -460,8 +460,12 @@ fn kept_actors_are_the_best_and_the_start_drives_as_before(stderr: &str, held: &
                 let rest = &line[line.find(after).unwrap_or_else(|| panic!("{line}")) + after.len()..];
                 rest.split(|c: char| !(c.is_ascii_digit() || c == '.')).next().unwrap().parse().unwrap()
             };
-            let (at, kept, start) = (number("episode "), number("(OS "), number("; "));
+            let (at, kept, start) = (number("episode "), number("(OS "), number("; OS "));
+            // the kept actor's route first, the start's last
+            let routes: Vec<f64> =
+                line.split(", route ").skip(1).map(|r| r.split(' ').next().unwrap().parse().unwrap()).collect();
             assert!(kept >= start, "the kept actor scores no worse than the start: {line}");
+            assert!(routes[0] >= 0.9 * routes[1], "the kept actor drives its routes about as far: {line}");
             match at as usize {
                 0 => assert_eq!(row(&tuned), row(model), "the start kept drives as before: {line}"),
                 6 => {}

@@ -235,3 +235,34 @@ fn the_language_model_table_is_tad_models() {
         assert!(row[1].contains(&format!("=={}`", model.version)), "{name}'s version in {}", row[1]);
     }
 }
+
+/// spec/gym.md's observation table (`| `name` | length | … |`) and the kinematics layout
+/// are `tad_policy`'s observations.
+#[test]
+fn the_observation_tables_are_tad_policys() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let gym = std::fs::read_to_string(root.join("spec/gym.md")).unwrap();
+    let rows: Vec<(String, usize)> = gym
+        .lines()
+        .skip_while(|l| !l.starts_with("| `observation=` | length |"))
+        .skip(2)
+        .take_while(|l| l.starts_with('|'))
+        .map(|l| {
+            let cells: Vec<&str> = l.trim_matches('|').split('|').map(str::trim).collect();
+            (cells[0].trim_matches('`').to_string(), cells[1].parse().expect("a length"))
+        })
+        .collect();
+    let code: Vec<(String, usize)> =
+        tad_policy::Observation::ALL.iter().map(|(name, o)| (name.to_string(), o.width())).collect();
+    assert_eq!(rows, code);
+    // the kinematics table's offsets: one row per value an actor adds
+    let offsets: usize = gym
+        .lines()
+        .skip_while(|l| !l.starts_with("The `kinematics` observation"))
+        .skip_while(|l| !l.starts_with("| offset | value |"))
+        .skip(2)
+        .take_while(|l| l.starts_with('|'))
+        .map(|l| l.trim_matches('|').split('|').next().unwrap().split(',').count())
+        .sum();
+    assert_eq!(offsets, tad_policy::NEAR_FEATURES);
+}

@@ -95,7 +95,7 @@ use tad_metrics::StopReason;
 use tad_policy::{EgoPolicy, Learned, PolicyError};
 use tad_runtime::Scene;
 
-pub use config::{Algo, Config, MAX_BUFFER, MAX_WIDTH};
+pub use config::{Algo, CHATSCENE_COLLISION_SHARE, Config, MAX_BUFFER, MAX_WIDTH};
 pub use gemm::kernel_name;
 pub use imitate::{Imitation, ImitationRound};
 pub use reward::{Reward, Rewarder};
@@ -248,12 +248,12 @@ fn row_width(obs: usize) -> usize {
 }
 
 /// The critics of each algorithm, by name (their order is the checkpoint's).
-struct Critics {
+struct CriticNets {
     nets: Vec<(&'static str, Net)>,
 }
 
-impl Critics {
-    fn new(config: &Config, obs: usize, actor: &Net, rng: &mut SplitMix64) -> Result<Critics, TrainError> {
+impl CriticNets {
+    fn new(config: &Config, obs: usize, actor: &Net, rng: &mut SplitMix64) -> Result<CriticNets, TrainError> {
         let mut nets = Vec::new();
         match config.algo {
             Algo::Sac | Algo::Td3 => {
@@ -267,7 +267,7 @@ impl Critics {
             }
             Algo::Ppo => nets.push(("v", Net::random(obs, &config.hidden, &[("fc_v", 1)], rng)?)),
         }
-        Ok(Critics { nets })
+        Ok(CriticNets { nets })
     }
 
     fn get(&self, name: &str) -> &Net {
@@ -294,7 +294,7 @@ pub struct Trainer {
     actor: Net,
     plain: PlainActor,
     actor_opt: Adam,
-    critics: Critics,
+    critics: CriticNets,
     critic_opt: Adam,
     replay: Replay,
     /// Colliding steps, apart ([`Config::collision_share`]; empty without it).
@@ -324,7 +324,7 @@ impl Trainer {
         if config.algo == Algo::Ppo {
             actor.constant_std(INITIAL_STD)?;
         }
-        let critics = Critics::new(&config, obs, &actor, &mut rng)?;
+        let critics = CriticNets::new(&config, obs, &actor, &mut rng)?;
         let actor_opt = Adam::new(actor.vars(), config.actor_lr)?;
         let critic_opt = Adam::new(critics.trained(), config.critic_lr)?;
         let plain = PlainActor::of(&actor)?;
@@ -569,6 +569,51 @@ impl Trainer {
     pub fn save_actor(&self, path: impl AsRef<Path>) -> Result<(), TrainError> {
         Ok(self.actor()?.save(path)?)
     }
+
+    /// A copy of the trained critics (SAC's and TD3's `q1`, `q2`; PPO's `v`), each tensor
+    /// under `{critic}.{parameter}`: what fine-tuning starts from beside the actor, as
+    /// ChatScene goes on from SafeBench's checkpoint, critics and all.
+    pub fn critics(&self) -> Result<Critics, TrainError> {
+        let mut tensors = std::collections::HashMap::new();
+        for (name, net) in self.critics.nets.iter().filter(|(n, _)| !n.ends_with("_target")) {
+            for (key, t) in net.tensors(&format!("{name}.")) {
+                tensors.insert(key, t.copy().map_err(tensor_error)?);
+            }
+        }
+        Ok(Critics(tensors))
+    }
+
+    /// Start the critics from `bytes` (a [`Critics::save`] file, named `source` in errors):
+    /// each trained critic set, its target a copy of it, the optimizer's moments fresh. The
+    /// widths must be the run's.
+    pub fn init_critics(&mut self, bytes: &[u8], source: &str) -> Result<(), TrainError> {
+        let broken = |message: String| TrainError::Checkpoint { path: source.to_string(), message };
+        let tensors = candle_core::safetensors::load_buffer(bytes, &candle_core::Device::Cpu)
+            .map_err(|e| broken(format!("not a safetensors file: {e}")))?;
+        let trained: Vec<&'static str> =
+            self.critics.nets.iter().map(|(n, _)| *n).filter(|n| !n.ends_with("_target")).collect();
+        for name in trained {
+            let prefix = format!("{name}.");
+            self.critics.get(name).set(&tensors, &prefix, source)?;
+            if let Some((_, target)) = self.critics.nets.iter().find(|(n, _)| *n == format!("{name}_target")) {
+                target.set(&tensors, &prefix, source)?;
+            }
+        }
+        self.critic_opt = Adam::new(self.critics.trained(), self.config.critic_lr)?;
+        Ok(())
+    }
+}
+
+/// Critics taken out of a run ([`Trainer::critics`]).
+pub struct Critics(std::collections::HashMap<String, candle_core::Tensor>);
+
+impl Critics {
+    /// Write them as one safetensors file.
+    pub fn save(&self, path: impl AsRef<Path>) -> Result<(), TrainError> {
+        let path = path.as_ref();
+        candle_core::safetensors::save(&self.0, path)
+            .map_err(|e| TrainError::Io { path: path.display().to_string(), message: format!("cannot write it: {e}") })
+    }
 }
 
 /// The thread settings of a process that trains. Call it at the start of the process,
@@ -578,10 +623,10 @@ impl Trainer {
 ///   networks (256 × 256, batches of 64 to 512) that made learning steps 5× slower than one
 ///   thread (measured by `bench --rl`), and it competes with the parallel rollouts.
 /// - `RAYON_NUM_THREADS`, unless set, to the threads rayon's pool starts anyway (the
-///   available parallelism). candle asks for it at every matrix product and, without it,
-///   counts the physical cores by reading `/proc/cpuinfo` each time: 15-35 % of a learning
-///   step. The products give the same numbers for any thread count (gemm splits the
-///   output, not the sums).
+///   available parallelism). candle asks for it at every one of its matrix products and,
+///   without it, counts the physical cores by reading `/proc/cpuinfo` each time (15-35 %
+///   of a learning step, when the layers were candle's matmul; they are this crate's
+///   `gemm` now, whose numbers do not depend on the thread count).
 pub fn set_up_threads() {
     // SAFETY (both): called at the start of the process, before any other thread reads the
     // environment

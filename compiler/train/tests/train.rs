@@ -179,6 +179,59 @@ fn an_existing_actor_is_fine_tuned() {
     assert_ne!(trainer.actor().expect("actor").mu(&[0.0, 0.0, 8.0, 0.0]), start.mu(&[0.0, 0.0, 8.0, 0.0]));
 }
 
+/// A run's critics written out and read into another run of the same widths: the second
+/// run's first learning step is the first run's; damaged or mismatched critics are errors.
+#[test]
+fn critics_go_from_one_run_to_another() {
+    let dir = temp("critics");
+    let scenes = [scene(30, false)];
+    let config = Config { start_training: 20, batch: 16, updates_per_episode: 1, ..small(4) };
+    let mut first = Trainer::new(config.clone()).expect("a trainer");
+    train(&mut first, &scenes, 3);
+    assert!(first.updates() > 0);
+    first.critics().expect("critics").save(dir.join("critics.safetensors")).expect("saved");
+    let bytes = std::fs::read(dir.join("critics.safetensors")).expect("written");
+
+    // the same start twice, once with the first run's critics
+    let start = first.actor().expect("actor");
+    let run = |critics: Option<&[u8]>| {
+        let mut t = Trainer::new(Config { seed: 11, ..config.clone() }).expect("a trainer");
+        t.init_actor(&start).expect("takes the actor");
+        if let Some(bytes) = critics {
+            t.init_critics(bytes, "critics.safetensors").expect("takes the critics");
+        }
+        train(&mut t, &scenes, 2);
+        t.save_checkpoint(dir.join(if critics.is_some() { "with" } else { "fresh" })).expect("saved");
+        t
+    };
+    let (with, fresh) = (run(Some(&bytes)), run(None));
+    assert!(with.updates() > 0 && fresh.updates() > 0);
+    let read = |name: &str| std::fs::read(dir.join(name)).expect("written");
+    assert_ne!(read("with/critics.safetensors"), read("fresh/critics.safetensors"), "the critics started elsewhere");
+    // the targets started as copies of the critics they follow
+    let mut again = Trainer::new(Config { seed: 11, ..config.clone() }).expect("a trainer");
+    again.init_critics(&bytes, "critics.safetensors").expect("takes the critics");
+    again.save_checkpoint(dir.join("again")).expect("saved");
+    let saved = candle_core::safetensors::load(dir.join("again/critics.safetensors"), &candle_core::Device::Cpu)
+        .expect("a safetensors file");
+    for (name, t) in &saved {
+        if let Some(trained) = name.strip_prefix("q1_target.").map(|rest| format!("q1.{rest}")) {
+            let values = |t: &candle_core::Tensor| t.flatten_all().unwrap().to_vec1::<f32>().unwrap();
+            assert_eq!(values(t), values(&saved[&trained]), "{name}");
+        }
+    }
+
+    let mut err = |bytes: &[u8]| again.init_critics(bytes, "x").expect_err("an error").to_string();
+    let garbage = err(b"garbage");
+    assert!(garbage.contains("not a safetensors file"), "{garbage}");
+    let actor = std::fs::read(dir.join("with/actor.safetensors")).expect("written");
+    let swapped = err(&actor);
+    assert!(swapped.contains("q1."), "{swapped}");
+    let mut wide = Trainer::new(Config { hidden: vec![8], ..config.clone() }).expect("a trainer");
+    assert!(wide.init_critics(&bytes, "x").is_err(), "other widths");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn the_split_keeps_three_fifths_of_each_behaviour() {
     let mut keys = Vec::new();

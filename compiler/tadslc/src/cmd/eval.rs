@@ -316,13 +316,17 @@ pub fn finetune(args: &EvalArgs, plan: &Plan, kept: &[Kept]) -> Result<Status, C
                 t.after_name
             )?;
         } else {
-            let start = t.start_os.map(|os| format!("; {os:.3} at the start")).unwrap_or_default();
+            let start = t
+                .start_score
+                .map(|s| format!("; OS {:.3}, route {:.3} at the start", s.os, s.route))
+                .unwrap_or_default();
             errln!(
-                "`{}`: kept the actor of episode {} of {} (OS {:.3} on the {} it trained on{start})",
+                "`{}`: kept the actor of episode {} of {} (OS {:.3}, route {:.3} on the {} it trained on{start})",
                 t.after_name,
                 t.kept_at,
                 args.finetune,
-                t.kept_os,
+                t.kept_score.os,
+                t.kept_score.route,
                 plural(subset.len(), "scene")
             )?;
         }

@@ -36,8 +36,13 @@ pub struct TrainEgoArgs {
     /// ChatScene's SAC settings (`adv_scenic.yaml`) instead of SafeBench's
     #[arg(long)]
     pub chatscene: bool,
-    /// What the actor sees: SafeBench's 4 values or the 13-value `state`
-    #[arg(long, value_parser = ["safebench", "state"], default_value = "safebench")]
+    /// Keep colliding steps apart, as ChatScene's fine-tuning does: a ring of their own,
+    /// drawn for a fifth of every off-policy batch
+    #[arg(long)]
+    pub collisions_apart: bool,
+    /// What the actor sees: SafeBench's 4 values, the 13-value `state`, or the `kinematics`
+    /// (the `state` and the six actors nearest the ego)
+    #[arg(long, value_parser = observation_names(), default_value = "safebench")]
     pub observation: String,
     /// Training episodes in all (SafeBench: 2000; ChatScene: 600) (at most 10,000,000)
     #[arg(long, value_name = "N", value_parser = crate::count::<10_000_000>)]
@@ -124,6 +129,7 @@ impl TrainEgoArgs {
             envs: self.envs,
             critic_warmup: self.critic_warmup,
             bc_weight: self.bc_weight,
+            collision_share: if self.collisions_apart { tad_train::CHATSCENE_COLLISION_SHARE } else { 0.0 },
             compat: self.compat || base.compat,
             seed: self.seed,
             ..base
@@ -165,6 +171,11 @@ fn no_learning_step(trainer: &Trainer, warm: bool, checkpoint: &Path) -> Result<
          starts at {needed} (more --episodes)"
     )?;
     Ok(())
+}
+
+/// The observations' names, from `tad_policy::Observation::ALL`.
+fn observation_names() -> clap::builder::PossibleValuesParser {
+    clap::builder::PossibleValuesParser::new(tad_policy::Observation::ALL.map(|(name, _)| name))
 }
 
 /// A scenario's behaviour for the split (`none` for a `.tadc` file, which has no source).
@@ -270,10 +281,12 @@ pub fn run(args: &TrainEgoArgs, color: bool) -> Result<Status, CliError> {
         std::fs::write(path, svg).map_err(|e| CliError::usage(format!("cannot write `{}`: {e}", path.display())))?;
     }
     match selection.and_then(|s| s.best) {
-        Some((episode, judged, actor)) => {
+        Some((episode, judged, actor, critics)) => {
             actor.save(&args.out).map_err(CliError::usage)?;
+            critics.save(critics_path(&args.out)).map_err(CliError::usage)?;
             errln!(
-                "kept the actor of episode {episode}: validation collision rate {:.3}, route {:.3}",
+                "kept the actor of episode {episode} and its critics (`{}`): validation collision rate {:.3}, route {:.3}",
+                critics_path(&args.out).display(),
                 judged.collision_rate,
                 judged.route_complete
             )?;
@@ -446,7 +459,8 @@ fn curves(
 /// (`tad_eval::pretrain`), the best kept with its episode.
 struct Selection {
     units: Vec<tad_eval::Unit>,
-    best: Option<(u64, Judged, tad_policy::Learned)>,
+    /// The best so far: its episode, how it did, the actor and the critics beside it.
+    best: Option<(u64, Judged, tad_policy::Learned, tad_train::Critics)>,
     /// Each judged episode and its collision rate.
     history: Vec<[f64; 2]>,
 }
@@ -483,11 +497,17 @@ impl Selection {
         )
         .map_err(Stop::Closed)?;
         self.history.push([episode as f64, judged.collision_rate]);
-        if eligible && self.best.as_ref().is_none_or(|(_, b, _)| judged.better_than(b)) {
-            self.best = Some((episode, judged, actor));
+        if eligible && self.best.as_ref().is_none_or(|(_, b, _, _)| judged.better_than(b)) {
+            self.best = Some((episode, judged, actor, trainer.critics().map_err(Stop::Train)?));
         }
         Ok(())
     }
+}
+
+/// Where `--pretrained` writes the kept actor's critics: `X.critics.safetensors` beside
+/// `X.safetensors` (what `tad_policy::pretrained` ships beside each actor).
+fn critics_path(out: &std::path::Path) -> std::path::PathBuf {
+    out.with_extension("critics.safetensors")
 }
 
 /// Why a training loop stopped early.
