@@ -8,6 +8,7 @@
 //!     forward (causal) ─▶ cross-entropy on the answer's tokens only ─▶ backward ─▶ AdamW
 //!     every N steps: checkpoint (adapter, optimizer moments, position, RNG) ──▶ resume
 //! ──▶ adapter_model.safetensors + adapter_config.json (PEFT) ──▶ tad-local's decoder (--adapter)
+//! ──▶ adapter.gguf (the same adapter as llama.cpp's LoRA GGUF) ──▶ llama-server --lora
 //! ```
 //!
 //! The optimizer is AdamW as candle-nn writes it (the same update, bias-corrected), kept
@@ -332,6 +333,7 @@ pub fn train_samples(
     let shape = weights.shape;
     let adapter = lora.to_adapter(&shape, &config.base_model).map_err(FinetuneError::Training)?;
     adapter.save(out).map_err(FinetuneError::Io)?;
+    adapter.save_gguf(&out.join(tad_local::GGUF_FILE), &shape).map_err(FinetuneError::Io)?;
     if config.checkpoint_every > 0 {
         save_checkpoint(out, &lora, &shape, &config.base_model, &optimizer, &state).map_err(FinetuneError::Io)?;
     }

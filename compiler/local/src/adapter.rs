@@ -3,6 +3,13 @@
 //! (`base_model.model.model.layers.{i}.self_attn.q_proj.lora_A.weight`, `[r, in]`, and
 //! `lora_B.weight`, `[out, r]`).
 //!
+//! [`Adapter::save_gguf`] writes the same adapter as llama.cpp's LoRA GGUF (`llama-server
+//! --lora FILE`): `general.type` `adapter`, `adapter.type` `lora`, the base model's
+//! architecture, and per pair `blk.{i}.attn_q.weight.lora_a` (`[in, r]` in ggml's order,
+//! PEFT's `[r, in]` data) and `….lora_b` (`[r, out]`), f32, `lora_b`'s rows in the GGUF's
+//! order; the scale is folded into `lora_b` and `adapter.lora.alpha` is the rank, so
+//! llama.cpp's `alpha / r` is 1 and rsLoRA's `alpha / √r` carries over.
+//!
 //! An adapter is untrusted input: [`Adapter::load`] reads the files and checks that the
 //! config and the tensors agree with each other, [`Adapter::check`] that every tensor fits
 //! the model; neither panics on any file.
@@ -72,6 +79,20 @@ impl Target {
             Target::O => (q, shape.dim),
             Target::Gate | Target::Up => (shape.dim, shape.hidden),
             Target::Down => (shape.hidden, shape.dim),
+        }
+    }
+
+    /// The projection's tensor in a GGUF (`blk.{i}.attn_q.weight`, …): llama.cpp's name,
+    /// the same for llama and qwen2.
+    pub fn gguf(self) -> &'static str {
+        match self {
+            Target::Q => "attn_q",
+            Target::K => "attn_k",
+            Target::V => "attn_v",
+            Target::O => "attn_output",
+            Target::Gate => "ffn_gate",
+            Target::Up => "ffn_up",
+            Target::Down => "ffn_down",
         }
     }
 
@@ -326,6 +347,98 @@ impl Adapter {
     }
 }
 
+/// The adapter's file for llama.cpp, beside PEFT's in an adapter's directory.
+pub const GGUF_FILE: &str = "adapter.gguf";
+
+impl Adapter {
+    /// Writes the adapter as llama.cpp's LoRA GGUF (the module's header) for a model of
+    /// `shape`, whole or not at all (a `.part` file renamed over it).
+    pub fn save_gguf(&self, path: &Path, shape: &Shape) -> Result<(), String> {
+        self.check(shape)?;
+        let scale = self.scale();
+        let mut tensors = Vec::new();
+        for (&(layer, target), lora) in &self.layers {
+            let name = |half: &str| format!("blk.{layer}.{}.weight.lora_{half}", target.gguf());
+            let b: Vec<f32> = hf_to_gguf_rows(&lora.b, self.rank, target, shape).iter().map(|v| v * scale).collect();
+            tensors.push((name("a"), [lora.inputs, self.rank], lora.a.clone()));
+            tensors.push((name("b"), [self.rank, lora.outputs], b));
+        }
+        let arch = match shape.arch {
+            crate::Arch::Llama => "llama",
+            crate::Arch::Qwen2 => "qwen2",
+        };
+        let metadata = [
+            ("general.architecture", Meta::Text(arch)),
+            ("general.type", Meta::Text("adapter")),
+            ("adapter.type", Meta::Text("lora")),
+            ("adapter.lora.alpha", Meta::Float(self.rank as f32)),
+            ("general.alignment", Meta::Int(GGUF_ALIGNMENT as u32)),
+        ];
+        let bytes = gguf_bytes(&metadata, &tensors);
+        let partial = path.with_extension("gguf.part");
+        std::fs::write(&partial, bytes).map_err(|e| format!("cannot write `{}`: {e}", partial.display()))?;
+        std::fs::rename(&partial, path).map_err(|e| format!("cannot write `{}`: {e}", path.display()))
+    }
+}
+
+/// A GGUF metadata value of the kinds an adapter needs.
+enum Meta<'a> {
+    Int(u32),
+    Float(f32),
+    Text(&'a str),
+}
+
+/// The alignment of a GGUF's tensor data (ggml's default, stated in the file too).
+const GGUF_ALIGNMENT: usize = 32;
+
+/// A GGUF version 3 file: the header, the metadata, each tensor's name, dimensions
+/// (ggml's order: fastest first), type (f32) and offset, then the data, each tensor's
+/// start aligned, offsets running in order.
+fn gguf_bytes(metadata: &[(&str, Meta)], tensors: &[(String, [usize; 2], Vec<f32>)]) -> Vec<u8> {
+    fn text(out: &mut Vec<u8>, s: &str) {
+        out.extend((s.len() as u64).to_le_bytes());
+        out.extend(s.as_bytes());
+    }
+    let pad = |n: usize| n.div_ceil(GGUF_ALIGNMENT) * GGUF_ALIGNMENT;
+    let mut out = Vec::new();
+    out.extend(b"GGUF");
+    out.extend(3u32.to_le_bytes());
+    out.extend((tensors.len() as u64).to_le_bytes());
+    out.extend((metadata.len() as u64).to_le_bytes());
+    for (key, value) in metadata {
+        text(&mut out, key);
+        match value {
+            Meta::Int(v) => {
+                out.extend(4u32.to_le_bytes());
+                out.extend(v.to_le_bytes());
+            }
+            Meta::Float(v) => {
+                out.extend(6u32.to_le_bytes());
+                out.extend(v.to_le_bytes());
+            }
+            Meta::Text(v) => {
+                out.extend(8u32.to_le_bytes());
+                text(&mut out, v);
+            }
+        }
+    }
+    let mut offset = 0;
+    for (name, dims, values) in tensors {
+        text(&mut out, name);
+        out.extend(2u32.to_le_bytes());
+        dims.iter().for_each(|d| out.extend((*d as u64).to_le_bytes()));
+        out.extend(0u32.to_le_bytes()); // GGML_TYPE_F32
+        out.extend((offset as u64).to_le_bytes());
+        offset += pad(values.len() * 4);
+    }
+    out.resize(pad(out.len()), 0);
+    for (_, _, values) in tensors {
+        values.iter().for_each(|v| out.extend(v.to_le_bytes()));
+        out.resize(pad(out.len()), 0);
+    }
+    out
+}
+
 /// The GGUF row of Hugging Face's row `row` in a q or k projection with heads of
 /// `head_dim`: within a head, HF's `s·half + i` is GGUF's `2i + s`.
 fn gguf_row(row: usize, head_dim: usize) -> usize {
@@ -385,6 +498,78 @@ mod tests {
         assert_eq!(deinterleave_rows(&g, 3, 8), b);
         // HF's row 4 (the second half's first) of head 0 is GGUF's row 1
         assert_eq!(&g[3..6], &b[12..15]);
+    }
+
+    /// A two-layer llama adapter written as llama.cpp's GGUF and read back by candle's
+    /// reader: the keys llama.cpp asks for, one pair per projection with ggml's dimensions,
+    /// q's `lora_b` interleaved and scaled, the others scaled only.
+    #[test]
+    fn the_gguf_is_llama_cpps_adapter() {
+        use candle_core::quantized::gguf_file::{Content, Value};
+        let shape = Shape {
+            arch: crate::Arch::Llama,
+            layers: 2,
+            dim: 8,
+            hidden: 12,
+            heads: 2,
+            kv_heads: 1,
+            head_dim: 4,
+            context: 64,
+            eps: 1e-5,
+            rope_base: 1e4,
+        };
+        let rank = 2;
+        let mut layers = BTreeMap::new();
+        for layer in 0..2 {
+            for target in [Target::Q, Target::V] {
+                let (inputs, outputs) = target.dims(&shape);
+                let values = |n: usize, k: usize| (0..n).map(|i| (i + 100 * k + layer) as f32).collect::<Vec<f32>>();
+                layers.insert(
+                    (layer, target),
+                    Lora { a: values(rank * inputs, 1), b: values(outputs * rank, 2), inputs, outputs },
+                );
+            }
+        }
+        let adapter = Adapter {
+            rank,
+            alpha: 8.0,
+            rslora: false,
+            targets: vec![Target::Q, Target::V],
+            base_model: "x".into(),
+            layers,
+        };
+        let dir = std::env::temp_dir().join(format!("tad-local-gguf-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(GGUF_FILE);
+        adapter.save_gguf(&path, &shape).unwrap();
+        let mut file = std::fs::File::open(&path).unwrap();
+        let content = Content::read(&mut file).unwrap();
+        let text = |k: &str| content.metadata[k].to_string().unwrap().clone();
+        assert_eq!(
+            (text("general.architecture"), text("general.type"), text("adapter.type")),
+            ("llama".into(), "adapter".into(), "lora".into())
+        );
+        assert!(matches!(content.metadata["adapter.lora.alpha"], Value::F32(a) if a == rank as f32));
+        assert_eq!(content.tensor_infos.len(), 8);
+        let mut tensor = |name: &str| {
+            let t = content.tensor(&mut file, name, &Device::Cpu).unwrap().dequantize(&Device::Cpu).unwrap();
+            (t.dims().to_vec(), t.flatten_all().unwrap().to_vec1::<f32>().unwrap())
+        };
+        let scale = adapter.scale();
+        for ((layer, target), lora) in &adapter.layers {
+            let name = format!("blk.{layer}.{}.weight.lora_", target.gguf());
+            assert_eq!(tensor(&format!("{name}a")), (vec![rank, lora.inputs], lora.a.clone()), "{name}a");
+            let b = hf_to_gguf_rows(&lora.b, rank, *target, &shape).iter().map(|v| v * scale).collect();
+            assert_eq!(tensor(&format!("{name}b")), (vec![lora.outputs, rank], b), "{name}b");
+        }
+        // q's rows were reordered, v's not
+        let (_, q) = tensor("blk.0.attn_q.weight.lora_b");
+        assert_ne!(q, adapter.layers[&(0, Target::Q)].b.iter().map(|v| v * scale).collect::<Vec<_>>());
+        // a model it does not fit is refused, nothing written
+        let other = Shape { layers: 3, ..shape };
+        let refused = dir.join("refused.gguf");
+        assert!(adapter.save_gguf(&refused, &other).is_err() && !refused.exists());
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]
