@@ -43,11 +43,13 @@ def main():
     a = p.parse_args()
     torch.set_num_threads(a.threads)
     from stable_baselines3 import PPO, SAC, TD3
+    from stable_baselines3.common.logger import Logger
 
     env = Blank(a.obs)
     kwargs = dict(policy_kwargs=dict(net_arch=[a.hidden, a.hidden]), device="cpu", seed=0, verbose=0)
     if a.algo == "ppo":
         model = PPO("MlpPolicy", env, n_steps=a.rollout, batch_size=a.batch, n_epochs=a.epochs, **kwargs)
+        model.set_logger(Logger(None, []))  # SB3's default logger makes a directory in /tmp
         model.learn(total_timesteps=1)  # fills the rollout and trains once (warm-up)
         start = time.perf_counter()
         model.train()
@@ -56,6 +58,7 @@ def main():
     else:
         cls = SAC if a.algo == "sac" else TD3
         model = cls("MlpPolicy", env, batch_size=a.batch, learning_starts=0, buffer_size=10_000, **kwargs)
+        model.set_logger(Logger(None, []))
         model.learn(total_timesteps=a.batch + 1)
         model.train(gradient_steps=10, batch_size=a.batch)  # warm-up
         start = time.perf_counter()
