@@ -121,6 +121,15 @@ fn the_loss_falls_and_the_adapter_reloads(shape: Shape) {
     assert_eq!(config["task_type"], "CAUSAL_LM");
     assert_eq!(config["r"], 4);
     assert_eq!(config["base_model_name_or_path"], tad_local::model(tad_local::ALIGN_DEFAULT).unwrap().upstream);
+    // and beside them llama.cpp's GGUF of the same adapter, its q rows in the model's order
+    let mut file = std::fs::File::open(out.join(tad_local::GGUF_FILE)).unwrap();
+    let gguf = candle_core::quantized::gguf_file::Content::read(&mut file).unwrap();
+    assert_eq!(gguf.metadata["general.type"].to_string().unwrap(), "adapter");
+    assert_eq!(gguf.tensor_infos.len(), 2 * 7 * shape.layers);
+    let q_b = gguf.tensor(&mut file, "blk.1.attn_q.weight.lora_b", &candle_core::Device::Cpu).unwrap();
+    let values: Vec<f32> = q_b.dequantize(&candle_core::Device::Cpu).unwrap().flatten_all().unwrap().to_vec1().unwrap();
+    let expected = tad_local::hf_to_gguf_rows(&adapter.layers[&(1, Target::Q)].b, 4, Target::Q, &shape);
+    assert_eq!(values, expected.iter().map(|v| v * adapter.scale()).collect::<Vec<_>>());
 }
 
 #[test]
