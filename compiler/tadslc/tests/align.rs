@@ -218,6 +218,10 @@ fn finetune_and_adapters_refuse_bad_input_with_status_2() {
     let out = tadslc(&["finetune", path(&dir.join("missing.jsonl")), "-o", path(&dir.join("a"))], "");
     assert_eq!(code(&out), 2, "{}", stderr(&out));
     assert!(stderr(&out).contains("missing.jsonl"), "{}", stderr(&out));
+    // a directory without examples says which files it was looked in for
+    let out = tadslc(&["finetune", path(&dir), "-o", path(&dir.join("a"))], "");
+    assert_eq!(code(&out), 2, "{}", stderr(&out));
+    assert!(stderr(&out).contains("`messages.jsonl`, `prompt_completion.jsonl`, `train.jsonl`"), "{}", stderr(&out));
     std::fs::write(dir.join("data.jsonl"), "{\"messages\": []}\n").unwrap();
     let out =
         tadslc(&["finetune", path(&dir.join("data.jsonl")), "-o", path(&dir.join("a")), "--targets", "q,wrong"], "");

@@ -12,7 +12,8 @@ use crate::{Status, errln, outln};
 #[derive(clap::Args, Debug, Clone)]
 pub struct FinetuneArgs {
     /// Examples: a JSONL file (TRL's `messages`, or `prompt` and `completion`), or a
-    /// directory holding messages.jsonl (as `tadslc sft-export` writes) or train.jsonl
+    /// directory holding messages.jsonl or prompt_completion.jsonl (as `tadslc sft-export`
+    /// writes them) or train.jsonl
     pub data: PathBuf,
     /// The adapter's directory (PEFT: adapter_model.safetensors, adapter_config.json)
     #[arg(short, long, value_name = "DIR")]
@@ -52,13 +53,18 @@ pub struct FinetuneArgs {
     pub model: String,
 }
 
-/// The examples' file: `data` itself, or `data/messages.jsonl`, or `data/train.jsonl`.
-fn data_file(data: &Path) -> PathBuf {
+/// The files a directory of examples is looked in for, in order: `sft-export`'s two forms
+/// (either holds the same examples), then TRL's usual name.
+const DATA_FILES: [&str; 3] = ["messages.jsonl", "prompt_completion.jsonl", "train.jsonl"];
+
+/// The examples' file: `data` itself, or the first of [`DATA_FILES`] in it.
+fn data_file(data: &Path) -> Result<PathBuf, String> {
     if !data.is_dir() {
-        return data.to_path_buf();
+        return Ok(data.to_path_buf());
     }
-    let exported = data.join("messages.jsonl");
-    if exported.is_file() { exported } else { data.join("train.jsonl") }
+    DATA_FILES.iter().map(|name| data.join(name)).find(|file| file.is_file()).ok_or_else(|| {
+        format!("`{}` holds none of {}", data.display(), DATA_FILES.map(|name| format!("`{name}`")).join(", "))
+    })
 }
 
 impl FinetuneArgs {
@@ -95,7 +101,7 @@ impl FinetuneArgs {
 /// flags, unreadable examples, no model, a checkpoint of another run), 1 when training fails.
 pub fn run(args: &FinetuneArgs) -> Result<Status, CliError> {
     let config = args.config().map_err(CliError::usage)?;
-    let file = data_file(&args.data);
+    let file = data_file(&args.data).map_err(CliError::usage)?;
     let text = std::fs::read_to_string(&file)
         .map_err(|e| CliError::usage(format!("cannot read `{}`: {e}", file.display())))?;
     let examples = tad_finetune::read_jsonl(&text).map_err(|e| CliError::usage(format!("{}: {e}", file.display())))?;
