@@ -275,12 +275,26 @@ impl CriticNets {
         &self.nets.iter().find(|(n, _)| *n == name).expect("a critic of the algorithm").1
     }
 
-    /// The networks the critic optimizer moves (not the targets).
+    /// The networks the critic optimizer moves: every one but the targets.
+    fn learners(&self) -> impl Iterator<Item = &(&'static str, Net)> {
+        self.nets.iter().filter(|(n, _)| !n.ends_with(TARGET))
+    }
+
+    /// The target that follows the network `name`, if it has one.
+    fn target_of(&self, name: &str) -> Option<&Net> {
+        self.nets.iter().find(|(n, _)| n.strip_suffix(TARGET) == Some(name)).map(|(_, net)| net)
+    }
+
+    /// The learners' variables, named `{net}.{parameter}`.
     fn trained(&self) -> Vec<(String, candle_core::Var)> {
-        let trained = self.nets.iter().filter(|(n, _)| !n.ends_with("_target"));
-        trained.flat_map(|(n, net)| net.vars().into_iter().map(move |(v, var)| (format!("{n}.{v}"), var))).collect()
+        self.learners()
+            .flat_map(|(n, net)| net.vars().into_iter().map(move |(v, var)| (format!("{n}.{v}"), var)))
+            .collect()
     }
 }
+
+/// How a target network's name ends (`q1_target` follows `q1`).
+const TARGET: &str = "_target";
 
 /// The standard deviation of the pre-tanh action a stochastic head starts with where none
 /// is learnt yet (PPO's fresh actor; an actor without `fc_std`): SB3's `log_std_init` 0 is
@@ -575,7 +589,7 @@ impl Trainer {
     /// ChatScene goes on from SafeBench's checkpoint, critics and all.
     pub fn critics(&self) -> Result<Critics, TrainError> {
         let mut tensors = std::collections::HashMap::new();
-        for (name, net) in self.critics.nets.iter().filter(|(n, _)| !n.ends_with("_target")) {
+        for (name, net) in self.critics.learners() {
             for (key, t) in net.tensors(&format!("{name}.")) {
                 tensors.insert(key, t.copy().map_err(tensor_error)?);
             }
@@ -590,12 +604,10 @@ impl Trainer {
         let broken = |message: String| TrainError::Checkpoint { path: source.to_string(), message };
         let tensors = candle_core::safetensors::load_buffer(bytes, &candle_core::Device::Cpu)
             .map_err(|e| broken(format!("not a safetensors file: {e}")))?;
-        let trained: Vec<&'static str> =
-            self.critics.nets.iter().map(|(n, _)| *n).filter(|n| !n.ends_with("_target")).collect();
-        for name in trained {
+        for (name, net) in self.critics.learners() {
             let prefix = format!("{name}.");
-            self.critics.get(name).set(&tensors, &prefix, source)?;
-            if let Some((_, target)) = self.critics.nets.iter().find(|(n, _)| *n == format!("{name}_target")) {
+            net.set(&tensors, &prefix, source)?;
+            if let Some(target) = self.critics.target_of(name) {
                 target.set(&tensors, &prefix, source)?;
             }
         }

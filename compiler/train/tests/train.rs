@@ -179,8 +179,9 @@ fn an_existing_actor_is_fine_tuned() {
     assert_ne!(trainer.actor().expect("actor").mu(&[0.0, 0.0, 8.0, 0.0]), start.mu(&[0.0, 0.0, 8.0, 0.0]));
 }
 
-/// A run's critics written out and read into another run of the same widths: the second
-/// run's first learning step is the first run's; damaged or mismatched critics are errors.
+/// A run's critics written out and read into another run of the same widths: that run
+/// trains on from them (its critics end elsewhere than a fresh start's), its targets start
+/// as their copies; damaged or mismatched critics are errors.
 #[test]
 fn critics_go_from_one_run_to_another() {
     let dir = temp("critics");
