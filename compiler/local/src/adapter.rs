@@ -363,12 +363,8 @@ impl Adapter {
             tensors.push((name("a"), [lora.inputs, self.rank], lora.a.clone()));
             tensors.push((name("b"), [self.rank, lora.outputs], b));
         }
-        let arch = match shape.arch {
-            crate::Arch::Llama => "llama",
-            crate::Arch::Qwen2 => "qwen2",
-        };
         let metadata = [
-            ("general.architecture", Meta::Text(arch)),
+            ("general.architecture", Meta::Text(shape.arch.name())),
             ("general.type", Meta::Text("adapter")),
             ("adapter.type", Meta::Text("lora")),
             ("adapter.lora.alpha", Meta::Float(self.rank as f32)),

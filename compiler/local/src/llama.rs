@@ -177,6 +177,19 @@ pub enum Arch {
 }
 
 impl Arch {
+    /// Every architecture by its name in a GGUF (`general.architecture`).
+    pub const ALL: [(&'static str, Arch); 2] = [("llama", Arch::Llama), ("qwen2", Arch::Qwen2)];
+
+    /// The architecture a GGUF's `general.architecture` names.
+    pub fn parse(name: &str) -> Option<Arch> {
+        Arch::ALL.iter().find(|(n, _)| *n == name).map(|&(_, a)| a)
+    }
+
+    /// Its name in a GGUF.
+    pub fn name(self) -> &'static str {
+        Arch::ALL.iter().find(|(_, a)| *a == self).map(|&(n, _)| n).unwrap_or_default()
+    }
+
     /// Whether the GGUF's query and key rows are llama.cpp's per-head interleaving of
     /// Hugging Face's, so that rope rotates adjacent pairs (llama). qwen2's are Hugging
     /// Face's own, and rope rotates each head's halves.
@@ -243,11 +256,10 @@ impl Shape {
     pub fn from_gguf(content: &Content) -> Result<Shape, String> {
         let meta = |k: &str| content.metadata.get(k).ok_or_else(|| format!("no `{k}` in the GGUF metadata"));
         let name = meta("general.architecture")?.to_string().map_err(error)?.clone();
-        let arch = match name.as_str() {
-            "llama" => Arch::Llama,
-            "qwen2" => Arch::Qwen2,
-            _ => return Err(format!("a `{name}` model: the architectures supported are llama and qwen2")),
-        };
+        let arch = Arch::parse(&name).ok_or_else(|| {
+            let known = Arch::ALL.map(|(n, _)| n).join(" and ");
+            format!("a `{name}` model: the architectures supported are {known}")
+        })?;
         // every key is under the architecture's name
         let key = |k: &str| format!("{name}.{k}");
         let int = |k: &str| meta(&key(k)).and_then(|v| v.to_u32().map_err(error)).map(|v| v as usize);
@@ -685,6 +697,14 @@ mod tests {
         candle_core::quantized::gguf_file::write(&mut out, &meta, &tensors).unwrap();
         out.set_position(0);
         out
+    }
+
+    #[test]
+    fn every_architecture_has_one_name() {
+        for (name, arch) in Arch::ALL {
+            assert_eq!((Arch::parse(name), arch.name()), (Some(arch), name));
+        }
+        assert_eq!(Arch::parse("mistral"), None);
     }
 
     #[test]
