@@ -20,6 +20,7 @@ use toktrie::{TokEnv, TokRxInfo, TokTrie, TokenId, TokenizerEnv};
 
 use crate::adapter::Adapter;
 use crate::llama::{Cache, Model};
+use crate::prompts::PromptStore;
 
 pub struct Engine {
     model: Model,
@@ -28,6 +29,10 @@ pub struct Engine {
     prefix: Option<Vec<u32>>,
     /// The keys and values of the last prompt and answer, from the first position.
     cache: Cache,
+    /// What makes this model's outputs what they are: its file, the adapter, the kernels.
+    identity: Vec<u8>,
+    /// Where system messages' caches are kept between processes, if anywhere.
+    store: Option<PromptStore>,
     tokenizer: Arc<Tokenizer>,
     /// `<|im_end|>`, and the end-of-text token.
     im_end: u32,
@@ -59,6 +64,28 @@ impl Timing {
             mask_s: self.mask_s - before.mask_s,
         }
     }
+}
+
+/// The model file (its path, size and time), the adapter's numbers and the kernels: two
+/// engines with the same identity compute the same keys and values.
+fn identity(path: &std::path::Path, adapter: Option<&Adapter>, kernels: &str) -> Vec<u8> {
+    let mut out = Vec::new();
+    let path = path.canonicalize().unwrap_or_else(|_| path.to_path_buf());
+    out.extend_from_slice(path.to_string_lossy().as_bytes());
+    if let Ok(meta) = std::fs::metadata(&path) {
+        out.extend_from_slice(&meta.len().to_le_bytes());
+        let time = meta.modified().ok().and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok());
+        out.extend_from_slice(&time.map_or(0, |t| t.as_nanos()).to_le_bytes());
+    }
+    out.extend_from_slice(kernels.as_bytes());
+    if let Some(adapter) = adapter {
+        out.extend_from_slice(format!("{} {} {}", adapter.rank, adapter.alpha, adapter.rslora).as_bytes());
+        for ((layer, target), lora) in &adapter.layers {
+            out.extend_from_slice(format!("{layer} {}", target.module()).as_bytes());
+            lora.a.iter().chain(&lora.b).for_each(|x| out.extend_from_slice(&x.to_le_bytes()));
+        }
+    }
+    out
 }
 
 fn failed(what: &str, e: impl std::fmt::Display) -> Error {
@@ -142,6 +169,7 @@ impl Engine {
                 Error::new(ErrorKind::Request, format!("the adapter does not fit the local model: {e}"))
             })?;
         }
+        let identity = identity(path, adapter, model.kernels());
         let context = model.shape.context;
         let cache = model.new_cache();
         let id = |t: &str| tokenizer.token_to_id(t);
@@ -153,6 +181,8 @@ impl Engine {
             model,
             prefix: None,
             cache,
+            identity,
+            store: None,
             tokenizer: Arc::new(tokenizer),
             im_end,
             end_of_text,
@@ -220,11 +250,19 @@ impl Engine {
         self.prefix = None;
     }
 
+    /// Keeps each new system message's keys and values in `dir` ([`PromptStore`]), and
+    /// reads them from there when a prompt starts with one this engine has not read.
+    pub fn keep_prompts(&mut self, dir: std::path::PathBuf) {
+        self.store = Some(PromptStore::new(dir, &self.identity));
+    }
+
     /// Reads `prompt` into the cache and returns the logits after it: from the cached
-    /// system message when the prompt starts with it, else from the start, remembering
-    /// this prompt's first message as the new prefix. Also returns how many tokens were read.
+    /// system message when the prompt starts with it (in memory, else in the store), else
+    /// from the start, remembering this prompt's first message as the new prefix (and
+    /// keeping it in the store). Also returns how many tokens were read.
     fn prefill(&mut self, prompt: &[u32], first: usize) -> (Vec<f32>, usize) {
         let cached = self.prefix.as_ref().filter(|p| prompt.len() > p.len() && prompt.starts_with(p));
+        let has_prefix = first > 0 && first < prompt.len();
         let done = match cached {
             Some(p) => {
                 let done = p.len();
@@ -232,12 +270,34 @@ impl Engine {
                 done
             }
             None => {
-                self.cache = self.model.new_cache();
-                self.prefix = (first > 0 && first < prompt.len()).then(|| prompt[..first].to_vec());
-                0
+                self.prefix = has_prefix.then(|| prompt[..first].to_vec());
+                let width = self.model.shape.kv_heads * self.model.shape.head_dim;
+                let kept = self
+                    .store
+                    .as_ref()
+                    .filter(|_| has_prefix)
+                    .and_then(|store| store.load(&prompt[..first], self.model.shape.layers, width));
+                match kept {
+                    Some(cache) => {
+                        self.cache = cache;
+                        first
+                    }
+                    None => {
+                        self.cache = self.model.new_cache();
+                        0
+                    }
+                }
             }
         };
-        (self.model.forward(&prompt[done..], &mut self.cache), prompt.len() - done)
+        let logits = self.model.forward(&prompt[done..], &mut self.cache);
+        if done == 0
+            && has_prefix
+            && let Some(store) = &self.store
+        {
+            // a cache that cannot be written costs the next process a prefill, nothing more
+            let _ = store.save(&prompt[..first], &self.cache);
+        }
+        (logits, prompt.len() - done)
     }
 
     /// The model's weights in memory, and the dot-product kernels chosen for this CPU.

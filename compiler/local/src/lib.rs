@@ -13,6 +13,7 @@ mod adapter;
 mod engine;
 mod kquant;
 mod llama;
+mod prompts;
 mod quant;
 
 use std::sync::{Arc, Mutex};
@@ -22,6 +23,7 @@ use tad_llm::{Chat, ChatFuture, Error, ErrorKind, OnText, Request};
 pub use adapter::{Adapter, GGUF_FILE, Lora, Target, gguf_to_hf_rows, hf_to_gguf_rows, interleave_rows, tensor_name};
 pub use engine::{Engine, Timing, chatml, tokenizer};
 pub use llama::{Arch, Shape};
+pub use prompts::PromptStore;
 pub use tokenizers::Tokenizer;
 
 // The table of models and their fetching live in `tad-models`, shared with `tad-embed`.
@@ -45,12 +47,25 @@ impl LocalChat {
     /// As [`LocalChat::load`], with a LoRA adapter applied.
     pub fn load_with(model: &Model, threads: usize, adapter: Option<&Adapter>) -> Result<LocalChat, String> {
         let path = model.require()?;
-        let engine = Engine::load_with(&path, threads, adapter).map_err(|e| e.to_string())?;
+        let mut engine = Engine::load_with(&path, threads, adapter).map_err(|e| e.to_string())?;
+        if let Some(dir) = prompt_dir() {
+            engine.keep_prompts(dir);
+        }
         Ok(LocalChat { engine: Arc::new(Mutex::new(engine)), name: model.name.to_string() })
     }
 
     pub fn timing(&self) -> Timing {
         self.engine.lock().unwrap_or_else(|e| e.into_inner()).timing
+    }
+}
+
+/// Where [`LocalChat`] keeps system messages' caches ([`PromptStore`]): the directory
+/// `TADSL_PROMPT_CACHE` names, nowhere when it is `off`, else `prompts` in the model cache.
+pub fn prompt_dir() -> Option<std::path::PathBuf> {
+    match std::env::var_os("TADSL_PROMPT_CACHE").filter(|v| !v.is_empty()) {
+        Some(v) if v == "off" => None,
+        Some(dir) => Some(dir.into()),
+        None => Some(cache_dir().join("prompts")),
     }
 }
 

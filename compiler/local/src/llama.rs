@@ -302,6 +302,25 @@ pub struct Cache {
 }
 
 impl Cache {
+    /// A cache of `len` positions from each layer's keys and values.
+    pub(crate) fn from_layers(layers: Vec<(Vec<u16>, Vec<u16>)>, len: usize) -> Cache {
+        let (k, v) = layers.into_iter().unzip();
+        Cache { k, v, len }
+    }
+
+    pub(crate) fn layers(&self) -> usize {
+        self.k.len()
+    }
+
+    /// Halves a position takes in one layer's keys (as many in its values).
+    pub(crate) fn width(&self) -> usize {
+        self.k.first().map_or(0, |k| k.len() / self.len.max(1))
+    }
+
+    pub(crate) fn layers_kv(&self) -> impl Iterator<Item = (&[u16], &[u16])> {
+        self.k.iter().zip(&self.v).map(|(k, v)| (k.as_slice(), v.as_slice()))
+    }
+
     /// Forgets every position from `len` on.
     pub fn truncate(&mut self, len: usize) {
         if len >= self.len {

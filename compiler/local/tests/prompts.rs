@@ -1,0 +1,62 @@
+//! The system message's keys and values kept on disk (`Engine::keep_prompts`), on the
+//! smallest model: a second process reads them instead of the prefill and answers the same
+//! tokens; a damaged file is read as no file, and replaced. Skips when the model is not
+//! installed, unless `TAD_REQUIRE_MODEL=1` (CI), which fetches it.
+
+use tad_llm::{Message, Request, Role};
+use tad_local::Engine;
+
+fn request(user: &str) -> Request {
+    let system = "You write traffic scenarios. ".repeat(40);
+    let mut request = Request::new(vec![Message::text(Role::System, system), Message::text(Role::User, user)]);
+    request.max_tokens = 24;
+    request.temperature = 0.0;
+    request
+}
+
+fn kv_files(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
+    let mut files: Vec<_> = std::fs::read_dir(dir)
+        .map(|d| d.flatten().map(|e| e.path()).filter(|p| p.extension().is_some_and(|x| x == "kv")).collect())
+        .unwrap_or_default();
+    files.sort();
+    files
+}
+
+#[test]
+fn a_kept_system_message_is_read_not_prefilled_and_gives_the_same_answer() {
+    let Some(path) = tad_local::for_tests(tad_local::SMALLEST) else { return };
+    let dir = std::env::temp_dir().join(format!("tad-prompt-store-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let run = |user: &str| {
+        let mut engine = Engine::load(&path, 1).unwrap();
+        engine.keep_prompts(dir.clone());
+        let answer = engine.generate(&request(user)).unwrap();
+        (answer.text, answer.usage.prompt_tokens, engine.timing.prefill_tokens)
+    };
+
+    let (first, prompt, read) = run("A bus ahead.");
+    assert_eq!(read, prompt, "the first process reads the whole prompt");
+    let files = kv_files(&dir);
+    assert_eq!(files.len(), 1, "the system message is kept");
+
+    let (again, _, read_again) = run("A bus ahead.");
+    assert_eq!(again, first, "the kept keys and values are the prefill's");
+    assert!(read_again < prompt / 4, "only the user's turn is read: {read_again} of {prompt}");
+
+    // another user turn after the same system message reads the same file
+    let (_, other_prompt, other_read) = run("Two cyclists on the left.");
+    assert!(other_read < other_prompt / 4);
+    assert_eq!(kv_files(&dir), files);
+
+    // a damaged file is no file: the prompt is read whole, the answer is the same, and the
+    // file is written again
+    let mut bytes = std::fs::read(&files[0]).unwrap();
+    let middle = bytes.len() / 2;
+    bytes[middle] ^= 0x40;
+    std::fs::write(&files[0], &bytes).unwrap();
+    let (repaired, _, read_whole) = run("A bus ahead.");
+    assert_eq!((repaired.as_str(), read_whole), (first.as_str(), prompt));
+    let (_, _, read_after) = run("A bus ahead.");
+    assert!(read_after < prompt / 4, "the damaged file was replaced");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
