@@ -135,7 +135,7 @@ impl Lowerer<'_> {
             match member {
                 cst::Member::Section(section) => self.section(section, &mut scenario),
                 cst::Member::Actor(actor) => {
-                    if let Some(group) = self.actor(actor, &scenario) {
+                    if let Some(group) = self.actor(actor, &scenario, &s.body.items) {
                         self.groups.entry(group.name.text.clone()).or_insert(scenario.actors.len());
                         scenario.actors.push(group);
                     }
@@ -199,7 +199,8 @@ impl Lowerer<'_> {
         scenario.sections.push(Section { def, span: section.span, name_span: name.span, attrs });
     }
 
-    fn actor(&mut self, actor: &cst::Actor, scenario: &Scenario) -> Option<ActorGroup> {
+    /// `members`: the scenario's, for a name no group has.
+    fn actor(&mut self, actor: &cst::Actor, scenario: &Scenario, members: &[cst::Member]) -> Option<ActorGroup> {
         let name = &actor.name;
         if name.text == "ego" {
             self.report(
@@ -213,6 +214,11 @@ impl Lowerer<'_> {
                 .with_help("describe the ego vehicle in the `ego { ... }` section, or rename this group"),
             );
         } else if let Some(previous) = self.groups.get(&name.text).map(|&i| &scenario.actors[i]) {
+            // the first `NAME_N` no group of the scenario has: a rename the compiler can make
+            let taken = |candidate: &str| {
+                members.iter().any(|m| matches!(m, cst::Member::Actor(a) if a.name.text == candidate))
+            };
+            let free = (2..).map(|n| format!("{}_{n}", name.text)).find(|c| !taken(c)).unwrap_or_default();
             self.report(
                 Diagnostic::new(
                     Code::E0209,
@@ -226,7 +232,8 @@ impl Lowerer<'_> {
                     earlier_module: None,
                 })
                 .with_secondary(previous.name.span, "first declared here")
-                .with_help("give each group its own name"),
+                .with_help(format!("give each group its own name, such as `{free}`"))
+                .with_fix(name.span, free, Applicability::MachineApplicable),
             );
             return None;
         }
@@ -826,4 +833,23 @@ fn wrong(field: &str, expected: &str, found: &str) -> Payload {
 
 fn join(words: &[Name]) -> String {
     words.iter().map(|w| w.text.as_str()).collect::<Vec<_>>().join("_")
+}
+
+#[cfg(test)]
+mod tests {
+    use tad_diagnostics::Code;
+
+    #[test]
+    fn a_duplicate_group_is_renamed_to_a_name_no_group_has() {
+        let src = "scenario demo {\n  actor parked: 2 car {\n  }\n  actor parked: 3 suv {\n  }\n  actor parked_2: 1 van {\n  }\n}\n";
+        let (_, diagnostics) = crate::analyze(src);
+        let duplicate = diagnostics.iter().find(|d| d.code == Code::E0209).expect("E0209");
+        assert_eq!(duplicate.fixes[0].replacement, "parked_3");
+        let (fixed, applied) = tad_diagnostics::apply_fixes(src, &diagnostics);
+        assert_eq!(applied, 1);
+        assert!(fixed.contains("actor parked_3: 3 suv"), "{fixed}");
+        let (module, after) = crate::analyze(&fixed);
+        assert!(after.iter().all(|d| d.code != Code::E0209), "{after:?}");
+        assert_eq!(module.scenario.unwrap().actors.len(), 3);
+    }
 }
