@@ -66,16 +66,19 @@ impl Timing {
     }
 }
 
-/// The model file (its path, size and time), the adapter's numbers and the kernels: two
-/// engines with the same identity compute the same keys and values.
+/// The model file and the program (each's path, size and time: a rebuilt decoder is
+/// another), the adapter's numbers and the kernels: two engines with the same identity
+/// compute the same keys and values.
 fn identity(path: &std::path::Path, adapter: Option<&Adapter>, kernels: &str) -> Vec<u8> {
     let mut out = Vec::new();
-    let path = path.canonicalize().unwrap_or_else(|_| path.to_path_buf());
-    out.extend_from_slice(path.to_string_lossy().as_bytes());
-    if let Ok(meta) = std::fs::metadata(&path) {
-        out.extend_from_slice(&meta.len().to_le_bytes());
-        let time = meta.modified().ok().and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok());
-        out.extend_from_slice(&time.map_or(0, |t| t.as_nanos()).to_le_bytes());
+    for file in [Some(path.to_path_buf()), std::env::current_exe().ok()].into_iter().flatten() {
+        let file = file.canonicalize().unwrap_or(file);
+        out.extend_from_slice(file.to_string_lossy().as_bytes());
+        if let Ok(meta) = std::fs::metadata(&file) {
+            out.extend_from_slice(&meta.len().to_le_bytes());
+            let time = meta.modified().ok().and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok());
+            out.extend_from_slice(&time.map_or(0, |t| t.as_nanos()).to_le_bytes());
+        }
     }
     out.extend_from_slice(kernels.as_bytes());
     if let Some(adapter) = adapter {

@@ -2,8 +2,8 @@
 //! prompt's state: a later process whose prompt starts with the same system message reads
 //! them instead of prefilling it again (the translate prompt is about 3,000 tokens).
 //!
-//! A file is `DIR/KEY.kv`, `KEY` the sha256 of the format, the model's identity (its file,
-//! size and time, the adapter's weights, the kernels) and the tokens. The file is
+//! A file is `DIR/KEY.kv`, `KEY` the sha256 of the format, the model's identity (the GGUF
+//! file and the program, the adapter's weights, the kernels) and the tokens. The file is
 //! untrusted: it repeats its tokens and shape, and ends with the sha256 of what precedes it;
 //! anything that does not match the model and the prompt is ignored, and the prefix is
 //! read as if there were no file. It is written under a temporary name and renamed, so a
