@@ -44,12 +44,25 @@ pub fn constraint(dialect: Dialect, vocabulary: &Vocabulary, modules: &[String])
     }
 }
 
-/// The in-context example of the prompts: TrafficAlign's first translation example.
+/// The in-context example of the describe prompt: TrafficAlign's first translation example.
 const EXAMPLE: &str = include_str!("../../../examples/paper/nl_to_dsl_example_1.tad");
 
-/// The example's description and its program (without comments and `source`).
+/// The translate prompt's worked examples, written for it (not from the benchmark): each a
+/// program whose `source.description` is what it translates.
+const TRANSLATE_EXAMPLES: &[&str] = &[
+    include_str!("../prompts/examples/junction_at_dusk.tad"),
+    include_str!("../prompts/examples/country_road_at_dawn.tad"),
+    include_str!("../prompts/examples/highway_merge.tad"),
+];
+
+/// The describe prompt's example: its description and its program.
 pub fn prompt_example() -> (String, String) {
-    let (module, _) = tad_syntax::analyze(EXAMPLE);
+    example_parts(EXAMPLE)
+}
+
+/// An example's description and its program (without comments and `source`).
+fn example_parts(text: &str) -> (String, String) {
+    let (module, _) = tad_syntax::analyze(text);
     let description = module
         .scenario
         .as_ref()
@@ -59,20 +72,28 @@ pub fn prompt_example() -> (String, String) {
             _ => None,
         })
         .unwrap_or_default();
-    let program = with_provenance(EXAMPLE, &Provenance::default());
-    (description, program.trim_end().to_string())
+    let program = with_provenance(text, &Provenance::default());
+    (description.trim_end().to_string(), program.trim().to_string())
+}
+
+/// The translate prompt's examples, as the model reads them: each description, then its
+/// program in a code block.
+pub fn translate_examples() -> String {
+    let shown = TRANSLATE_EXAMPLES.iter().map(|text| {
+        let (description, program) = example_parts(text);
+        format!("Description:\n{description}\n\nProgram:\n```tad\n{program}\n```")
+    });
+    shown.collect::<Vec<_>>().join("\n\n")
 }
 
 /// The first request of a translation: the prompt with the vocabulary of the checker's
-/// region, the example, and the description.
+/// region, the worked examples, and the description.
 pub fn translate_messages(description: &str, checker: &Checker) -> Vec<tad_llm::Message> {
     let scope = tad_grammar::scope(checker.options.region.as_deref()).or_else(|_| tad_grammar::scope(None));
     let vocabulary = scope.map(|(v, _)| prompt::vocabulary(&v)).unwrap_or_default();
-    let (example_description, example_program) = prompt_example();
     prompt::TRANSLATE.messages(&[
         ("vocabulary", &vocabulary),
-        ("example_description", &example_description),
-        ("example_program", &example_program),
+        ("examples", &translate_examples()),
         ("description", description),
     ])
 }
@@ -207,5 +228,22 @@ mod tests {
         let (module, diagnostics) = tad_syntax::analyze(&out);
         assert!(diagnostics.is_empty(), "{out}\n{diagnostics:?}");
         assert_eq!(module.scenario.unwrap().name.map(|n| n.text).as_deref(), Some("a"));
+    }
+
+    #[test]
+    fn the_translate_examples_are_complete_as_the_model_reads_them() {
+        let checker = Checker::default();
+        for text in TRANSLATE_EXAMPLES {
+            let (description, program) = example_parts(text);
+            assert!(description.len() > 100, "{text}");
+            let verdict = checker.check(&program, tad_db::Language::Tad);
+            assert_eq!(verdict.class, tad_check::Class::Complete, "{program}\n{:?}", verdict.lines);
+            // a speed keeps the description's unit, so mph is only warned about (W0402)
+            assert!(verdict.lines.iter().all(|l| l.starts_with("W0402")), "{:?}", verdict.lines);
+        }
+        let shown = translate_examples();
+        assert_eq!(shown.matches("```tad\n").count(), TRANSLATE_EXAMPLES.len());
+        assert!(shown.contains("use rural\n\nscenario country_road_at_dawn {"), "{shown}");
+        assert!(!shown.contains("source {") && !shown.contains("//"), "{shown}");
     }
 }

@@ -24,7 +24,7 @@ macro_rules! template {
 }
 
 template!(DESCRIBE, "describe.v1");
-template!(TRANSLATE, "translate.v1");
+template!(TRANSLATE, "translate.v2");
 template!(GENERATE, "generate.v1");
 template!(GENERATE_TUNED, "generate-tuned.v1");
 template!(REPAIR, "repair.v1");
@@ -89,7 +89,8 @@ fn fill(line: &str, vars: &[(&str, &str)]) -> String {
 }
 
 /// Every section's fields and what they take, the names from `vocabulary`:
-/// `road.type: straight_road, curve, ...`.
+/// `road.type: straight_road, curve, ...`. Names a standard module declares follow the
+/// prelude's, after the `use` line they need.
 pub fn vocabulary(vocabulary: &Vocabulary) -> String {
     let mut out = Vec::new();
     let sections: Vec<&SectionDef> = schema::SECTIONS.iter().copied().filter(|s| s.name != "source").collect();
@@ -97,23 +98,49 @@ pub fn vocabulary(vocabulary: &Vocabulary) -> String {
         for field in section.fields {
             let what = match (field.ty, field.vocabulary) {
                 (ValueType::Symbol | ValueType::SymbolList, Some(kind)) => {
-                    let names = vocabulary.names(kind).join(", ");
+                    let names = names(vocabulary, kind);
                     if field.ty == ValueType::SymbolList { format!("a list of [{names}], [] for none") } else { names }
                 }
                 (ValueType::Choice(words), _) => words.join(", "),
                 (ValueType::Position, _) => {
-                    format!("RELATION of REFERENCE; relations: {}", vocabulary.names("relation").join(", "))
+                    format!("RELATION of REFERENCE; relations: {}", names(vocabulary, "relation"))
                 }
                 (ty, _) => format!("{} (e.g. {})", ty.describe(), field.example),
             };
             let param = if field.param && matches!(field.ty, ValueType::Symbol) { "; or a choice a | b" } else { "" };
-            let range =
-                if field.param && !matches!(field.ty, ValueType::Symbol) { "; or a range 30..40 km/h" } else { "" };
+            let range = match field.param && !matches!(field.ty, ValueType::Symbol) {
+                true => format!("; or a range {}", range_example(field.example)),
+                false => String::new(),
+            };
             out.push(format!("- {}.{}: {what}{param}{range}", section.name, field.name));
         }
     }
-    out.push(format!("- actor header TYPE: {}", vocabulary.names("actor_type").join(", ")));
+    out.push(format!("- actor header TYPE: {}", names(vocabulary, "actor_type")));
     out.join("\n")
+}
+
+/// A kind's canonical names: the prelude's, then each standard module's after
+/// "with `use M`:".
+fn names(vocabulary: &Vocabulary, kind: &str) -> String {
+    let mut groups: Vec<(&str, Vec<&str>)> = Vec::new();
+    for entry in vocabulary.entries(kind) {
+        match groups.iter_mut().find(|(module, _)| *module == entry.module) {
+            Some((_, names)) => names.push(&entry.name),
+            None => groups.push((&entry.module, vec![&entry.name])),
+        }
+    }
+    let shown = groups.iter().map(|(module, names)| match *module == tad_db::PRELUDE {
+        true => names.join(", "),
+        false => format!("with `use {module}`: {}", names.join(", ")),
+    });
+    shown.collect::<Vec<_>>().join("; ")
+}
+
+/// A range in the unit of a field's example (`15 m` gives `15..30 m`).
+fn range_example(example: &str) -> String {
+    let (number, unit) = example.split_once(' ').unwrap_or((example, ""));
+    let twice = number.parse::<f64>().map(|n| n * 2.0).unwrap_or(0.0);
+    format!("{number}..{twice} {unit}").trim_end().to_string()
 }
 
 #[cfg(test)]
@@ -136,6 +163,7 @@ mod tests {
         let text = super::vocabulary(&vocabulary);
         assert!(text.contains("- environment.weather: clear, cloudy"), "{text}");
         assert!(text.contains("bison"), "the region's module is in scope");
+        assert!(text.contains("with `use national_park`: elk, bison"), "{text}");
         let (core, _) = tad_grammar::scope(Some("los_angeles")).unwrap();
         assert!(!super::vocabulary(&core).contains("bison"));
     }
