@@ -218,7 +218,10 @@ fn write_stdlib() -> Option<PathBuf> {
             continue;
         }
         std::fs::create_dir_all(path.parent()?).ok()?;
-        let partial = path.with_extension(format!("tad.{}", std::process::id()));
+        // a name of this call's own: tests open workspaces on several threads of one process
+        static CALLS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+        let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let partial = path.with_extension(format!("tad.{}.{call}", std::process::id()));
         std::fs::write(&partial, text).ok()?;
         let mut permissions = std::fs::metadata(&partial).ok()?.permissions();
         permissions.set_readonly(true);
