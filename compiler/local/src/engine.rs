@@ -14,6 +14,7 @@ use candle_core::{Device, Tensor};
 use candle_transformers::generation::LogitsProcessor;
 use llguidance::api::TopLevelGrammar;
 use llguidance::{Matcher, ParserFactory};
+use sha2::{Digest, Sha256};
 use tad_llm::{Answer, Constraint, Error, ErrorKind, Finish, Part, Request, Usage};
 use tokenizers::Tokenizer;
 use toktrie::{TokEnv, TokRxInfo, TokTrie, TokenId, TokenizerEnv};
@@ -29,8 +30,9 @@ pub struct Engine {
     prefix: Option<Vec<u32>>,
     /// The keys and values of the last prompt and answer, from the first position.
     cache: Cache,
-    /// What makes this model's outputs what they are: its file, the adapter, the kernels.
-    identity: Vec<u8>,
+    /// The sha256 of what makes this model's outputs what they are: its file, the program,
+    /// the adapter, the kernels.
+    identity: [u8; 32],
     /// Where system messages' caches are kept between processes, if anywhere.
     store: Option<PromptStore>,
     tokenizer: Arc<Tokenizer>,
@@ -67,28 +69,28 @@ impl Timing {
 }
 
 /// The model file and the program (each's path, size and time: a rebuilt decoder is
-/// another), the adapter's numbers and the kernels: two engines with the same identity
-/// compute the same keys and values.
-fn identity(path: &std::path::Path, adapter: Option<&Adapter>, kernels: &str) -> Vec<u8> {
-    let mut out = Vec::new();
+/// another), the adapter's numbers and the kernels, hashed: two engines with the same
+/// identity compute the same keys and values.
+fn identity(path: &std::path::Path, adapter: Option<&Adapter>, kernels: &str) -> [u8; 32] {
+    let mut hash = Sha256::new();
     for file in [Some(path.to_path_buf()), std::env::current_exe().ok()].into_iter().flatten() {
         let file = file.canonicalize().unwrap_or(file);
-        out.extend_from_slice(file.to_string_lossy().as_bytes());
+        hash.update(file.to_string_lossy().as_bytes());
         if let Ok(meta) = std::fs::metadata(&file) {
-            out.extend_from_slice(&meta.len().to_le_bytes());
+            hash.update(meta.len().to_le_bytes());
             let time = meta.modified().ok().and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok());
-            out.extend_from_slice(&time.map_or(0, |t| t.as_nanos()).to_le_bytes());
+            hash.update(time.map_or(0, |t| t.as_nanos()).to_le_bytes());
         }
     }
-    out.extend_from_slice(kernels.as_bytes());
+    hash.update(kernels.as_bytes());
     if let Some(adapter) = adapter {
-        out.extend_from_slice(format!("{} {} {}", adapter.rank, adapter.alpha, adapter.rslora).as_bytes());
+        hash.update(format!("{} {} {}", adapter.rank, adapter.alpha, adapter.rslora).as_bytes());
         for ((layer, target), lora) in &adapter.layers {
-            out.extend_from_slice(format!("{layer} {}", target.module()).as_bytes());
-            lora.a.iter().chain(&lora.b).for_each(|x| out.extend_from_slice(&x.to_le_bytes()));
+            hash.update(format!("{layer} {}", target.module()).as_bytes());
+            lora.a.iter().chain(&lora.b).for_each(|x| hash.update(x.to_le_bytes()));
         }
     }
-    out
+    hash.finalize().into()
 }
 
 fn failed(what: &str, e: impl std::fmt::Display) -> Error {
@@ -256,7 +258,7 @@ impl Engine {
     /// Keeps each new system message's keys and values in `dir` ([`PromptStore`]), and
     /// reads them from there when a prompt starts with one this engine has not read.
     pub fn keep_prompts(&mut self, dir: std::path::PathBuf) {
-        self.store = Some(PromptStore::new(dir, &self.identity));
+        self.store = Some(PromptStore::new(dir, self.identity));
     }
 
     /// Reads `prompt` into the cache and returns the logits after it: from the cached

@@ -11,7 +11,7 @@
 //! so the kept values are the bits a prefill would compute.
 
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use sha2::{Digest, Sha256};
 
@@ -31,13 +31,9 @@ pub struct PromptStore {
 }
 
 impl PromptStore {
-    /// A store in `dir` for the model whose identity `identity` hashes.
-    pub fn new(dir: PathBuf, identity: &[u8]) -> PromptStore {
-        PromptStore { dir, identity: Sha256::digest(identity).into() }
-    }
-
-    pub fn dir(&self) -> &Path {
-        &self.dir
+    /// A store in `dir` for the model whose identity hashes to `identity`.
+    pub fn new(dir: PathBuf, identity: [u8; 32]) -> PromptStore {
+        PromptStore { dir, identity }
     }
 
     fn path(&self, tokens: &[u32]) -> PathBuf {
@@ -77,9 +73,7 @@ impl PromptStore {
             }
         }
     }
-}
 
-impl PromptStore {
     /// Removes the oldest files beyond [`KEPT`].
     fn evict(&self) {
         let Ok(entries) = std::fs::read_dir(&self.dir) else { return };
@@ -135,12 +129,9 @@ fn decode(bytes: &[u8], identity: &[u8; 32], tokens: &[u32], layers: usize, widt
     if !same || rest.len() != 2 * 2 * layers * n * width {
         return None;
     }
-    let halves: Vec<u16> = rest.chunks_exact(2).map(|b| u16::from_le_bytes([b[0], b[1]])).collect();
-    let mut chunks = halves.chunks_exact(n * width).map(<[u16]>::to_vec);
-    let mut kv = Vec::with_capacity(layers);
-    for _ in 0..layers {
-        kv.push((chunks.next()?, chunks.next()?));
-    }
+    let halves = |chunk: &[u8]| chunk.chunks_exact(2).map(|b| u16::from_le_bytes([b[0], b[1]])).collect();
+    let mut chunks = rest.chunks_exact(2 * n * width).map(halves);
+    let kv = (0..layers).map(|_| Some((chunks.next()?, chunks.next()?))).collect::<Option<Vec<_>>>()?;
     Some(Cache::from_layers(kv, n))
 }
 
@@ -156,7 +147,7 @@ mod tests {
     #[test]
     fn a_kept_prefix_reads_back_and_anything_else_is_ignored() {
         let dir = std::env::temp_dir().join(format!("tad-prompts-{}", std::process::id()));
-        let store = PromptStore::new(dir.clone(), b"model a");
+        let store = PromptStore::new(dir.clone(), [1; 32]);
         let tokens = [5, 6, 7];
         let kept = cache(2, 4, 3);
         store.save(&tokens, &kept).unwrap();
@@ -166,7 +157,7 @@ mod tests {
         // another shape, other tokens, another model: nothing
         assert!(store.load(&tokens, 3, 4).is_none() && store.load(&tokens, 2, 8).is_none());
         assert!(store.load(&[5, 6, 8], 2, 4).is_none());
-        assert!(PromptStore::new(dir.clone(), b"model b").load(&tokens, 2, 4).is_none());
+        assert!(PromptStore::new(dir.clone(), [2; 32]).load(&tokens, 2, 4).is_none());
         // a flipped bit, a cut file, garbage: ignored, never a panic
         let path = store.path(&tokens);
         let good = std::fs::read(&path).unwrap();
