@@ -431,17 +431,26 @@ pub fn scatter_axes(title: &str, axes: (&str, &str), sets: &[(&str, Vec<[f64; 2]
     out
 }
 
-/// Round values from `lo` to `hi`: multiples of 1, 2 or 5 times a power of ten, three to
-/// six of them (none for a range that is not finite and positive).
+/// Round values from `lo` to `hi`: multiples of 1, 2 or 5 times a power of ten, the finest
+/// such step that gives at most six of them (none for a range that is not finite and
+/// positive).
 fn nice_ticks(lo: f64, hi: f64) -> Vec<f64> {
     let range = hi - lo;
     if !(range.is_finite() && range > 0.0) {
         return Vec::new();
     }
-    let p = 10f64.powf((range / 4.0).log10().floor());
-    let step = [1.0, 2.0, 5.0, 10.0].into_iter().map(|k| k * p).find(|s| range / s <= 5.0).unwrap_or(10.0 * p);
-    let first = (lo / step).ceil() as i64;
-    let last = (hi / step).floor() as i64;
+    let p = 10f64.powf((range / 6.0).log10().floor());
+    // a hair of slack, so that 0.8 / 0.2 is 4, not 3.9999999
+    let span = |step: f64| ((lo / step - 1e-9).ceil() as i64, (hi / step + 1e-9).floor() as i64);
+    let step = [1.0, 2.0, 5.0, 10.0, 20.0]
+        .into_iter()
+        .map(|k| k * p)
+        .find(|&s| {
+            let (first, last) = span(s);
+            last - first < 6
+        })
+        .unwrap_or(20.0 * p);
+    let (first, last) = span(step);
     (first..=last).map(|k| k as f64 * step).collect()
 }
 
@@ -461,8 +470,8 @@ fn tick(v: f64) -> String {
 pub type Panel<'a> = (&'a str, Vec<(&'a str, Vec<[f64; 2]>)>);
 
 /// Line charts stacked over one x axis: each panel a y label and named series of (x, y)
-/// points, each panel scaled to its own range (training curves: return and collision rate
-/// over episodes).
+/// points, each panel scaled to its own range with round ticks on both axes (training
+/// curves: return and collision rate over episodes).
 pub fn curves(title: &str, x_label: &str, panels: &[Panel]) -> String {
     let (plot_w, plot_h, margin, legend_w, gap) = (560.0, 200.0, 56.0, 190.0, 44.0);
     let width = plot_w + 2.0 * margin + legend_w;
@@ -491,11 +500,25 @@ pub fn curves(title: &str, x_label: &str, panels: &[Panel]) -> String {
             out,
             "<rect x=\"{margin}\" y=\"{top}\" width=\"{plot_w}\" height=\"{plot_h}\" fill=\"none\" stroke=\"#999\"/>"
         );
-        for (value, y) in [(y1, top + 4.0), (y0, top + plot_h)] {
+        for value in nice_ticks(y0, y1) {
+            let y = top + plot_h * (1.0 - (value - y0) / sy);
             let _ = writeln!(
                 out,
-                "<text x=\"{}\" y=\"{y}\" font-size=\"10\" text-anchor=\"end\" {FONT}>{value:.3}</text>",
-                margin - 4.0
+                "<line x1=\"{margin}\" y1=\"{y:.1}\" x2=\"{:.1}\" y2=\"{y:.1}\" stroke=\"#eee\"/><text class=\"y-tick\" x=\"{:.1}\" y=\"{:.1}\" font-size=\"10\" text-anchor=\"end\" {FONT}>{}</text>",
+                margin + plot_w,
+                margin - 4.0,
+                y + 3.5,
+                tick(value)
+            );
+        }
+        for value in nice_ticks(x0, x1) {
+            let x = margin + plot_w * (value - x0) / sx;
+            let _ = writeln!(
+                out,
+                "<line x1=\"{x:.1}\" y1=\"{top}\" x2=\"{x:.1}\" y2=\"{:.1}\" stroke=\"#eee\"/><text class=\"x-tick\" x=\"{x:.1}\" y=\"{:.1}\" font-size=\"10\" text-anchor=\"middle\" {FONT}>{}</text>",
+                top + plot_h,
+                top + plot_h + 13.0,
+                tick(value)
             );
         }
         let _ = writeln!(
@@ -528,7 +551,7 @@ pub fn curves(title: &str, x_label: &str, panels: &[Panel]) -> String {
     }
     let _ = writeln!(
         out,
-        "<text x=\"{}\" y=\"{}\" font-size=\"11\" text-anchor=\"middle\" {FONT}>{} ({x0:.0} to {x1:.0})</text>",
+        "<text class=\"axis-title\" x=\"{}\" y=\"{}\" font-size=\"12\" text-anchor=\"middle\" {FONT}>{}</text>",
         margin + plot_w / 2.0,
         height - 8.0,
         escape(x_label)
@@ -602,6 +625,24 @@ mod tests {
         let first = svg.split("class=\"group\" x=\"").nth(1).and_then(|r| r.split('"').next()?.parse::<f64>().ok());
         let reach = long.chars().count() as f64 * 11.0 * CHAR_EM * 35f64.to_radians().cos();
         assert!(first.is_some_and(|x| x - reach >= 0.0), "{first:?} - {reach} clips the first group's name");
+    }
+
+    #[test]
+    fn curves_tick_both_axes_with_round_values_inside_each_panel() {
+        let ret: Vec<[f64; 2]> = (0..=300).map(|e| [e as f64, -40.0 + 0.37 * e as f64]).collect();
+        let rate: Vec<[f64; 2]> = (0..=300).map(|e| [e as f64, 0.8 - 0.002 * e as f64]).collect();
+        let svg = curves("t", "episode", &[("return", vec![("sac", ret)]), ("collision rate", vec![("sac", rate)])]);
+        let labels = |class: &str| -> Vec<f64> {
+            let marker = format!("class=\"{class}\"");
+            svg.split(&marker).skip(1).filter_map(|r| r.split('>').nth(1)?.split('<').next()?.parse().ok()).collect()
+        };
+        let (y, x) = (labels("y-tick"), labels("x-tick"));
+        // return -40..71: ticks every 20 from -40; rate 0.2..0.8: every 0.1 or 0.2
+        assert!(y.contains(&-40.0) && y.contains(&60.0) && y.contains(&0.2) && y.contains(&0.8), "{y:?}");
+        assert!(y.iter().all(|v| (-40.0..=71.0).contains(v)), "a tick outside its panel's range: {y:?}");
+        assert_eq!(x.iter().filter(|v| **v == 0.0 || **v == 300.0).count(), 4, "both ends, on both panels: {x:?}");
+        assert!(x.len() >= 8 && x.windows(2).all(|w| w[0] < w[1] || w[1] == 0.0), "{x:?}");
+        assert!(svg.contains(">episode</text>"));
     }
 
     #[test]
