@@ -189,8 +189,10 @@ fn every_example_keeps_its_meaning_in_scenic() {
     let programs = emit(&examples, &dir, &tracer);
     let files: Vec<PathBuf> = programs.iter().map(|p| p.file.clone()).collect();
     let started = Instant::now();
-    let traces =
-        tracer.run(&files, &TraceOptions { seeds: (0..seeds).collect(), steps: STEPS, ..TraceOptions::default() });
+    // one Scenic process a core: the traces do not depend on how the files are batched
+    let jobs = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let traces = tracer
+        .run(&files, &TraceOptions { seeds: (0..seeds).collect(), steps: STEPS, jobs, ..TraceOptions::default() });
     let seconds = started.elapsed().as_secs_f64();
     let mut table = String::new();
     let _ = writeln!(
