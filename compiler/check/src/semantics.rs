@@ -62,7 +62,7 @@ pub fn check(
     if let Some(ego) = ego {
         let behaviors = entries(vocabulary, "behavior", ego.attr("behavior"));
         for behavior in &behaviors {
-            performers(Some(behavior), ego.attr("behavior"), EGO_KIND, "the ego vehicle", out);
+            performers(vocabulary, Some(behavior), ego.attr("behavior"), EGO_KIND, "the ego vehicle", out);
         }
         let kind = vocabulary.get("actor_kind", EGO_KIND);
         speeds(ego.attr("speed"), &behaviors, kind, None, context, "the ego vehicle", out);
@@ -96,7 +96,7 @@ pub fn check(
         let behaviors = entries(vocabulary, "behavior", behavior_attr);
         if let Some(kind) = actor_kind {
             for behavior in &behaviors {
-                performers(Some(behavior), behavior_attr, kind, &what, out);
+                performers(vocabulary, Some(behavior), behavior_attr, kind, &what, out);
             }
         }
         let kind = actor_kind.and_then(|k| vocabulary.get("actor_kind", k));
@@ -276,25 +276,49 @@ fn lanes_check(
     }
 }
 
-fn performers(behavior: Option<&Entry>, attr: Option<&Attr>, kind: &str, what: &str, out: &mut Vec<Diagnostic>) {
+/// E0502: a behavior its actor kind does not perform. The help names the kind's own
+/// behaviors of the same sort (keeping still when the rejected one has a `max_speed`, else
+/// moving), in declaration order; the fix takes the first when the field holds one name.
+fn performers(
+    vocabulary: &Vocabulary,
+    behavior: Option<&Entry>,
+    attr: Option<&Attr>,
+    kind: &str,
+    what: &str,
+    out: &mut Vec<Diagnostic>,
+) {
     let (Some(behavior), Some(attr)) = (behavior, attr) else { return };
     let Some(performers) = behavior.symbols("performers") else { return };
-    if !performs(behavior, kind) {
-        out.push(
-            Diagnostic::new(
-                Code::E0502,
-                format!("{what} cannot `{}`: it is a {kind}", behavior.name),
-                attr.value_span,
-                format!("not something a {kind} does"),
-            )
-            .with_payload(Payload::Incompatible {
-                subject: kind.to_string(),
-                value: behavior.name.clone(),
-                allowed: performers.iter().map(|p| p.to_string()).collect(),
-            })
-            .with_note(format!("`{}` is done by {}", behavior.name, quoted(&performers))),
-        );
+    if performs(behavior, kind) {
+        return;
     }
+    let still = behavior.speed("max_speed").is_some();
+    let instead: Vec<&str> = vocabulary
+        .entries("behavior")
+        .into_iter()
+        .filter(|b| performs(b, kind) && b.speed("max_speed").is_some() == still)
+        .map(|b| b.name.as_str())
+        .collect();
+    let mut d = Diagnostic::new(
+        Code::E0502,
+        format!("{what} cannot `{}`: it is a {kind}", behavior.name),
+        attr.value_span,
+        format!("not something a {kind} does"),
+    )
+    .with_payload(Payload::Incompatible {
+        subject: kind.to_string(),
+        value: behavior.name.clone(),
+        allowed: performers.iter().map(|p| p.to_string()).collect(),
+    })
+    .with_note(format!("`{}` is done by {}", behavior.name, quoted(&performers)));
+    if let Some(first) = instead.first() {
+        let sort = if still { "keeps still" } else { "moves" };
+        d = d.with_help(format!("a {kind} {sort} with {}", quoted(&instead)));
+        if attr.symbol().is_some() {
+            d = d.with_fix(attr.value_span, *first, Applicability::MaybeIncorrect);
+        }
+    }
+    out.push(d);
 }
 
 /// A speed, or a range of speeds, judged by its bounds, in order: its upper bound against
