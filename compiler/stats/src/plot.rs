@@ -384,27 +384,13 @@ pub fn scatter_axes(title: &str, axes: (&str, &str), sets: &[(&str, Vec<[f64; 2]
         out,
         "<rect class=\"plot-area\" x=\"{left}\" y=\"{top}\" width=\"{size}\" height=\"{size}\" fill=\"none\" stroke=\"#999\"/>"
     );
-    for vx in nice_ticks(x0, x1) {
-        let x = px(vx);
-        let _ = writeln!(
-            out,
-            "<line x1=\"{x:.1}\" y1=\"{top}\" x2=\"{x:.1}\" y2=\"{:.1}\" stroke=\"#eee\"/><text x=\"{x:.1}\" y=\"{:.1}\" font-size=\"10\" text-anchor=\"middle\">{}</text>",
-            top + size,
-            top + size + 14.0,
-            tick(vx)
-        );
-    }
-    for vy in nice_ticks(y0, y1) {
-        let y = py(vy);
-        let _ = writeln!(
-            out,
-            "<line x1=\"{left}\" y1=\"{y:.1}\" x2=\"{:.1}\" y2=\"{y:.1}\" stroke=\"#eee\"/><text x=\"{:.1}\" y=\"{:.1}\" font-size=\"10\" text-anchor=\"end\">{}</text>",
-            left + size,
-            left - 5.0,
-            y + 3.5,
-            tick(vy)
-        );
-    }
+    let frame = Frame { left, top, width: size, height: size };
+    grid(
+        &mut out,
+        &frame,
+        nice_ticks(x0, x1).into_iter().map(|v| (v, px(v))),
+        nice_ticks(y0, y1).into_iter().map(|v| (v, py(v))),
+    );
     for (c, (name, points)) in sets.iter().enumerate() {
         let _ = write!(
             out,
@@ -466,6 +452,39 @@ fn tick(v: f64) -> String {
     if s.starts_with('-') && s.trim_start_matches(['-', '0', '.']).is_empty() { s[1..].to_string() } else { s }
 }
 
+/// A plot's frame, in pixels.
+struct Frame {
+    left: f64,
+    top: f64,
+    width: f64,
+    height: f64,
+}
+
+/// Grid lines across `frame` at each tick, labelled below it (`x-tick`) and left of it
+/// (`y-tick`); a tick is its value and its pixel.
+fn grid(out: &mut String, frame: &Frame, xs: impl Iterator<Item = (f64, f64)>, ys: impl Iterator<Item = (f64, f64)>) {
+    let Frame { left, top, width, height } = *frame;
+    for (value, x) in xs {
+        let _ = writeln!(
+            out,
+            "<line x1=\"{x:.1}\" y1=\"{top}\" x2=\"{x:.1}\" y2=\"{:.1}\" stroke=\"#eee\"/><text class=\"x-tick\" x=\"{x:.1}\" y=\"{:.1}\" font-size=\"10\" text-anchor=\"middle\" {FONT}>{}</text>",
+            top + height,
+            top + height + 14.0,
+            tick(value)
+        );
+    }
+    for (value, y) in ys {
+        let _ = writeln!(
+            out,
+            "<line x1=\"{left}\" y1=\"{y:.1}\" x2=\"{:.1}\" y2=\"{y:.1}\" stroke=\"#eee\"/><text class=\"y-tick\" x=\"{:.1}\" y=\"{:.1}\" font-size=\"10\" text-anchor=\"end\" {FONT}>{}</text>",
+            left + width,
+            left - 5.0,
+            y + 3.5,
+            tick(value)
+        );
+    }
+}
+
 /// A panel of [`curves`]: its y label and its named series of (x, y) points.
 pub type Panel<'a> = (&'a str, Vec<(&'a str, Vec<[f64; 2]>)>);
 
@@ -500,27 +519,10 @@ pub fn curves(title: &str, x_label: &str, panels: &[Panel]) -> String {
             out,
             "<rect x=\"{margin}\" y=\"{top}\" width=\"{plot_w}\" height=\"{plot_h}\" fill=\"none\" stroke=\"#999\"/>"
         );
-        for value in nice_ticks(y0, y1) {
-            let y = top + plot_h * (1.0 - (value - y0) / sy);
-            let _ = writeln!(
-                out,
-                "<line x1=\"{margin}\" y1=\"{y:.1}\" x2=\"{:.1}\" y2=\"{y:.1}\" stroke=\"#eee\"/><text class=\"y-tick\" x=\"{:.1}\" y=\"{:.1}\" font-size=\"10\" text-anchor=\"end\" {FONT}>{}</text>",
-                margin + plot_w,
-                margin - 4.0,
-                y + 3.5,
-                tick(value)
-            );
-        }
-        for value in nice_ticks(x0, x1) {
-            let x = margin + plot_w * (value - x0) / sx;
-            let _ = writeln!(
-                out,
-                "<line x1=\"{x:.1}\" y1=\"{top}\" x2=\"{x:.1}\" y2=\"{:.1}\" stroke=\"#eee\"/><text class=\"x-tick\" x=\"{x:.1}\" y=\"{:.1}\" font-size=\"10\" text-anchor=\"middle\" {FONT}>{}</text>",
-                top + plot_h,
-                top + plot_h + 13.0,
-                tick(value)
-            );
-        }
+        let frame = Frame { left: margin, top, width: plot_w, height: plot_h };
+        let xs = nice_ticks(x0, x1).into_iter().map(|v| (v, margin + plot_w * (v - x0) / sx));
+        let ys = nice_ticks(y0, y1).into_iter().map(|v| (v, top + plot_h * (1.0 - (v - y0) / sy)));
+        grid(&mut out, &frame, xs, ys);
         let _ = writeln!(
             out,
             "<text x=\"{}\" y=\"{}\" font-size=\"12\" {FONT}>{}</text>",
