@@ -24,11 +24,11 @@ macro_rules! template {
 }
 
 template!(DESCRIBE, "describe.v1");
-template!(TRANSLATE, "translate.v3");
+template!(TRANSLATE, "translate.v2");
 template!(GENERATE, "generate.v1");
 template!(GENERATE_TUNED, "generate-tuned.v1");
 template!(REPAIR, "repair.v1");
-template!(REFINE, "refine.v2");
+template!(REFINE, "refine.v1");
 template!(REFINE_DESCRIPTION, "refine-description.v1");
 
 pub const ALL: &[Template] = &[DESCRIBE, TRANSLATE, GENERATE, GENERATE_TUNED, REPAIR, REFINE, REFINE_DESCRIPTION];
