@@ -3,7 +3,9 @@
 //!
 //! With a constraint (llguidance's Lark, or a JSON Schema) every step's logits are masked to
 //! the tokens that keep the output in the grammar, and the end of the answer is allowed only
-//! where the grammar accepts: what comes out parses.
+//! where the grammar accepts: what comes out parses. The mask is computed before the output
+//! projection, which then computes only the allowed tokens' rows (Qwen2.5-Coder-1.5B's
+//! untied 151,936-row head is about a sixth of a step's arithmetic).
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -20,7 +22,7 @@ use tokenizers::Tokenizer;
 use toktrie::{TokEnv, TokRxInfo, TokTrie, TokenId, TokenizerEnv};
 
 use crate::adapter::Adapter;
-use crate::llama::{Cache, Model};
+use crate::llama::{Cache, Last, Model};
 use crate::prompts::PromptStore;
 
 pub struct Engine {
@@ -261,11 +263,11 @@ impl Engine {
         self.store = Some(PromptStore::new(dir, self.identity));
     }
 
-    /// Reads `prompt` into the cache and returns the logits after it: from the cached
+    /// Reads `prompt` into the cache and returns its last token's state: from the cached
     /// system message when the prompt starts with it (in memory, else in the store), else
     /// from the start, remembering this prompt's first message as the new prefix (and
     /// keeping it in the store). Also returns how many tokens were read.
-    fn prefill(&mut self, prompt: &[u32], first: usize) -> (Vec<f32>, usize) {
+    fn prefill(&mut self, prompt: &[u32], first: usize) -> (Last, usize) {
         let cached = self.prefix.as_ref().filter(|p| prompt.len() > p.len() && prompt.starts_with(p));
         let has_prefix = first > 0 && first < prompt.len();
         let done = match cached {
@@ -294,7 +296,7 @@ impl Engine {
                 }
             }
         };
-        let logits = self.model.forward(&prompt[done..], &mut self.cache);
+        let last = self.model.read(&prompt[done..], &mut self.cache);
         if done == 0
             && has_prefix
             && let Some(store) = &self.store
@@ -302,7 +304,7 @@ impl Engine {
             // a cache that cannot be written costs the next process a prefill, nothing more
             let _ = store.save(&prompt[..first], &self.cache);
         }
-        (logits, prompt.len() - done)
+        (last, prompt.len() - done)
     }
 
     /// The model's weights in memory, and the dot-product kernels chosen for this CPU.
@@ -371,7 +373,7 @@ impl Engine {
         let mut sampler = LogitsProcessor::new(request.seed.unwrap_or(0), temperature, None);
 
         let start = Instant::now();
-        let (mut logits, read) = self.prefill(&prompt, first);
+        let (mut last, read) = self.prefill(&prompt, first);
         self.timing.prefill_tokens += read as u64;
         self.timing.prefill_s += start.elapsed().as_secs_f64();
 
@@ -380,17 +382,17 @@ impl Engine {
         let mut finish = Finish::Length;
         let mut emitted = 0;
         for _ in 0..request.max_tokens as usize {
-            let mut row = std::mem::take(&mut logits);
-            if let Some(m) = matcher.as_mut() {
-                let t = Instant::now();
-                let mask = m.compute_mask().map_err(|e| failed("grammar", e))?;
-                for (i, value) in row.iter_mut().enumerate() {
-                    if !mask.is_allowed(i as TokenId) {
-                        *value = f32::NEG_INFINITY;
-                    }
+            // with a grammar, only the allowed tokens' logits are computed
+            let allowed = match matcher.as_mut() {
+                Some(m) => {
+                    let t = Instant::now();
+                    let mask = m.compute_mask().map_err(|e| failed("grammar", e))?;
+                    self.timing.mask_s += t.elapsed().as_secs_f64();
+                    Some(mask.to_list())
                 }
-                self.timing.mask_s += t.elapsed().as_secs_f64();
-            }
+                None => None,
+            };
+            let row = self.model.logits(&last, allowed.as_deref());
             let masked = Tensor::new(row.as_slice(), &Device::Cpu).map_err(|e| failed("logits", e))?;
             let token = sampler.sample(&masked).map_err(|e| failed("sampling", e))?;
             let end = token == self.im_end || Some(token) == self.end_of_text;
@@ -411,7 +413,7 @@ impl Engine {
             if let Some(f) = on_text.as_mut() {
                 emitted = self.stream_text(&out, emitted, *f);
             }
-            logits = self.model.forward(&[token], &mut self.cache);
+            last = self.model.read(&[token], &mut self.cache);
         }
         self.timing.decode_tokens += out.len() as u64;
         self.timing.decode_s += decode_start.elapsed().as_secs_f64();

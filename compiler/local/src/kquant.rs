@@ -284,6 +284,20 @@ mod avx2 {
         }
     }
 
+    /// As [`add`] for `q` in 0..16, which `maddubs` takes unsigned as it is (the same
+    /// integers without the two sign steps).
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    fn add_unsigned<const N: usize>(acc: &mut [__m256; N], q: __m256i, w: f32, x: [&Q8_1; N]) {
+        let ones = _mm256_set1_epi16(1);
+        for (acc, x) in acc.iter_mut().zip(x) {
+            // SAFETY: 32 bytes, an unaligned load
+            let xq = unsafe { _mm256_loadu_si256(x.qs.as_ptr().cast()) };
+            let sums = _mm256_madd_epi16(_mm256_maddubs_epi16(q, xq), ones);
+            *acc = _mm256_fmadd_ps(_mm256_set1_ps(w * x.d), _mm256_cvtepi32_ps(sums), *acc);
+        }
+    }
+
     #[target_feature(enable = "avx2,fma")]
     #[inline]
     fn hsum(v: __m256) -> f32 {
@@ -325,7 +339,7 @@ mod avx2 {
 
     #[target_feature(enable = "avx2,fma")]
     fn q4_k<const N: usize>(w: &[Q4K], x: [&[Q8_1]; N]) -> [f32; N] {
-        let (low, ones) = (_mm256_set1_epi8(0x0f), _mm256_set1_epi16(1));
+        let low = _mm256_set1_epi8(0x0f);
         let mut acc = [_mm256_setzero_ps(); N];
         let mut mins = [0f32; N];
         for (i, b) in w.iter().enumerate() {
@@ -337,7 +351,7 @@ mod avx2 {
                     let sub = 2 * pair + h;
                     let Some(xs) = blocks(&x, i * (SUPER / BLOCK) + sub) else { return finish(acc, mins) };
                     let (sc, m) = b.scale_min(sub);
-                    add(&mut acc, q, ones, b.d * sc as f32, xs);
+                    add_unsigned(&mut acc, q, b.d * sc as f32, xs);
                     for (min, x) in mins.iter_mut().zip(xs) {
                         *min += b.dmin * m as f32 * x.s;
                     }

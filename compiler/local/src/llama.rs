@@ -109,6 +109,30 @@ impl Matrix {
         }
     }
 
+    /// Each listed row against `x` (one token), the unlisted rows −∞; listed rows past the
+    /// matrix are ignored. With a pool, workers take parts of the list.
+    fn product_rows(&self, k: &Kernels, x: &[Q8_1], list: &[u32], pool: Option<&rayon::ThreadPool>) -> Vec<f32> {
+        let rows = self.rows();
+        let list: Vec<usize> = list.iter().map(|&r| r as usize).filter(|&r| r < rows).collect();
+        let mut values = vec![0f32; list.len()];
+        match pool.filter(|p| p.current_num_threads() > 1 && list.len() > 1) {
+            None => values.iter_mut().zip(&list).for_each(|(v, &r)| *v = self.row(k, r, x)),
+            Some(pool) => {
+                let per = list.len().div_ceil(pool.current_num_threads());
+                pool.scope(|s| {
+                    for (part, rs) in values.chunks_mut(per).zip(list.chunks(per)) {
+                        s.spawn(move |_| part.iter_mut().zip(rs).for_each(|(v, &r)| *v = self.row(k, r, x)));
+                    }
+                });
+            }
+        }
+        let mut out = vec![f32::NEG_INFINITY; rows];
+        for (&r, v) in list.iter().zip(values) {
+            out[r] = v;
+        }
+        out
+    }
+
     /// `out[t·rows + r] = row r · x[t]` for each token `t` of the chunk; each row is read
     /// once for all the chunk's tokens. With a pool, workers take ranges of rows.
     fn product(&self, k: &Kernels, x: &[Vec<Q8_1>], out: &mut [f32], pool: Option<&rayon::ThreadPool>) {
@@ -145,6 +169,9 @@ impl Matrix {
         }
     }
 }
+
+/// The last token's final state, normalized and quantized for the output projection.
+pub struct Last(Vec<Q8_1>);
 
 /// The row `w` against the tokens `x`, four at a time, the rest one by one.
 fn fours<B>(w: &[B], x: &[Vec<Q8_1>], k: quant::FormatKernels<B>, out: &mut Vec<f32>) {
@@ -438,15 +465,39 @@ impl Model {
 
     /// Reads `tokens` after what `cache` holds and returns the logits after the last one.
     pub fn forward(&mut self, tokens: &[u32], cache: &mut Cache) -> Vec<f32> {
-        const CHUNK: usize = 64;
-        let mut logits = Vec::new();
-        for chunk in tokens.chunks(CHUNK) {
-            logits = self.forward_chunk(chunk, cache);
-        }
-        logits
+        let last = self.read(tokens, cache);
+        self.logits(&last, None)
     }
 
-    fn forward_chunk(&mut self, tokens: &[u32], cache: &mut Cache) -> Vec<f32> {
+    /// Reads `tokens` after what `cache` holds and returns the last one's final state, for
+    /// [`Model::logits`].
+    pub fn read(&mut self, tokens: &[u32], cache: &mut Cache) -> Last {
+        const CHUNK: usize = 64;
+        let mut last = Last(Vec::new());
+        for chunk in tokens.chunks(CHUNK) {
+            last = self.forward_chunk(chunk, cache);
+        }
+        last
+    }
+
+    /// The output projection of `last`: every token's logit, or with `only`, those of the
+    /// listed tokens and −∞ for the others. A listed token's logit is the one the whole
+    /// projection gives, bit for bit (its row is computed alone either way), so a grammar's
+    /// allowed tokens are all a constrained step needs.
+    pub fn logits(&self, last: &Last, only: Option<&[u32]>) -> Vec<f32> {
+        let head = self.output.as_ref().unwrap_or(&self.embedding);
+        let pool = self.pool.as_ref();
+        match only {
+            None => {
+                let mut logits = vec![0f32; head.rows()];
+                head.product(&self.kernels, std::slice::from_ref(&last.0), &mut logits, pool);
+                logits
+            }
+            Some(tokens) => head.product_rows(&self.kernels, &last.0, tokens, pool),
+        }
+    }
+
+    fn forward_chunk(&mut self, tokens: &[u32], cache: &mut Cache) -> Last {
         let Shape { dim, hidden, heads, kv_heads, head_dim, eps, .. } = self.shape;
         let n = tokens.len();
         let start = cache.len;
@@ -563,12 +614,9 @@ impl Model {
         let last = &x[(n - 1) * dim..];
         let mut out = vec![0f32; dim];
         rms_norm(last, &self.output_norm, eps, dim, &mut out);
-        let mut lq = vec![Vec::new()];
-        quant::quantize(&out, &mut lq[0]);
-        let head = self.output.as_ref().unwrap_or(&self.embedding);
-        let mut logits = vec![0f32; head.rows()];
-        head.product(k, &lq, &mut logits, pool);
-        logits
+        let mut lq = Vec::new();
+        quant::quantize(&out, &mut lq);
+        Last(lq)
     }
 }
 
@@ -774,6 +822,22 @@ mod tests {
         let mut two = Model::load(&Content::read(&mut file3).unwrap(), &mut file3, 2).unwrap();
         let mut cache = two.new_cache();
         assert_eq!(two.forward(&tokens, &mut cache), chunked);
+
+        // the listed rows alone (a grammar's allowed tokens) are the whole projection's
+        // values, on one thread and on two; the others are −∞
+        let listed = [0, 7, 260, 23346, 49151, 49152, u32::MAX];
+        for (model, what) in [(&mut ours, "one thread"), (&mut two, "two threads")] {
+            let mut cache = model.new_cache();
+            let last = model.read(&tokens, &mut cache);
+            let some = model.logits(&last, Some(&listed));
+            assert_eq!(some.len(), chunked.len(), "{what}");
+            for (r, (&a, &b)) in some.iter().zip(&chunked).enumerate() {
+                match listed.contains(&(r as u32)) {
+                    true => assert_eq!(a.to_bits(), b.to_bits(), "row {r}, {what}"),
+                    false => assert_eq!(a, f32::NEG_INFINITY, "row {r}, {what}"),
+                }
+            }
+        }
 
         // a token at a time (decoding) reads the same as a chunk (prefill)
         let mut cache = ours.new_cache();
