@@ -24,7 +24,7 @@ use crate::{BenchError, Report, proc_status_kib};
 
 /// What `bench --llm` measures.
 pub struct LlmArgs {
-    /// llama.cpp's server for the peer (else `TADSL_LLAMA_SERVER`; without one the peer is
+    /// llama.cpp's server for the peer (else `TADSL_LLAMA_SERVER`, unless empty; without one the peer is
     /// skipped).
     pub llama_server: Option<PathBuf>,
     pub threads: usize,
@@ -102,8 +102,17 @@ pub fn run(args: &LlmArgs, progress: &mut dyn FnMut(&str)) -> Result<Report, Ben
         gguf.display()
     ));
 
+    // a peer that cannot be started is found out before the local model's minutes are spent
+    let server = args
+        .llama_server
+        .clone()
+        .or_else(|| std::env::var_os("TADSL_LLAMA_SERVER").filter(|v| !v.is_empty()).map(PathBuf::from));
+    if let Some(server) = server.as_ref().filter(|s| !s.is_file()) {
+        return Err(BenchError(format!("no llama-server at `{}`", server.display())));
+    }
+
     let (local, prompts, local_texts) = measure_local(&gguf, args.threads, &requests, &lark, progress)?;
-    let peer = match args.llama_server.clone().or_else(|| std::env::var_os("TADSL_LLAMA_SERVER").map(PathBuf::from)) {
+    let peer = match server {
         Some(server) => Some(measure_server(&server, &gguf, args.threads, &prompts, args.max_tokens, &gbnf)?),
         None => {
             progress("no llama-server (--llama-server PATH or TADSL_LLAMA_SERVER): the peer is skipped");

@@ -176,3 +176,15 @@ fn an_adapter_brings_the_model_it_was_trained_on() {
     let out = run(&args);
     assert!(stdout(&out).contains("with model local smollm2-135m"), "{}\n{}", stdout(&out), stderr(&out));
 }
+
+#[test]
+fn bench_llm_with_a_missing_peer_fails_before_measuring() {
+    if !installed() {
+        return;
+    }
+    let args = ["bench", "--llm", "--model", SMALLEST, "--llama-server", "/nonexistent/llama-server"];
+    let out = run(&args);
+    assert_eq!(code(&out), 2, "{}", stderr(&out));
+    assert!(stderr(&out).contains("bench --llm: no llama-server at `/nonexistent/llama-server`"), "{}", stderr(&out));
+    assert!(!stderr(&out).contains("tad-local:"), "the local model was measured first: {}", stderr(&out));
+}
