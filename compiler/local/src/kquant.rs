@@ -3,15 +3,20 @@
 //! sub-blocks of 32, each with a 6-bit scale and minimum) and Q6_K (sixteen sub-blocks of 16,
 //! each with an 8-bit scale).
 //!
-//! Their dot products take the same activations as the other kernels: blocks of 32 values
-//! quantized to 8 bits with their sum ([`Q8_1`]), eight to a super-block. Each block's
-//! integer sum is scaled once, so a product is the dequantized weights against the
-//! dequantized activations, up to float rounding. The scalar kernels unpack a block's
-//! small integers and sum; the AVX2 ones do the same on the packed bytes, 32 values a step,
-//! and differ from them only in the order of the float additions.
+//! Q5_0 takes the activations the other 32-value formats take ([`Q8_1`]). The K formats
+//! take theirs as llama.cpp does, a super-block at a time ([`Q8K`]: one scale for 256
+//! values, and the sum of every 16 of them). A super-block's product is then one integer
+//! sum, with each sub-block's scale applied as an integer: a Q4_K minimum meets the
+//! activations' sums of 16, and Q6_K's offset of 32 is taken off the same way, so its
+//! values go into the multiply unsigned. The floats enter once per 256 values.
+//! The scalar kernels unpack a block's small integers and sum; the AVX2 ones do the same on
+//! the packed bytes, 32 values a step. For the K formats the two are the same integers
+//! scaled in the same order, so they give the same bits; for Q5_0 they differ in the order
+//! of the float additions.
 //!
-//! The layouts are ggml's (`ggml-common.h`, `block_q5_0`, `block_q4_K`, `block_q6_K`); the
-//! tests hold the dequantization to candle's on random blocks and on the real files.
+//! The layouts are ggml's (`ggml-common.h`, `block_q5_0`, `block_q4_K`, `block_q6_K`,
+//! `block_q8_K`); the tests hold the dequantization to candle's on random blocks and on the
+//! real files.
 
 use crate::quant::{BLOCK, FormatKernels, Q8_1, f16_to_f32};
 
@@ -37,6 +42,43 @@ pub struct Q4K {
     /// Per 64 values: the first 32 in the low nibbles of 32 bytes, the next 32 in their
     /// high nibbles.
     pub qs: [u8; 128],
+}
+
+/// Activations for the K formats: `d·q` over 256 values, q in −127..=127, and `bsums[j]`
+/// the sum of the `q` of values `16j..16j + 16`.
+#[derive(Clone, Copy, Debug)]
+pub struct Q8K {
+    pub d: f32,
+    pub qs: [i8; SUPER],
+    pub bsums: [i16; 16],
+}
+
+impl Default for Q8K {
+    fn default() -> Self {
+        Q8K { d: 0.0, qs: [0; SUPER], bsums: [0; 16] }
+    }
+}
+
+/// Quantizes `x` into `out`, a super-block per 256 values (a shorter tail is left out: the
+/// K formats' rows are whole super-blocks). As ggml's `quantize_row_q8_K`, the value of
+/// largest magnitude goes to −127 and the rest round to nearest, ties to even.
+pub fn quantize_k(x: &[f32], out: &mut Vec<Q8K>) {
+    out.clear();
+    for chunk in x.chunks_exact(SUPER) {
+        let max = chunk.iter().fold(0f32, |m, &v| if v.abs() > m.abs() { v } else { m });
+        let mut block = Q8K::default();
+        if max != 0.0 && max.is_finite() {
+            let inverse = -127.0 / max;
+            for (q, &v) in block.qs.iter_mut().zip(chunk) {
+                *q = (inverse * v).round_ties_even().min(127.0) as i8;
+            }
+            for (sum, q) in block.bsums.iter_mut().zip(block.qs.chunks_exact(16)) {
+                *sum = q.iter().map(|&q| q as i16).sum();
+            }
+            block.d = 1.0 / inverse;
+        }
+        out.push(block);
+    }
 }
 
 /// `d·sc_b·(q − 32)` for sub-block `b = position / 16`, q in 0..64: four bits in `ql`, two in `qh`.
@@ -121,6 +163,15 @@ impl Q4K {
         }
     }
 
+    /// The eight scales and the eight minima.
+    fn scales_mins(&self) -> ([u8; 8], [u8; 8]) {
+        let (mut scales, mut mins) = ([0; 8], [0; 8]);
+        for j in 0..8 {
+            (scales[j], mins[j]) = self.scale_min(j);
+        }
+        (scales, mins)
+    }
+
     /// The 256 values as integers in 0..16, in order.
     fn values(&self) -> [u8; SUPER] {
         let mut q = [0u8; SUPER];
@@ -196,36 +247,38 @@ pub fn dot_q5_0(w: &[Q5_0], x: &[Q8_1]) -> f32 {
     w.iter().zip(x).map(|(b, x)| b.d * x.d * isum(&b.values(), &x.qs) as f32).sum()
 }
 
-/// Q4_K super-blocks against eight activation blocks each: per sub-block
-/// `d·sc·dx·Σq·x − dmin·m·s` (the minimum meets the activations' sum).
-pub fn dot_q4_k(w: &[Q4K], x: &[Q8_1]) -> f32 {
+/// Q4_K super-blocks against as many activation super-blocks: per super-block
+/// `d·dx·Σ sc·Σq·x − dmin·dx·Σ m·Σx` (a minimum meets its sub-block's two sums of 16).
+pub fn dot_q4_k(w: &[Q4K], x: &[Q8K]) -> f32 {
     let mut total = 0.0;
-    for (b, x) in w.iter().zip(x.chunks_exact(SUPER / BLOCK)) {
-        let q = b.values();
-        for (sub, (q, x)) in q.chunks_exact(BLOCK).zip(x).enumerate() {
-            let (sc, m) = b.scale_min(sub);
-            total += b.d * sc as f32 * x.d * isum(q, &x.qs) as f32 - b.dmin * m as f32 * x.s;
+    for (b, x) in w.iter().zip(x) {
+        let (q, (scales, mins)) = (b.values(), b.scales_mins());
+        let (mut sum, mut min) = (0i32, 0i32);
+        for sub in 0..SUPER / BLOCK {
+            let at = BLOCK * sub..BLOCK * (sub + 1);
+            sum += scales[sub] as i32 * isum(&q[at.clone()], &x.qs[at]);
+            min += mins[sub] as i32 * (x.bsums[2 * sub] as i32 + x.bsums[2 * sub + 1] as i32);
         }
+        total += b.d * x.d * sum as f32 - b.dmin * x.d * min as f32;
     }
     total
 }
 
-/// Q6_K super-blocks against eight activation blocks each: per 16 values `d·sc·dx·Σq·x`.
-pub fn dot_q6_k(w: &[Q6K], x: &[Q8_1]) -> f32 {
+/// Q6_K super-blocks against as many activation super-blocks: `d·dx·Σ sc·Σq·x` per 16 values.
+pub fn dot_q6_k(w: &[Q6K], x: &[Q8K]) -> f32 {
     let mut total = 0.0;
-    for (b, x) in w.iter().zip(x.chunks_exact(SUPER / BLOCK)) {
+    for (b, x) in w.iter().zip(x) {
         let q = b.values();
-        for (sub, q) in q.chunks_exact(16).enumerate() {
-            let x = &x[sub / 2];
-            let qs = &x.qs[16 * (sub % 2)..16 * (sub % 2) + 16];
-            total += b.d * b.scales[sub] as f32 * x.d * isum(q, qs) as f32;
-        }
+        let sum: i32 = (0..16)
+            .map(|sub| b.scales[sub] as i32 * isum(&q[16 * sub..16 * sub + 16], &x.qs[16 * sub..16 * sub + 16]))
+            .sum();
+        total += b.d * x.d * sum as f32;
     }
     total
 }
 
 /// The three formats' kernels.
-pub type Formats = (FormatKernels<Q5_0>, FormatKernels<Q4K>, FormatKernels<Q6K>);
+pub type Formats = (FormatKernels<Q5_0>, FormatKernels<Q4K, Q8K>, FormatKernels<Q6K, Q8K>);
 
 /// The AVX2 kernels; only for a CPU [`crate::quant::Kernels::detect`] found them on.
 #[cfg(target_arch = "x86_64")]
@@ -245,13 +298,15 @@ pub fn scalar_kernels() -> Formats {
     )
 }
 
-/// The same products on packed blocks, 32 values a step: a block's values as signed bytes,
-/// their products with a token's in 16-bit pairs (`maddubs` through the sign trick),
-/// summed to eight 32-bit lanes against 16-bit scales, scaled and accumulated in floats.
-/// Each block is unpacked once for all the tokens of a call.
+/// The same products on packed blocks, 32 values a step: a block's values as bytes, their
+/// products with a token's in 16-bit pairs (`maddubs`; Q5_0's signed values through the sign
+/// trick), summed to eight 32-bit lanes against 16-bit scales. Q5_0 scales and accumulates
+/// the lanes in floats per block; the K formats sum them as integers over a super-block and
+/// scale that as the scalar kernels do. Each block is unpacked once for all the tokens of
+/// a call.
 #[cfg(target_arch = "x86_64")]
 mod avx2 {
-    use super::{BLOCK, Q4K, Q5_0, Q6K, Q8_1, SUPER};
+    use super::{BLOCK, Q4K, Q5_0, Q6K, Q8_1, Q8K};
     use std::arch::x86_64::*;
 
     pub fn q5_0_safe<const N: usize>(w: &[Q5_0], x: [&[Q8_1]; N]) -> [f32; N] {
@@ -259,12 +314,12 @@ mod avx2 {
         unsafe { q5_0(w, x) }
     }
 
-    pub fn q4_k_safe<const N: usize>(w: &[Q4K], x: [&[Q8_1]; N]) -> [f32; N] {
+    pub fn q4_k_safe<const N: usize>(w: &[Q4K], x: [&[Q8K]; N]) -> [f32; N] {
         // SAFETY: as above
         unsafe { q4_k(w, x) }
     }
 
-    pub fn q6_k_safe<const N: usize>(w: &[Q6K], x: [&[Q8_1]; N]) -> [f32; N] {
+    pub fn q6_k_safe<const N: usize>(w: &[Q6K], x: [&[Q8K]; N]) -> [f32; N] {
         // SAFETY: as above
         unsafe { q6_k(w, x) }
     }
@@ -280,20 +335,6 @@ mod avx2 {
             let xq = unsafe { _mm256_loadu_si256(x.qs.as_ptr().cast()) };
             let pairs = _mm256_maddubs_epi16(magnitude, _mm256_sign_epi8(xq, q));
             let sums = _mm256_madd_epi16(pairs, scales);
-            *acc = _mm256_fmadd_ps(_mm256_set1_ps(w * x.d), _mm256_cvtepi32_ps(sums), *acc);
-        }
-    }
-
-    /// As [`add`] for `q` in 0..16, which `maddubs` takes unsigned as it is (the same
-    /// integers without the two sign steps).
-    #[target_feature(enable = "avx2,fma")]
-    #[inline]
-    fn add_unsigned<const N: usize>(acc: &mut [__m256; N], q: __m256i, w: f32, x: [&Q8_1; N]) {
-        let ones = _mm256_set1_epi16(1);
-        for (acc, x) in acc.iter_mut().zip(x) {
-            // SAFETY: 32 bytes, an unaligned load
-            let xq = unsafe { _mm256_loadu_si256(x.qs.as_ptr().cast()) };
-            let sums = _mm256_madd_epi16(_mm256_maddubs_epi16(q, xq), ones);
             *acc = _mm256_fmadd_ps(_mm256_set1_ps(w * x.d), _mm256_cvtepi32_ps(sums), *acc);
         }
     }
@@ -337,41 +378,77 @@ mod avx2 {
         Some(std::array::from_fn(|t| &x[t][i]))
     }
 
+    /// Super-blocks to go: as many as the row and every token have.
+    fn supers<const N: usize>(w: usize, x: &[&[Q8K]; N]) -> usize {
+        x.iter().map(|x| x.len()).fold(w, usize::min)
+    }
+
+    /// `sums += Σ maddubs(q, x)·scales`, the 32 activations at `x`.
     #[target_feature(enable = "avx2,fma")]
-    fn q4_k<const N: usize>(w: &[Q4K], x: [&[Q8_1]; N]) -> [f32; N] {
+    #[inline]
+    fn add_k(sums: &mut __m256i, q: __m256i, x: &[i8], scales: __m256i) {
+        debug_assert!(x.len() >= 32);
+        // SAFETY: 32 bytes, an unaligned load (the callers' slices are 32 long)
+        let xq = unsafe { _mm256_loadu_si256(x.as_ptr().cast()) };
+        *sums = _mm256_add_epi32(*sums, _mm256_madd_epi16(_mm256_maddubs_epi16(q, xq), scales));
+    }
+
+    /// The sum of eight 32-bit lanes.
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    fn hsum_i32(v: __m256i) -> i32 {
+        let v = _mm_add_epi32(_mm256_castsi256_si128(v), _mm256_extracti128_si256(v, 1));
+        let v = _mm_add_epi32(v, _mm_shuffle_epi32(v, 0b01_00_11_10));
+        let v = _mm_add_epi32(v, _mm_shuffle_epi32(v, 0b10_11_00_01));
+        _mm_cvtsi128_si32(v)
+    }
+
+    /// A token's sums of 16, as sixteen 16-bit lanes.
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    fn bsums(x: &Q8K) -> __m256i {
+        // SAFETY: 16 values of 2 bytes, an unaligned load
+        unsafe { _mm256_loadu_si256(x.bsums.as_ptr().cast()) }
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    fn q4_k<const N: usize>(w: &[Q4K], x: [&[Q8K]; N]) -> [f32; N] {
         let low = _mm256_set1_epi8(0x0f);
-        let mut acc = [_mm256_setzero_ps(); N];
-        let mut mins = [0f32; N];
-        for (i, b) in w.iter().enumerate() {
+        let mut totals = [0f32; N];
+        for (i, b) in w[..supers(w.len(), &x)].iter().enumerate() {
+            let (scales, mins) = b.scales_mins();
+            // each minimum twice, against the two sums of 16 of its sub-block
+            let mins: [i16; 16] = std::array::from_fn(|j| mins[j / 2] as i16);
+            // SAFETY: 16 values of 2 bytes, an unaligned load
+            let mins = unsafe { _mm256_loadu_si256(mins.as_ptr().cast()) };
+            let mut sums = [_mm256_setzero_si256(); N];
             for pair in 0..4 {
                 // SAFETY: 32 of the 128 bytes, an unaligned load
                 let packed = unsafe { _mm256_loadu_si256(b.qs.as_ptr().add(32 * pair).cast()) };
                 let halves = [_mm256_and_si256(packed, low), _mm256_and_si256(_mm256_srli_epi16(packed, 4), low)];
                 for (h, q) in halves.into_iter().enumerate() {
                     let sub = 2 * pair + h;
-                    let Some(xs) = blocks(&x, i * (SUPER / BLOCK) + sub) else { return finish(acc, mins) };
-                    let (sc, m) = b.scale_min(sub);
-                    add_unsigned(&mut acc, q, b.d * sc as f32, xs);
-                    for (min, x) in mins.iter_mut().zip(xs) {
-                        *min += b.dmin * m as f32 * x.s;
+                    let scale = _mm256_set1_epi16(scales[sub] as i16);
+                    for (sums, x) in sums.iter_mut().zip(x) {
+                        add_k(sums, q, &x[i].qs[BLOCK * sub..BLOCK * (sub + 1)], scale);
                     }
                 }
             }
+            for ((total, sums), x) in totals.iter_mut().zip(sums).zip(x) {
+                let x = &x[i];
+                let (sum, min) = (hsum_i32(sums), hsum_i32(_mm256_madd_epi16(mins, bsums(x))));
+                *total += b.d * x.d * sum as f32 - b.dmin * x.d * min as f32;
+            }
         }
-        finish(acc, mins)
+        totals
     }
 
     #[target_feature(enable = "avx2,fma")]
-    #[inline]
-    fn finish<const N: usize>(acc: [__m256; N], mins: [f32; N]) -> [f32; N] {
-        std::array::from_fn(|t| hsum(acc[t]) - mins[t])
-    }
-
-    #[target_feature(enable = "avx2,fma")]
-    fn q6_k<const N: usize>(w: &[Q6K], x: [&[Q8_1]; N]) -> [f32; N] {
-        let (low, top, offset) = (_mm256_set1_epi8(0x0f), _mm256_set1_epi8(0x30), _mm256_set1_epi8(32));
-        let mut acc = [_mm256_setzero_ps(); N];
-        for (i, b) in w.iter().enumerate() {
+    fn q6_k<const N: usize>(w: &[Q6K], x: [&[Q8K]; N]) -> [f32; N] {
+        let (low, top) = (_mm256_set1_epi8(0x0f), _mm256_set1_epi8(0x30));
+        let mut totals = [0f32; N];
+        for (i, b) in w[..supers(w.len(), &x)].iter().enumerate() {
+            let mut sums = [_mm256_setzero_si256(); N];
             for n in 0..2 {
                 // SAFETY: 32-byte unaligned loads inside ql (128 bytes) and qh (64)
                 let (ql0, ql1, qh) = unsafe {
@@ -381,6 +458,7 @@ mod avx2 {
                         _mm256_loadu_si256(b.qh.as_ptr().add(32 * n).cast()),
                     )
                 };
+                // the values unsigned, 0..64: the offset of 32 is taken off below
                 let quarters = [
                     _mm256_or_si256(_mm256_and_si256(ql0, low), _mm256_and_si256(_mm256_slli_epi16(qh, 4), top)),
                     _mm256_or_si256(_mm256_and_si256(ql1, low), _mm256_and_si256(_mm256_slli_epi16(qh, 2), top)),
@@ -392,15 +470,23 @@ mod avx2 {
                 ];
                 for (j, q) in quarters.into_iter().enumerate() {
                     let block = 4 * n + j;
-                    let Some(xs) = blocks(&x, i * (SUPER / BLOCK) + block) else { return acc.map(|a| hsum(a)) };
                     // each 16-value half by its own scale
                     let (s0, s1) = (b.scales[2 * block] as i16, b.scales[2 * block + 1] as i16);
                     let scales = _mm256_set_m128i(_mm_set1_epi16(s1), _mm_set1_epi16(s0));
-                    add(&mut acc, _mm256_sub_epi8(q, offset), scales, b.d, xs);
+                    for (sums, x) in sums.iter_mut().zip(x) {
+                        add_k(sums, q, &x[i].qs[BLOCK * block..BLOCK * (block + 1)], scales);
+                    }
                 }
             }
+            // SAFETY: 16 bytes, an unaligned load
+            let scales = _mm256_cvtepi8_epi16(unsafe { _mm_loadu_si128(b.scales.as_ptr().cast()) });
+            for ((total, sums), x) in totals.iter_mut().zip(sums).zip(x) {
+                let x = &x[i];
+                let offset = _mm256_slli_epi32(_mm256_madd_epi16(scales, bsums(x)), 5);
+                *total += b.d * x.d * hsum_i32(_mm256_sub_epi32(sums, offset)) as f32;
+            }
         }
-        acc.map(|a| hsum(a))
+        totals
     }
 }
 
@@ -468,25 +554,59 @@ mod tests {
     fn dot_products_are_the_dequantized_ones() {
         let mut rng = SplitMix64::new(9);
         let x: Vec<f32> = (0..4 * SUPER).map(|_| (rng.unit() as f32 - 0.5) * 3.0).collect();
-        let mut xq = Vec::new();
+        let (mut xq, mut xk) = (Vec::new(), Vec::new());
         quantize(&x, &mut xq);
-        let xd: Vec<f32> = xq.iter().flat_map(|b| b.qs.iter().map(move |&q| b.d * q as f32)).collect();
+        quantize_k(&x, &mut xk);
         for dtype in [GgmlDType::Q5_0, GgmlDType::Q4K, GgmlDType::Q6K] {
             let blocks = 4 * SUPER / (dtype.block_size());
             let bytes = random_blocks(dtype, blocks, 13);
             let w = ours(dtype, &bytes);
-            let want: f64 = w.iter().zip(&xd).map(|(a, b)| f64::from(*a) * f64::from(*b)).sum();
             let crate::quant::Kernels { q5_0, q4_k, q6_k, .. } = crate::quant::Kernels::detect();
-            let got = match dtype {
-                GgmlDType::Q5_0 => [dot_q5_0(&read_q5_0(&bytes), &xq), (q5_0.one)(&read_q5_0(&bytes), &xq)],
-                GgmlDType::Q4K => [dot_q4_k(&read_q4_k(&bytes), &xq), (q4_k.one)(&read_q4_k(&bytes), &xq)],
-                _ => [dot_q6_k(&read_q6_k(&bytes), &xq), (q6_k.one)(&read_q6_k(&bytes), &xq)],
+            let (got, xd): ([f32; 2], Vec<f32>) = match dtype {
+                GgmlDType::Q5_0 => (
+                    [dot_q5_0(&read_q5_0(&bytes), &xq), (q5_0.one)(&read_q5_0(&bytes), &xq)],
+                    xq.iter().flat_map(|b| b.qs.iter().map(move |&q| b.d * q as f32)).collect(),
+                ),
+                GgmlDType::Q4K => (
+                    [dot_q4_k(&read_q4_k(&bytes), &xk), (q4_k.one)(&read_q4_k(&bytes), &xk)],
+                    xk.iter().flat_map(|b| b.qs.iter().map(move |&q| b.d * q as f32)).collect(),
+                ),
+                _ => (
+                    [dot_q6_k(&read_q6_k(&bytes), &xk), (q6_k.one)(&read_q6_k(&bytes), &xk)],
+                    xk.iter().flat_map(|b| b.qs.iter().map(move |&q| b.d * q as f32)).collect(),
+                ),
             };
+            let want: f64 = w.iter().zip(&xd).map(|(a, b)| f64::from(*a) * f64::from(*b)).sum();
             let size: f64 = w.iter().zip(&xd).map(|(a, b)| (f64::from(*a) * f64::from(*b)).abs()).sum();
             for got in got {
                 assert!((f64::from(got) - want).abs() <= 1e-5 * size, "{dtype:?}: {got} against {want}");
             }
         }
+    }
+
+    /// Q8_K as ggml makes it: the largest magnitude at −127, every value within half a step,
+    /// the sums of 16 the sums of the values.
+    #[test]
+    fn super_block_activations_are_ggmls() {
+        let mut rng = SplitMix64::new(3);
+        let x: Vec<f32> = (0..2 * SUPER + 7).map(|_| (rng.unit() as f32 - 0.5) * 8.0).collect();
+        let mut xk = Vec::new();
+        quantize_k(&x, &mut xk);
+        assert_eq!(xk.len(), 2, "a tail shorter than a super-block is left out");
+        for (b, chunk) in xk.iter().zip(x.chunks_exact(SUPER)) {
+            let at = (0..SUPER).max_by(|&i, &j| chunk[i].abs().total_cmp(&chunk[j].abs())).unwrap();
+            assert_eq!(b.qs[at], -127);
+            for (&q, &v) in b.qs.iter().zip(chunk) {
+                assert!((b.d * q as f32 - v).abs() <= 0.5 * b.d.abs() * 1.0001, "{v} as {q}·{}", b.d);
+            }
+            for (j, &sum) in b.bsums.iter().enumerate() {
+                assert_eq!(sum as i32, b.qs[16 * j..16 * j + 16].iter().map(|&q| q as i32).sum::<i32>());
+            }
+        }
+        quantize_k(&[0.0; SUPER], &mut xk);
+        assert!(xk[0].d == 0.0 && xk[0].qs.iter().all(|&q| q == 0));
+        quantize_k(&[f32::NAN; SUPER], &mut xk);
+        assert!(xk[0].d == 0.0, "a block without a finite extreme quantizes to zeros");
     }
 
     /// On the real Qwen2.5-Coder-0.5B file (when installed): every Q5_0, Q4_K and Q6_K
@@ -524,32 +644,47 @@ mod tests {
         let mut rng = SplitMix64::new(21);
         for round in 0..100 {
             let supers = 1 + rng.below(4);
-            let xs: Vec<Vec<Q8_1>> = (0..4)
+            let xs: Vec<Vec<f32>> = (0..4)
                 .map(|t| {
-                    let x: Vec<f32> = (0..supers * SUPER)
+                    (0..supers * SUPER)
                         .map(|i| match round % 10 {
                             0 => [127.0, -127.0][(i + t) % 2],
                             _ => (rng.unit() as f32 - 0.5) * 4.0,
                         })
-                        .collect();
-                    let mut xq = Vec::new();
-                    quantize(&x, &mut xq);
-                    xq
+                        .collect()
                 })
                 .collect();
-            let x4 = [&xs[0][..], &xs[1][..], &xs[2][..], &xs[3][..]];
-            fn agree<B>(k: &FormatKernels<B>, scalar: Dot<B>, w: &[B], x4: [&[Q8_1]; 4], what: &str) {
+            fn quantized<A>(xs: &[Vec<f32>], quantize: fn(&[f32], &mut Vec<A>)) -> Vec<Vec<A>> {
+                xs.iter()
+                    .map(|x| {
+                        let mut q = Vec::new();
+                        quantize(x, &mut q);
+                        q
+                    })
+                    .collect()
+            }
+            let (xq, xk) = (quantized(&xs, quantize), quantized(&xs, quantize_k));
+            // `exact`: the same bits (the K formats), else the same up to float rounding
+            fn agree<B, A>(k: &FormatKernels<B, A>, scalar: Dot<B, A>, w: &[B], x: &[Vec<A>], exact: bool, what: &str) {
+                let x4 = [&x[0][..], &x[1][..], &x[2][..], &x[3][..]];
                 let four = (k.four)(w, x4);
                 for (t, x) in x4.into_iter().enumerate() {
                     let want = scalar(w, x);
                     for got in [(k.one)(w, x), four[t]] {
-                        assert!((got - want).abs() <= 1e-4 * want.abs().max(1.0), "{what}: {got} against {want}");
+                        match exact {
+                            true => assert_eq!(got.to_bits(), want.to_bits(), "{what}: {got} against {want}"),
+                            false => assert!(
+                                (got - want).abs() <= 1e-4 * want.abs().max(1.0),
+                                "{what}: {got} against {want}"
+                            ),
+                        }
                     }
                 }
             }
-            agree(&q5_0, dot_q5_0, &read_q5_0(&random_blocks(GgmlDType::Q5_0, supers * 8, round)), x4, "Q5_0");
-            agree(&q4_k, dot_q4_k, &read_q4_k(&random_blocks(GgmlDType::Q4K, supers, round)), x4, "Q4_K");
-            agree(&q6_k, dot_q6_k, &read_q6_k(&random_blocks(GgmlDType::Q6K, supers, round)), x4, "Q6_K");
+            let (q5, q4, q6) = (GgmlDType::Q5_0, GgmlDType::Q4K, GgmlDType::Q6K);
+            agree(&q5_0, dot_q5_0, &read_q5_0(&random_blocks(q5, supers * 8, round)), &xq, false, "Q5_0");
+            agree(&q4_k, dot_q4_k, &read_q4_k(&random_blocks(q4, supers, round)), &xk, true, "Q4_K");
+            agree(&q6_k, dot_q6_k, &read_q6_k(&random_blocks(q6, supers, round)), &xk, true, "Q6_K");
         }
     }
 }

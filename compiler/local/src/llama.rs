@@ -2,8 +2,9 @@
 //! a small model: the weights stay as they are in the GGUF file (SmolLM2: Q4_1 layers, the
 //! Q8_0 embedding that is also the output projection; Qwen2.5-Coder: Q4_K, Q6_K, Q5_0 and
 //! Q8_0, [`crate::kquant`]), activations are quantized to 8 bits a block before each product
-//! ([`crate::quant`]), and the KV cache is appended in place, each query head reading its
-//! group's key/value head directly (no copies of the cache).
+//! (blocks of 32, [`crate::quant`]; super-blocks of 256 for the K formats, [`Input`]), and
+//! the KV cache is appended in place, each query head reading its group's key/value head
+//! directly (no copies of the cache).
 //!
 //! `qwen2` is llama with biases on the query, key and value projections and the rotary
 //! embedding over the two halves of each head (llama's GGUF layout rotates adjacent pairs);
@@ -23,7 +24,7 @@ use candle_core::quantized::GgmlDType;
 use candle_core::quantized::gguf_file::Content;
 
 use crate::adapter::{Adapter, Target, hf_to_gguf_rows};
-use crate::kquant::{self, Q4K, Q5_0, Q6K, SUPER};
+use crate::kquant::{self, Q4K, Q5_0, Q6K, Q8K, SUPER};
 use crate::quant::{self, BLOCK, Heads, Kernels, Q4_1, Q8_0, Q8_1};
 
 /// A weight matrix: `rows` rows of `cols` values, row after row, in blocks (`per_row` of
@@ -57,13 +58,14 @@ impl Matrix {
         }
     }
 
-    fn row(&self, k: &Kernels, r: usize, x: &[Q8_1]) -> f32 {
+    fn row(&self, k: &Kernels, r: usize, x: &Input) -> f32 {
+        let (blocks, supers) = (x.blocks(), x.supers());
         match self {
-            Matrix::Q4_1 { blocks, per_row, .. } => (k.q4_1.one)(&blocks[r * per_row..(r + 1) * per_row], x),
-            Matrix::Q8_0 { blocks, per_row, .. } => (k.q8_0)(&blocks[r * per_row..(r + 1) * per_row], x),
-            Matrix::Q5_0 { blocks, per_row, .. } => (k.q5_0.one)(&blocks[r * per_row..(r + 1) * per_row], x),
-            Matrix::Q4K { blocks, per_row, .. } => (k.q4_k.one)(&blocks[r * per_row..(r + 1) * per_row], x),
-            Matrix::Q6K { blocks, per_row, .. } => (k.q6_k.one)(&blocks[r * per_row..(r + 1) * per_row], x),
+            Matrix::Q4_1 { blocks: w, per_row, .. } => (k.q4_1.one)(&w[r * per_row..(r + 1) * per_row], blocks),
+            Matrix::Q8_0 { blocks: w, per_row, .. } => (k.q8_0)(&w[r * per_row..(r + 1) * per_row], blocks),
+            Matrix::Q5_0 { blocks: w, per_row, .. } => (k.q5_0.one)(&w[r * per_row..(r + 1) * per_row], blocks),
+            Matrix::Q4K { blocks: w, per_row, .. } => (k.q4_k.one)(&w[r * per_row..(r + 1) * per_row], supers),
+            Matrix::Q6K { blocks: w, per_row, .. } => (k.q6_k.one)(&w[r * per_row..(r + 1) * per_row], supers),
         }
     }
 
@@ -97,21 +99,22 @@ impl Matrix {
     }
 
     /// Row `r` against every token of the chunk, four at a time where the kernel can.
-    fn row_all(&self, k: &Kernels, r: usize, x: &[Vec<Q8_1>], out: &mut Vec<f32>) {
+    fn row_all(&self, k: &Kernels, r: usize, x: &[Input], out: &mut Vec<f32>) {
         out.clear();
         let row = |blocks: usize| r * blocks..(r + 1) * blocks;
+        let (blocks, supers) = (Input::blocks, Input::supers);
         match self {
-            Matrix::Q4_1 { blocks, per_row, .. } => fours(&blocks[row(*per_row)], x, k.q4_1, out),
-            Matrix::Q5_0 { blocks, per_row, .. } => fours(&blocks[row(*per_row)], x, k.q5_0, out),
-            Matrix::Q4K { blocks, per_row, .. } => fours(&blocks[row(*per_row)], x, k.q4_k, out),
-            Matrix::Q6K { blocks, per_row, .. } => fours(&blocks[row(*per_row)], x, k.q6_k, out),
+            Matrix::Q4_1 { blocks: w, per_row, .. } => fours(&w[row(*per_row)], x, blocks, k.q4_1, out),
+            Matrix::Q5_0 { blocks: w, per_row, .. } => fours(&w[row(*per_row)], x, blocks, k.q5_0, out),
+            Matrix::Q4K { blocks: w, per_row, .. } => fours(&w[row(*per_row)], x, supers, k.q4_k, out),
+            Matrix::Q6K { blocks: w, per_row, .. } => fours(&w[row(*per_row)], x, supers, k.q6_k, out),
             Matrix::Q8_0 { .. } => out.extend(x.iter().map(|xt| self.row(k, r, xt))),
         }
     }
 
     /// Each listed row against `x` (one token), the unlisted rows −∞; listed rows past the
     /// matrix are ignored. With a pool, workers take parts of the list.
-    fn product_rows(&self, k: &Kernels, x: &[Q8_1], list: &[u32], pool: Option<&rayon::ThreadPool>) -> Vec<f32> {
+    fn product_rows(&self, k: &Kernels, x: &Input, list: &[u32], pool: Option<&rayon::ThreadPool>) -> Vec<f32> {
         let rows = self.rows();
         let list: Vec<usize> = list.iter().map(|&r| r as usize).filter(|&r| r < rows).collect();
         let mut values = vec![0f32; list.len()];
@@ -135,7 +138,7 @@ impl Matrix {
 
     /// `out[t·rows + r] = row r · x[t]` for each token `t` of the chunk; each row is read
     /// once for all the chunk's tokens. With a pool, workers take ranges of rows.
-    fn product(&self, k: &Kernels, x: &[Vec<Q8_1>], out: &mut [f32], pool: Option<&rayon::ThreadPool>) {
+    fn product(&self, k: &Kernels, x: &[Input], out: &mut [f32], pool: Option<&rayon::ThreadPool>) {
         let rows = self.rows();
         let Some(pool) = pool.filter(|p| p.current_num_threads() > 1) else {
             let mut row = Vec::with_capacity(x.len());
@@ -170,16 +173,46 @@ impl Matrix {
     }
 }
 
-/// The last token's final state, normalized and quantized for the output projection.
-pub struct Last(Vec<Q8_1>);
+/// One token's activations quantized for every format: in blocks of 32 ([`Q8_1`]), and in
+/// super-blocks of 256 for the K formats ([`Q8K`]).
+#[derive(Clone, Default)]
+struct Input {
+    blocks: Vec<Q8_1>,
+    supers: Vec<Q8K>,
+}
 
-/// The row `w` against the tokens `x`, four at a time, the rest one by one.
-fn fours<B>(w: &[B], x: &[Vec<Q8_1>], k: quant::FormatKernels<B>, out: &mut Vec<f32>) {
+impl Input {
+    fn set(&mut self, x: &[f32]) {
+        quant::quantize(x, &mut self.blocks);
+        kquant::quantize_k(x, &mut self.supers);
+    }
+
+    fn blocks(&self) -> &[Q8_1] {
+        &self.blocks
+    }
+
+    fn supers(&self) -> &[Q8K] {
+        &self.supers
+    }
+}
+
+/// The last token's final state, normalized and quantized for the output projection.
+pub struct Last(Input);
+
+/// The row `w` against the tokens `x` (their activations `A`), four at a time, the rest one
+/// by one.
+fn fours<B, A>(
+    w: &[B],
+    x: &[Input],
+    activations: fn(&Input) -> &[A],
+    k: quant::FormatKernels<B, A>,
+    out: &mut Vec<f32>,
+) {
     let mut chunks = x.chunks_exact(4);
     for c in chunks.by_ref() {
-        out.extend((k.four)(w, [&c[0], &c[1], &c[2], &c[3]]));
+        out.extend((k.four)(w, [0, 1, 2, 3].map(|t| activations(&c[t]))));
     }
-    out.extend(chunks.remainder().iter().map(|xt| (k.one)(w, xt)));
+    out.extend(chunks.remainder().iter().map(|xt| (k.one)(w, activations(xt))));
 }
 
 struct Layer {
@@ -473,7 +506,7 @@ impl Model {
     /// [`Model::logits`].
     pub fn read(&mut self, tokens: &[u32], cache: &mut Cache) -> Last {
         const CHUNK: usize = 64;
-        let mut last = Last(Vec::new());
+        let mut last = Last(Input::default());
         for chunk in tokens.chunks(CHUNK) {
             last = self.forward_chunk(chunk, cache);
         }
@@ -512,12 +545,12 @@ impl Model {
             self.embed(token, &mut x[t * dim..(t + 1) * dim]);
         }
         let mut normed = vec![0f32; n * dim];
-        let mut xq: Vec<Vec<Q8_1>> = vec![Vec::new(); n];
+        let mut xq = vec![Input::default(); n];
         let (mut q, mut kk, mut vv) = (vec![0f32; n * dim], vec![0f32; n * kv_dim], vec![0f32; n * kv_dim]);
         let mut attn = vec![0f32; n * dim];
         let mut proj = vec![0f32; n * dim];
         let (mut gate, mut up) = (vec![0f32; n * hidden], vec![0f32; n * hidden]);
-        let mut hq: Vec<Vec<Q8_1>> = vec![Vec::new(); n];
+        let mut hq = vec![Input::default(); n];
         let mut scores = Vec::new();
         let scale = 1.0 / (head_dim as f32).sqrt();
         let pairs = head_dim / 2;
@@ -526,7 +559,7 @@ impl Model {
             let lora = |t: Target| self.lora.as_ref().and_then(|(l, s)| Some((l[li][t as usize].as_ref()?, *s)));
             rms_norm(&x, &layer.attn_norm, eps, dim, &mut normed);
             for (t, xt) in xq.iter_mut().enumerate() {
-                quant::quantize(&normed[t * dim..(t + 1) * dim], xt);
+                xt.set(&normed[t * dim..(t + 1) * dim]);
             }
             layer.q.product(k, &xq, &mut q, pool);
             layer.k.product(k, &xq, &mut kk, pool);
@@ -573,7 +606,7 @@ impl Model {
                 None => attn.chunks_mut(head_dim).enumerate().for_each(|(i, out)| attend(i, out, &mut scores)),
             }
             for (t, xt) in xq.iter_mut().enumerate() {
-                quant::quantize(&attn[t * dim..(t + 1) * dim], xt);
+                xt.set(&attn[t * dim..(t + 1) * dim]);
             }
             layer.o.product(k, &xq, &mut proj, pool);
             if let Some((pair, scale)) = lora(Target::O) {
@@ -584,7 +617,7 @@ impl Model {
             }
             rms_norm(&x, &layer.ffn_norm, eps, dim, &mut normed);
             for (t, xt) in xq.iter_mut().enumerate() {
-                quant::quantize(&normed[t * dim..(t + 1) * dim], xt);
+                xt.set(&normed[t * dim..(t + 1) * dim]);
             }
             layer.gate.product(k, &xq, &mut gate, pool);
             layer.up.product(k, &xq, &mut up, pool);
@@ -598,7 +631,7 @@ impl Model {
                 *g = *g / (1.0 + (-*g).exp()) * u;
             }
             for (t, ht) in hq.iter_mut().enumerate() {
-                quant::quantize(&gate[t * hidden..(t + 1) * hidden], ht);
+                ht.set(&gate[t * hidden..(t + 1) * hidden]);
             }
             layer.down.product(k, &hq, &mut proj, pool);
             if let Some((pair, scale)) = lora(Target::Down) {
@@ -614,9 +647,9 @@ impl Model {
         let last = &x[(n - 1) * dim..];
         let mut out = vec![0f32; dim];
         rms_norm(last, &self.output_norm, eps, dim, &mut out);
-        let mut lq = Vec::new();
-        quant::quantize(&out, &mut lq);
-        Last(lq)
+        let mut last = Input::default();
+        last.set(&out);
+        Last(last)
     }
 }
 

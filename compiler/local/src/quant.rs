@@ -142,25 +142,25 @@ pub fn quantize(x: &[f32], out: &mut Vec<Q8_1>) {
     }
 }
 
-/// A row's product with one token, and with four at once (the row's blocks unpacked once
-/// for the four).
-pub type Dot<B> = fn(&[B], &[Q8_1]) -> f32;
-pub type Dot4<B> = fn(&[B], [&[Q8_1]; 4]) -> [f32; 4];
+/// A row's product with one token's activations `A`, and with four at once (the row's
+/// blocks unpacked once for the four).
+pub type Dot<B, A = Q8_1> = fn(&[B], &[A]) -> f32;
+pub type Dot4<B, A = Q8_1> = fn(&[B], [&[A]; 4]) -> [f32; 4];
 
 /// The kernels of one format.
-pub struct FormatKernels<B> {
-    pub one: Dot<B>,
-    pub four: Dot4<B>,
+pub struct FormatKernels<B, A = Q8_1> {
+    pub one: Dot<B, A>,
+    pub four: Dot4<B, A>,
 }
 
 // by hand: a derive would ask `B: Copy` of the blocks
-impl<B> Clone for FormatKernels<B> {
+impl<B, A> Clone for FormatKernels<B, A> {
     fn clone(&self) -> Self {
         *self
     }
 }
 
-impl<B> Copy for FormatKernels<B> {}
+impl<B, A> Copy for FormatKernels<B, A> {}
 
 /// The dot products, chosen once for this CPU.
 #[derive(Clone, Copy)]
@@ -168,8 +168,8 @@ pub struct Kernels {
     pub q4_1: FormatKernels<Q4_1>,
     pub q8_0: Dot<Q8_0>,
     pub q5_0: FormatKernels<crate::kquant::Q5_0>,
-    pub q4_k: FormatKernels<crate::kquant::Q4K>,
-    pub q6_k: FormatKernels<crate::kquant::Q6K>,
+    pub q4_k: FormatKernels<crate::kquant::Q4K, crate::kquant::Q8K>,
+    pub q6_k: FormatKernels<crate::kquant::Q6K, crate::kquant::Q8K>,
     /// `out = softmax(q·kᵀ·scale)·v` over a head's positions (`scores` is scratch), the
     /// cache in half precision.
     pub attend: fn(&[f32], &Heads, f32, &mut Vec<f32>, &mut [f32]),
