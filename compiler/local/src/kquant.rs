@@ -324,17 +324,17 @@ mod avx2 {
         unsafe { q6_k(w, x) }
     }
 
-    /// `acc[t] += w·dx_t · Σ q·x_t·scale`, `q` signed with |q| ≤ 32 (so the 16-bit pairs
-    /// cannot saturate), `scales` 16-bit per pair of values.
+    /// `acc[t] += w·dx_t · Σ q·x_t`, `q` signed with |q| ≤ 16 (so the 16-bit pairs cannot
+    /// saturate).
     #[target_feature(enable = "avx2,fma")]
     #[inline]
-    fn add<const N: usize>(acc: &mut [__m256; N], q: __m256i, scales: __m256i, w: f32, x: [&Q8_1; N]) {
-        let magnitude = _mm256_sign_epi8(q, q);
+    fn add<const N: usize>(acc: &mut [__m256; N], q: __m256i, w: f32, x: [&Q8_1; N]) {
+        let (magnitude, ones) = (_mm256_sign_epi8(q, q), _mm256_set1_epi16(1));
         for (acc, x) in acc.iter_mut().zip(x) {
             // SAFETY: 32 bytes, an unaligned load
             let xq = unsafe { _mm256_loadu_si256(x.qs.as_ptr().cast()) };
             let pairs = _mm256_maddubs_epi16(magnitude, _mm256_sign_epi8(xq, q));
-            let sums = _mm256_madd_epi16(pairs, scales);
+            let sums = _mm256_madd_epi16(pairs, ones);
             *acc = _mm256_fmadd_ps(_mm256_set1_ps(w * x.d), _mm256_cvtepi32_ps(sums), *acc);
         }
     }
@@ -354,7 +354,6 @@ mod avx2 {
         let spread = _mm256_set_epi64x(0x0303030303030303, 0x0202020202020202, 0x0101010101010101, 0);
         let bit = _mm256_set1_epi64x(0x8040201008040201u64 as i64);
         let (low, fifth, sixteen) = (_mm_set1_epi8(0x0f), _mm256_set1_epi8(0x10), _mm256_set1_epi8(16));
-        let ones = _mm256_set1_epi16(1);
         let mut acc = [_mm256_setzero_ps(); N];
         for (i, b) in w.iter().enumerate() {
             // SAFETY: 16 bytes, an unaligned load
@@ -364,7 +363,7 @@ mod avx2 {
             let high = _mm256_and_si256(_mm256_cmpeq_epi8(bits, bit), fifth);
             let q = _mm256_sub_epi8(_mm256_or_si256(nibbles, high), sixteen);
             let Some(xs) = blocks(&x, i) else { break };
-            add(&mut acc, q, ones, b.d, xs);
+            add(&mut acc, q, b.d, xs);
         }
         acc.map(|a| hsum(a))
     }
@@ -557,27 +556,25 @@ mod tests {
         let (mut xq, mut xk) = (Vec::new(), Vec::new());
         quantize(&x, &mut xq);
         quantize_k(&x, &mut xk);
+        // the values each activation form stands for
+        let xq_values: Vec<f32> = xq.iter().flat_map(|b| b.qs.iter().map(move |&q| b.d * q as f32)).collect();
+        let xk_values: Vec<f32> = xk.iter().flat_map(|b| b.qs.iter().map(move |&q| b.d * q as f32)).collect();
         for dtype in [GgmlDType::Q5_0, GgmlDType::Q4K, GgmlDType::Q6K] {
             let blocks = 4 * SUPER / (dtype.block_size());
             let bytes = random_blocks(dtype, blocks, 13);
             let w = ours(dtype, &bytes);
             let crate::quant::Kernels { q5_0, q4_k, q6_k, .. } = crate::quant::Kernels::detect();
-            let (got, xd): ([f32; 2], Vec<f32>) = match dtype {
-                GgmlDType::Q5_0 => (
-                    [dot_q5_0(&read_q5_0(&bytes), &xq), (q5_0.one)(&read_q5_0(&bytes), &xq)],
-                    xq.iter().flat_map(|b| b.qs.iter().map(move |&q| b.d * q as f32)).collect(),
-                ),
-                GgmlDType::Q4K => (
-                    [dot_q4_k(&read_q4_k(&bytes), &xk), (q4_k.one)(&read_q4_k(&bytes), &xk)],
-                    xk.iter().flat_map(|b| b.qs.iter().map(move |&q| b.d * q as f32)).collect(),
-                ),
-                _ => (
-                    [dot_q6_k(&read_q6_k(&bytes), &xk), (q6_k.one)(&read_q6_k(&bytes), &xk)],
-                    xk.iter().flat_map(|b| b.qs.iter().map(move |&q| b.d * q as f32)).collect(),
-                ),
+            let (got, xd) = match dtype {
+                GgmlDType::Q5_0 => {
+                    ([dot_q5_0(&read_q5_0(&bytes), &xq), (q5_0.one)(&read_q5_0(&bytes), &xq)], &xq_values)
+                }
+                GgmlDType::Q4K => {
+                    ([dot_q4_k(&read_q4_k(&bytes), &xk), (q4_k.one)(&read_q4_k(&bytes), &xk)], &xk_values)
+                }
+                _ => ([dot_q6_k(&read_q6_k(&bytes), &xk), (q6_k.one)(&read_q6_k(&bytes), &xk)], &xk_values),
             };
-            let want: f64 = w.iter().zip(&xd).map(|(a, b)| f64::from(*a) * f64::from(*b)).sum();
-            let size: f64 = w.iter().zip(&xd).map(|(a, b)| (f64::from(*a) * f64::from(*b)).abs()).sum();
+            let want: f64 = w.iter().zip(xd).map(|(a, b)| f64::from(*a) * f64::from(*b)).sum();
+            let size: f64 = w.iter().zip(xd).map(|(a, b)| (f64::from(*a) * f64::from(*b)).abs()).sum();
             for got in got {
                 assert!((f64::from(got) - want).abs() <= 1e-5 * size, "{dtype:?}: {got} against {want}");
             }
