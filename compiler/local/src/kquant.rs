@@ -37,8 +37,10 @@ pub struct Q5_0 {
 pub struct Q4K {
     pub d: f32,
     pub dmin: f32,
-    /// Eight 6-bit scales and eight 6-bit minima, packed (`scale_min`).
-    pub scales: [u8; 12],
+    /// The eight 6-bit scales and the eight 6-bit minima, unpacked once when the file is
+    /// read (the file packs them into 12 bytes: [`scale_min`]), not at every product.
+    pub scales: [u8; 8],
+    pub mins: [u8; 8],
     /// Per 64 values: the first 32 in the low nibbles of 32 bytes, the next 32 in their
     /// high nibbles.
     pub qs: [u8; 128],
@@ -70,7 +72,7 @@ pub fn quantize_k(x: &[f32], out: &mut Vec<Q8K>) {
         if max != 0.0 && max.is_finite() {
             let inverse = -127.0 / max;
             for (q, &v) in block.qs.iter_mut().zip(chunk) {
-                *q = (inverse * v).round_ties_even().min(127.0) as i8;
+                *q = nearest_even(inverse * v).min(127.0) as i8;
             }
             for (sum, q) in block.bsums.iter_mut().zip(block.qs.chunks_exact(16)) {
                 *sum = q.iter().map(|&q| q as i16).sum();
@@ -79,6 +81,14 @@ pub fn quantize_k(x: &[f32], out: &mut Vec<Q8K>) {
         }
         out.push(block);
     }
+}
+
+/// `x` rounded to the nearest integer, ties to even, for |x| ≤ 2²²: adding and taking off
+/// 1.5·2²³ leaves no bits below the unit, rounded as the FPU rounds (to nearest, ties to
+/// even); a zero may lose its sign. `f32::round_ties_even` is a call into libm on a CPU baseline without SSE4.1.
+fn nearest_even(x: f32) -> f32 {
+    const MAGIC: f32 = 12_582_912.0;
+    (x + MAGIC) - MAGIC
 }
 
 /// `d·sc_b·(q − 32)` for sub-block `b = position / 16`, q in 0..64: four bits in `ql`, two in `qh`.
@@ -110,11 +120,13 @@ pub fn read_q5_0(bytes: &[u8]) -> Vec<Q5_0> {
 pub fn read_q4_k(bytes: &[u8]) -> Vec<Q4K> {
     bytes
         .chunks_exact(144)
-        .map(|b| Q4K {
-            d: half(b, 0),
-            dmin: half(b, 2),
-            scales: b[4..16].try_into().unwrap_or([0; 12]),
-            qs: b[16..144].try_into().unwrap_or([0; 128]),
+        .map(|b| {
+            let packed: [u8; 12] = b[4..16].try_into().unwrap_or([0; 12]);
+            let (mut scales, mut mins) = ([0; 8], [0; 8]);
+            for j in 0..8 {
+                (scales[j], mins[j]) = scale_min(&packed, j);
+            }
+            Q4K { d: half(b, 0), dmin: half(b, 2), scales, mins, qs: b[16..144].try_into().unwrap_or([0; 128]) }
         })
         .collect()
 }
@@ -152,26 +164,17 @@ impl Q5_0 {
     }
 }
 
+/// Sub-block `j`'s 6-bit scale and minimum in a Q4_K's 12 packed bytes (ggml's
+/// `get_scale_min_k4`).
+fn scale_min(q: &[u8; 12], j: usize) -> (u8, u8) {
+    if j < 4 {
+        (q[j] & 63, q[j + 4] & 63)
+    } else {
+        ((q[j + 4] & 0x0f) | ((q[j - 4] >> 6) << 4), (q[j + 4] >> 4) | ((q[j] >> 6) << 4))
+    }
+}
+
 impl Q4K {
-    /// Sub-block `j`'s 6-bit scale and minimum (ggml's `get_scale_min_k4`).
-    fn scale_min(&self, j: usize) -> (u8, u8) {
-        let q = &self.scales;
-        if j < 4 {
-            (q[j] & 63, q[j + 4] & 63)
-        } else {
-            ((q[j + 4] & 0x0f) | ((q[j - 4] >> 6) << 4), (q[j + 4] >> 4) | ((q[j] >> 6) << 4))
-        }
-    }
-
-    /// The eight scales and the eight minima.
-    fn scales_mins(&self) -> ([u8; 8], [u8; 8]) {
-        let (mut scales, mut mins) = ([0; 8], [0; 8]);
-        for j in 0..8 {
-            (scales[j], mins[j]) = self.scale_min(j);
-        }
-        (scales, mins)
-    }
-
     /// The 256 values as integers in 0..16, in order.
     fn values(&self) -> [u8; SUPER] {
         let mut q = [0u8; SUPER];
@@ -218,7 +221,7 @@ pub fn dequantize_q4_k(blocks: &[Q4K], out: &mut Vec<f32>) {
     for b in blocks {
         let q = b.values();
         for (sub, chunk) in q.chunks_exact(BLOCK).enumerate() {
-            let (sc, m) = b.scale_min(sub);
+            let (sc, m) = (b.scales[sub], b.mins[sub]);
             let (scale, min) = (b.d * sc as f32, b.dmin * m as f32);
             out.extend(chunk.iter().map(|&v| scale * v as f32 - min));
         }
@@ -252,7 +255,7 @@ pub fn dot_q5_0(w: &[Q5_0], x: &[Q8_1]) -> f32 {
 pub fn dot_q4_k(w: &[Q4K], x: &[Q8K]) -> f32 {
     let mut total = 0.0;
     for (b, x) in w.iter().zip(x) {
-        let (q, (scales, mins)) = (b.values(), b.scales_mins());
+        let (q, scales, mins) = (b.values(), b.scales, b.mins);
         let (mut sum, mut min) = (0i32, 0i32);
         for sub in 0..SUPER / BLOCK {
             let at = BLOCK * sub..BLOCK * (sub + 1);
@@ -410,16 +413,23 @@ mod avx2 {
         unsafe { _mm256_loadu_si256(x.bsums.as_ptr().cast()) }
     }
 
+    /// Each of a Q4_K's minima twice, as 16-bit lanes against the two sums of 16 of its
+    /// sub-block.
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    fn mins16(b: &Q4K) -> __m256i {
+        let twice = _mm_set_epi8(7, 7, 6, 6, 5, 5, 4, 4, 3, 3, 2, 2, 1, 1, 0, 0);
+        // SAFETY: 8 bytes, an unaligned load
+        let mins = unsafe { _mm_loadl_epi64(b.mins.as_ptr().cast()) };
+        _mm256_cvtepu8_epi16(_mm_shuffle_epi8(mins, twice))
+    }
+
     #[target_feature(enable = "avx2,fma")]
     fn q4_k<const N: usize>(w: &[Q4K], x: [&[Q8K]; N]) -> [f32; N] {
         let low = _mm256_set1_epi8(0x0f);
         let mut totals = [0f32; N];
         for (i, b) in w[..supers(w.len(), &x)].iter().enumerate() {
-            let (scales, mins) = b.scales_mins();
-            // each minimum twice, against the two sums of 16 of its sub-block
-            let mins: [i16; 16] = std::array::from_fn(|j| mins[j / 2] as i16);
-            // SAFETY: 16 values of 2 bytes, an unaligned load
-            let mins = unsafe { _mm256_loadu_si256(mins.as_ptr().cast()) };
+            let (scales, mins) = (&b.scales, mins16(b));
             let mut sums = [_mm256_setzero_si256(); N];
             for pair in 0..4 {
                 // SAFETY: 32 of the 128 bytes, an unaligned load
@@ -445,10 +455,25 @@ mod avx2 {
     #[target_feature(enable = "avx2,fma")]
     fn q6_k<const N: usize>(w: &[Q6K], x: [&[Q8K]; N]) -> [f32; N] {
         let (low, top) = (_mm256_set1_epi8(0x0f), _mm256_set1_epi8(0x30));
+        // block j of a half's four: scale 2j's two bytes over the low 16 bytes, 2j + 1's
+        // over the high 16 (of a half's eight 16-bit scales, in both 128-bit lanes)
+        let pick: [__m256i; 4] = std::array::from_fn(|j| {
+            let (a, b) = (4 * j as i8, 4 * j as i8 + 2);
+            let lane =
+                |s: i8| _mm_set_epi8(s + 1, s, s + 1, s, s + 1, s, s + 1, s, s + 1, s, s + 1, s, s + 1, s, s + 1, s);
+            _mm256_set_m128i(lane(b), lane(a))
+        });
         let mut totals = [0f32; N];
         for (i, b) in w[..supers(w.len(), &x)].iter().enumerate() {
+            // SAFETY: 16 bytes, an unaligned load
+            let scales = _mm256_cvtepi8_epi16(unsafe { _mm_loadu_si128(b.scales.as_ptr().cast()) });
             let mut sums = [_mm256_setzero_si256(); N];
             for n in 0..2 {
+                // scales 8n..8n + 8 in both lanes
+                let half = match n {
+                    0 => _mm256_permute2x128_si256::<0x00>(scales, scales),
+                    _ => _mm256_permute2x128_si256::<0x11>(scales, scales),
+                };
                 // SAFETY: 32-byte unaligned loads inside ql (128 bytes) and qh (64)
                 let (ql0, ql1, qh) = unsafe {
                     (
@@ -470,15 +495,12 @@ mod avx2 {
                 for (j, q) in quarters.into_iter().enumerate() {
                     let block = 4 * n + j;
                     // each 16-value half by its own scale
-                    let (s0, s1) = (b.scales[2 * block] as i16, b.scales[2 * block + 1] as i16);
-                    let scales = _mm256_set_m128i(_mm_set1_epi16(s1), _mm_set1_epi16(s0));
+                    let block_scales = _mm256_shuffle_epi8(half, pick[j]);
                     for (sums, x) in sums.iter_mut().zip(x) {
-                        add_k(sums, q, &x[i].qs[BLOCK * block..BLOCK * (block + 1)], scales);
+                        add_k(sums, q, &x[i].qs[BLOCK * block..BLOCK * (block + 1)], block_scales);
                     }
                 }
             }
-            // SAFETY: 16 bytes, an unaligned load
-            let scales = _mm256_cvtepi8_epi16(unsafe { _mm_loadu_si128(b.scales.as_ptr().cast()) });
             for ((total, sums), x) in totals.iter_mut().zip(sums).zip(x) {
                 let x = &x[i];
                 let offset = _mm256_slli_epi32(_mm256_madd_epi16(scales, bsums(x)), 5);
@@ -535,6 +557,17 @@ mod tests {
             _ => dequantize_q6_k(&read_q6_k(bytes), &mut out),
         }
         out
+    }
+
+    #[test]
+    fn nearest_even_is_round_ties_even() {
+        for i in -1300..=1300 {
+            for x in [i as f32 / 10.0, i as f32 / 10.0 + 0.05, i as f32 / 2.0] {
+                let x = x.clamp(-128.0, 128.0);
+                // equal as numbers: −0.5 gives +0 here, −0 there (the same `i8`)
+                assert_eq!(nearest_even(x), x.round_ties_even(), "{x}");
+            }
+        }
     }
 
     #[test]
