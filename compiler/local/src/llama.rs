@@ -589,21 +589,23 @@ impl Model {
             cache.k[li].extend(kk.iter().map(|&x| quant::f32_to_f16(x)));
             cache.v[li].extend(vv.iter().map(|&x| quant::f32_to_f16(x)));
             let (keys, values) = (&cache.k[li], &cache.v[li]);
-            // one query head of one token: `i = t·heads + h`, causal over positions 0..=start+t
+            // the query heads of one key/value head of one token, `i = t·kv_heads + kv`,
+            // causal over positions 0..=start+t (they are `group` heads one after another)
+            let width = group * head_dim;
             let attend = |i: usize, out: &mut [f32], scores: &mut Vec<f32>| {
-                let (t, h) = (i / heads, i % heads);
-                let heads =
-                    Heads { keys, values, stride: kv_dim, offset: (h / group) * head_dim, positions: start + t + 1 };
-                (k.attend)(&q[i * head_dim..(i + 1) * head_dim], &heads, scale, scores, out);
+                let (t, kv) = (i / kv_heads, i % kv_heads);
+                let offset = kv * head_dim;
+                let cache = Heads { keys, values, stride: kv_dim, offset, dim: head_dim, positions: start + t + 1 };
+                (k.attend)(&q[i * width..(i + 1) * width], &cache, scale, scores, out);
             };
             match pool {
                 Some(pool) => pool.install(|| {
                     use rayon::prelude::*;
-                    attn.par_chunks_mut(head_dim)
+                    attn.par_chunks_mut(width)
                         .enumerate()
                         .for_each_init(Vec::new, |scores, (i, out)| attend(i, out, scores))
                 }),
-                None => attn.chunks_mut(head_dim).enumerate().for_each(|(i, out)| attend(i, out, &mut scores)),
+                None => attn.chunks_mut(width).enumerate().for_each(|(i, out)| attend(i, out, &mut scores)),
             }
             for (t, xt) in xq.iter_mut().enumerate() {
                 xt.set(&attn[t * dim..(t + 1) * dim]);

@@ -170,20 +170,41 @@ pub struct Kernels {
     pub q5_0: FormatKernels<crate::kquant::Q5_0>,
     pub q4_k: FormatKernels<crate::kquant::Q4K, crate::kquant::Q8K>,
     pub q6_k: FormatKernels<crate::kquant::Q6K, crate::kquant::Q8K>,
-    /// `out = softmax(q·kᵀ·scale)·v` over a head's positions (`scores` is scratch), the
-    /// cache in half precision.
-    pub attend: fn(&[f32], &Heads, f32, &mut Vec<f32>, &mut [f32]),
+    /// `out = softmax(q·kᵀ·scale)·v` over a key/value head's positions for each query head
+    /// that shares it (`q` and `out` hold them one after another, `Heads::dim` wide each;
+    /// `scores` is scratch), the cache in half precision.
+    pub attend: Attend,
     pub name: &'static str,
 }
 
-/// One key/value head of the KV cache: position `p`'s vector at `p·stride + offset`, in
-/// half precision (as llama.cpp keeps it: half the memory and the bandwidth of f32).
+/// Attention over one key/value head for the query heads that share it ([`Kernels::attend`]).
+pub type Attend = fn(&[f32], &Heads, f32, &mut Vec<f32>, &mut [f32]);
+
+/// One key/value head of the KV cache: position `p`'s vector at `p·stride + offset`, `dim`
+/// wide, in half precision (as llama.cpp keeps it: half the memory and the bandwidth of f32).
 pub struct Heads<'a> {
     pub keys: &'a [u16],
     pub values: &'a [u16],
     pub stride: usize,
     pub offset: usize,
+    pub dim: usize,
     pub positions: usize,
+}
+
+/// Each query head of `q` against `heads` alone, through `attend_with`.
+#[inline(always)]
+fn attend_each(
+    dot: impl Fn(&[f32], &[u16]) -> f32 + Copy,
+    axpy: impl Fn(&mut [f32], f32, &[u16]) + Copy,
+    q: &[f32],
+    heads: &Heads,
+    scale: f32,
+    scores: &mut Vec<f32>,
+    out: &mut [f32],
+) {
+    for (q, out) in q.chunks_exact(heads.dim.max(1)).zip(out.chunks_exact_mut(heads.dim.max(1))) {
+        attend_with(dot, axpy, q, heads, scale, scores, out);
+    }
 }
 
 /// Attention written over any dot product and `axpy`.
@@ -245,7 +266,7 @@ impl Kernels {
             q5_0,
             q4_k,
             q6_k,
-            attend: |q, h, scale, scores, out| attend_with(dot_scalar, axpy_scalar, q, h, scale, scores, out),
+            attend: |q, h, scale, scores, out| attend_each(dot_scalar, axpy_scalar, q, h, scale, scores, out),
             name: "scalar",
         }
     }
@@ -325,51 +346,88 @@ mod avx2 {
         unsafe { _mm256_cvtph_ps(_mm_loadu_si128(at.cast())) }
     }
 
+    /// The query heads of a group at once: each key and value is widened once for all of
+    /// them, each head's products summed in a register of its own (a dot product is no
+    /// chain of dependent multiply-adds). Heads of a width that is no multiple of 16, and
+    /// groups of more than 8, take the plain loop.
     #[target_feature(enable = "avx2,fma,f16c")]
     fn attend(q: &[f32], heads: &Heads, scale: f32, scores: &mut Vec<f32>, out: &mut [f32]) {
-        if q.len() != 64 || out.len() != 64 {
-            return super::attend_with(|a, b| dot(a, b), |o, w, v| axpy(o, w, v), q, heads, scale, scores, out);
+        let d = heads.dim;
+        let group = q.len().checked_div(d).unwrap_or(0);
+        let end = heads.positions.saturating_sub(1) * heads.stride + heads.offset + d;
+        let fits = d.is_multiple_of(16)
+            && group * d == q.len()
+            && out.len() == q.len()
+            && heads.positions > 0
+            && end <= heads.keys.len()
+            && end <= heads.values.len();
+        let grouped: Option<super::Attend> = match group {
+            _ if !fits => None,
+            1 => Some(grouped::<1>),
+            2 => Some(grouped::<2>),
+            3 => Some(grouped::<3>),
+            4 => Some(grouped::<4>),
+            5 => Some(grouped::<5>),
+            6 => Some(grouped::<6>),
+            7 => Some(grouped::<7>),
+            8 => Some(grouped::<8>),
+            _ => None,
+        };
+        match grouped {
+            Some(f) => f(q, heads, scale, scores, out),
+            None => super::attend_each(|a, b| dot(a, b), |o, w, v| axpy(o, w, v), q, heads, scale, scores, out),
         }
-        // a 64-wide head: the query and the output held in eight registers each
-        let end = heads.positions.saturating_sub(1) * heads.stride + heads.offset + 64;
-        if end > heads.keys.len() || end > heads.values.len() {
-            return super::attend_with(|a, b| dot(a, b), |o, w, v| axpy(o, w, v), q, heads, scale, scores, out);
-        }
-        // SAFETY: every load below is within `end`, checked above; q and out are 64 long
+    }
+
+    /// [`attend`] for `G` query heads; the caller has checked every bound.
+    #[target_feature(enable = "avx2,fma,f16c")]
+    fn grouped<const G: usize>(q: &[f32], heads: &Heads, scale: f32, scores: &mut Vec<f32>, out: &mut [f32]) {
+        let (d, n) = (heads.dim, heads.positions);
+        scores.clear();
+        scores.resize(G * n, 0.0);
+        let at = |p: usize| p * heads.stride + heads.offset;
+        // SAFETY: every key and value read is within `at(n - 1) + d`, which `attend` checked
+        // against both slices; q and out are G·d long, so are the scores G·n
         unsafe {
-            let qv: [__m256; 8] = std::array::from_fn(|j| _mm256_loadu_ps(q.as_ptr().add(8 * j)));
-            scores.clear();
-            let mut max = f32::NEG_INFINITY;
-            for p in 0..heads.positions {
-                let key = heads.keys.as_ptr().add(p * heads.stride + heads.offset);
-                let mut a = _mm256_mul_ps(qv[0], halves(key));
-                let mut b = _mm256_mul_ps(qv[1], halves(key.add(8)));
-                a = _mm256_fmadd_ps(qv[2], halves(key.add(16)), a);
-                b = _mm256_fmadd_ps(qv[3], halves(key.add(24)), b);
-                a = _mm256_fmadd_ps(qv[4], halves(key.add(32)), a);
-                b = _mm256_fmadd_ps(qv[5], halves(key.add(40)), b);
-                a = _mm256_fmadd_ps(qv[6], halves(key.add(48)), a);
-                b = _mm256_fmadd_ps(qv[7], halves(key.add(56)), b);
-                let score = hsum(_mm256_add_ps(a, b)) * scale;
-                max = max.max(score);
-                scores.push(score);
-            }
-            let mut sum = 0.0;
-            for v in scores.iter_mut() {
-                *v = (*v - max).exp();
-                sum += *v;
-            }
-            let mut o = [_mm256_setzero_ps(); 8];
-            for (p, &w) in scores.iter().enumerate() {
-                let value = heads.values.as_ptr().add(p * heads.stride + heads.offset);
-                let w = _mm256_set1_ps(w);
-                for (j, o) in o.iter_mut().enumerate() {
-                    *o = _mm256_fmadd_ps(w, halves(value.add(8 * j)), *o);
+            for p in 0..n {
+                let key = heads.keys.as_ptr().add(at(p));
+                let mut acc = [_mm256_setzero_ps(); G];
+                for j in (0..d).step_by(8) {
+                    let k = halves(key.add(j));
+                    for (h, acc) in acc.iter_mut().enumerate() {
+                        *acc = _mm256_fmadd_ps(_mm256_loadu_ps(q.as_ptr().add(h * d + j)), k, *acc);
+                    }
+                }
+                for (h, acc) in acc.into_iter().enumerate() {
+                    *scores.get_unchecked_mut(h * n + p) = hsum(acc) * scale;
                 }
             }
-            let inv = _mm256_set1_ps(1.0 / sum);
-            for (j, o) in o.iter().enumerate() {
-                _mm256_storeu_ps(out.as_mut_ptr().add(8 * j), _mm256_mul_ps(*o, inv));
+            let mut sums = [0f32; G];
+            for (sum, head) in sums.iter_mut().zip(scores.chunks_exact_mut(n)) {
+                let max = head.iter().fold(f32::NEG_INFINITY, |a, &b| a.max(b));
+                for v in head.iter_mut() {
+                    *v = (*v - max).exp();
+                    *sum += *v;
+                }
+            }
+            // 16 of the d values at a time, for every head of the group
+            for j in (0..d).step_by(16) {
+                let mut o = [[_mm256_setzero_ps(); 2]; G];
+                for p in 0..n {
+                    let value = heads.values.as_ptr().add(at(p) + j);
+                    let (v0, v1) = (halves(value), halves(value.add(8)));
+                    for (h, o) in o.iter_mut().enumerate() {
+                        let w = _mm256_set1_ps(*scores.get_unchecked(h * n + p));
+                        o[0] = _mm256_fmadd_ps(w, v0, o[0]);
+                        o[1] = _mm256_fmadd_ps(w, v1, o[1]);
+                    }
+                }
+                for (h, o) in o.iter().enumerate() {
+                    let inv = _mm256_set1_ps(1.0 / sums[h]);
+                    let dst = out.as_mut_ptr().add(h * d + j);
+                    _mm256_storeu_ps(dst, _mm256_mul_ps(o[0], inv));
+                    _mm256_storeu_ps(dst.add(8), _mm256_mul_ps(o[1], inv));
+                }
             }
         }
     }
@@ -564,24 +622,32 @@ mod tests {
         for k in [Kernels::scalar(), Kernels::detect()] {
             let single = (k.q4_1.one)(&w, &xq);
             assert!((k.q4_1.four)(&w, four).iter().all(|v| (v - single).abs() <= 1e-4 * single.abs().max(1.0)));
-            // attention over 5 positions of a 2-head cache: a 12-wide head and a 64-wide one
-            for d in [12, 64] {
+            // attention over the second head of a 2-head cache: heads 12, 64 and 128 wide,
+            // groups of 1, 3, 6 and 9 query heads (9: past the widest group the kernels take),
+            // over 5 positions and over 37
+            for (d, group, positions) in [(12, 1, 5), (64, 1, 5), (64, 3, 37), (128, 6, 5), (128, 6, 37), (64, 9, 5)] {
                 let halves = |v: Vec<f32>| -> (Vec<u16>, Vec<f32>) {
                     let h: Vec<u16> = v.iter().map(|&x| f32_to_f16(x)).collect();
                     let back = h.iter().map(|&x| f16_to_f32(x)).collect();
                     (h, back)
                 };
-                let q = seeded(d, 2);
-                let ((keys16, keys), (values16, values)) = (halves(seeded(10 * d, 3)), halves(seeded(10 * d, 4)));
-                let heads = Heads { keys: &keys16, values: &values16, stride: 2 * d, offset: d, positions: 5 };
-                let mut out = vec![0.0; d];
+                let q = seeded(group * d, 2);
+                let cache = |seed| halves(seeded(2 * positions * d, seed));
+                let ((keys16, keys), (values16, values)) = (cache(3), cache(4));
+                let heads = Heads { keys: &keys16, values: &values16, stride: 2 * d, offset: d, dim: d, positions };
+                let mut out = vec![0.0; group * d];
                 (k.attend)(&q, &heads, 0.5, &mut Vec::new(), &mut out);
-                let scores: Vec<f32> =
-                    (0..5).map(|p| (0..d).map(|i| q[i] * keys[p * 2 * d + d + i]).sum::<f32>() * 0.5).collect();
-                let total: f32 = scores.iter().map(|s| s.exp()).sum();
-                for (i, o) in out.iter().enumerate() {
-                    let exact: f32 = (0..5).map(|p| scores[p].exp() / total * values[p * 2 * d + d + i]).sum();
-                    assert!((o - exact).abs() < 1e-5, "{} d={d}: {o} vs {exact}", k.name);
+                for (h, (q, out)) in q.chunks_exact(d).zip(out.chunks_exact(d)).enumerate() {
+                    let at = |p: usize| p * 2 * d + d;
+                    let scores: Vec<f32> =
+                        (0..positions).map(|p| (0..d).map(|i| q[i] * keys[at(p) + i]).sum::<f32>() * 0.5).collect();
+                    let max = scores.iter().fold(f32::NEG_INFINITY, |a, &b| a.max(b));
+                    let total: f32 = scores.iter().map(|s| (s - max).exp()).sum();
+                    for (i, o) in out.iter().enumerate() {
+                        let exact: f32 =
+                            (0..positions).map(|p| (scores[p] - max).exp() / total * values[at(p) + i]).sum();
+                        assert!((o - exact).abs() < 1e-5, "{} d={d} head {h} of {group}: {o} vs {exact}", k.name);
+                    }
                 }
             }
         }
