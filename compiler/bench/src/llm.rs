@@ -44,6 +44,8 @@ struct Side {
     decode_s: f64,
     constrained_tokens: f64,
     constrained_s: f64,
+    /// Of the constrained tokens, those the grammar forced (the local model only).
+    forced_tokens: f64,
     /// llguidance's masks (the local model only).
     mask_s: f64,
     peak_kib: Option<u64>,
@@ -167,6 +169,7 @@ fn measure_local(
         let (spent, _) = timed(&constrained)?;
         side.constrained_tokens += spent.decode_tokens as f64;
         side.constrained_s += spent.decode_s;
+        side.forced_tokens += spent.forced_tokens as f64;
         side.mask_s += spent.mask_s;
     }
     for request in requests {
@@ -318,10 +321,11 @@ fn table(local: &Side, peer: Option<&Side>, prompts: &[Vec<u32>]) -> Vec<String>
     let mib = |s: &Side| s.peak_kib.map_or(f64::NAN, |k| k as f64 / 1024.0);
     lines.push(row("peak memory MiB", mib(local), peer.map(mib), 0));
     lines.push(format!(
-        "tokens: prefill {:.0}, decode {:.0}, constrained {:.0} (tad-local){}",
+        "tokens: prefill {:.0}, decode {:.0}, constrained {:.0} of which {:.0} forced (tad-local){}",
         local.prefill_tokens,
         local.decode_tokens,
         local.constrained_tokens,
+        local.forced_tokens,
         peer.map(|p| format!(
             "; prefill {:.0}, decode {:.0}, constrained {:.0} (llama-server)",
             p.prefill_tokens, p.decode_tokens, p.constrained_tokens

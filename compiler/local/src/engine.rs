@@ -5,7 +5,9 @@
 //! the tokens that keep the output in the grammar, and the end of the answer is allowed only
 //! where the grammar accepts: what comes out parses. The mask is computed before the output
 //! projection, which then computes only the allowed tokens' rows (Qwen2.5-Coder-1.5B's
-//! untied 151,936-row head is about a sixth of a step's arithmetic).
+//! untied 151,936-row head is about a sixth of a step's arithmetic). The tokens the grammar
+//! forces after a decided one (llguidance's fast-forward: indentation, braces, a field's
+//! colon) are not decided one at a time: they are read with that token in one pass.
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -42,6 +44,9 @@ pub struct Engine {
     im_end: u32,
     end_of_text: Option<u32>,
     factory: Option<Arc<ParserFactory>>,
+    /// Whether forced tokens are read with the sampled one (on unless
+    /// `TADSL_FAST_FORWARD=off`, to measure against).
+    fast_forward: bool,
     context: usize,
     /// Seconds spent in prefill and decode, and in masks, over the engine's life.
     pub timing: Timing,
@@ -53,6 +58,8 @@ pub struct Timing {
     pub prefill_tokens: u64,
     pub prefill_s: f64,
     pub decode_tokens: u64,
+    /// Of the decoded tokens, those the grammar forced (read with the token before them).
+    pub forced_tokens: u64,
     pub decode_s: f64,
     pub mask_s: f64,
 }
@@ -64,6 +71,7 @@ impl Timing {
             prefill_tokens: self.prefill_tokens - before.prefill_tokens,
             prefill_s: self.prefill_s - before.prefill_s,
             decode_tokens: self.decode_tokens - before.decode_tokens,
+            forced_tokens: self.forced_tokens - before.forced_tokens,
             decode_s: self.decode_s - before.decode_s,
             mask_s: self.mask_s - before.mask_s,
         }
@@ -97,6 +105,17 @@ fn identity(path: &std::path::Path, adapter: Option<&Adapter>, kernels: &str) ->
 
 fn failed(what: &str, e: impl std::fmt::Display) -> Error {
     Error::new(ErrorKind::Server, format!("the local model {what}: {e}"))
+}
+
+/// The tokens `matcher` forces next, at most `room` of them, consumed and counted.
+fn take_forced(matcher: &mut Matcher, room: usize, timing: &mut Timing) -> Result<Vec<u32>, Error> {
+    let mut forced = matcher.compute_ff_tokens();
+    forced.truncate(room);
+    if !forced.is_empty() {
+        matcher.consume_tokens(&forced).map_err(|e| failed("grammar", e))?;
+        timing.forced_tokens += forced.len() as u64;
+    }
+    Ok(forced)
 }
 
 /// The tokenizer as llguidance's token environment.
@@ -194,6 +213,7 @@ impl Engine {
             im_end,
             end_of_text,
             factory: None,
+            fast_forward: std::env::var("TADSL_FAST_FORWARD").map_or(true, |v| v != "off"),
             context,
             timing: Timing::default(),
         })
@@ -250,6 +270,12 @@ impl Engine {
     /// The tokens the model reads for `request` (for a peer fed the same input).
     pub fn prompt_tokens(&self, request: &Request) -> Result<Vec<u32>, Error> {
         Ok(self.prompt(request)?.0)
+    }
+
+    /// Reads the tokens a grammar forces with the sampled one before them (`true`, the
+    /// default), or decides each alone.
+    pub fn set_fast_forward(&mut self, on: bool) {
+        self.fast_forward = on;
     }
 
     /// Drops the cached system message, so the next prompt is read whole.
@@ -381,7 +407,15 @@ impl Engine {
         let mut out: Vec<u32> = Vec::new();
         let mut finish = Finish::Length;
         let mut emitted = 0;
-        for _ in 0..request.max_tokens as usize {
+        // what the grammar forces at the start is read at once too
+        if let Some(m) = matcher.as_mut().filter(|_| self.fast_forward) {
+            let forced = take_forced(m, request.max_tokens as usize, &mut self.timing)?;
+            if !forced.is_empty() {
+                out.extend(&forced);
+                last = self.model.read(&forced, &mut self.cache);
+            }
+        }
+        while out.len() < request.max_tokens as usize {
             // with a grammar, only the allowed tokens' logits are computed
             let allowed = match matcher.as_mut() {
                 Some(m) => {
@@ -409,11 +443,24 @@ impl Engine {
                 finish = Finish::Stop;
                 break;
             }
-            out.push(token);
+            // the tokens the grammar forces next are read with this one, in one pass
+            let mut step = vec![token];
+            if let Some(m) = matcher.as_mut().filter(|_| self.fast_forward) {
+                let room = (request.max_tokens as usize).saturating_sub(out.len() + 1);
+                step.extend(take_forced(m, room, &mut self.timing)?);
+            }
+            out.extend(&step);
             if let Some(f) = on_text.as_mut() {
                 emitted = self.stream_text(&out, emitted, *f);
             }
-            last = self.model.read(&[token], &mut self.cache);
+            if matcher.as_ref().is_some_and(|m| m.is_stopped()) {
+                finish = Finish::Stop;
+                break;
+            }
+            if out.len() >= request.max_tokens as usize {
+                break;
+            }
+            last = self.model.read(&step, &mut self.cache);
         }
         self.timing.decode_tokens += out.len() as u64;
         self.timing.decode_s += decode_start.elapsed().as_secs_f64();
