@@ -85,7 +85,8 @@ pub fn quantize_k(x: &[f32], out: &mut Vec<Q8K>) {
 
 /// `x` rounded to the nearest integer, ties to even, for |x| ≤ 2²²: adding and taking off
 /// 1.5·2²³ leaves no bits below the unit, rounded as the FPU rounds (to nearest, ties to
-/// even); a zero may lose its sign. `f32::round_ties_even` is a call into libm on a CPU baseline without SSE4.1.
+/// even); a zero may lose its sign. `f32::round_ties_even` is a call into libm on a CPU
+/// baseline without SSE4.1.
 fn nearest_even(x: f32) -> f32 {
     const MAGIC: f32 = 12_582_912.0;
     (x + MAGIC) - MAGIC
