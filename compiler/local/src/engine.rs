@@ -44,8 +44,7 @@ pub struct Engine {
     im_end: u32,
     end_of_text: Option<u32>,
     factory: Option<Arc<ParserFactory>>,
-    /// Whether forced tokens are read with the sampled one (on unless
-    /// `TADSL_FAST_FORWARD=off`, to measure against).
+    /// Whether forced tokens are read with the sampled one ([`Engine::set_fast_forward`]).
     fast_forward: bool,
     context: usize,
     /// Seconds spent in prefill and decode, and in masks, over the engine's life.
@@ -213,7 +212,7 @@ impl Engine {
             im_end,
             end_of_text,
             factory: None,
-            fast_forward: std::env::var("TADSL_FAST_FORWARD").map_or(true, |v| v != "off"),
+            fast_forward: true,
             context,
             timing: Timing::default(),
         })

@@ -51,6 +51,8 @@ impl LocalChat {
         if let Some(dir) = prompt_dir() {
             engine.keep_prompts(dir);
         }
+        // forced tokens decided one at a time, to measure against
+        engine.set_fast_forward(std::env::var_os("TADSL_FAST_FORWARD").is_none_or(|v| v != "off"));
         Ok(LocalChat { engine: Arc::new(Mutex::new(engine)), name: model.name.to_string() })
     }
 
