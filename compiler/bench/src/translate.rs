@@ -9,7 +9,8 @@
 //! exactly); a truth group without a partner counts every attribute it states as wrong,
 //! and an answer group without one counts as one wrong value of each group attribute. An
 //! answer without a program gets every attribute wrong. Speeds agree within 10 % or
-//! 1 m/s, whichever is wider; everything else agrees when equal.
+//! 1 m/s, whichever is wider; everything else agrees when equal. Each case's line is
+//! followed by its misses, the answer's value beside the truth's.
 //!
 //! The translation itself is the host's (the CLI builds the session): this module pairs
 //! the files, runs the loop over them through a callback, and scores.
@@ -64,6 +65,15 @@ pub enum Value {
     Text(String),
     /// m/s
     Speed(f64),
+}
+
+impl std::fmt::Display for Value {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Value::Text(t) => f.write_str(t),
+            Value::Speed(v) => write!(f, "{:.1} km/h", v * 3.6),
+        }
+    }
 }
 
 impl Value {
@@ -160,10 +170,13 @@ fn speed(f: &Field<Param<tad_ir::MetresPerSecond>>) -> Option<Value> {
     Some(Value::Speed(mid))
 }
 
-/// Right and total per attribute, in report order.
+/// Right and total per attribute, in report order, and what each miss was.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Tally {
     pub per: BTreeMap<&'static str, (u32, u32)>,
+    /// `weather: clear, truth rainy`, a group's attributes after its truth's type and
+    /// place (`group 2 (truck) relation: …`), in report order.
+    pub misses: Vec<String>,
 }
 
 impl Tally {
@@ -173,11 +186,16 @@ impl Tally {
         entry.1 += 1;
     }
 
+    fn miss(&mut self, what: String) {
+        self.misses.push(what);
+    }
+
     /// Right and total over every attribute.
     pub fn overall(&self) -> (u32, u32) {
         self.per.values().fold((0, 0), |(r, t), (a, b)| (r + a, t + b))
     }
 
+    /// Adds `other`'s counts (its misses stay its own).
     pub fn merge(&mut self, other: &Tally) {
         for (key, (r, t)) in &other.per {
             let entry = self.per.entry(key).or_default();
@@ -192,15 +210,21 @@ pub fn score(truth: &Attributes, answer: Option<&Attributes>) -> Tally {
     let mut tally = Tally::default();
     let empty = Attributes::default();
     let a = answer.unwrap_or(&empty);
-    let mut fields = |keys: &[&'static str], t: &[Option<Value>], a: &[Option<Value>]| {
+    let mut fields = |keys: &[&'static str], t: &[Option<Value>], a: &[Option<Value>], whose: &str| {
         for (k, key) in keys.iter().enumerate() {
             if let Some(t) = t.get(k).and_then(Option::as_ref) {
-                tally.add(key, a.get(k).and_then(Option::as_ref).is_some_and(|a| t.agrees(a)));
+                let answered = a.get(k).and_then(Option::as_ref);
+                let right = answered.is_some_and(|a| t.agrees(a));
+                tally.add(key, right);
+                if !right {
+                    let answered = answered.map_or("none".to_string(), Value::to_string);
+                    tally.miss(format!("{whose}{key}: {answered}, truth {t}"));
+                }
             }
         }
     };
-    fields(&SCENE, &truth.scene, &a.scene);
-    fields(&EGO, &truth.ego, &a.ego);
+    fields(&SCENE, &truth.scene, &a.scene, "");
+    fields(&EGO, &truth.ego, &a.ego, "");
     let agreeing = |t: &[Option<Value>], a: &[Option<Value>]| {
         t.iter().zip(a).filter(|(t, a)| matches!((t, a), (Some(t), Some(a)) if t.agrees(a))).count() as i64
     };
@@ -210,12 +234,16 @@ pub fn score(truth: &Attributes, answer: Option<&Attributes>) -> Tally {
     let none = vec![None; GROUP.len()];
     for (i, t) in truth.groups.iter().enumerate() {
         let answered = partner[i].map_or(&none, |j| &a.groups[j]);
-        fields(&GROUP, t, answered);
+        let kind = t.first().and_then(Option::as_ref).map_or(String::new(), |v| format!(" ({v})"));
+        fields(&GROUP, t, answered, &format!("group {}{kind} ", i + 1));
     }
-    let matched = partner.iter().flatten().count();
-    for _ in matched..a.groups.len() {
-        for key in GROUP {
-            tally.add(key, false);
+    for (j, g) in a.groups.iter().enumerate() {
+        if !partner.contains(&Some(j)) {
+            for key in GROUP {
+                tally.add(key, false);
+            }
+            let kind = g.first().and_then(Option::as_ref).map_or(String::new(), |v| format!(" ({v})"));
+            tally.miss(format!("an answer group without a truth{kind}"));
         }
     }
     tally
@@ -329,6 +357,9 @@ pub fn run(
             if answer.rounds == 1 { "" } else { "s" },
             answer.seconds
         ));
+        for miss in &tally.misses {
+            progress(&format!("  {miss}"));
+        }
         scored.push(Scored { name: case.name.clone(), answer, tally });
     }
     Ok(scored)
@@ -422,10 +453,12 @@ mod tests {
         assert_eq!(tally.per["weather"], (0, 1));
         assert_eq!(tally.per["count"], (1, 2));
         assert_eq!(tally.per["type"], (2, 2));
+        assert_eq!(tally.misses, ["weather: clear, truth rainy", "group 1 (car) count: 2, truth 3"]);
         let extra =
             format!("{}  actor stray: 1 bicycle {{\n    behavior: cross\n  }}\n}}", TRUTH.trim_end_matches('}'));
         let tally = score(&truth, attributes(&extra).as_ref());
         assert_eq!(tally.per["type"], (2, 3), "an invented group is a wrong value of each attribute");
+        assert_eq!(tally.misses, ["an answer group without a truth (bicycle)"]);
         let nothing = score(&truth, None);
         assert_eq!(nothing.overall().0, 0);
         assert_eq!(nothing.overall().1, score(&truth, Some(&truth)).overall().1);
