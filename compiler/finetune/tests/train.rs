@@ -32,8 +32,10 @@ fn tiny(arch: Arch) -> Shape {
     }
 }
 
+/// A fresh directory under the build's scratch space (not the system's `/tmp`, where 30 of
+/// them were left behind after every run).
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("tad-finetune-{name}-{}", std::process::id()));
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("tad-finetune-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir
