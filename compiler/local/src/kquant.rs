@@ -8,12 +8,11 @@
 //! values, and the sum of every 16 of them). A super-block's product is then one integer
 //! sum, with each sub-block's scale applied as an integer: a Q4_K minimum meets the
 //! activations' sums of 16, and Q6_K's offset of 32 is taken off the same way, so its
-//! values go into the multiply unsigned. The floats enter once per 256 values, in eight
-//! lanes that meet only at the end of a row (no horizontal sum per super-block).
+//! values go into the multiply unsigned. The floats enter once per 256 values.
 //! The scalar kernels unpack a block's small integers and sum; the AVX2 ones do the same on
-//! the packed bytes, 32 values a step. For the K formats the two are the same integers in
-//! the same lanes, scaled and summed in the same order, so they give the same bits; for
-//! Q5_0 they differ in the order of the float additions.
+//! the packed bytes, 32 values a step. For the K formats the two are the same integers
+//! scaled in the same order, so they give the same bits; for Q5_0 they differ in the order
+//! of the float additions.
 //!
 //! The layouts are ggml's (`ggml-common.h`, `block_q5_0`, `block_q4_K`, `block_q6_K`,
 //! `block_q8_K`); the tests hold the dequantization to candle's on random blocks and on the
@@ -252,58 +251,34 @@ pub fn dot_q5_0(w: &[Q5_0], x: &[Q8_1]) -> f32 {
     w.iter().zip(x).map(|(b, x)| b.d * x.d * isum(&b.values(), &x.qs) as f32).sum()
 }
 
-/// Lanes of a K-format product, as the AVX2 kernels keep them: lane `m` holds values
-/// `4m..4m + 4` of every 32, scaled and summed in floats across the super-blocks (a fused
-/// multiply-add each), so the lanes meet once, at the end of the row.
-const LANES: usize = 8;
-
-/// The lanes' sum in the AVX2 kernels' order: halves, then pairs, then the last two.
-fn lane_sum(v: [f32; LANES]) -> f32 {
-    let half: [f32; 4] = std::array::from_fn(|i| v[i] + v[i + 4]);
-    (half[0] + half[2]) + (half[1] + half[3])
-}
-
-/// A super-block's integer sums by lane: `Σ scale(block)·Σq·x` over values `4m..4m + 4`
-/// of each block of 32 (`scale` gives each run of four its scale).
-fn lane_sums<Q: Copy + Into<i32>>(q: &[Q; SUPER], x: &[i8; SUPER], scale: impl Fn(usize) -> i32) -> [i32; LANES] {
-    let mut sums = [0i32; LANES];
-    for (run, (q, x)) in q.chunks_exact(4).zip(x.chunks_exact(4)).enumerate() {
-        sums[run % LANES] += scale(run) * isum(q, x);
-    }
-    sums
-}
-
 /// Q4_K super-blocks against as many activation super-blocks: per super-block
-/// `d·dx·Σ sc·Σq·x − dmin·dx·Σ m·Σx` (a minimum meets its sub-block's two sums of 16), by lane.
+/// `d·dx·Σ sc·Σq·x − dmin·dx·Σ m·Σx` (a minimum meets its sub-block's two sums of 16).
 pub fn dot_q4_k(w: &[Q4K], x: &[Q8K]) -> f32 {
-    let mut lanes = [0f32; LANES];
+    let mut total = 0.0;
     for (b, x) in w.iter().zip(x) {
-        let sums = lane_sums(&b.values(), &x.qs, |run| b.scales[4 * run / BLOCK] as i32);
-        let (d, dmin) = (b.d * x.d, b.dmin * x.d);
-        for (m, lane) in lanes.iter_mut().enumerate() {
-            let min = b.mins[m] as i32 * (x.bsums[2 * m] as i32 + x.bsums[2 * m + 1] as i32);
-            *lane = (-dmin).mul_add(min as f32, d.mul_add(sums[m] as f32, *lane));
+        let (q, scales, mins) = (b.values(), b.scales, b.mins);
+        let (mut sum, mut min) = (0i32, 0i32);
+        for sub in 0..SUPER / BLOCK {
+            let at = BLOCK * sub..BLOCK * (sub + 1);
+            sum += scales[sub] as i32 * isum(&q[at.clone()], &x.qs[at]);
+            min += mins[sub] as i32 * (x.bsums[2 * sub] as i32 + x.bsums[2 * sub + 1] as i32);
         }
+        total += b.d * x.d * sum as f32 - b.dmin * x.d * min as f32;
     }
-    lane_sum(lanes)
+    total
 }
 
-/// Q6_K super-blocks against as many activation super-blocks: `d·dx·Σ sc·Σq·x` per 16
-/// values, by lane (the values unsigned, their offset of 32 taken off through the sums of 16).
+/// Q6_K super-blocks against as many activation super-blocks: `d·dx·Σ sc·Σq·x` per 16 values.
 pub fn dot_q6_k(w: &[Q6K], x: &[Q8K]) -> f32 {
-    let mut lanes = [0f32; LANES];
+    let mut total = 0.0;
     for (b, x) in w.iter().zip(x) {
-        let q = b.values().map(|v| v as i32 + 32);
-        let sums = lane_sums(&q, &x.qs, |run| b.scales[4 * run / 16] as i32);
-        let d = b.d * x.d;
-        for (m, lane) in lanes.iter_mut().enumerate() {
-            let offset = 32
-                * (b.scales[2 * m] as i32 * x.bsums[2 * m] as i32
-                    + b.scales[2 * m + 1] as i32 * x.bsums[2 * m + 1] as i32);
-            *lane = d.mul_add((sums[m] - offset) as f32, *lane);
-        }
+        let q = b.values();
+        let sum: i32 = (0..16)
+            .map(|sub| b.scales[sub] as i32 * isum(&q[16 * sub..16 * sub + 16], &x.qs[16 * sub..16 * sub + 16]))
+            .sum();
+        total += b.d * x.d * sum as f32;
     }
-    lane_sum(lanes)
+    total
 }
 
 /// The three formats' kernels.
@@ -330,8 +305,8 @@ pub fn scalar_kernels() -> Formats {
 /// The same products on packed blocks, 32 values a step: a block's values as bytes, their
 /// products with a token's in 16-bit pairs (`maddubs`; Q5_0's signed values through the sign
 /// trick), summed to eight 32-bit lanes against 16-bit scales. Q5_0 scales and accumulates
-/// the lanes in floats per block; the K formats sum them as integers over a super-block,
-/// then scale and accumulate the lanes in floats as the scalar kernels do. Each block is unpacked once for all the tokens of
+/// the lanes in floats per block; the K formats sum them as integers over a super-block and
+/// scale that as the scalar kernels do. Each block is unpacked once for all the tokens of
 /// a call.
 #[cfg(target_arch = "x86_64")]
 mod avx2 {
@@ -421,6 +396,16 @@ mod avx2 {
         *sums = _mm256_add_epi32(*sums, _mm256_madd_epi16(_mm256_maddubs_epi16(q, xq), scales));
     }
 
+    /// The sum of eight 32-bit lanes.
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    fn hsum_i32(v: __m256i) -> i32 {
+        let v = _mm_add_epi32(_mm256_castsi256_si128(v), _mm256_extracti128_si256(v, 1));
+        let v = _mm_add_epi32(v, _mm_shuffle_epi32(v, 0b01_00_11_10));
+        let v = _mm_add_epi32(v, _mm_shuffle_epi32(v, 0b10_11_00_01));
+        _mm_cvtsi128_si32(v)
+    }
+
     /// A token's sums of 16, as sixteen 16-bit lanes.
     #[target_feature(enable = "avx2,fma")]
     #[inline]
@@ -443,7 +428,7 @@ mod avx2 {
     #[target_feature(enable = "avx2,fma")]
     fn q4_k<const N: usize>(w: &[Q4K], x: [&[Q8K]; N]) -> [f32; N] {
         let low = _mm256_set1_epi8(0x0f);
-        let mut acc = [_mm256_setzero_ps(); N];
+        let mut totals = [0f32; N];
         for (i, b) in w[..supers(w.len(), &x)].iter().enumerate() {
             let (scales, mins) = (&b.scales, mins16(b));
             let mut sums = [_mm256_setzero_si256(); N];
@@ -459,14 +444,13 @@ mod avx2 {
                     }
                 }
             }
-            for ((acc, sums), x) in acc.iter_mut().zip(sums).zip(x) {
+            for ((total, sums), x) in totals.iter_mut().zip(sums).zip(x) {
                 let x = &x[i];
-                let min = _mm256_madd_epi16(mins, bsums(x));
-                let sum = _mm256_fmadd_ps(_mm256_set1_ps(b.d * x.d), _mm256_cvtepi32_ps(sums), *acc);
-                *acc = _mm256_fnmadd_ps(_mm256_set1_ps(b.dmin * x.d), _mm256_cvtepi32_ps(min), sum);
+                let (sum, min) = (hsum_i32(sums), hsum_i32(_mm256_madd_epi16(mins, bsums(x))));
+                *total += b.d * x.d * sum as f32 - b.dmin * x.d * min as f32;
             }
         }
-        acc.map(|a| hsum(a))
+        totals
     }
 
     #[target_feature(enable = "avx2,fma")]
@@ -480,7 +464,7 @@ mod avx2 {
                 |s: i8| _mm_set_epi8(s + 1, s, s + 1, s, s + 1, s, s + 1, s, s + 1, s, s + 1, s, s + 1, s, s + 1, s);
             _mm256_set_m128i(lane(b), lane(a))
         });
-        let mut acc = [_mm256_setzero_ps(); N];
+        let mut totals = [0f32; N];
         for (i, b) in w[..supers(w.len(), &x)].iter().enumerate() {
             // SAFETY: 16 bytes, an unaligned load
             let scales = _mm256_cvtepi8_epi16(unsafe { _mm_loadu_si128(b.scales.as_ptr().cast()) });
@@ -518,14 +502,13 @@ mod avx2 {
                     }
                 }
             }
-            for ((acc, sums), x) in acc.iter_mut().zip(sums).zip(x) {
+            for ((total, sums), x) in totals.iter_mut().zip(sums).zip(x) {
                 let x = &x[i];
                 let offset = _mm256_slli_epi32(_mm256_madd_epi16(scales, bsums(x)), 5);
-                let lanes = _mm256_cvtepi32_ps(_mm256_sub_epi32(sums, offset));
-                *acc = _mm256_fmadd_ps(_mm256_set1_ps(b.d * x.d), lanes, *acc);
+                *total += b.d * x.d * hsum_i32(_mm256_sub_epi32(sums, offset)) as f32;
             }
         }
-        acc.map(|a| hsum(a))
+        totals
     }
 }
 
