@@ -186,10 +186,6 @@ impl Tally {
         entry.1 += 1;
     }
 
-    fn miss(&mut self, what: String) {
-        self.misses.push(what);
-    }
-
     /// Right and total over every attribute.
     pub fn overall(&self) -> (u32, u32) {
         self.per.values().fold((0, 0), |(r, t), (a, b)| (r + a, t + b))
@@ -218,7 +214,7 @@ pub fn score(truth: &Attributes, answer: Option<&Attributes>) -> Tally {
                 tally.add(key, right);
                 if !right {
                     let answered = answered.map_or("none".to_string(), Value::to_string);
-                    tally.miss(format!("{whose}{key}: {answered}, truth {t}"));
+                    tally.misses.push(format!("{whose}{key}: {answered}, truth {t}"));
                 }
             }
         }
@@ -234,19 +230,22 @@ pub fn score(truth: &Attributes, answer: Option<&Attributes>) -> Tally {
     let none = vec![None; GROUP.len()];
     for (i, t) in truth.groups.iter().enumerate() {
         let answered = partner[i].map_or(&none, |j| &a.groups[j]);
-        let kind = t.first().and_then(Option::as_ref).map_or(String::new(), |v| format!(" ({v})"));
-        fields(&GROUP, t, answered, &format!("group {}{kind} ", i + 1));
+        fields(&GROUP, t, answered, &format!("group {}{} ", i + 1, kind(t)));
     }
     for (j, g) in a.groups.iter().enumerate() {
         if !partner.contains(&Some(j)) {
             for key in GROUP {
                 tally.add(key, false);
             }
-            let kind = g.first().and_then(Option::as_ref).map_or(String::new(), |v| format!(" ({v})"));
-            tally.miss(format!("an answer group without a truth{kind}"));
+            tally.misses.push(format!("an answer group without a truth{}", kind(g)));
         }
     }
     tally
+}
+
+/// A group's type for a miss's line: ` (truck)`, or nothing when it states none.
+fn kind(group: &[Option<Value>]) -> String {
+    group.first().and_then(Option::as_ref).map_or(String::new(), |v| format!(" ({v})"))
 }
 
 /// For each row, the column it is assigned to (at most one row per column) so that the
