@@ -32,13 +32,9 @@ fn tiny(arch: Arch) -> Shape {
     }
 }
 
-/// A fresh directory under the build's scratch space (not the system's `/tmp`, where 30 of
-/// them were left behind after every run).
+/// A fresh directory under the build's scratch space, not the system's `/tmp`.
 fn scratch(name: &str) -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("tad-finetune-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    tad_test_support::scratch(Path::new(env!("CARGO_TARGET_TMPDIR")), &format!("tad-finetune-{name}"))
 }
 
 fn cosine(a: &[f32], b: &[f32]) -> f32 {
