@@ -187,8 +187,8 @@ fn constrain_sends_the_grammar_in_the_servers_field() {
     assert_eq!(openai.requests()[0]["response_format"]["type"], "json_schema");
 }
 
-/// `bench --translate` over the repository's descriptions: a server that answers each
-/// with its own ground truth scores 100 %; one that answers with one fixed program scores
+/// `bench --translate` over the repository's descriptions, the server constrained: one that
+/// answers each with its own ground truth scores 100 %; one that answers with one fixed program scores
 /// what that program gets right, and its answers are kept.
 #[test]
 fn bench_translate_scores_answers_against_the_ground_truth() {
@@ -209,6 +209,8 @@ fn bench_translate_scores_answers_against_the_ground_truth() {
     let report = stdout(&out);
     assert!(report.contains("on 88 descriptions"), "{report}");
     assert!(report.contains("| **overall** |") && report.contains("**100.0 %**"), "{report}");
+    // every model is measured constrained, a server as `translate --constrain` asks it
+    assert!(server.requests().iter().all(|r| r["response_format"]["type"] == "json_schema"));
 
     let dir = scratch("bench-translate");
     let fixed = FakeLlm::start(|_, _| fenced(COMPLETE));

@@ -243,13 +243,14 @@ fn translate(args: &Args) -> Result<Status, CliError> {
     use tad_bench::translate::{Answer, Case};
     use tad_frontend::{backend, store, translate::Translator};
 
-    /// The LLM flags parsed as `translate` parses them, so their defaults live there.
+    /// The LLM flags parsed as `translate` parses them, so their defaults live there; every
+    /// model is constrained, a server as `translate --constrain` asks it.
     #[derive(clap::Parser)]
     struct Flags {
         #[command(flatten)]
         llm: crate::llm::LlmArgs,
     }
-    let mut argv = vec!["bench".to_string(), "--threads".into(), args.threads.to_string()];
+    let mut argv = vec!["bench".to_string(), "--constrain".into(), "--threads".into(), args.threads.to_string()];
     argv.extend(["--max-rounds".into(), args.max_rounds.to_string()]);
     argv.extend(args.model.iter().flat_map(|m| ["--model".to_string(), m.clone()]));
     let llm = <Flags as clap::Parser>::try_parse_from(argv).map_err(|e| CliError::usage(e.to_string()))?.llm;
