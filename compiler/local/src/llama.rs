@@ -101,10 +101,7 @@ impl Matrix {
     }
 
     /// Rows `rows` against every token of the chunk, row after row
-    /// (`out[(r − rows.start)·n + t]`). Four tokens at a time where the kernel can, each four
-    /// against every row of the range in turn: a few rows and four tokens' activations stay
-    /// in the first-level cache together, where row by row all the chunk's activations would
-    /// pass through it for every row.
+    /// (`out[(r − rows.start)·n + t]`), as [`tile`] takes them.
     fn rows_all(&self, k: &Kernels, rows: Range<usize>, x: &[Input], out: &mut Vec<f32>) {
         out.clear();
         out.resize(rows.len() * x.len(), 0.0);
@@ -157,8 +154,9 @@ impl Matrix {
         let part = |w: usize| {
             let mut part = Vec::with_capacity(per * x.len());
             let mut values = Vec::new();
-            for start in (w * per..rows.min((w + 1) * per)).step_by(TILE) {
-                self.rows_all(k, start..rows.min((w + 1) * per).min(start + TILE), x, &mut values);
+            let end = rows.min((w + 1) * per);
+            for start in (w * per..end).step_by(TILE) {
+                self.rows_all(k, start..end.min(start + TILE), x, &mut values);
                 part.extend_from_slice(&values);
             }
             part

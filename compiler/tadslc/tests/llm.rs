@@ -188,8 +188,8 @@ fn constrain_sends_the_grammar_in_the_servers_field() {
 }
 
 /// `bench --translate` over the repository's descriptions, the server constrained: one that
-/// answers each with its own ground truth scores 100 %; one that answers with one fixed program scores
-/// what that program gets right, and its answers are kept.
+/// answers each with its own ground truth scores 100 %; one that answers with one fixed
+/// program scores what that program gets right, and its answers are kept.
 #[test]
 fn bench_translate_scores_answers_against_the_ground_truth() {
     let truth_dir = repo().join("tests/llm/truth");
