@@ -34,6 +34,10 @@ pub struct Engine {
     prefix: Option<Vec<u32>>,
     /// The keys and values of the last prompt and answer, from the first position.
     cache: Cache,
+    /// The tokens whose keys and values `cache` holds, in order: a prompt that starts with
+    /// some of them (a repair round: the last prompt and answer, then the repair) reads on
+    /// after them.
+    held: Vec<u32>,
     /// The sha256 of what makes this model's outputs what they are: its file, the program,
     /// the adapter, the kernels.
     identity: [u8; 32],
@@ -205,6 +209,7 @@ impl Engine {
         Ok(Engine {
             model,
             prefix: None,
+            held: Vec::new(),
             cache,
             identity,
             store: None,
@@ -262,6 +267,7 @@ impl Engine {
     /// message is dropped).
     pub fn logits(&mut self, tokens: &[u32]) -> Vec<f32> {
         self.prefix = None;
+        self.held.clear();
         self.cache = self.model.new_cache();
         self.model.forward(tokens, &mut self.cache)
     }
@@ -277,9 +283,11 @@ impl Engine {
         self.fast_forward = on;
     }
 
-    /// Drops the cached system message, so the next prompt is read whole.
+    /// Drops the cached system message and what followed it, so the next prompt is read
+    /// whole.
     pub fn forget_prefix(&mut self) {
         self.prefix = None;
+        self.held.clear();
     }
 
     /// Keeps each new system message's keys and values in `dir` ([`PromptStore`]), and
@@ -289,7 +297,8 @@ impl Engine {
     }
 
     /// Reads `prompt` into the cache and returns its last token's state: from the cached
-    /// system message when the prompt starts with it (in memory, else in the store), else
+    /// system message when the prompt starts with it (in memory, else in the store), and
+    /// past whatever else of the cache it starts with (the last answer, for a repair), else
     /// from the start, remembering this prompt's first message as the new prefix (and
     /// keeping it in the store). Also returns how many tokens were read.
     fn prefill(&mut self, prompt: &[u32], first: usize) -> (Last, usize) {
@@ -297,7 +306,9 @@ impl Engine {
         let has_prefix = first > 0 && first < prompt.len();
         let done = match cached {
             Some(p) => {
-                let done = p.len();
+                // at least the last token is read, for its state
+                let same = self.held.iter().zip(prompt).take_while(|(a, b)| a == b).count();
+                let done = p.len().max(same.min(prompt.len() - 1));
                 self.cache.truncate(done);
                 done
             }
@@ -321,7 +332,8 @@ impl Engine {
                 }
             }
         };
-        let last = self.model.read(&prompt[done..], &mut self.cache);
+        self.held = prompt[..done].to_vec();
+        let last = self.read(&prompt[done..]);
         if done == 0
             && has_prefix
             && let Some(store) = &self.store
@@ -330,6 +342,12 @@ impl Engine {
             let _ = store.save(&prompt[..first], &self.cache);
         }
         (last, prompt.len() - done)
+    }
+
+    /// Reads `tokens` after the cache's, noting them as held.
+    fn read(&mut self, tokens: &[u32]) -> Last {
+        self.held.extend_from_slice(tokens);
+        self.model.read(tokens, &mut self.cache)
     }
 
     /// The model's weights in memory, and the dot-product kernels chosen for this CPU.
@@ -411,7 +429,7 @@ impl Engine {
             let forced = take_forced(m, request.max_tokens as usize, &mut self.timing)?;
             if !forced.is_empty() {
                 out.extend(&forced);
-                last = self.model.read(&forced, &mut self.cache);
+                last = self.read(&forced);
             }
         }
         while out.len() < request.max_tokens as usize {
@@ -459,7 +477,7 @@ impl Engine {
             if out.len() >= request.max_tokens as usize {
                 break;
             }
-            last = self.model.read(&step, &mut self.cache);
+            last = self.read(&step);
         }
         self.timing.decode_tokens += out.len() as u64;
         self.timing.decode_s += decode_start.elapsed().as_secs_f64();

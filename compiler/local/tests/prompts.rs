@@ -60,3 +60,24 @@ fn a_kept_system_message_is_read_not_prefilled_and_gives_the_same_answer() {
     assert!(read_after < prompt / 4, "the damaged file was replaced");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A repair round's prompt is the last prompt and answer and then the repair: only the
+/// repair is read, and the answer is the one an engine reading the whole prompt gives.
+#[test]
+fn a_repair_round_reads_on_after_the_last_answer() {
+    let Some(path) = tad_local::for_tests(tad_local::SMALLEST) else { return };
+    let first = request("A bus ahead.");
+    let mut engine = Engine::load(&path, 1).unwrap();
+    let answer = engine.generate(&first).unwrap();
+    let mut repair = first.clone();
+    repair.messages.push(Message::text(Role::Assistant, answer.text.clone()));
+    repair.messages.push(Message::text(Role::User, "E0500 2:5: unknown weather `sunnyish`. Write the program again."));
+    let before = engine.timing;
+    let again = engine.generate(&repair).unwrap();
+    let read = engine.timing.since(&before).prefill_tokens;
+    let added = again.usage.prompt_tokens - answer.usage.prompt_tokens;
+    assert!(read + answer.usage.completion_tokens / 2 < added, "read {read} of the {added} new tokens");
+
+    let whole = Engine::load(&path, 1).unwrap().generate(&repair).unwrap();
+    assert_eq!(again.text, whole.text, "reading on gives the whole prompt's answer");
+}
