@@ -12,7 +12,7 @@
 //! check-and-repair loop on `tad-db` (the same checks as `tadslc check`) over `tad-llm`,
 //! [`synth`], [`generate`] and [`translate`] are the pipelines, [`backend`] picks who
 //! answers (a server or the model in process), [`store`] writes what they produce (sanitised
-//! names, atomic files, JSON Lines), [`summary`] counts what happened, [`sft`] turns a corpus into fine-tuning data. Everything a model
+//! names, atomic files, JSON Lines), [`summary`] counts what happened, [`shots`] retrieves translations to show before a description, [`sft`] turns a corpus into fine-tuning data. Everything a model
 //! writes is untrusted: it never names a path, never breaks a record, and every loop is
 //! bounded in rounds, tokens and time.
 
@@ -22,6 +22,7 @@ pub mod generate;
 pub mod prompt;
 pub mod session;
 pub mod sft;
+pub mod shots;
 pub mod store;
 pub mod summary;
 pub mod synth;

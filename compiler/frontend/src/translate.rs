@@ -7,6 +7,7 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::shots::Pool;
 use crate::{Outcome, Round, Session, Summary, store};
 
 /// The description files of `paths` (directories searched for `*.txt`), in order.
@@ -49,13 +50,23 @@ pub struct Translator<'a> {
     pub region: Option<&'a str>,
     /// The tool and its version, for the provenance (`tadslc 0.1.0`).
     pub tool: &'a str,
+    /// Translations shown before each description: the pool, and how many of its nearest.
+    pub shots: Option<(&'a Pool, usize)>,
 }
 
 impl Translator<'_> {
     /// One description through the loop: the outcome and the program with its provenance.
     pub fn one(&self, path: &Path, text: &str, on_round: &mut dyn FnMut(&Round)) -> (Outcome, Option<String>) {
         let item = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "stdin".into());
-        let messages = crate::translate_messages(text, self.session.checker);
+        let mut messages = crate::translate_messages(text, self.session.checker);
+        let mut comments = Vec::new();
+        if let Some((pool, k)) = self.shots {
+            let shots = pool.nearest(text, k);
+            let ask = |d: &str| crate::prompt::TRANSLATE.render(&[("description", d)]).user;
+            messages = crate::shots::interleave(messages, &shots, ask);
+            let names: Vec<&str> = shots.iter().map(|s| s.name.as_str()).collect();
+            comments.push(format!("shown first: {}", names.join(", ")));
+        }
         let outcome = self.runtime.block_on(self.session.run(&item, messages, crate::prompt::TRANSLATE.id, on_round));
         let provenance = crate::Provenance {
             comments: vec![format!(
@@ -66,7 +77,10 @@ impl Translator<'_> {
                 outcome.rounds,
                 if outcome.rounds == 1 { "" } else { "s" },
                 crate::prompt::TRANSLATE.id
-            )],
+            )]
+            .into_iter()
+            .chain(comments)
+            .collect(),
             region: self.region.map(String::from),
             description: Some(text.to_string()),
             ..Default::default()

@@ -107,6 +107,40 @@ fn translate_takes_the_description_as_text() {
     assert_eq!(code(&run(&["translate", "--text", "  "], &[])), 2);
 }
 
+/// `--pool` shows the translations whose descriptions read most like this one as earlier
+/// turns, the nearest last, and names them in the provenance; programs without a
+/// description or with an error are left out with a warning.
+#[test]
+fn translate_shows_the_pools_nearest_translations_first() {
+    let dir = scratch("llm-pool");
+    let pool = dir.join("pool");
+    std::fs::create_dir_all(&pool).unwrap();
+    let with = |name: &str, description: &str| {
+        let source = format!("scenario {name} {{\n  source {{\n    description: \"{description}\"\n  }}");
+        COMPLETE.replacen("scenario bus_ahead {", &source, 1)
+    };
+    std::fs::write(pool.join("bus.tad"), with("bus", "A red bus drives ahead of the ego in town.")).unwrap();
+    std::fs::write(pool.join("deer.tad"), with("deer", "Deer cross a foggy country road at dawn.")).unwrap();
+    std::fs::write(pool.join("truck.tad"), with("truck", "A truck merges onto a rainy highway.")).unwrap();
+    std::fs::write(pool.join("bare.tad"), COMPLETE).unwrap();
+    std::fs::write(pool.join("broken.tad"), with("broken", "A bus.").replace("clear", "sunnyish")).unwrap();
+    let server = FakeLlm::script(vec![fenced(COMPLETE)]);
+    let args = ["translate", "--text", "A bus ahead of the ego in town.", "--pool", pool.to_str().unwrap()];
+    let out = run(&args, &env_of(&served(&server)));
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    let messages = server.requests()[0]["messages"].as_array().unwrap().clone();
+    let roles: Vec<&str> = messages.iter().map(|m| m["role"].as_str().unwrap()).collect();
+    assert_eq!(roles, ["system", "user", "assistant", "user", "assistant", "user"]);
+    let text = |i: usize| messages[i]["content"].as_str().map(String::from).unwrap_or_else(|| messages[i].to_string());
+    assert!(text(3).contains("A red bus drives ahead") && text(4).contains("scenario bus {"), "the nearest last");
+    assert!(!text(4).contains("source") && text(5).contains("A bus ahead of the ego in town."));
+    assert!(stdout(&out).contains("// shown first: ") && stdout(&out).contains(", bus\n"), "{}", stdout(&out));
+    assert!(stderr(&out).contains("leaves out 2 programs"), "{}", stderr(&out));
+
+    assert_eq!(code(&run(&["translate", "--text", "A bus.", "--pool", "no/such/dir"], &[])), 2);
+    assert_eq!(code(&run(&["translate", "--text", "A bus.", "--shots", "3"], &[])), 2, "--shots needs a pool");
+}
+
 #[test]
 fn an_incomplete_scenario_gets_the_refinement_request() {
     let dir = scratch("llm-refine");

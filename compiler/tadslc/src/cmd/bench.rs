@@ -80,6 +80,8 @@ pub struct Args {
     /// server's, or an interrupted run's
     #[arg(long, value_name = "DIR", requires = "translate", conflicts_with_all = ["model", "out"])]
     pub answers: Option<PathBuf>,
+    #[command(flatten)]
+    pub shots: crate::cmd::translate::ShotArgs,
     /// Samples of each language server measurement
     #[arg(long, value_name = "N", default_value_t = 200, requires = "lsp")]
     pub samples: usize,
@@ -265,7 +267,9 @@ fn translate(args: &Args) -> Result<Status, CliError> {
     let session = llm.session(&backend, &checker, constraint, 0.0);
     let runtime = backend::runtime().map_err(CliError::usage)?;
     let tool = format!("tadslc {}", env!("CARGO_PKG_VERSION"));
-    let translator = Translator { session: &session, runtime: &runtime, region: None, tool: &tool };
+    let pool = args.shots.load()?;
+    let shots = pool.as_ref().map(|p| (p, args.shots.shots));
+    let translator = Translator { session: &session, runtime: &runtime, region: None, tool: &tool, shots };
     let mut manifest = match &args.out {
         Some(dir) => Some(
             store::Jsonl::append(&dir.join("faithfulness.jsonl"))

@@ -6,6 +6,7 @@
 use std::path::PathBuf;
 
 use tad_frontend::backend;
+use tad_frontend::shots::Pool;
 use tad_frontend::translate::{self, Translator};
 use tad_frontend::{Round, Session, store};
 use tad_llm::Constraint;
@@ -38,7 +39,40 @@ pub struct Args {
     #[arg(long)]
     pub stream: bool,
     #[command(flatten)]
+    pub shots: ShotArgs,
+    #[command(flatten)]
     pub llm: LlmArgs,
+}
+
+/// Translations retrieved from a pool and shown before each description
+/// (`tad_frontend::shots`).
+#[derive(clap::Args, Clone, Debug)]
+pub struct ShotArgs {
+    /// Before each description, show the model the translations of this pool whose
+    /// descriptions read most like it: programs with a `source.description` (a region's
+    /// corpus, checked translations), or `truth/NAME.tad` beside `descriptions/NAME.txt`
+    #[arg(long, value_name = "DIR")]
+    pub pool: Option<PathBuf>,
+    /// How many of the pool's translations are shown
+    #[arg(long, value_name = "N", default_value_t = 2, requires = "pool")]
+    pub shots: usize,
+}
+
+impl ShotArgs {
+    /// The pool, if one is named; a warning names the programs it leaves out.
+    pub fn load(&self) -> Result<Option<Pool>, CliError> {
+        let Some(dir) = &self.pool else { return Ok(None) };
+        let pool = Pool::load(dir).map_err(CliError::usage)?;
+        if !pool.skipped.is_empty() {
+            errln!(
+                "warning: the pool leaves out {} program{} without a description or with an error: {}",
+                pool.skipped.len(),
+                if pool.skipped.len() == 1 { "" } else { "s" },
+                pool.skipped.join(", ")
+            )?;
+        }
+        Ok(Some(pool))
+    }
 }
 
 pub fn run(t: &Args) -> Result<Status, CliError> {
@@ -90,7 +124,9 @@ pub fn run(t: &Args) -> Result<Status, CliError> {
     };
     let runtime = backend::runtime().map_err(CliError::usage)?;
     let tool = format!("tadslc {}", env!("CARGO_PKG_VERSION"));
-    let translator = Translator { session: &session, runtime: &runtime, region, tool: &tool };
+    let pool = t.shots.load()?;
+    let shots = pool.as_ref().map(|p| (p, t.shots.shots));
+    let translator = Translator { session: &session, runtime: &runtime, region, tool: &tool, shots };
     if !batch {
         let text = match &t.text {
             Some(words) if words.trim().is_empty() => {
