@@ -6,9 +6,10 @@
 //! lines, one scenario with its sections in canonical order, two-space indentation, one
 //! field per line in the schema's order, each field at most once. A program in it parses;
 //! the checker still judges its meaning (lanes against the road, behaviours against the
-//! actor's kind, completeness). Numbers and names are bounded in length, and lists and the
-//! groups in number, so that a decoder cannot run away inside one: a small model otherwise
-//! repeats groups or list items until its token limit cuts the program short.
+//! actor's kind, completeness). Numbers, names, strings and comment lines are bounded in
+//! length, and lists and the groups in number, so that a decoder cannot run away inside one:
+//! a small model otherwise repeats groups, list items or a sentence of a comment until its
+//! token limit cuts the program short.
 
 use tad_check::Vocabulary;
 use tad_syntax::lexer::UNITS;
@@ -20,6 +21,12 @@ use crate::ir::{Expr, Grammar, alt, class, lit, not_class, opt, r, rep, seq, sta
 const NAME_MAX: u32 = 48;
 /// Comment lines before the program.
 const COMMENTS_MAX: u32 = 8;
+/// Characters in a comment line after `//`.
+const COMMENT_MAX: u32 = 120;
+/// Characters in a string, and in a text block (a `source.description`, which answers need
+/// not write: the benchmark's longest description has 642).
+const STRING_MAX: u32 = 200;
+const TEXT_MAX: u32 = 1000;
 /// Actor groups in a scenario (the examples and the benchmark's truths have at most 5).
 const GROUPS_MAX: u32 = 12;
 /// Names in a list field (the examples and truths have at most 5).
@@ -100,15 +107,19 @@ pub fn grammar(vocabulary: &Vocabulary, modules: &[String]) -> Grammar {
         "string",
         seq([
             lit("\""),
-            star(alt([
-                not_class(&['"', '\\', '\n']),
-                seq([lit("\\"), class(&[('"', '"'), ('\\', '\\'), ('n', 'n'), ('t', 't')])]),
-            ])),
+            rep(
+                alt([
+                    not_class(&['"', '\\', '\n']),
+                    seq([lit("\\"), class(&[('"', '"'), ('\\', '\\'), ('n', 'n'), ('t', 't')])]),
+                ]),
+                0,
+                STRING_MAX,
+            ),
             lit("\""),
         ]),
     );
-    g.terminal("text-block", seq([lit("\"\"\""), star(not_class(&['"'])), lit("\"\"\"")]));
-    g.terminal("comment", seq([lit("//"), star(not_class(&['\n'])), lit("\n")]));
+    g.terminal("text-block", seq([lit("\"\"\""), rep(not_class(&['"']), 0, TEXT_MAX), lit("\"\"\"")]));
+    g.terminal("comment", seq([lit("//"), rep(not_class(&['\n']), 0, COMMENT_MAX), lit("\n")]));
     g
 }
 

@@ -143,6 +143,7 @@ fn mutants(text: &str) -> Vec<(&'static str, String)> {
     push("a lane that is not a number", "lane: 1", "lane: one");
     push("a range in a single-valued field", "lanes: ", "lanes: 1..");
     push("prose before the program", "scenario ", "Here is the scenario:\nscenario ");
+    out.push(("a comment line that runs on", format!("// {}\n{text}", "If you need more, ask. ".repeat(6))));
     out
 }
 
