@@ -4,8 +4,9 @@
 //! The fixed examples of the prompt teach TAD's form; these teach the conventions on cases
 //! like the one at hand (a region's corpus, a user's checked translations). A pool is a
 //! directory of programs whose `source.description` says what they translate, or the
-//! benchmark's layout (`truth/NAME.tad` beside `descriptions/NAME.txt`). A program the
-//! checker finds an error in is not shown. Descriptions are ranked by Okapi BM25 over
+//! benchmark's layout (`truth/NAME.tad` beside `descriptions/NAME.txt`). A program is
+//! shown as the checker reads it, after its machine-applicable fixes; one with an error
+//! left, without a description or unreadable is not shown, and the pool says why. Descriptions are ranked by Okapi BM25 over
 //! their lower-cased words (k1 = 1.2, b = 0.75), ties by name, so the choice is
 //! deterministic; a pool entry whose description is the one being translated is never
 //! shown, so a pool may hold the set it is asked about. The examples go after the system
@@ -40,7 +41,7 @@ pub struct Pool {
     words: Vec<(HashMap<String, u32>, usize)>,
     /// In how many descriptions each word occurs.
     documents: HashMap<String, u32>,
-    /// Programs left out: no description, or an error.
+    /// Programs left out, each with why: no description, an error, unreadable.
     pub skipped: Vec<String>,
 }
 
@@ -54,19 +55,9 @@ impl Pool {
         let checker = Checker::default();
         let mut pool = Pool::default();
         for path in tad_db::host::with_extension(dir, "tad") {
-            let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-            let text = std::fs::read_to_string(&path).map_err(|e| format!("cannot read `{}`: {e}", path.display()))?;
-            let (own, program) = crate::example_parts(&text);
-            let description = match own.is_empty() {
-                false => Some(own),
-                true => beside(&path).and_then(|p| std::fs::read_to_string(p).ok()),
-            };
-            let description = description.map(|d| d.trim().to_string()).filter(|d| !d.is_empty());
-            match description {
-                Some(d) if checker.check(&program, Language::Tad).errors == 0 => {
-                    pool.push(Shot { name, description: d, program })
-                }
-                _ => pool.skipped.push(path.display().to_string()),
+            match entry(&checker, &path) {
+                Ok(shot) => pool.push(shot),
+                Err(why) => pool.skipped.push(format!("{} ({why})", path.display())),
             }
         }
         if pool.shots.is_empty() {
@@ -122,6 +113,25 @@ impl Pool {
         chosen.reverse();
         chosen
     }
+}
+
+/// The pool entry of the program at `path`, as the checker reads it (its machine-applicable
+/// fixes applied), or why it is left out.
+fn entry(checker: &Checker, path: &Path) -> Result<Shot, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("cannot be read: {e}"))?;
+    let (own, program) = crate::example_parts(&text);
+    let description = match own.is_empty() {
+        false => Some(own),
+        true => beside(path).and_then(|p| std::fs::read_to_string(p).ok()),
+    };
+    let description = description.map(|d| d.trim().to_string()).filter(|d| !d.is_empty());
+    let description = description.ok_or("no description")?;
+    let verdict = checker.check(&program, Language::Tad);
+    if verdict.errors > 0 {
+        return Err(format!("{} error{}", verdict.errors, if verdict.errors == 1 { "" } else { "s" }));
+    }
+    let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    Ok(Shot { name, description, program: verdict.tad.map_or(program, |t| t.trim().to_string()) })
 }
 
 /// `messages` (system, then the question) with `shots` as earlier turns between them, each

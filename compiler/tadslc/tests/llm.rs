@@ -135,7 +135,9 @@ fn translate_shows_the_pools_nearest_translations_first() {
     assert!(text(3).contains("A red bus drives ahead") && text(4).contains("scenario bus {"), "the nearest last");
     assert!(!text(4).contains("source") && text(5).contains("A bus ahead of the ego in town."));
     assert!(stdout(&out).contains("// shown first: ") && stdout(&out).contains(", bus\n"), "{}", stdout(&out));
-    assert!(stderr(&out).contains("leaves out 2 programs"), "{}", stderr(&out));
+    let warning = stderr(&out);
+    assert!(warning.contains("leaves out 2 programs") && warning.contains("bare.tad (no description)"), "{warning}");
+    assert!(warning.contains("broken.tad (1 error)"), "{warning}");
 
     assert_eq!(code(&run(&["translate", "--text", "A bus.", "--pool", "no/such/dir"], &[])), 2);
     assert_eq!(code(&run(&["translate", "--text", "A bus.", "--shots", "3"], &[])), 2, "--shots needs a pool");

@@ -65,7 +65,7 @@ impl ShotArgs {
         let pool = Pool::load(dir).map_err(CliError::usage)?;
         if !pool.skipped.is_empty() {
             errln!(
-                "warning: the pool leaves out {} program{} without a description or with an error: {}",
+                "warning: the pool leaves out {} program{}: {}",
                 pool.skipped.len(),
                 if pool.skipped.len() == 1 { "" } else { "s" },
                 pool.skipped.join(", ")
