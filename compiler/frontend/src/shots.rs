@@ -6,11 +6,12 @@
 //! directory of programs whose `source.description` says what they translate, or the
 //! benchmark's layout (`truth/NAME.tad` beside `descriptions/NAME.txt`). A program is
 //! shown as the checker reads it, after its machine-applicable fixes; one with an error
-//! left, without a description or unreadable is not shown, and the pool says why. Descriptions are ranked by Okapi BM25 over
-//! their lower-cased words (k1 = 1.2, b = 0.75), ties by name, so the choice is
-//! deterministic; a pool entry whose description is the one being translated is never
-//! shown, so a pool may hold the set it is asked about. The examples go after the system
-//! message, as earlier turns of the chat, so the cached system message stays the same.
+//! left, without a description or unreadable is not shown, and the pool says why.
+//! Descriptions are ranked by Okapi BM25 over their lower-cased words (k1 = 1.2,
+//! b = 0.75), ties by name, so the choice is deterministic; a pool entry whose description
+//! is the one being translated is never shown, so a pool may hold the set it is asked
+//! about. The examples go after the system message, as earlier turns of the chat, so the
+//! cached system message stays the same.
 
 use std::collections::HashMap;
 use std::path::Path;
