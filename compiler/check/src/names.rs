@@ -196,7 +196,7 @@ pub fn scenario(scenario: &Scenario, vocabulary: &Vocabulary, out: &mut Vec<Diag
             attr(vocabulary, a, out);
             let Known::Given(Val::Position(position)) = &a.value else { continue };
             resolve_symbol(vocabulary, "relation", "position", &position.relation, out);
-            if let Some(target) = reference(scenario, &groups, vocabulary, &position.reference, out) {
+            if let Some(target) = reference(scenario, index, &groups, vocabulary, &position.reference, out) {
                 resolved.targets.insert(index, target);
             }
         }
@@ -231,9 +231,42 @@ pub fn target(groups: &Groups<'_>, vocabulary: &Vocabulary, name: &str) -> Optio
     vocabulary.get("road_element", name).map(|entry| Target::RoadElement(entry.name.clone()))
 }
 
+/// The one group an unknown reference most likely means, and why, when a typo's distance
+/// finds none: a reference is often the group described (`parked_suv` for the only `suv`
+/// group, whatever it is called), or shares a word with one group's name (`lead` and
+/// `lead_car`). Words are the name's `_`-separated parts; types compare by their canonical
+/// names, so `suvs` finds `suv`. The group holding the position (`holder`) is not a
+/// candidate: it cannot be placed relative to itself.
+fn meant_group<'s>(
+    scenario: &'s Scenario,
+    holder: usize,
+    vocabulary: &Vocabulary,
+    name: &str,
+) -> Option<(&'s str, String)> {
+    let canonical = |word: &str| vocabulary.lookup("actor_type", word).entry().map(|e| e.name.clone());
+    let words: Vec<&str> = name.split('_').filter(|w| !w.is_empty()).collect();
+    let types: Vec<String> = words.iter().filter_map(|w| canonical(w)).collect();
+    let only = |matching: Vec<(&'s str, String)>| <[_; 1]>::try_from(matching).ok().map(|[g]| g);
+    let others = || scenario.actors.iter().enumerate().filter(move |(i, _)| *i != holder).map(|(_, g)| g);
+    let of_type = others()
+        .filter_map(|g| Some((g.name.text.as_str(), canonical(&g.kind.value.given()?.name)?)))
+        .filter(|(_, kind)| types.contains(kind))
+        .map(|(group, kind)| (group, format!("the only `{kind}` group")))
+        .collect();
+    only(of_type).or_else(|| {
+        let sharing = others()
+            .map(|g| g.name.text.as_str())
+            .filter(|g| g.split('_').any(|w| !w.is_empty() && words.contains(&w)))
+            .map(|g| (g, "the only group whose name shares a word with it".to_string()))
+            .collect();
+        only(sharing)
+    })
+}
+
 /// A position's reference, reported when it names nothing and when written as an alias.
 fn reference(
     scenario: &Scenario,
+    holder: usize,
     groups: &Groups<'_>,
     vocabulary: &Vocabulary,
     symbol: &Symbol,
@@ -257,7 +290,14 @@ fn reference(
         symbol.span,
         "not `ego`, an actor group or a road element",
     );
-    let (mut d, _) = tad_syntax::suggest::unknown(d, "reference", &symbol.name, symbol.span, candidates);
+    let (mut d, guessed) = tad_syntax::suggest::unknown(d, "reference", &symbol.name, symbol.span, candidates);
+    if !guessed && let Some((group, why)) = meant_group(scenario, holder, vocabulary, &symbol.name) {
+        d = d.with_help(format!("did you mean `{group}`, {why}?")).with_fix(
+            symbol.span,
+            group.to_string(),
+            Applicability::MaybeIncorrect,
+        );
+    }
     if !groups.is_empty() {
         d = d.with_note(format!("the actor groups are {}", quoted(&groups)));
     }
