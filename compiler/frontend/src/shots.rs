@@ -38,8 +38,9 @@ pub struct Shot {
 #[derive(Debug, Default)]
 pub struct Pool {
     shots: Vec<Shot>,
-    /// Each shot's word counts and length in words.
-    words: Vec<(HashMap<String, u32>, usize)>,
+    /// Each shot's word counts, length in words, and description with its whitespace
+    /// normalised (to know the question's own).
+    words: Vec<(HashMap<String, u32>, usize, String)>,
     /// In how many descriptions each word occurs.
     documents: HashMap<String, u32>,
     /// Programs left out, each with why: no description, an error, unreadable.
@@ -84,7 +85,7 @@ impl Pool {
         for w in counts.keys() {
             *self.documents.entry(w.clone()).or_default() += 1;
         }
-        self.words.push((counts, words.len()));
+        self.words.push((counts, words.len(), normalise(&shot.description)));
         self.shots.push(shot);
     }
 
@@ -94,10 +95,10 @@ impl Pool {
         let query = words(description);
         let same = normalise(description);
         let n = self.shots.len() as f64;
-        let mean = self.words.iter().map(|(_, len)| *len as f64).sum::<f64>() / n.max(1.0);
+        let mean = self.words.iter().map(|(_, len, _)| *len as f64).sum::<f64>() / n.max(1.0);
         let mut scored: Vec<(f64, &Shot)> = Vec::new();
-        for (shot, (counts, len)) in self.shots.iter().zip(&self.words) {
-            if normalise(&shot.description) == same {
+        for (shot, (counts, len, normalised)) in self.shots.iter().zip(&self.words) {
+            if *normalised == same {
                 continue;
             }
             let mut score = 0.0;

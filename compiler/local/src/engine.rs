@@ -29,9 +29,10 @@ use crate::prompts::PromptStore;
 
 pub struct Engine {
     model: Model,
-    /// The last prompt's system message: a request that starts with it reads on from the
-    /// cache cut back to its length, nothing copied.
-    prefix: Option<Vec<u32>>,
+    /// How many of `held`'s tokens are the last prompt's system message (0: none): a
+    /// request that starts with it reads on from the cache cut back to its length, nothing
+    /// copied.
+    prefix: usize,
     /// The keys and values of the last prompt and answer, from the first position.
     cache: Cache,
     /// The tokens whose keys and values `cache` holds, in order: a prompt that starts with
@@ -208,7 +209,7 @@ impl Engine {
         let end_of_text = id("<|endoftext|>");
         Ok(Engine {
             model,
-            prefix: None,
+            prefix: 0,
             held: Vec::new(),
             cache,
             identity,
@@ -266,7 +267,7 @@ impl Engine {
     /// The logits after `tokens`, read from the first position (the cached system
     /// message is dropped).
     pub fn logits(&mut self, tokens: &[u32]) -> Vec<f32> {
-        self.prefix = None;
+        self.prefix = 0;
         self.held.clear();
         self.cache = self.model.new_cache();
         self.model.forward(tokens, &mut self.cache)
@@ -286,7 +287,7 @@ impl Engine {
     /// Drops the cached system message and what followed it, so the next prompt is read
     /// whole.
     pub fn forget_prefix(&mut self) {
-        self.prefix = None;
+        self.prefix = 0;
         self.held.clear();
     }
 
@@ -302,33 +303,31 @@ impl Engine {
     /// from the start, remembering this prompt's first message as the new prefix (and
     /// keeping it in the store). Also returns how many tokens were read.
     fn prefill(&mut self, prompt: &[u32], first: usize) -> (Last, usize) {
-        let cached = self.prefix.as_ref().filter(|p| prompt.len() > p.len() && prompt.starts_with(p));
+        let p = self.prefix;
+        let cached = p > 0 && prompt.len() > p && self.held.len() >= p && prompt[..p] == self.held[..p];
         let has_prefix = first > 0 && first < prompt.len();
-        let done = match cached {
-            Some(p) => {
-                // at least the last token is read, for its state
-                let same = self.held.iter().zip(prompt).take_while(|(a, b)| a == b).count();
-                let done = p.len().max(same.min(prompt.len() - 1));
-                self.cache.truncate(done);
-                done
-            }
-            None => {
-                self.prefix = has_prefix.then(|| prompt[..first].to_vec());
-                let width = self.model.shape.kv_heads * self.model.shape.head_dim;
-                let kept = self
-                    .store
-                    .as_ref()
-                    .filter(|_| has_prefix)
-                    .and_then(|store| store.load(&prompt[..first], self.model.shape.layers, width));
-                match kept {
-                    Some(cache) => {
-                        self.cache = cache;
-                        first
-                    }
-                    None => {
-                        self.cache = self.model.new_cache();
-                        0
-                    }
+        let done = if cached {
+            // at least the last token is read, for its state
+            let same = self.held.iter().zip(prompt).take_while(|(a, b)| a == b).count();
+            let done = p.max(same.min(prompt.len() - 1));
+            self.cache.truncate(done);
+            done
+        } else {
+            self.prefix = if has_prefix { first } else { 0 };
+            let width = self.model.shape.kv_heads * self.model.shape.head_dim;
+            let kept = self
+                .store
+                .as_ref()
+                .filter(|_| has_prefix)
+                .and_then(|store| store.load(&prompt[..first], self.model.shape.layers, width));
+            match kept {
+                Some(cache) => {
+                    self.cache = cache;
+                    first
+                }
+                None => {
+                    self.cache = self.model.new_cache();
+                    0
                 }
             }
         };
