@@ -136,7 +136,7 @@ fn llama_cpp_applies_the_adapters_gguf_as_the_decoder_does() {
         let tokenizer = tad_local::tokenizer(&content).expect("its tokenizer");
         let (prompt, _) = tad_local::chatml(&tokenizer, &[("user", "Name a colour.")]).expect("tokens");
         let adapter = random_adapter(&shape, 7);
-        let dir = std::env::temp_dir().join(format!("tad-lora-gguf-{name}-{}", std::process::id()));
+        let dir = tad_test_support::scratch(Path::new(env!("CARGO_TARGET_TMPDIR")), &format!("lora-gguf-{name}"));
         adapter.save(&dir).expect("PEFT's files");
         let gguf = dir.join(tad_local::GGUF_FILE);
         adapter.save_gguf(&gguf, &shape).expect("the GGUF");

@@ -25,8 +25,7 @@ fn kv_files(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
 #[test]
 fn a_kept_system_message_is_read_not_prefilled_and_gives_the_same_answer() {
     let Some(path) = tad_local::for_tests(tad_local::SMALLEST) else { return };
-    let dir = std::env::temp_dir().join(format!("tad-prompt-store-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
+    let dir = tad_test_support::scratch(std::path::Path::new(env!("CARGO_TARGET_TMPDIR")), "prompt-store");
     let run = |user: &str| {
         let mut engine = Engine::load(&path, 1).unwrap();
         engine.keep_prompts(dir.clone());

@@ -23,8 +23,7 @@ fn nvim() -> Option<std::path::PathBuf> {
 fn run(plugin: bool) {
     let Some(nvim) = nvim() else { return };
     let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").canonicalize().unwrap();
-    let dir = std::env::temp_dir().join(format!("tadsl-nvim-e2e-{}-{plugin}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = tad_test_support::scratch(Path::new(env!("CARGO_TARGET_TMPDIR")), &format!("nvim-e2e-{plugin}"));
     let example = std::fs::read_to_string(repo.join("examples/safety/right_turn.tad")).unwrap();
     let clean = dir.join("right_turn.tad");
     std::fs::write(&clean, &example).unwrap();

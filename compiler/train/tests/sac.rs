@@ -6,6 +6,10 @@ use tad_policy::{EgoPolicy, Learned};
 use tad_runtime::Scene;
 use tad_train::{Config, TrainError, Trainer, split};
 
+fn scratch(name: &str) -> std::path::PathBuf {
+    tad_test_support::scratch(std::path::Path::new(env!("CARGO_TARGET_TMPDIR")), name)
+}
+
 /// The ego alone on a straight road: the return rewards driving along the route at the
 /// stated speed, straight.
 const ALONE: &str = "scenario alone {
@@ -73,8 +77,7 @@ fn training_improves_the_return() {
 fn a_resumed_run_is_the_unbroken_run() {
     let scene = scene(ALONE);
     let config = Config { start_training: 50, updates_per_episode: 2, ..small(7) };
-    let dir = std::env::temp_dir().join(format!("tad-train-resume-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
+    let dir = scratch("resume");
     let mut whole = Trainer::new(config.clone()).unwrap();
     for _ in 0..4 {
         let t = whole.task(1);
@@ -107,7 +110,7 @@ fn a_resumed_run_is_the_unbroken_run() {
 fn the_saved_actor_drives_as_learned() {
     let scene = scene(ALONE);
     let trainer = Trainer::new(small(3)).unwrap();
-    let path = std::env::temp_dir().join(format!("tad-train-actor-{}.safetensors", std::process::id()));
+    let path = scratch("actor").join("actor.safetensors");
     trainer.save_actor(&path).unwrap();
     let mut loaded = tad_policy::parse_policy(&format!("learned:{}", path.display())).unwrap();
     let mut own = trainer.actor().unwrap();
@@ -133,8 +136,7 @@ fn split_keeps_three_fifths_of_each_behaviour() {
 
 #[test]
 fn damaged_checkpoints_and_settings_are_errors() {
-    let dir = std::env::temp_dir().join(format!("tad-train-bad-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
+    let dir = scratch("bad").join("checkpoint");
     assert!(matches!(Trainer::load_checkpoint(&dir), Err(TrainError::Io { .. })));
     let trainer = Trainer::new(small(2)).unwrap();
     trainer.save_checkpoint(&dir).unwrap();

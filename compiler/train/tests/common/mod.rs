@@ -126,8 +126,5 @@ pub fn mean_return(trainer: &Trainer, scenes: &[Scene]) -> f64 {
 }
 
 pub fn temp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("tad-train-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("a temporary directory");
-    dir
+    tad_test_support::scratch(std::path::Path::new(env!("CARGO_TARGET_TMPDIR")), name)
 }
