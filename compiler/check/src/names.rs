@@ -291,12 +291,18 @@ fn reference(
         "not `ego`, an actor group or a road element",
     );
     let (mut d, guessed) = tad_syntax::suggest::unknown(d, "reference", &symbol.name, symbol.span, candidates);
-    if !guessed && let Some((group, why)) = meant_group(scenario, holder, vocabulary, &symbol.name) {
-        d = d.with_help(format!("did you mean `{group}`, {why}?")).with_fix(
-            symbol.span,
-            group.to_string(),
-            Applicability::MaybeIncorrect,
-        );
+    if !guessed {
+        d = match meant_group(scenario, holder, vocabulary, &symbol.name) {
+            Some((group, why)) => d.with_help(format!("did you mean `{group}`, {why}?")).with_fix(
+                symbol.span,
+                group.to_string(),
+                Applicability::MaybeIncorrect,
+            ),
+            None => d.with_help(format!(
+                "declare an actor group `{}`, or place this one relative to `ego`, a road element or another group",
+                symbol.name
+            )),
+        };
     }
     if !groups.is_empty() {
         d = d.with_note(format!("the actor groups are {}", quoted(&groups)));
