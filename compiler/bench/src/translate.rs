@@ -365,8 +365,9 @@ pub fn run(
 }
 
 /// The report: per-attribute and overall accuracy, valid@1, valid after repair, mean
-/// rounds, tokens and seconds per scenario.
-pub fn report(model: &str, scored: &[Scored]) -> Report {
+/// rounds, tokens and seconds per scenario (unless not `recorded`: answers read back
+/// without the run's manifest).
+pub fn report(model: &str, scored: &[Scored], recorded: bool) -> Report {
     let mut all = Tally::default();
     for s in scored {
         all.merge(&s.tally);
@@ -390,6 +391,12 @@ pub fn report(model: &str, scored: &[Scored]) -> Report {
     let count = |f: &dyn Fn(&Answer) -> bool| scored.iter().filter(|s| f(&s.answer)).count();
     let mean = |f: &dyn Fn(&Answer) -> f64| scored.iter().map(|s| f(&s.answer)).sum::<f64>() / n;
     lines.push(String::new());
+    if !recorded {
+        lines.push(
+            "valid@1, rounds, tokens and seconds: not recorded (no `faithfulness.jsonl` with the answers)".into(),
+        );
+        return Report { lines, ..Report::default() };
+    }
     lines.push(format!(
         "valid@1 {:.1} %, valid after repair {:.1} %, {:.2} rounds, {:.0} tokens and {:.1} s per scenario",
         100.0 * count(&|a| a.valid_round == Some(1)) as f64 / n,

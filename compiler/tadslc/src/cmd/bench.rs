@@ -304,7 +304,7 @@ fn translate(args: &Args) -> Result<Status, CliError> {
         let scored = tad_bench::translate::run(&cases, &mut one, progress)?;
         match write_error {
             Some(e) => Err(BenchError(format!("cannot write the answers: {e}"))),
-            None => Ok(tad_bench::translate::report(&label, &scored)),
+            None => Ok(tad_bench::translate::report(&label, &scored, true)),
         }
     })
 }
@@ -339,7 +339,7 @@ fn answered(cases: &[tad_bench::translate::Case], dir: &std::path::Path) -> Resu
             }
         };
         let scored = tad_bench::translate::run(&cases, &mut one, progress)?;
-        Ok(tad_bench::translate::report(&label, &scored))
+        Ok(tad_bench::translate::report(&label, &scored, !records.is_empty()))
     })
 }
 
