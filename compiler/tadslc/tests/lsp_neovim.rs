@@ -3,6 +3,8 @@
 //! hover, completion, a quick fix and formatting. Skipped loudly without `nvim`, unless
 //! `TAD_REQUIRE_EDITORS=1` (CI), which makes a missing editor a failure.
 
+mod common;
+
 use std::path::Path;
 use std::process::Command;
 use std::time::{Duration, Instant};
@@ -23,7 +25,7 @@ fn nvim() -> Option<std::path::PathBuf> {
 fn run(plugin: bool) {
     let Some(nvim) = nvim() else { return };
     let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").canonicalize().unwrap();
-    let dir = tad_test_support::scratch(Path::new(env!("CARGO_TARGET_TMPDIR")), &format!("nvim-e2e-{plugin}"));
+    let dir = common::scratch(&format!("nvim-e2e-{plugin}"));
     let example = std::fs::read_to_string(repo.join("examples/safety/right_turn.tad")).unwrap();
     let clean = dir.join("right_turn.tad");
     std::fs::write(&clean, &example).unwrap();

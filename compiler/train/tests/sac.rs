@@ -2,13 +2,12 @@
 //! (seeded), a resumed run is the unbroken one, the split, the saved actor drives as
 //! `learned:PATH`, and damaged checkpoints are errors.
 
+mod common;
+
+use common::temp;
 use tad_policy::{EgoPolicy, Learned};
 use tad_runtime::Scene;
 use tad_train::{Config, TrainError, Trainer, split};
-
-fn scratch(name: &str) -> std::path::PathBuf {
-    tad_test_support::scratch(std::path::Path::new(env!("CARGO_TARGET_TMPDIR")), name)
-}
 
 /// The ego alone on a straight road: the return rewards driving along the route at the
 /// stated speed, straight.
@@ -77,7 +76,7 @@ fn training_improves_the_return() {
 fn a_resumed_run_is_the_unbroken_run() {
     let scene = scene(ALONE);
     let config = Config { start_training: 50, updates_per_episode: 2, ..small(7) };
-    let dir = scratch("resume");
+    let dir = temp("resume");
     let mut whole = Trainer::new(config.clone()).unwrap();
     for _ in 0..4 {
         let t = whole.task(1);
@@ -110,7 +109,7 @@ fn a_resumed_run_is_the_unbroken_run() {
 fn the_saved_actor_drives_as_learned() {
     let scene = scene(ALONE);
     let trainer = Trainer::new(small(3)).unwrap();
-    let path = scratch("actor").join("actor.safetensors");
+    let path = temp("actor").join("actor.safetensors");
     trainer.save_actor(&path).unwrap();
     let mut loaded = tad_policy::parse_policy(&format!("learned:{}", path.display())).unwrap();
     let mut own = trainer.actor().unwrap();
@@ -136,7 +135,7 @@ fn split_keeps_three_fifths_of_each_behaviour() {
 
 #[test]
 fn damaged_checkpoints_and_settings_are_errors() {
-    let dir = scratch("bad").join("checkpoint");
+    let dir = temp("bad").join("checkpoint");
     assert!(matches!(Trainer::load_checkpoint(&dir), Err(TrainError::Io { .. })));
     let trainer = Trainer::new(small(2)).unwrap();
     trainer.save_checkpoint(&dir).unwrap();
