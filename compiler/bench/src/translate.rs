@@ -391,20 +391,18 @@ pub fn report(model: &str, scored: &[Scored], recorded: bool) -> Report {
     let count = |f: &dyn Fn(&Answer) -> bool| scored.iter().filter(|s| f(&s.answer)).count();
     let mean = |f: &dyn Fn(&Answer) -> f64| scored.iter().map(|s| f(&s.answer)).sum::<f64>() / n;
     lines.push(String::new());
-    if !recorded {
-        lines.push(
-            "valid@1, rounds, tokens and seconds: not recorded (no `faithfulness.jsonl` with the answers)".into(),
-        );
-        return Report { lines, ..Report::default() };
-    }
-    lines.push(format!(
-        "valid@1 {:.1} %, valid after repair {:.1} %, {:.2} rounds, {:.0} tokens and {:.1} s per scenario",
-        100.0 * count(&|a| a.valid_round == Some(1)) as f64 / n,
-        100.0 * count(&|a| a.valid_round.is_some()) as f64 / n,
-        mean(&|a| a.rounds as f64),
-        mean(&|a| a.tokens as f64),
-        mean(&|a| a.seconds),
-    ));
+    lines.push(if recorded {
+        format!(
+            "valid@1 {:.1} %, valid after repair {:.1} %, {:.2} rounds, {:.0} tokens and {:.1} s per scenario",
+            100.0 * count(&|a| a.valid_round == Some(1)) as f64 / n,
+            100.0 * count(&|a| a.valid_round.is_some()) as f64 / n,
+            mean(&|a| a.rounds as f64),
+            mean(&|a| a.tokens as f64),
+            mean(&|a| a.seconds),
+        )
+    } else {
+        "valid@1, rounds, tokens and seconds: not recorded (no `faithfulness.jsonl` with the answers)".into()
+    });
     Report { lines, ..Report::default() }
 }
 
