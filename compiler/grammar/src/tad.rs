@@ -5,13 +5,21 @@
 //! It is the language `tadslc fmt` prints (`spec/language.md` §8): comment lines, `use`
 //! lines, one scenario with its sections in canonical order, two-space indentation, one
 //! field per line in the schema's order, each field at most once. A program in it parses;
-//! the checker still judges its meaning (lanes against the road, behaviours against the
-//! actor's kind, completeness). Numbers, names, strings and comment lines are bounded in
-//! length, and lists and the groups in number, so that a decoder cannot run away inside one:
-//! a small model otherwise repeats groups, list items or a sentence of a comment until its
-//! token limit cuts the program short.
+//! the checker still judges most of its meaning (lanes against the road's `lanes`,
+//! references, completeness). Rules of meaning are here where what they depend on is
+//! written first. The type comes before the behaviour: each actor kind has its own group
+//! rule, whose behaviours are those the kind performs (`performers`; the ego's are a
+//! vehicle's), so a cyclist cannot `stand` (E0502). The road comes before the ego and the
+//! groups: a direction profile ([`Profile`]) keeps them out of negative lanes on a one-way
+//! road (E0501). A group's count is at least 1 (E0509). Each would otherwise cost a repair
+//! round.
+//!
+//! Numbers, names, strings and comment lines are bounded in length, and lists and the
+//! groups in number, so that a decoder cannot run away inside one: a small model otherwise
+//! repeats groups, list items or a sentence of a comment until its token limit cuts the
+//! program short.
 
-use tad_check::Vocabulary;
+use tad_check::{EGO_KIND, Vocabulary, performs};
 use tad_syntax::lexer::UNITS;
 use tad_syntax::schema::{self, FieldDef, SectionDef, Unit, ValueType};
 
@@ -35,6 +43,11 @@ const LIST_MAX: u32 = 8;
 pub fn grammar(vocabulary: &Vocabulary, modules: &[String]) -> Grammar {
     let mut g = Grammar::default();
     let uses = if modules.is_empty() { opt(lit("\n")) } else { star(seq([lit("use "), r("module"), lit("\n")])) };
+    // the road, the ego and the groups, as one of the direction profiles
+    let profiles = PROFILES.iter().map(|p| {
+        let road = if p.one_way { r(&p.rule("road")) } else { opt(r(&p.rule("road"))) };
+        seq([road, opt(r(&p.rule("ego"))), rep(r(&p.rule("actor")), 0, GROUPS_MAX)])
+    });
     g.rule(
         "file",
         seq([
@@ -46,9 +59,7 @@ pub fn grammar(vocabulary: &Vocabulary, modules: &[String]) -> Grammar {
             lit(" {\n"),
             opt(r("source")),
             opt(r("environment")),
-            opt(r("road")),
-            opt(r("ego")),
-            rep(r("actor"), 0, GROUPS_MAX),
+            alt(profiles),
             lit("}"),
             opt(lit("\n")),
         ]),
@@ -56,27 +67,24 @@ pub fn grammar(vocabulary: &Vocabulary, modules: &[String]) -> Grammar {
     if !modules.is_empty() {
         g.rule("module", alt(modules.iter().map(|m| lit(m.clone()))));
     }
-    let mut kinds: Vec<&'static str> = Vec::new();
-    for section in schema::SECTIONS {
-        g.rule(section.name, block(section, lit(format!("  {} {{\n", section.name)), "  ", &mut kinds));
+    for section in [&schema::SOURCE, &schema::ENVIRONMENT] {
+        g.rule(section.name, block(section, section_head(section), |f| opt(r(&field_rule(section, f)))));
     }
-    let header = seq([
-        lit("  actor "),
-        r("name"),
-        lit(": "),
-        opt(seq([r("count"), lit(" ")])),
-        alt([r(&kind_rule("actor_type")), lit("unspecified")]),
-        lit(" {\n"),
-    ]);
-    g.rule("actor", block(&schema::ACTOR, header, "  ", &mut kinds));
-    g.rule("count", alt([seq([r("int"), opt(seq([lit(".."), r("int")]))]), lit("unspecified")]));
-    kinds.push("actor_type");
-    kinds.push("relation");
+    for profile in PROFILES {
+        road_and_ego(&mut g, profile);
+        actors(&mut g, vocabulary, profile);
+    }
+    behaviors(&mut g, vocabulary);
+    directions(&mut g, vocabulary);
+    // a group has at least one actor (E0509)
+    g.rule("count", alt([seq([r("count-int"), opt(seq([lit(".."), r("count-int")]))]), lit("unspecified")]));
 
     // one rule per field, named after its section
+    let mut kinds: Vec<&'static str> = vec!["relation", BEHAVIOR];
     for section in schema::SECTIONS.iter().copied().chain([&schema::ACTOR]) {
-        for field in section.fields {
-            g.rule(&field_rule(section, field), seq([lit(format!("    {}: ", field.name)), value(field), lit("\n")]));
+        for field in section.fields.iter().filter(|f| !by_profile(section, f)) {
+            kinds.extend(field.vocabulary);
+            g.rule(&field_rule(section, field), field_line(field, &kind_rule(field.vocabulary.unwrap_or("none"))));
         }
     }
     g.rule("position", seq([r(&kind_rule("relation")), lit(" of "), r("name")]));
@@ -88,7 +96,8 @@ pub fn grammar(vocabulary: &Vocabulary, modules: &[String]) -> Grammar {
             .collect();
         g.rule(&unit_rule(unit_kind), alt(units));
     }
-    kinds.dedup();
+    let mut seen = std::collections::HashSet::new();
+    kinds.retain(|k| seen.insert(*k));
     for kind in kinds {
         let names: Vec<Expr> = vocabulary.names(kind).into_iter().map(lit).collect();
         // a kind nothing declares still needs a rule; `none` is the one name every list takes
@@ -98,6 +107,8 @@ pub fn grammar(vocabulary: &Vocabulary, modules: &[String]) -> Grammar {
 
     g.terminal("name", seq([class(&[('a', 'z'), ('A', 'Z'), ('_', '_')]), rep(r("name-char"), 0, NAME_MAX - 1)]));
     g.terminal("name-char", class(&[('a', 'z'), ('A', 'Z'), ('0', '9'), ('_', '_')]));
+    g.terminal("count-int", seq([class(&[('1', '9')]), rep(class(&[('0', '9')]), 0, 4)]));
+    g.terminal("lane-index-one-way", rep(class(&[('0', '9')]), 1, 5));
     g.terminal("int", seq([opt(lit("-")), rep(class(&[('0', '9')]), 1, 5)]));
     g.terminal(
         "number",
@@ -123,6 +134,138 @@ pub fn grammar(vocabulary: &Vocabulary, modules: &[String]) -> Grammar {
     g
 }
 
+/// The field whose names depend on who performs them.
+const BEHAVIOR: &str = "behavior";
+
+/// Which lanes the ego and the groups may be in, decided by the road's `direction`: on a
+/// direction without opposite lanes (`one_way`) no lane is negative (E0501). Each profile
+/// has its own road, ego and actor rules.
+struct Profile {
+    one_way: bool,
+}
+
+const PROFILES: &[Profile] = &[Profile { one_way: false }, Profile { one_way: true }];
+
+impl Profile {
+    /// `base`'s rule in this profile: `road`, or `road-one-way`.
+    fn rule(&self, base: &str) -> String {
+        if self.one_way { format!("{base}-one-way") } else { base.to_string() }
+    }
+
+    /// A `lane:` line of this profile.
+    fn lane(&self, field: &FieldDef) -> Expr {
+        let index = if self.one_way { r("lane-index-one-way") } else { r("int") };
+        seq([lit(format!("    {}: ", field.name)), alt([index, lit("unspecified")]), lit("\n")])
+    }
+}
+
+fn section_head(section: &SectionDef) -> Expr {
+    lit(format!("  {} {{\n", section.name))
+}
+
+/// The profile's `road` (its `direction` one of the profile's, stated when one-way) and
+/// `ego` (a vehicle's behaviours, the profile's lanes).
+fn road_and_ego(g: &mut Grammar, profile: &Profile) {
+    let road = &schema::ROAD;
+    let direction = r(if profile.one_way { "direction-one-way-name" } else { "direction-opposite-name" });
+    g.rule(
+        &profile.rule("road"),
+        block(road, section_head(road), |f| match f.name {
+            "direction" if profile.one_way => seq([lit("    direction: "), direction.clone(), lit("\n")]),
+            "direction" => opt(seq([lit("    direction: "), alt([direction.clone(), lit("unspecified")]), lit("\n")])),
+            _ => opt(r(&field_rule(road, f))),
+        }),
+    );
+    let ego = &schema::EGO;
+    g.rule(
+        &profile.rule("ego"),
+        block(ego, section_head(ego), |f| match f.name {
+            BEHAVIOR => opt(field_line(f, &behavior_rule(EGO_KIND))),
+            LANE => opt(profile.lane(f)),
+            _ => opt(r(&field_rule(ego, f))),
+        }),
+    );
+}
+
+/// The field that takes a lane index.
+const LANE: &str = "lane";
+
+/// Whether the profiles write this field themselves rather than share one rule for it.
+fn by_profile(section: &SectionDef, field: &FieldDef) -> bool {
+    matches!((section.name, field.name), ("road", "direction") | ("ego" | "actor", BEHAVIOR | LANE))
+}
+
+/// `actor` in `profile`: one alternative per actor kind that has types, its types in the
+/// header and its performers' behaviours in the block; types without a kind and
+/// `unspecified` take any behaviour.
+fn actors(g: &mut Grammar, vocabulary: &Vocabulary, profile: &Profile) {
+    let types = vocabulary.entries("actor_type");
+    let mut groups = Vec::new();
+    for kind in vocabulary.names("actor_kind") {
+        let of_kind: Vec<Expr> =
+            types.iter().filter(|t| t.symbol("kind") == Some(kind)).map(|t| lit(&t.name)).collect();
+        if !of_kind.is_empty() {
+            groups.push((profile.rule(&format!("actor-{}", kind.replace('_', "-"))), alt(of_kind), Some(kind)));
+        }
+    }
+    let kindless: Vec<Expr> = types
+        .iter()
+        .filter(|t| t.symbol("kind").is_none_or(|k| vocabulary.get("actor_kind", k).is_none()))
+        .map(|t| lit(&t.name))
+        .chain([lit("unspecified")])
+        .collect();
+    groups.push((profile.rule("actor-any"), alt(kindless), None));
+
+    let actor = &schema::ACTOR;
+    for (rule, names, kind) in &groups {
+        let header =
+            seq([lit("  actor "), r("name"), lit(": "), opt(seq([r("count"), lit(" ")])), names.clone(), lit(" {\n")]);
+        let behaviors = kind.map_or_else(|| kind_rule(BEHAVIOR), behavior_rule);
+        g.rule(
+            rule,
+            block(actor, header, |f| match f.name {
+                BEHAVIOR => opt(field_line(f, &behaviors)),
+                LANE => opt(profile.lane(f)),
+                _ => opt(r(&field_rule(actor, f))),
+            }),
+        );
+    }
+    g.rule(&profile.rule("actor"), alt(groups.iter().map(|(rule, _, _)| r(rule))));
+}
+
+/// Each actor kind's behaviours, and the ego's: those the kind performs (`performers`).
+fn behaviors(g: &mut Grammar, vocabulary: &Vocabulary) {
+    let mut kinds = vocabulary.names("actor_kind");
+    if !kinds.contains(&EGO_KIND) {
+        kinds.push(EGO_KIND);
+    }
+    for kind in kinds {
+        let names: Vec<Expr> =
+            vocabulary.entries(BEHAVIOR).into_iter().filter(|b| performs(b, kind)).map(|b| lit(&b.name)).collect();
+        let names = if names.is_empty() { vec![lit("none")] } else { names };
+        g.rule(&behavior_rule(kind), alt(names));
+    }
+}
+
+/// The directions with opposite lanes (or not saying), and those without.
+fn directions(g: &mut Grammar, vocabulary: &Vocabulary) {
+    let (one_way, opposite): (Vec<_>, Vec<_>) =
+        vocabulary.entries("direction").into_iter().partition(|d| d.flag("opposite_lanes") == Some(false));
+    for (rule, names) in [("direction-one-way-name", one_way), ("direction-opposite-name", opposite)] {
+        let names: Vec<Expr> = names.into_iter().map(|d| lit(&d.name)).collect();
+        g.rule(rule, alt(if names.is_empty() { vec![lit("none")] } else { names }));
+    }
+}
+
+fn behavior_rule(kind: &str) -> String {
+    format!("behavior-of-{}", kind.replace('_', "-"))
+}
+
+/// `    FIELD: VALUE` and a newline, names of a name field from the rule `names`.
+fn field_line(field: &FieldDef, names: &str) -> Expr {
+    seq([lit(format!("    {}: ", field.name)), value(field, names), lit("\n")])
+}
+
 fn field_rule(section: &SectionDef, field: &FieldDef) -> String {
     format!("{}-{}", section.name, field.name.replace('_', "-"))
 }
@@ -135,27 +278,25 @@ fn unit_rule(kind: ValueType) -> String {
     format!("{}-unit", kind.describe().trim_start_matches("a ").replace(' ', "-"))
 }
 
-fn block(section: &SectionDef, head: Expr, indent: &str, kinds: &mut Vec<&'static str>) -> Expr {
+/// A section's block: its head, each field in the schema's order as `field` gives it, and
+/// the closing brace.
+fn block(section: &SectionDef, head: Expr, field: impl Fn(&FieldDef) -> Expr) -> Expr {
     let mut items = vec![head];
-    for field in section.fields {
-        if let Some(kind) = field.vocabulary {
-            kinds.push(kind);
-        }
-        items.push(opt(r(&field_rule(section, field))));
-    }
-    items.push(lit(format!("{indent}}}\n")));
+    items.extend(section.fields.iter().map(field));
+    items.push(lit("  }\n"));
     seq(items)
 }
 
-/// The values a field takes, `unspecified` among them.
-fn value(field: &FieldDef) -> Expr {
+/// The values a field takes, `unspecified` among them; a name field's names from the rule
+/// `names`.
+fn value(field: &FieldDef, names: &str) -> Expr {
     let given = match field.ty {
         ValueType::Symbol => {
-            let name = r(&kind_rule(field.vocabulary.unwrap_or("none")));
+            let name = r(names);
             if field.param { seq([name.clone(), rep(seq([lit(" | "), name]), 0, 7)]) } else { name }
         }
         ValueType::SymbolList => {
-            let name = r(&kind_rule(field.vocabulary.unwrap_or("none")));
+            let name = r(names);
             alt([lit("[]"), seq([lit("["), name.clone(), rep(seq([lit(", "), name]), 0, LIST_MAX - 1), lit("]")])])
         }
         ValueType::Integer => r("int"),

@@ -101,6 +101,33 @@ fn programs() -> Vec<(String, String)> {
     examples().into_iter().map(|p| (p.display().to_string(), std::fs::read_to_string(&p).unwrap())).collect()
 }
 
+/// The answers a translation should give: the benchmark's ground truths and the translate
+/// prompt's worked examples, without their comment lines (truths explain themselves at
+/// length; answers need not).
+fn answers() -> Vec<(String, String)> {
+    let repo = tad_test_support::repo();
+    let dirs = [repo.join("tests/llm/truth"), repo.join("compiler/frontend/prompts/examples")];
+    let files = dirs.iter().flat_map(|d| std::fs::read_dir(d).unwrap()).map(|e| e.unwrap().path());
+    let tad = files.filter(|p| p.extension().is_some_and(|e| e == "tad"));
+    tad.map(|p| {
+        let text = std::fs::read_to_string(&p).unwrap();
+        let code: String = text.lines().filter(|l| !l.starts_with("//")).map(|l| format!("{l}\n")).collect();
+        (p.display().to_string(), code.trim_start().to_string())
+    })
+    .collect()
+}
+
+#[test]
+fn the_grammar_accepts_every_truth_and_worked_example() {
+    let factory = factory();
+    let grammar = TopLevelGrammar::from_lark(lark(None));
+    let answers = answers();
+    assert!(answers.len() >= 80, "{}", answers.len());
+    for (path, text) in answers {
+        accepts(&factory, &grammar, &text).unwrap_or_else(|e| panic!("{path}: {e}"));
+    }
+}
+
 #[test]
 fn the_lark_grammar_accepts_every_example_and_the_region_grammar_its_own() {
     let factory = factory();
@@ -142,6 +169,10 @@ fn mutants(text: &str) -> Vec<(&'static str, String)> {
     push("a missing brace", "\n  }\n", "\n");
     push("a lane that is not a number", "lane: 1", "lane: one");
     push("a range in a single-valued field", "lanes: ", "lanes: 1..");
+    if let Some(header) = text.lines().find(|l| l.starts_with("  actor ") && l.contains(": 1 ")) {
+        push("a group of no actors", header, &header.replacen(": 1 ", ": 0 ", 1));
+        push("a group of a negative count", header, &header.replacen(": 1 ", ": -1 ", 1));
+    }
     push("prose before the program", "scenario ", "Here is the scenario:\nscenario ");
     out.push(("a comment line that runs on", format!("// {}\n{text}", "If you need more, ask. ".repeat(6))));
     out
@@ -202,5 +233,86 @@ fn the_json_schema_validates_every_example_and_rejects_mutants() {
         let mut bad = value;
         bad.as_object_mut().unwrap().remove("actors");
         assert!(!validator.is_valid(&bad), "{path}: no actors");
+    }
+}
+
+/// A program of one group of `kind` that does `behavior`, and an ego that does `ego`.
+fn one_group(kind: &str, behavior: &str, ego: &str) -> String {
+    format!(
+        "scenario performers {{\n  ego {{\n    behavior: {ego}\n  }}\n  actor group: 2 {kind} {{\n    behavior: {behavior}\n  }}\n}}\n"
+    )
+}
+
+/// Whether the checker rejects the program because someone does what their kind does not.
+fn checker_rejects_performer(text: &str) -> bool {
+    let mut db = tad_db::Database::new(Default::default());
+    let file = db.set_source("performers.tad".into(), text.to_string(), tad_db::Language::Tad, &tad_db::NoFs);
+    tad_db::check(&db, file).diagnostics.iter().any(|d| d.code.as_str() == "E0502")
+}
+
+#[test]
+fn the_grammar_allows_a_behavior_exactly_when_the_checker_does() {
+    let factory = factory();
+    let grammar = TopLevelGrammar::from_lark(lark(None));
+    let (vocabulary, _) = tad_grammar::scope(None).unwrap();
+    // one type of each kind, and one without a stated type
+    let mut kinds: Vec<String> = vocabulary
+        .names("actor_kind")
+        .into_iter()
+        .filter_map(|k| vocabulary.entries("actor_type").into_iter().find(|t| t.symbol("kind") == Some(k)))
+        .map(|t| t.name.clone())
+        .collect();
+    kinds.push("unspecified".into());
+    assert!(kinds.len() >= 5, "{kinds:?}");
+    let (mut allowed, mut refused) = (0, 0);
+    for kind in &kinds {
+        for behavior in vocabulary.names("behavior") {
+            let text = one_group(kind, behavior, "move_forward");
+            let rejected = checker_rejects_performer(&text);
+            assert_eq!(accepts(&factory, &grammar, &text).is_err(), rejected, "{kind} that does {behavior}");
+            if rejected { refused += 1 } else { allowed += 1 }
+        }
+    }
+    for behavior in vocabulary.names("behavior") {
+        let text = one_group("car", "move_forward", behavior);
+        let rejected = checker_rejects_performer(&text);
+        assert_eq!(accepts(&factory, &grammar, &text).is_err(), rejected, "an ego that does {behavior}");
+        refused += rejected as usize;
+    }
+    // both sides of the rule are exercised: a cyclist cannot `stand`, nor can the ego
+    assert!(allowed > 50 && refused > 20, "{allowed} allowed, {refused} refused");
+    assert!(accepts(&factory, &grammar, &one_group("bicycle", "stand", "move_forward")).is_err());
+    assert!(accepts(&factory, &grammar, &one_group("bicycle", "stopped", "move_forward")).is_ok());
+    assert!(accepts(&factory, &grammar, &one_group("car", "move_forward", "stand")).is_err());
+}
+
+#[test]
+fn on_a_one_way_road_no_lane_is_negative() {
+    let factory = factory();
+    let grammars = [
+        ("lark", TopLevelGrammar::from_lark(lark(None))),
+        ("gbnf", TopLevelGrammar::from_lark(gbnf_to_lark(&gbnf(None)))),
+    ];
+    let program = |direction: &str, ego: &str, group: &str| {
+        format!(
+            "scenario lanes {{\n  road {{\n    lanes: 2\n{direction}  }}\n  ego {{\n    lane: {ego}\n  }}\n  actor bus: 1 bus {{\n    lane: {group}\n  }}\n}}\n"
+        )
+    };
+    for (notation, grammar) in &grammars {
+        for (direction, ego, group, checker_accepts) in [
+            ("    direction: two_way\n", "1", "-1", true),
+            ("", "1", "-1", true),
+            ("    direction: unspecified\n", "1", "-1", true),
+            ("    direction: one_way\n", "1", "2", true),
+            ("    direction: one_way\n", "1", "-1", false),
+            ("    direction: one_way\n", "-2", "1", false),
+        ] {
+            let text = program(direction, ego, group);
+            let mut db = tad_db::Database::new(Default::default());
+            let file = db.set_source("lanes.tad".into(), text.clone(), tad_db::Language::Tad, &tad_db::NoFs);
+            let e0501 = tad_db::check(&db, file).diagnostics.iter().any(|d| d.code.as_str() == "E0501");
+            assert_eq!(!e0501, checker_accepts, "the checker on {text}");
+            assert_eq!(accepts(&factory, grammar, &text).is_ok(), checker_accepts, "{notation} on {text}");
+        }
     }
 }
