@@ -136,6 +136,8 @@ pub fn grammar(vocabulary: &Vocabulary, modules: &[String]) -> Grammar {
 
 /// The field whose names depend on who performs them.
 const BEHAVIOR: &str = "behavior";
+/// The field that takes a lane index.
+const LANE: &str = "lane";
 
 /// Which lanes the ego and the groups may be in, decided by the road's `direction`: on a
 /// direction without opposite lanes (`one_way`) no lane is negative (E0501). Each profile
@@ -186,9 +188,6 @@ fn road_and_ego(g: &mut Grammar, profile: &Profile) {
         }),
     );
 }
-
-/// The field that takes a lane index.
-const LANE: &str = "lane";
 
 /// Whether the profiles write this field themselves rather than share one rule for it.
 fn by_profile(section: &SectionDef, field: &FieldDef) -> bool {
