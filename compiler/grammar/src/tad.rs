@@ -169,12 +169,12 @@ fn section_head(section: &SectionDef) -> Expr {
 /// `ego` (a vehicle's behaviours, the profile's lanes).
 fn road_and_ego(g: &mut Grammar, profile: &Profile) {
     let road = &schema::ROAD;
-    let direction = r(if profile.one_way { "direction-one-way-name" } else { "direction-opposite-name" });
     g.rule(
         &profile.rule("road"),
         block(road, section_head(road), |f| match f.name {
-            "direction" if profile.one_way => seq([lit("    direction: "), direction.clone(), lit("\n")]),
-            "direction" => opt(seq([lit("    direction: "), alt([direction.clone(), lit("unspecified")]), lit("\n")])),
+            // stated, and only a direction without opposite lanes: not `unspecified`
+            "direction" if profile.one_way => seq([lit("    direction: "), r("direction-one-way-name"), lit("\n")]),
+            "direction" => opt(field_line(f, "direction-opposite-name")),
             _ => opt(r(&field_rule(road, f))),
         }),
     );

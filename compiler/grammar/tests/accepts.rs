@@ -107,14 +107,14 @@ fn programs() -> Vec<(String, String)> {
 fn answers() -> Vec<(String, String)> {
     let repo = tad_test_support::repo();
     let dirs = [repo.join("tests/llm/truth"), repo.join("compiler/frontend/prompts/examples")];
-    let files = dirs.iter().flat_map(|d| std::fs::read_dir(d).unwrap()).map(|e| e.unwrap().path());
-    let tad = files.filter(|p| p.extension().is_some_and(|e| e == "tad"));
-    tad.map(|p| {
-        let text = std::fs::read_to_string(&p).unwrap();
-        let code: String = text.lines().filter(|l| !l.starts_with("//")).map(|l| format!("{l}\n")).collect();
-        (p.display().to_string(), code.trim_start().to_string())
-    })
-    .collect()
+    let files = dirs.iter().flat_map(|d| tad_test_support::files(d, "tad"));
+    files
+        .map(|p| {
+            let text = tad_test_support::read(&p);
+            let code: String = text.lines().filter(|l| !l.starts_with("//")).map(|l| format!("{l}\n")).collect();
+            (p.display().to_string(), code.trim_start().to_string())
+        })
+        .collect()
 }
 
 #[test]
