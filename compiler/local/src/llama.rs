@@ -172,26 +172,50 @@ impl Matrix {
             }),
         }
         for (w, part) in parts.iter().enumerate() {
-            for (i, v) in part.iter().enumerate() {
-                let (r, t) = (w * per + i / x.len(), i % x.len());
-                out[t * rows + r] = *v;
+            for (i, row) in part.chunks_exact(x.len().max(1)).enumerate() {
+                for (t, v) in row.iter().enumerate() {
+                    out[t * rows + w * per + i] = *v;
+                }
             }
         }
     }
 }
 
-/// One token's activations quantized for every format: in blocks of 32 ([`Q8_1`]), and in
-/// super-blocks of 256 for the K formats ([`Q8K`]).
+/// One token's activations quantized for the model's formats: in blocks of 32 ([`Q8_1`]),
+/// and in super-blocks of 256 for the K formats ([`Q8K`]); a form no matrix of the model
+/// takes stays empty.
 #[derive(Clone, Default)]
 struct Input {
     blocks: Vec<Q8_1>,
     supers: Vec<Q8K>,
 }
 
+/// The activation forms a model's matrices take: blocks of 32, super-blocks of 256.
+#[derive(Clone, Copy, Debug, Default)]
+struct Forms {
+    blocks: bool,
+    supers: bool,
+}
+
+impl Forms {
+    fn of<'a>(matrices: impl IntoIterator<Item = &'a Matrix>) -> Forms {
+        matrices.into_iter().fold(Forms::default(), |forms, m| match m {
+            Matrix::Q4K { .. } | Matrix::Q6K { .. } => Forms { supers: true, ..forms },
+            Matrix::Q4_1 { .. } | Matrix::Q8_0 { .. } | Matrix::Q5_0 { .. } => Forms { blocks: true, ..forms },
+        })
+    }
+}
+
 impl Input {
-    fn set(&mut self, x: &[f32]) {
-        quant::quantize(x, &mut self.blocks);
-        kquant::quantize_k(x, &mut self.supers);
+    fn set(&mut self, x: &[f32], forms: Forms) {
+        match forms.blocks {
+            true => quant::quantize(x, &mut self.blocks),
+            false => self.blocks.clear(),
+        }
+        match forms.supers {
+            true => kquant::quantize_k(x, &mut self.supers),
+            false => self.supers.clear(),
+        }
     }
 
     fn blocks(&self) -> &[Q8_1] {
@@ -298,6 +322,8 @@ pub struct Shape {
 
 pub struct Model {
     pub shape: Shape,
+    /// The activation forms its matrices take, so a token is quantized only into those.
+    forms: Forms,
     embedding: Matrix,
     output: Option<Matrix>,
     output_norm: Vec<f32>,
@@ -457,8 +483,15 @@ impl Model {
             .then(|| rayon::ThreadPoolBuilder::new().num_threads(threads).build())
             .transpose()
             .map_err(error)?;
+        let forms = Forms::of(
+            layers
+                .iter()
+                .flat_map(|l| [&l.q, &l.k, &l.v, &l.o, &l.gate, &l.up, &l.down])
+                .chain(Some(output.as_ref().unwrap_or(&embedding))),
+        );
         Ok(Model {
             shape,
+            forms,
             embedding,
             output,
             output_norm,
@@ -560,8 +593,7 @@ impl Model {
         self.rope_upto(start + n);
         let kv_dim = kv_heads * head_dim;
         let group = heads / kv_heads;
-        let pool = self.pool.as_ref();
-        let k = &self.kernels;
+        let (pool, k, forms) = (self.pool.as_ref(), &self.kernels, self.forms);
 
         let mut x = vec![0f32; n * dim];
         for (t, &token) in tokens.iter().enumerate() {
@@ -582,7 +614,7 @@ impl Model {
             let lora = |t: Target| self.lora.as_ref().and_then(|(l, s)| Some((l[li][t as usize].as_ref()?, *s)));
             rms_norm(&x, &layer.attn_norm, eps, dim, &mut normed);
             for (t, xt) in xq.iter_mut().enumerate() {
-                xt.set(&normed[t * dim..(t + 1) * dim]);
+                xt.set(&normed[t * dim..(t + 1) * dim], forms);
             }
             layer.q.product(k, &xq, &mut q, pool);
             layer.k.product(k, &xq, &mut kk, pool);
@@ -631,7 +663,7 @@ impl Model {
                 None => attn.chunks_mut(width).enumerate().for_each(|(i, out)| attend(i, out, &mut scores)),
             }
             for (t, xt) in xq.iter_mut().enumerate() {
-                xt.set(&attn[t * dim..(t + 1) * dim]);
+                xt.set(&attn[t * dim..(t + 1) * dim], forms);
             }
             layer.o.product(k, &xq, &mut proj, pool);
             if let Some((pair, scale)) = lora(Target::O) {
@@ -642,7 +674,7 @@ impl Model {
             }
             rms_norm(&x, &layer.ffn_norm, eps, dim, &mut normed);
             for (t, xt) in xq.iter_mut().enumerate() {
-                xt.set(&normed[t * dim..(t + 1) * dim]);
+                xt.set(&normed[t * dim..(t + 1) * dim], forms);
             }
             layer.gate.product(k, &xq, &mut gate, pool);
             layer.up.product(k, &xq, &mut up, pool);
@@ -656,7 +688,7 @@ impl Model {
                 *g = *g / (1.0 + (-*g).exp()) * u;
             }
             for (t, ht) in hq.iter_mut().enumerate() {
-                ht.set(&gate[t * hidden..(t + 1) * hidden]);
+                ht.set(&gate[t * hidden..(t + 1) * hidden], forms);
             }
             layer.down.product(k, &hq, &mut proj, pool);
             if let Some((pair, scale)) = lora(Target::Down) {
@@ -673,7 +705,7 @@ impl Model {
         let mut out = vec![0f32; dim];
         rms_norm(last, &self.output_norm, eps, dim, &mut out);
         let mut last = Input::default();
-        last.set(&out);
+        last.set(&out, forms);
         Last(last)
     }
 }
