@@ -276,6 +276,13 @@ struct Layer {
     down: Matrix,
 }
 
+impl Layer {
+    /// The layer's weight matrices.
+    fn matrices(&self) -> [&Matrix; 7] {
+        [&self.q, &self.k, &self.v, &self.o, &self.gate, &self.up, &self.down]
+    }
+}
+
 /// The decoder architectures read.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Arch {
@@ -483,12 +490,8 @@ impl Model {
             .then(|| rayon::ThreadPoolBuilder::new().num_threads(threads).build())
             .transpose()
             .map_err(error)?;
-        let forms = Forms::of(
-            layers
-                .iter()
-                .flat_map(|l| [&l.q, &l.k, &l.v, &l.o, &l.gate, &l.up, &l.down])
-                .chain(Some(output.as_ref().unwrap_or(&embedding))),
-        );
+        let forms =
+            Forms::of(layers.iter().flat_map(Layer::matrices).chain(Some(output.as_ref().unwrap_or(&embedding))));
         Ok(Model {
             shape,
             forms,
@@ -518,11 +521,7 @@ impl Model {
 
     /// The bytes the weights take in memory.
     pub fn weight_bytes(&self) -> usize {
-        let layers: usize = self
-            .layers
-            .iter()
-            .map(|l| [&l.q, &l.k, &l.v, &l.o, &l.gate, &l.up, &l.down].iter().map(|m| m.bytes()).sum::<usize>())
-            .sum();
+        let layers: usize = self.layers.iter().map(|l| l.matrices().iter().map(|m| m.bytes()).sum::<usize>()).sum();
         layers + self.embedding.bytes() + self.output.as_ref().map_or(0, Matrix::bytes)
     }
 
