@@ -5,7 +5,8 @@
 //! JSONL (TRL's messages or prompt/completion) ──tokenize: ChatML as tad-local reads it──▶ samples
 //! GGUF ──dequantize (f32, frozen)──▶ Weights        LoRA A (Kaiming-uniform, seeded), B = 0 ──▶ Vars
 //! for each epoch, examples shuffled (seeded), one at a time (accumulated):
-//!     forward (causal) ─▶ cross-entropy on the answer's tokens only ─▶ backward ─▶ AdamW
+//!     forward (causal, each layer's input kept) ─▶ cross-entropy on the answer's tokens only
+//!     ─▶ backward, each layer recomputed from its input, last to first ─▶ AdamW
 //!     every N steps: checkpoint (adapter, optimizer moments, position, RNG) ──▶ resume
 //! ──▶ adapter_model.safetensors + adapter_config.json (PEFT) ──▶ tad-local's decoder (--adapter)
 //! ──▶ adapter.gguf (the same adapter as llama.cpp's LoRA GGUF) ──▶ llama-server --lora
@@ -22,6 +23,7 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use candle_core::backprop::GradStore;
 use candle_core::{Device, Tensor, Var};
 use serde::{Deserialize, Serialize};
 
@@ -52,6 +54,9 @@ pub struct Config {
     pub checkpoint_every: usize,
     /// Continue from the checkpoint in the output directory, if there is one.
     pub resume: bool,
+    /// Keep one layer's graph at a time and recompute each layer in the backward pass
+    /// (activation checkpointing): a fraction of the memory for a second forward pass.
+    pub recompute: bool,
     /// The adapter's `base_model_name_or_path`: the model's upstream name
     /// (`tad_models::Model::upstream`).
     pub base_model: String,
@@ -72,6 +77,7 @@ impl Default for Config {
             seed: 0,
             checkpoint_every: 0,
             resume: false,
+            recompute: true,
             base_model: tad_local::model(tad_local::ALIGN_DEFAULT).map_or("", |m| m.upstream).to_string(),
         }
     }
@@ -470,10 +476,9 @@ impl Run {
                 let mut loss_sum = 0f32;
                 for &i in batch {
                     let sample = &samples[i];
-                    let loss =
-                        weights.loss(&sample.tokens, sample.answer, Some(&self.lora), &self.rope).map_err(training)?;
-                    loss_sum += loss.to_scalar::<f32>().map_err(training)?;
-                    let store = loss.backward().map_err(training)?;
+                    let (loss, store) =
+                        sample_loss(weights, &self.lora, &self.rope, sample, config.recompute).map_err(training)?;
+                    loss_sum += loss;
                     for (slot, (_, var)) in grads.iter_mut().zip(&self.optimizer.vars) {
                         if let Some(g) = store.get(var.as_tensor()) {
                             let g = (g / batch.len() as f64).map_err(training)?;
@@ -534,4 +539,21 @@ impl Run {
         }
         Ok(())
     }
+}
+
+/// A sample's loss and its gradients, with each layer recomputed in the backward pass or
+/// the whole graph kept.
+fn sample_loss(
+    weights: &Weights,
+    lora: &LoraSet,
+    rope: &Rope,
+    sample: &Sample,
+    recompute: bool,
+) -> candle_core::Result<(f32, GradStore)> {
+    let (tokens, from) = (&sample.tokens, sample.answer);
+    if recompute {
+        return weights.loss_recomputed(tokens, from, lora, rope);
+    }
+    let loss = weights.loss(tokens, from, Some(lora), rope)?;
+    Ok((loss.to_scalar::<f32>()?, loss.backward()?))
 }

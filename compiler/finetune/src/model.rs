@@ -9,13 +9,17 @@
 //! ([`tad_local::hf_to_gguf_rows`]). qwen2's GGUF keeps Hugging Face's order and rope
 //! rotates each head's halves.
 //! Only candle operations with a backward pass are used (rope, RMSNorm and softmax are
-//! written out from them; candle-nn's fused kernels have none).
+//! written out from them; candle-nn's fused kernels have none), and one of this crate's:
+//! the frozen weights' product, whose backward pass computes no weight gradient.
+//! [`Weights::loss_recomputed`] keeps one layer's graph at a time and recomputes each
+//! layer in the backward pass.
 
 use std::collections::BTreeMap;
 use std::path::Path;
 
+use candle_core::backprop::GradStore;
 use candle_core::quantized::gguf_file::Content;
-use candle_core::{D, DType, Device, Tensor, Var};
+use candle_core::{CpuStorage, CustomOp1, D, DType, Device, Layout, Tensor, Var};
 use candle_nn::VarMap;
 use tad_local::{Adapter, Arch, Lora, Shape, Target, gguf_to_hf_rows, hf_to_gguf_rows, tensor_name};
 
@@ -298,6 +302,34 @@ impl Rope {
     }
 }
 
+/// `x Wᵀ` for a frozen `W` (`[out, in]`). candle's matmul would also compute `W`'s
+/// gradient in the backward pass, as large as `W` and as costly as the product itself, and
+/// keep it to the end; this op's backward gives `x`'s gradient alone.
+fn frozen(x: &Tensor, w: &Tensor) -> candle_core::Result<Tensor> {
+    x.contiguous()?.apply_op1(Frozen(w.clone()))
+}
+
+struct Frozen(Tensor);
+
+impl CustomOp1 for Frozen {
+    fn name(&self) -> &'static str {
+        "frozen-linear"
+    }
+
+    fn cpu_fwd(&self, storage: &CpuStorage, layout: &Layout) -> candle_core::Result<(CpuStorage, candle_core::Shape)> {
+        let Some((start, end)) = layout.contiguous_offsets() else {
+            candle_core::bail!("frozen-linear: the input is not contiguous")
+        };
+        let x = Tensor::from_slice(&storage.as_slice::<f32>()?[start..end], layout.shape(), &Device::Cpu)?;
+        let y = x.matmul(&self.0.t()?)?;
+        Ok((CpuStorage::F32(y.flatten_all()?.to_vec1()?), y.shape().clone()))
+    }
+
+    fn bwd(&self, _x: &Tensor, _y: &Tensor, grad: &Tensor) -> candle_core::Result<Option<Tensor>> {
+        Ok(Some(grad.matmul(&self.0)?))
+    }
+}
+
 fn rms_norm(x: &Tensor, weight: &Tensor, eps: f32) -> candle_core::Result<Tensor> {
     let mean = (x.sqr()?.sum_keepdim(D::Minus1)? / x.dim(D::Minus1)? as f64)?;
     x.broadcast_div(&(mean + eps as f64)?.sqrt()?)?.broadcast_mul(weight)
@@ -306,56 +338,75 @@ fn rms_norm(x: &Tensor, weight: &Tensor, eps: f32) -> candle_core::Result<Tensor
 impl Weights {
     /// `x Wᵀ (+ scale · (x Aᵀ) Bᵀ)`.
     fn linear(&self, x: &Tensor, layer: usize, t: Target, lora: Option<&LoraSet>) -> candle_core::Result<Tensor> {
-        let base = x.matmul(&self.blocks[layer].proj[t as usize].t()?)?;
+        let base = frozen(x, &self.blocks[layer].proj[t as usize])?;
         match lora.and_then(|l| Some((l.pair(layer, t)?, l.scale()))) {
             Some(((a, b), scale)) => base + (x.matmul(&a.t()?)?.matmul(&b.t()?)? * scale)?,
             None => Ok(base),
         }
     }
 
-    /// The final hidden states (after the output norm), `[t, dim]`, of `tokens` read from
-    /// the first position, attending causally.
-    pub fn hidden(&self, tokens: &[u32], lora: Option<&LoraSet>, rope: &Rope) -> candle_core::Result<Tensor> {
-        let Shape { dim, heads, kv_heads, head_dim, eps, .. } = self.shape;
-        let n = tokens.len();
-        let group = heads / kv_heads;
-        let device = Device::Cpu;
-        let ids = Tensor::new(tokens, &device)?;
-        let mut x = self.embedding.index_select(&ids, 0)?;
-        let mask: Vec<f32> = (0..n * n).map(|i| if i % n > i / n { f32::NEG_INFINITY } else { 0.0 }).collect();
-        let mask = Tensor::from_vec(mask, (n, n), &device)?;
-        let scale = 1.0 / (head_dim as f64).sqrt();
-        for (li, block) in self.blocks.iter().enumerate() {
-            let h = rms_norm(&x, &block.attn_norm, eps)?;
-            let split = |y: Tensor, count: usize| y.reshape((n, count, head_dim))?.transpose(0, 1)?.contiguous();
-            let qkv = |k: usize, t: Target| -> candle_core::Result<Tensor> {
-                let y = self.linear(&h, li, t, lora)?;
-                match &block.bias {
-                    Some(bias) => y.broadcast_add(&bias[k]),
-                    None => Ok(y),
-                }
-            };
-            let q = rope.apply(&split(qkv(0, Target::Q)?, heads)?)?;
-            let k = rope.apply(&split(qkv(1, Target::K)?, kv_heads)?)?;
-            let v = split(qkv(2, Target::V)?, kv_heads)?;
-            // query heads h = kv·group + g read key/value head kv: [kv, group·t, hd]
-            let q = q.reshape((kv_heads, group * n, head_dim))?;
-            let scores = (q.matmul(&k.t()?)? * scale)?.reshape((heads, n, n))?.broadcast_add(&mask)?;
-            let weights = candle_nn::ops::softmax(&scores, D::Minus1)?.reshape((kv_heads, group * n, n))?;
-            let attn = weights.matmul(&v)?.reshape((heads, n, head_dim))?.transpose(0, 1)?.reshape((n, dim))?;
-            x = (x + self.linear(&attn, li, Target::O, lora)?)?;
-            let h = rms_norm(&x, &block.ffn_norm, eps)?;
-            let gate = self.linear(&h, li, Target::Gate, lora)?;
-            let up = self.linear(&h, li, Target::Up, lora)?;
-            let mlp = self.linear(&(gate.silu()? * up)?, li, Target::Down, lora)?;
-            x = (x + mlp)?;
+    /// The residual stream after the last layer (before the output norm), `[t, dim]`, of
+    /// `tokens` read from the first position, attending causally.
+    fn residual(&self, tokens: &[u32], lora: Option<&LoraSet>, rope: &Rope) -> candle_core::Result<Tensor> {
+        let mask = causal_mask(tokens.len())?;
+        let mut x = self.embed(tokens)?;
+        for li in 0..self.blocks.len() {
+            x = self.block(li, &x, lora, rope, &mask)?;
         }
-        rms_norm(&x, &self.norm, eps)
+        Ok(x)
+    }
+
+    /// The final hidden states (after the output norm), `[t, dim]`.
+    pub fn hidden(&self, tokens: &[u32], lora: Option<&LoraSet>, rope: &Rope) -> candle_core::Result<Tensor> {
+        rms_norm(&self.residual(tokens, lora, rope)?, &self.norm, self.shape.eps)
+    }
+
+    fn embed(&self, tokens: &[u32]) -> candle_core::Result<Tensor> {
+        self.embedding.index_select(&Tensor::new(tokens, &Device::Cpu)?, 0)
+    }
+
+    /// Layer `li` applied to the residual stream `x` (`[t, dim]`).
+    fn block(
+        &self,
+        li: usize,
+        x: &Tensor,
+        lora: Option<&LoraSet>,
+        rope: &Rope,
+        mask: &Tensor,
+    ) -> candle_core::Result<Tensor> {
+        let Shape { dim, heads, kv_heads, head_dim, eps, .. } = self.shape;
+        let block = &self.blocks[li];
+        let n = x.dim(0)?;
+        let group = heads / kv_heads;
+        let scale = 1.0 / (head_dim as f64).sqrt();
+        let h = rms_norm(x, &block.attn_norm, eps)?;
+        let split = |y: Tensor, count: usize| y.reshape((n, count, head_dim))?.transpose(0, 1)?.contiguous();
+        let qkv = |k: usize, t: Target| -> candle_core::Result<Tensor> {
+            let y = self.linear(&h, li, t, lora)?;
+            match &block.bias {
+                Some(bias) => y.broadcast_add(&bias[k]),
+                None => Ok(y),
+            }
+        };
+        let q = rope.apply(&split(qkv(0, Target::Q)?, heads)?)?;
+        let k = rope.apply(&split(qkv(1, Target::K)?, kv_heads)?)?;
+        let v = split(qkv(2, Target::V)?, kv_heads)?;
+        // query heads h = kv·group + g read key/value head kv: [kv, group·t, hd]
+        let q = q.reshape((kv_heads, group * n, head_dim))?;
+        let scores = (q.matmul(&k.t()?)? * scale)?.reshape((heads, n, n))?.broadcast_add(mask)?;
+        let weights = candle_nn::ops::softmax(&scores, D::Minus1)?.reshape((kv_heads, group * n, n))?;
+        let attn = weights.matmul(&v)?.reshape((heads, n, head_dim))?.transpose(0, 1)?.reshape((n, dim))?;
+        let x = (x + self.linear(&attn, li, Target::O, lora)?)?;
+        let h = rms_norm(&x, &block.ffn_norm, eps)?;
+        let gate = self.linear(&h, li, Target::Gate, lora)?;
+        let up = self.linear(&h, li, Target::Up, lora)?;
+        let mlp = self.linear(&(gate.silu()? * up)?, li, Target::Down, lora)?;
+        x + mlp
     }
 
     /// The logits of `hidden` rows.
     pub fn head(&self, hidden: &Tensor) -> candle_core::Result<Tensor> {
-        hidden.matmul(&self.output.as_ref().unwrap_or(&self.embedding).t()?)
+        frozen(hidden, self.output.as_ref().unwrap_or(&self.embedding))
     }
 
     /// The logits after the last of `tokens`.
@@ -378,15 +429,94 @@ impl Weights {
         lora: Option<&LoraSet>,
         rope: &Rope,
     ) -> candle_core::Result<Tensor> {
-        let n = tokens.len();
-        if from == 0 || from >= n {
-            candle_core::bail!("no answer tokens to take the loss on");
-        }
-        let hidden = self.hidden(tokens, lora, rope)?;
-        // only the rows that predict an answer token go through the output head
-        let rows = hidden.narrow(0, from - 1, n - from)?;
-        let logits = self.head(&rows)?;
-        let targets = Tensor::new(&tokens[from..], &Device::Cpu)?;
-        candle_nn::loss::cross_entropy(&logits, &targets)
+        answer_tokens(tokens, from)?;
+        self.answer_loss(&self.residual(tokens, lora, rope)?, tokens, from)
     }
+
+    /// The loss of [`Weights::loss`] and its gradients in `lora`'s pairs, holding one
+    /// layer's graph at a time (activation checkpointing): the forward pass keeps only each
+    /// layer's input, and the backward pass recomputes each layer from it, last to first,
+    /// carrying the gradient of the layer's output, at the cost of a second forward pass.
+    pub fn loss_recomputed(
+        &self,
+        tokens: &[u32],
+        from: usize,
+        lora: &LoraSet,
+        rope: &Rope,
+    ) -> candle_core::Result<(f32, GradStore)> {
+        answer_tokens(tokens, from)?;
+        let mask = causal_mask(tokens.len())?;
+        // forward: each layer's graph is dropped as soon as its output is detached
+        let mut inputs = Vec::with_capacity(self.blocks.len());
+        let mut x = self.embed(tokens)?;
+        for li in 0..self.blocks.len() {
+            let next = self.block(li, &x, Some(lora), rope, &mask)?.detach();
+            inputs.push(x);
+            x = next;
+        }
+        // the head, a slice of the answer's rows at a time: its logits are a vocabulary wide
+        let top = Var::from_tensor(&x)?;
+        let (rows, mut value) = (tokens.len() - from, 0f32);
+        let mut carry = x.zeros_like()?;
+        for start in (0..rows).step_by(HEAD_ROWS) {
+            let len = HEAD_ROWS.min(rows - start);
+            let slice = top.narrow(0, from - 1 + start, len)?;
+            let targets = &tokens[from + start..from + start + len];
+            let loss = (self.rows_loss(&slice, targets)? * (len as f64 / rows as f64))?;
+            value += loss.to_scalar::<f32>()?;
+            carry = (carry + take_grad(&mut loss.backward()?, &top)?)?;
+        }
+        // backward: a layer's output gradient is `carry`, so `sum(y · carry)` has its gradients
+        let mut grads = GradStore::default();
+        for (li, input) in inputs.into_iter().enumerate().rev() {
+            let input = Var::from_tensor(&input)?;
+            let y = self.block(li, input.as_tensor(), Some(lora), rope, &mask)?;
+            let mut layer = (y * &carry)?.sum_all()?.backward()?;
+            // the embedding is frozen: the first layer's input needs no gradient
+            if li > 0 {
+                carry = take_grad(&mut layer, &input)?;
+            }
+            layer.remove(input.as_tensor());
+            grads.extend(layer)?;
+        }
+        Ok((value, grads))
+    }
+
+    /// The mean cross-entropy of `tokens[from..]` from the residual stream `x` of `tokens`.
+    fn answer_loss(&self, x: &Tensor, tokens: &[u32], from: usize) -> candle_core::Result<Tensor> {
+        // only the rows that predict an answer token go through the output head
+        self.rows_loss(&x.narrow(0, from - 1, tokens.len() - from)?, &tokens[from..])
+    }
+
+    /// The mean cross-entropy of `targets` predicted from the residual stream's `rows`.
+    fn rows_loss(&self, rows: &Tensor, targets: &[u32]) -> candle_core::Result<Tensor> {
+        let logits = self.head(&rms_norm(rows, &self.norm, self.shape.eps)?)?;
+        candle_nn::loss::cross_entropy(&logits, &Tensor::new(targets, &Device::Cpu)?)
+    }
+}
+
+/// Answer rows the recomputed loss sends through the output head at once: 128 rows of
+/// Qwen's 151,936 logits take 78 MB a copy.
+const HEAD_ROWS: usize = 128;
+
+/// Refuses a sample without answer tokens after a first one (`from` in `1..len`).
+fn answer_tokens(tokens: &[u32], from: usize) -> candle_core::Result<()> {
+    if from == 0 || from >= tokens.len() {
+        candle_core::bail!("no answer tokens to take the loss on");
+    }
+    Ok(())
+}
+
+/// Removes `var`'s gradient from `grads`.
+fn take_grad(grads: &mut GradStore, var: &Var) -> candle_core::Result<Tensor> {
+    match grads.remove(var.as_tensor()) {
+        Some(g) => Ok(g),
+        None => candle_core::bail!("no gradient reached a layer's input"),
+    }
+}
+
+/// `[n, n]`: 0 where a position may attend (itself and before), −∞ after.
+fn causal_mask(n: usize) -> candle_core::Result<Tensor> {
+    let mask: Vec<f32> = (0..n * n).map(|i| if i % n > i / n { f32::NEG_INFINITY } else { 0.0 }).collect();
+    Tensor::from_vec(mask, (n, n), &Device::Cpu)
 }

@@ -48,6 +48,10 @@ pub struct FinetuneArgs {
     /// Continue from the checkpoint in the output directory
     #[arg(long)]
     pub resume: bool,
+    /// Keep every layer's graph for the backward pass instead of recomputing each layer:
+    /// faster, more memory
+    #[arg(long)]
+    pub keep_graph: bool,
     /// The local model to adapt
     #[arg(long, default_value = tad_local::ALIGN_DEFAULT)]
     pub model: String,
@@ -92,6 +96,7 @@ impl FinetuneArgs {
             seed: self.seed,
             checkpoint_every: self.checkpoint_every,
             resume: self.resume,
+            recompute: !self.keep_graph,
             ..Config::default()
         })
     }
