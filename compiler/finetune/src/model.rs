@@ -255,6 +255,11 @@ impl LoraSet {
         out
     }
 
+    /// The `Var`s of `layer`'s pairs.
+    fn layer(&self, layer: usize) -> impl Iterator<Item = &Var> {
+        self.pairs.iter().filter(move |((l, _), _)| *l == layer).flat_map(|(_, (a, b))| [a, b])
+    }
+
     fn pair(&self, layer: usize, t: Target) -> Option<&(Var, Var)> {
         self.pairs.get(&(layer, t))
     }
@@ -476,8 +481,13 @@ impl Weights {
             if li > 0 {
                 carry = take_grad(&mut layer, &input)?;
             }
-            layer.remove(input.as_tensor());
-            grads.extend(layer)?;
+            // only the pairs' gradients are kept: the store also holds those of constants
+            // (the mask's, rope's, broadcast to the scores' size), dropped with it
+            for var in lora.layer(li) {
+                if let Some(g) = layer.remove(var.as_tensor()) {
+                    grads.insert(var.as_tensor(), g);
+                }
+            }
         }
         Ok((value, grads))
     }
