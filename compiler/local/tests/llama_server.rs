@@ -1,5 +1,5 @@
 //! An adapter as llama.cpp reads it: a seeded random LoRA adapter on each installed model
-//! (SmolLM2-135M, llama; Qwen2.5-Coder-0.5B, qwen2) written as PEFT's files and as
+//! (SmolLM2-135M, llama; Qwen2.5-Coder-0.5B and 1.5B, qwen2) written as PEFT's files and as
 //! `adapter.gguf`, then the next token's distribution after a prompt from this crate's
 //! decoder with `--adapter` against `llama-server --lora adapter.gguf` on the same GGUF.
 //! Runs with `TADSL_LLAMA_SERVER` (the binary); skips without it (CI's llama.cpp build is
@@ -125,7 +125,7 @@ fn llama_cpp_applies_the_adapters_gguf_as_the_decoder_does() {
         return;
     };
     let mut checked = 0;
-    for name in ["smollm2-135m", "qwen2.5-coder-0.5b"] {
+    for name in ["smollm2-135m", "qwen2.5-coder-0.5b", "qwen2.5-coder-1.5b"] {
         let Some(model) = installed(name) else {
             eprintln!("{name}: not installed (tadslc model fetch {name}), skipped");
             continue;

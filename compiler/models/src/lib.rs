@@ -261,8 +261,8 @@ const QWEN_0_5B_PARTS: &[(&str, &str)] = &[
 pub const DEFAULT: &str = "qwen2.5-coder-1.5b";
 
 /// The default model LoRA aligns (`tadslc finetune`): the largest whose training at
-/// `--max-len 512` fits in 24 GiB.
-pub const ALIGN_DEFAULT: &str = "qwen2.5-coder-0.5b";
+/// `--max-len 512` fits in 24 GiB, today the default model itself.
+pub const ALIGN_DEFAULT: &str = DEFAULT;
 
 /// The smallest language model: the real path's tests run on it.
 pub const SMALLEST: &str = "smollm2-135m";
