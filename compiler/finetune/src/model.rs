@@ -474,12 +474,14 @@ impl Weights {
         // backward: a layer's output gradient is `carry`, so `sum(y · carry)` has its gradients
         let mut grads = GradStore::default();
         for (li, input) in inputs.into_iter().enumerate().rev() {
-            let input = Var::from_tensor(&input)?;
-            let y = self.block(li, input.as_tensor(), Some(lora), rope, &mask)?;
+            // the embedding is frozen: the first layer's input needs no gradient, and as a
+            // constant it spares the backward pass the products that would compute one
+            let var = (li > 0).then(|| Var::from_tensor(&input)).transpose()?;
+            let x = var.as_ref().map_or(&input, |v| v.as_tensor());
+            let y = self.block(li, x, Some(lora), rope, &mask)?;
             let mut layer = (y * &carry)?.sum_all()?.backward()?;
-            // the embedding is frozen: the first layer's input needs no gradient
-            if li > 0 {
-                carry = take_grad(&mut layer, &input)?;
+            if let Some(var) = &var {
+                carry = take_grad(&mut layer, var)?;
             }
             // only the pairs' gradients are kept: the store also holds those of constants
             // (the mask's, rope's, broadcast to the scores' size), dropped with it
