@@ -10,9 +10,9 @@
 //! written first. The type comes before the behaviour: each actor kind has its own group
 //! rule, whose behaviours are those the kind performs (`performers`; the ego's are a
 //! vehicle's), so a cyclist cannot `stand` (E0502). The road comes before the ego and the
-//! groups: a direction profile ([`Profile`]) keeps them out of negative lanes on a one-way
-//! road (E0501). A group's count is at least 1 (E0509). Each would otherwise cost a repair
-//! round.
+//! groups: a profile ([`Profile`]) of its direction and lane count keeps them out of
+//! negative lanes on a one-way road (E0501) and within the road's lanes (E0500). A group's
+//! count is at least 1 (E0509). Each would otherwise cost a repair round.
 //!
 //! Numbers, names, strings and comment lines are bounded in length, and lists and the
 //! groups in number, so that a decoder cannot run away inside one: a small model otherwise
@@ -43,9 +43,11 @@ const LIST_MAX: u32 = 8;
 pub fn grammar(vocabulary: &Vocabulary, modules: &[String]) -> Grammar {
     let mut g = Grammar::default();
     let uses = if modules.is_empty() { opt(lit("\n")) } else { star(seq([lit("use "), r("module"), lit("\n")])) };
-    // the road, the ego and the groups, as one of the direction profiles
-    let profiles = PROFILES.iter().map(|p| {
-        let road = if p.one_way { r(&p.rule("road")) } else { opt(r(&p.rule("road"))) };
+    // the road, the ego and the groups, as one of the profiles
+    let profiles = profiles();
+    let alternatives = profiles.iter().map(|p| {
+        // a road stating its direction as one-way or its lanes is written; otherwise optional
+        let road = if p.one_way || p.lanes.is_some() { r(&p.rule("road")) } else { opt(r(&p.rule("road"))) };
         seq([road, opt(r(&p.rule("ego"))), rep(r(&p.rule("actor")), 0, GROUPS_MAX)])
     });
     g.rule(
@@ -59,7 +61,7 @@ pub fn grammar(vocabulary: &Vocabulary, modules: &[String]) -> Grammar {
             lit(" {\n"),
             opt(r("source")),
             opt(r("environment")),
-            alt(profiles),
+            alt(alternatives),
             lit("}"),
             opt(lit("\n")),
         ]),
@@ -70,7 +72,7 @@ pub fn grammar(vocabulary: &Vocabulary, modules: &[String]) -> Grammar {
     for section in [&schema::SOURCE, &schema::ENVIRONMENT] {
         g.rule(section.name, block(section, section_head(section), |f| opt(r(&field_rule(section, f)))));
     }
-    for profile in PROFILES {
+    for profile in &profiles {
         road_and_ego(&mut g, profile);
         actors(&mut g, vocabulary, profile);
     }
@@ -109,6 +111,14 @@ pub fn grammar(vocabulary: &Vocabulary, modules: &[String]) -> Grammar {
     g.terminal("name-char", class(&[('a', 'z'), ('A', 'Z'), ('0', '9'), ('_', '_')]));
     g.terminal("count-int", seq([class(&[('1', '9')]), rep(class(&[('0', '9')]), 0, 4)]));
     g.terminal("lane-index-one-way", rep(class(&[('0', '9')]), 1, 5));
+    // a lane count no profile names: more than LANES_PROFILED (0 and below are errors, E0500)
+    g.terminal(
+        "lanes-many",
+        alt([
+            class(&[((b'0' + LANES_PROFILED as u8 + 1) as char, '9')]),
+            seq([class(&[('1', '9')]), rep(class(&[('0', '9')]), 1, 4)]),
+        ]),
+    );
     g.terminal("int", seq([opt(lit("-")), rep(class(&[('0', '9')]), 1, 5)]));
     g.terminal(
         "number",
@@ -138,26 +148,64 @@ pub fn grammar(vocabulary: &Vocabulary, modules: &[String]) -> Grammar {
 const BEHAVIOR: &str = "behavior";
 /// The field that takes a lane index.
 const LANE: &str = "lane";
+/// The road's field that counts its lanes.
+const LANES: &str = "lanes";
 
-/// Which lanes the ego and the groups may be in, decided by the road's `direction`: on a
-/// direction without opposite lanes (`one_way`) no lane is negative (E0501). Each profile
-/// has its own road, ego and actor rules.
+/// The road's lane counts that have a profile of their own; a larger count (the truths
+/// have at most 5) leaves the lanes unbounded.
+const LANES_PROFILED: u32 = 6;
+
+/// Which lanes the ego and the groups may be in, decided by the road's `direction` and
+/// `lanes`: on a direction without opposite lanes (`one_way`) no lane is negative (E0501),
+/// and with `lanes: N` stated a lane is within ±N and not 0 (E0500). Each profile has its
+/// own road, ego and actor rules.
 struct Profile {
     one_way: bool,
+    /// The road's `lanes`, or `None` where it is not stated, `unspecified` or above
+    /// [`LANES_PROFILED`].
+    lanes: Option<u32>,
 }
 
-const PROFILES: &[Profile] = &[Profile { one_way: false }, Profile { one_way: true }];
+fn profiles() -> Vec<Profile> {
+    let lanes = std::iter::once(None).chain((1..=LANES_PROFILED).map(Some));
+    lanes.flat_map(|lanes| [false, true].map(|one_way| Profile { one_way, lanes })).collect()
+}
 
 impl Profile {
-    /// `base`'s rule in this profile: `road`, or `road-one-way`.
+    /// `base`'s rule in this profile: `road`, `road-one-way`, `road-lanes-2`, ...
     fn rule(&self, base: &str) -> String {
-        if self.one_way { format!("{base}-one-way") } else { base.to_string() }
+        let mut name = base.to_string();
+        if self.one_way {
+            name.push_str("-one-way");
+        }
+        if let Some(n) = self.lanes {
+            name.push_str(&format!("-lanes-{n}"));
+        }
+        name
     }
 
     /// A `lane:` line of this profile.
     fn lane(&self, field: &FieldDef) -> Expr {
-        let index = if self.one_way { r("lane-index-one-way") } else { r("int") };
+        let index = match self.lanes {
+            Some(n) => {
+                let ahead = (1..=n).map(|i| lit(i.to_string()));
+                let opposite = (1..=n).map(|i| lit(format!("-{i}"))).filter(|_| !self.one_way);
+                alt(ahead.chain(opposite))
+            }
+            None if self.one_way => r("lane-index-one-way"),
+            None => r("int"),
+        };
         seq([lit(format!("    {}: ", field.name)), alt([index, lit("unspecified")]), lit("\n")])
+    }
+
+    /// The road's `lanes:` line in this profile, optional where it is not stated.
+    fn lanes(&self, field: &FieldDef) -> Expr {
+        match self.lanes {
+            Some(n) => seq([lit(format!("    {}: ", field.name)), lit(n.to_string()), lit("\n")]),
+            None => {
+                opt(seq([lit(format!("    {}: ", field.name)), alt([r("lanes-many"), lit("unspecified")]), lit("\n")]))
+            }
+        }
     }
 }
 
@@ -165,8 +213,8 @@ fn section_head(section: &SectionDef) -> Expr {
     lit(format!("  {} {{\n", section.name))
 }
 
-/// The profile's `road` (its `direction` one of the profile's, stated when one-way) and
-/// `ego` (a vehicle's behaviours, the profile's lanes).
+/// The profile's `road` (its `direction` one of the profile's, stated when one-way; its
+/// `lanes` the profile's) and `ego` (a vehicle's behaviours, the profile's lanes).
 fn road_and_ego(g: &mut Grammar, profile: &Profile) {
     let road = &schema::ROAD;
     g.rule(
@@ -175,6 +223,7 @@ fn road_and_ego(g: &mut Grammar, profile: &Profile) {
             // stated, and only a direction without opposite lanes: not `unspecified`
             "direction" if profile.one_way => seq([lit("    direction: "), r("direction-one-way-name"), lit("\n")]),
             "direction" => opt(field_line(f, "direction-opposite-name")),
+            LANES => profile.lanes(f),
             _ => opt(r(&field_rule(road, f))),
         }),
     );
@@ -191,12 +240,13 @@ fn road_and_ego(g: &mut Grammar, profile: &Profile) {
 
 /// Whether the profiles write this field themselves rather than share one rule for it.
 fn by_profile(section: &SectionDef, field: &FieldDef) -> bool {
-    matches!((section.name, field.name), ("road", "direction") | ("ego" | "actor", BEHAVIOR | LANE))
+    matches!((section.name, field.name), ("road", "direction" | LANES) | ("ego" | "actor", BEHAVIOR | LANE))
 }
 
 /// `actor` in `profile`: one alternative per actor kind that has types, its types in the
-/// header and its performers' behaviours in the block; types without a kind and
-/// `unspecified` take any behaviour.
+/// header and its performers' behaviours in the block; types without a kind take any
+/// behaviour. A group names its type: one of type `unspecified` is nothing the layout can
+/// place, and a model that has nothing to write fills groups with it.
 fn actors(g: &mut Grammar, vocabulary: &Vocabulary, profile: &Profile) {
     let types = vocabulary.entries("actor_type");
     let mut groups = Vec::new();
@@ -211,9 +261,10 @@ fn actors(g: &mut Grammar, vocabulary: &Vocabulary, profile: &Profile) {
         .iter()
         .filter(|t| t.symbol("kind").is_none_or(|k| vocabulary.get("actor_kind", k).is_none()))
         .map(|t| lit(&t.name))
-        .chain([lit("unspecified")])
         .collect();
-    groups.push((profile.rule("actor-any"), alt(kindless), None));
+    if !kindless.is_empty() {
+        groups.push((profile.rule("actor-any"), alt(kindless), None));
+    }
 
     let actor = &schema::ACTOR;
     for (rule, names, kind) in &groups {
