@@ -61,7 +61,13 @@ pub fn prompt_example() -> (String, String) {
     example_parts(EXAMPLE)
 }
 
-/// An example's description and its program (without comments and `source`).
+/// The comment line that opens a translation: the road users the description names
+/// besides the ego, listed before the program is written so that each gets one group. The
+/// examples show it; it is dropped from the answer with the other comment lines.
+const ROAD_USERS: &str = "// road users:";
+
+/// An example's description and its program (without `source` and comments, but for its
+/// list of road users, which opens it).
 fn example_parts(text: &str) -> (String, String) {
     let (module, _) = tad_syntax::analyze(text);
     let description = module
@@ -73,7 +79,8 @@ fn example_parts(text: &str) -> (String, String) {
             _ => None,
         })
         .unwrap_or_default();
-    let program = with_provenance(text, &Provenance::default());
+    let mut program: String = text.lines().filter(|l| l.starts_with(ROAD_USERS)).map(|l| format!("{l}\n")).collect();
+    program.push_str(&with_provenance(text, &Provenance::default()));
     (description.trim_end().to_string(), program.trim().to_string())
 }
 
@@ -241,10 +248,14 @@ mod tests {
             assert_eq!(verdict.class, tad_check::Class::Complete, "{program}\n{:?}", verdict.lines);
             // a speed keeps the description's unit, so mph is only warned about (W0402)
             assert!(verdict.lines.iter().all(|l| l.starts_with("W0402")), "{:?}", verdict.lines);
+            // the program opens with its road users, one group each
+            let users = program.lines().next().and_then(|l| l.strip_prefix(ROAD_USERS)).expect(&program);
+            assert_eq!(users.split(';').count(), program.matches("\n  actor ").count(), "{program}");
         }
         let shown = translate_examples();
         assert_eq!(shown.matches("```tad\n").count(), TRANSLATE_EXAMPLES.len());
-        assert!(shown.contains("use rural\n\nscenario country_road_at_dawn {"), "{shown}");
-        assert!(!shown.contains("source {") && !shown.contains("//"), "{shown}");
+        assert!(shown.contains("\nuse rural\n\nscenario country_road_at_dawn {"), "{shown}");
+        assert!(!shown.contains("source {") && !shown.contains("worked example"), "{shown}");
+        assert_eq!(shown.matches("//").count(), TRANSLATE_EXAMPLES.len(), "{shown}");
     }
 }

@@ -24,7 +24,7 @@ macro_rules! template {
 }
 
 template!(DESCRIBE, "describe.v1");
-template!(TRANSLATE, "translate.v6");
+template!(TRANSLATE, "translate.v9");
 template!(GENERATE, "generate.v1");
 template!(GENERATE_TUNED, "generate-tuned.v1");
 template!(REPAIR, "repair.v1");
