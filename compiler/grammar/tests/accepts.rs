@@ -258,7 +258,7 @@ fn the_grammar_allows_a_behavior_exactly_when_the_checker_does() {
     let grammar = TopLevelGrammar::from_lark(lark(None));
     let (vocabulary, _) = tad_grammar::scope(None).unwrap();
     // one type of each kind
-    let mut kinds: Vec<String> = vocabulary
+    let kinds: Vec<String> = vocabulary
         .names("actor_kind")
         .into_iter()
         .filter_map(|k| vocabulary.entries("actor_type").into_iter().find(|t| t.symbol("kind") == Some(k)))
