@@ -27,8 +27,10 @@ use crate::ir::{Expr, Grammar, alt, class, lit, not_class, opt, r, rep, seq, sta
 
 /// The longest name a model may write (scenario and group names).
 const NAME_MAX: u32 = 48;
-/// Comment lines before the program.
-const COMMENTS_MAX: u32 = 8;
+/// Comment lines before the program: a translation's list of road users, which may wrap
+/// once. SmolLM2-135M, allowed eight, filled them with one road user repeated and ran out
+/// of tokens before the program.
+const COMMENTS_MAX: u32 = 2;
 /// Characters in a comment line after `//`.
 const COMMENT_MAX: u32 = 120;
 /// Characters in a string, and in a text block (a `source.description`, which answers need

@@ -103,7 +103,7 @@ fn programs() -> Vec<(String, String)> {
 
 /// The answers a translation should give: the benchmark's ground truths and the translate
 /// prompt's worked examples, without their comment lines (truths explain themselves at
-/// length; answers need not).
+/// length; answers need not) but for the examples' list of road users, which opens them.
 fn answers() -> Vec<(String, String)> {
     let repo = tad_test_support::repo();
     let dirs = [repo.join("tests/llm/truth"), repo.join("compiler/frontend/prompts/examples")];
@@ -111,7 +111,12 @@ fn answers() -> Vec<(String, String)> {
     files
         .map(|p| {
             let text = tad_test_support::read(&p);
-            let code: String = text.lines().filter(|l| !l.starts_with("//")).map(|l| format!("{l}\n")).collect();
+            let (users, code): (Vec<&str>, Vec<&str>) = text
+                .lines()
+                .filter(|l| !l.starts_with("//") || l.starts_with("// road users:"))
+                .partition(|l| l.starts_with("//"));
+            let code: String =
+                users.iter().chain(code.iter().skip_while(|l| l.is_empty())).map(|l| format!("{l}\n")).collect();
             (p.display().to_string(), code.trim_start().to_string())
         })
         .collect()
