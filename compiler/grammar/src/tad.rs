@@ -201,7 +201,7 @@ impl Profile {
     }
 
     /// The road's `lanes:` line in this profile, optional where it is not stated.
-    fn lanes(&self, field: &FieldDef) -> Expr {
+    fn lanes_line(&self, field: &FieldDef) -> Expr {
         match self.lanes {
             Some(n) => seq([lit(format!("    {}: ", field.name)), lit(n.to_string()), lit("\n")]),
             None => {
@@ -225,7 +225,7 @@ fn road_and_ego(g: &mut Grammar, profile: &Profile) {
             // stated, and only a direction without opposite lanes: not `unspecified`
             "direction" if profile.one_way => seq([lit("    direction: "), r("direction-one-way-name"), lit("\n")]),
             "direction" => opt(field_line(f, "direction-opposite-name")),
-            LANES => profile.lanes(f),
+            LANES => profile.lanes_line(f),
             _ => opt(r(&field_rule(road, f))),
         }),
     );

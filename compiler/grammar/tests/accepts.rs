@@ -111,12 +111,9 @@ fn answers() -> Vec<(String, String)> {
     files
         .map(|p| {
             let text = tad_test_support::read(&p);
-            let (users, code): (Vec<&str>, Vec<&str>) = text
-                .lines()
-                .filter(|l| !l.starts_with("//") || l.starts_with("// road users:"))
-                .partition(|l| l.starts_with("//"));
-            let code: String =
-                users.iter().chain(code.iter().skip_while(|l| l.is_empty())).map(|l| format!("{l}\n")).collect();
+            let users = text.lines().filter(|l| l.starts_with("// road users:"));
+            let program = text.lines().filter(|l| !l.starts_with("//")).skip_while(|l| l.is_empty());
+            let code: String = users.chain(program).map(|l| format!("{l}\n")).collect();
             (p.display().to_string(), code.trim_start().to_string())
         })
         .collect()
