@@ -9,7 +9,8 @@
 //! exactly); a truth group without a partner counts every attribute it states as wrong,
 //! and an answer group without one counts as one wrong value of each group attribute. An
 //! answer without a program gets every attribute wrong. Speeds agree within 10 % or
-//! 1 m/s, whichever is wider; everything else agrees when equal. Each case's line is
+//! 1 m/s, whichever is wider; everything else agrees when equal, a relation as the layout
+//! places it ([`relation`]: `opposite` in an oncoming lane is `front`). Each case's line is
 //! followed by its misses, the answer's value beside the truth's.
 //!
 //! The translation itself is the host's (the CLI builds the session): this module pairs
@@ -18,7 +19,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use tad_ir::{Entries, Field, Group, Kind, Named, Param, Reference, Scenario};
+use tad_ir::{Entries, Field, Group, Kind, Lateral, Named, Param, Reference, Scenario};
 
 use crate::{BenchError, Report};
 
@@ -130,6 +131,7 @@ fn group(s: &Scenario, g: &Group) -> Vec<Option<Value>> {
         Param::Range { min, max } => format!("{min}..{max}"),
         Param::Choice(options) => options.iter().map(i64::to_string).collect::<Vec<_>>().join(" | "),
     });
+    let lane = g.lane.get().map(|l| l.index());
     let relation = g.position.given().map(|p| {
         let of = match &p.reference.value {
             Reference::Ego => "ego".to_string(),
@@ -137,12 +139,27 @@ fn group(s: &Scenario, g: &Group) -> Vec<Option<Value>> {
             Reference::RoadElement(id) => e.get(*id).map(|r| r.name.clone()).unwrap_or_default(),
             Reference::Unknown(written) => written.clone(),
         };
-        format!("{} of {of}", e.name(&p.relation.value))
+        format!("{} of {of}", relation(e, &p.relation.value, lane))
     });
-    [name(e, &g.actor_type), count, param_name(e, &g.behavior), relation, g.lane.get().map(|l| l.index().to_string())]
+    [name(e, &g.actor_type), count, param_name(e, &g.behavior), relation, lane.map(|l| l.to_string())]
         .into_iter()
         .map(|v| v.map(Value::Text))
         .collect()
+}
+
+/// A relation's name as the scene places it. A relation `opposite` the reference (ahead,
+/// coming towards it) in a negative lane is where its `same`-side relation puts it: the
+/// layout gives `opposite of ego` and `front of ego` in lane -2 one place and one heading,
+/// and the truths write oncoming traffic the second way.
+fn relation(e: &Entries, relation: &Named<tad_ir::Relation>, lane: Option<i64>) -> String {
+    let written = e.name(relation).to_string();
+    let Some(attrs) = e.resolved(relation).map(|r| r.attrs) else { return written };
+    if attrs.lateral != Some(Lateral::Opposite) || lane.is_none_or(|l| l >= 0) {
+        return written;
+    }
+    let same_side = |r: &tad_ir::Relation| r.lateral == Some(Lateral::Same) && r.longitudinal == attrs.longitudinal;
+    let table = e.table::<tad_ir::Relation>();
+    table.iter().find(|(_, r)| same_side(&r.attrs)).map_or(written, |(_, r)| r.name.clone())
 }
 
 fn name<K: Kind>(e: &Entries, f: &Field<Named<K>>) -> Option<String> {
@@ -447,6 +464,35 @@ mod tests {
         let mut swapped = truth.clone();
         swapped.groups.reverse();
         assert_eq!(score(&truth, Some(&swapped)), tally);
+    }
+
+    /// A scenario with one oncoming car, its position and lane as written.
+    fn oncoming(road: &str, position: &str, lane: i64) -> String {
+        format!(
+            "scenario t {{\n  road {{\n    type: {road}\n    lanes: 2\n    direction: two_way\n  }}\n  ego {{\n    \
+             behavior: move_forward\n    lane: 1\n  }}\n  actor car: 1 car {{\n    behavior: move_forward\n    \
+             position: {position} of ego\n    lane: {lane}\n  }}\n}}\n"
+        )
+    }
+
+    #[test]
+    fn opposite_in_an_oncoming_lane_scores_as_front_because_the_layout_places_them_alike() {
+        let agents = |program: &str| {
+            let mut db = tad_db::Database::new(tad_check::Options::default());
+            let file = db.set_file(PathBuf::from("t.tad"), program.to_string());
+            let scenario = tad_db::resolve(&db, file).clone().expect("a scenario");
+            tad_layout::lay_out(&scenario).agents().cloned().collect::<Vec<_>>()
+        };
+        for road in ["straight_road", "intersection"] {
+            assert_eq!(agents(&oncoming(road, "opposite", -2)), agents(&oncoming(road, "front", -2)), "{road}");
+        }
+        let truth = attributes(&oncoming("straight_road", "front", -2)).expect("a scenario");
+        let answer = |position, lane| score(&truth, attributes(&oncoming("straight_road", position, lane)).as_ref());
+        assert_eq!(answer("opposite", -2).per["relation"], (1, 1));
+        assert_eq!(answer("oncoming", -1).per["relation"], (1, 1), "the alias too, whatever its lane");
+        // in the ego's direction `opposite` says something else than `front`
+        assert_eq!(answer("opposite", 2).per["relation"], (0, 1));
+        assert_eq!(answer("opposite", 2).misses[0], "group 1 (car) relation: opposite of ego, truth front of ego");
     }
 
     #[test]
