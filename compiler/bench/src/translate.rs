@@ -60,6 +60,25 @@ pub const SCENE: [&str; 7] = ["weather", "time", "road type", "lanes", "directio
 pub const EGO: [&str; 3] = ["ego behaviour", "ego speed", "ego lane"];
 pub const GROUP: [&str; 5] = ["type", "count", "behaviour", "relation", "lane"];
 
+/// Each attribute's field as a program writes it, in the order of [`SCENE`], [`EGO`] and
+/// [`GROUP`]; a group's is written after its name (`bus_ahead.lane`).
+const SCENE_FIELDS: [&str; 7] = [
+    "environment.weather",
+    "environment.time",
+    "road.type",
+    "road.lanes",
+    "road.direction",
+    "road.light",
+    "road.signs",
+];
+const EGO_FIELDS: [&str; 3] = ["ego.behavior", "ego.speed", "ego.lane"];
+const GROUP_FIELDS: [&str; 5] = ["type", "count", "behavior", "position", "lane"];
+
+/// The comment line of a ground truth that lists the fields its description does not
+/// state, whose values are plausible defaults: `// not stated: road.type, bus_ahead.lane`.
+/// They are not scored.
+pub const NOT_STATED: &str = "// not stated:";
+
 /// An attribute's value as the comparison sees it.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Value {
@@ -92,6 +111,33 @@ pub struct Attributes {
     pub scene: Vec<Option<Value>>,
     pub ego: Vec<Option<Value>>,
     pub groups: Vec<Vec<Option<Value>>>,
+    /// The groups' names, in the order of `groups`.
+    pub names: Vec<String>,
+}
+
+/// A ground truth's attributes: those of [`attributes`] but the ones its [`NOT_STATED`]
+/// lines list. `Ok(None)` when it holds no scenario; an error names a listed field that is
+/// no scored attribute of it.
+pub fn ground_truth(program: &str) -> Result<Option<Attributes>, String> {
+    let Some(mut attributes) = attributes(program) else { return Ok(None) };
+    let listed = program.lines().filter_map(|l| l.strip_prefix(NOT_STATED));
+    for field in listed.flat_map(|l| l.split(',')).map(str::trim).filter(|f| !f.is_empty()) {
+        let slot = if let Some(i) = SCENE_FIELDS.iter().position(|f| *f == field) {
+            attributes.scene.get_mut(i)
+        } else if let Some(i) = EGO_FIELDS.iter().position(|f| *f == field) {
+            attributes.ego.get_mut(i)
+        } else {
+            let (group, name) = field.rsplit_once('.').unwrap_or(("", field));
+            let g = attributes.names.iter().position(|n| n == group);
+            let i = GROUP_FIELDS.iter().position(|f| *f == name);
+            g.zip(i).and_then(|(g, i)| attributes.groups[g].get_mut(i))
+        };
+        match slot {
+            Some(value @ Some(_)) => *value = None,
+            _ => return Err(format!("`{field}` in `{NOT_STATED}` is no field the program states")),
+        }
+    }
+    Ok(Some(attributes))
 }
 
 /// The attributes of `program` resolved as the compiler reads it (its `use` lines
@@ -121,7 +167,8 @@ pub fn attributes(program: &str) -> Option<Attributes> {
         text(s.ego.lane.get().map(|l| l.index().to_string())),
     ];
     let groups = s.groups.iter().map(|g| group(s, g)).collect();
-    Some(Attributes { scene, ego, groups })
+    let names = s.groups.iter().map(|g| g.name.clone()).collect();
+    Some(Attributes { scene, ego, groups, names })
 }
 
 fn group(s: &Scenario, g: &Group) -> Vec<Option<Value>> {
@@ -360,7 +407,8 @@ pub fn run(
     for case in cases {
         let read = |p: &Path| std::fs::read_to_string(p).map_err(|e| BenchError(format!("{}: {e}", p.display())));
         let (text, truth_text) = (read(&case.description)?, read(&case.truth)?);
-        let truth = attributes(&truth_text)
+        let truth = ground_truth(&truth_text)
+            .map_err(|e| BenchError(format!("{}: {e}", case.truth.display())))?
             .ok_or_else(|| BenchError(format!("{}: the ground truth holds no scenario", case.truth.display())))?;
         let answer = translate(case, text.trim());
         let tally = score(&truth, answer.program.as_deref().and_then(attributes).as_ref());
@@ -493,6 +541,26 @@ mod tests {
         // in the ego's direction `opposite` says something else than `front`
         assert_eq!(answer("opposite", 2).per["relation"], (0, 1));
         assert_eq!(answer("opposite", 2).misses[0], "group 1 (car) relation: opposite of ego, truth front of ego");
+    }
+
+    #[test]
+    fn what_a_truth_lists_as_not_stated_is_not_scored() {
+        let listed = format!("{NOT_STATED} road.type, ego.lane, queue.lane\n{TRUTH}");
+        let truth = ground_truth(&listed).expect("known fields").expect("a scenario");
+        let answer = TRUTH.replace("straight_road", "curved_road").replace("lane: 1", "lane: 2");
+        let tally = score(&truth, attributes(&answer).as_ref());
+        let scored = |key| tally.per.get(key).copied().unwrap_or_default();
+        assert_eq!(scored("road type"), (0, 0));
+        assert_eq!(scored("ego lane"), (0, 0));
+        assert_eq!(scored("lane"), (0, 0), "the walkers state no lane, the queue's is not stated");
+        assert_eq!(tally.misses, Vec::<String>::new());
+        let all = score(&attributes(TRUTH).expect("a scenario"), attributes(&answer).as_ref());
+        assert_eq!(all.overall().1, tally.overall().1 + 3);
+        assert_eq!(all.overall().0, tally.overall().0);
+        for unknown in ["road.colour", "walkers.lane", "bus.lane", "ego.speed"] {
+            let err = ground_truth(&format!("{NOT_STATED} {unknown}\n{TRUTH}")).expect_err(unknown);
+            assert!(err.contains(&format!("`{unknown}`")), "{err}");
+        }
     }
 
     #[test]
