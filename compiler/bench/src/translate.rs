@@ -19,7 +19,8 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use tad_ir::{Entries, Field, Group, Kind, Lateral, Named, Param, Reference, Scenario};
+use tad_eval::interval::{Interval, RESAMPLES};
+use tad_ir::{Entries, Field, Group, Kind, Lateral, Named, Param, Reference, Rng, Scenario, SplitMix64};
 
 use crate::{BenchError, Report};
 
@@ -432,7 +433,50 @@ pub fn run(
 /// The report: per-attribute and overall accuracy, valid@1, valid after repair, mean
 /// rounds, tokens and seconds per scenario (unless not `recorded`: answers read back
 /// without the run's manifest).
-pub fn report(model: &str, scored: &[Scored], recorded: bool) -> Report {
+/// The overall accuracy of `scored`, in percent, with its 95 % interval: the descriptions
+/// drawn with replacement ([`RESAMPLES`] draws from `seed`).
+pub fn accuracy(scored: &[Scored], seed: u64) -> Interval {
+    let tallies: Vec<(u32, u32)> = scored.iter().map(|s| s.tally.overall()).collect();
+    bootstrap(tallies.len(), seed, |pick| percent(pick.iter().map(|&i| tallies[i])))
+}
+
+/// How many points `after`'s accuracy is above `before`'s over the descriptions both
+/// scored, with its 95 % interval: each draw the same descriptions for both, so the
+/// interval keeps their pairing. `None` when they share none.
+pub fn difference(before: &[Scored], after: &[Scored], seed: u64) -> Option<(usize, Interval)> {
+    let pairs: Vec<[(u32, u32); 2]> = before
+        .iter()
+        .filter_map(|b| after.iter().find(|a| a.name == b.name).map(|a| [b.tally.overall(), a.tally.overall()]))
+        .collect();
+    if pairs.is_empty() {
+        return None;
+    }
+    let points = |pick: &[usize]| {
+        let side = |k: usize| percent(pick.iter().map(|&i| pairs[i][k]));
+        side(1) - side(0)
+    };
+    Some((pairs.len(), bootstrap(pairs.len(), seed, points)))
+}
+
+/// Right over total, in percent, of some tallies.
+fn percent(tallies: impl Iterator<Item = (u32, u32)>) -> f64 {
+    let (r, t) = tallies.fold((0, 0), |(r, t), (a, b)| (r + a, t + b));
+    100.0 * f64::from(r) / f64::from(t.max(1))
+}
+
+/// `measure` of all `n` cases, with the percentiles of its value over [`RESAMPLES`] draws
+/// of `n` cases with replacement.
+fn bootstrap(n: usize, seed: u64, measure: impl Fn(&[usize]) -> f64) -> Interval {
+    let all: Vec<usize> = (0..n).collect();
+    let mut rng = SplitMix64::new(seed);
+    let draws = (0..RESAMPLES)
+        .map(|_| measure(&(0..n).map(|_| rng.below(n.max(1))).collect::<Vec<_>>()))
+        .filter(|_| n > 0)
+        .collect();
+    Interval::of(measure(&all), draws)
+}
+
+pub fn report(model: &str, scored: &[Scored], recorded: bool, seed: u64) -> Report {
     let mut all = Tally::default();
     for s in scored {
         all.merge(&s.tally);
@@ -453,6 +497,12 @@ pub fn report(model: &str, scored: &[Scored], recorded: bool) -> Report {
     }
     let (r, t) = all.overall();
     lines.push(format!("| **overall** | {r} | {t} | **{}** |", pct((r, t))));
+    lines.push(String::new());
+    let overall = accuracy(scored, seed);
+    lines.push(format!(
+        "overall {:.1} % [{:.1}, {:.1}]: the 95 % interval of {RESAMPLES} draws of the descriptions (seed {seed})",
+        overall.value, overall.low, overall.high
+    ));
     let count = |f: &dyn Fn(&Answer) -> bool| scored.iter().filter(|s| f(&s.answer)).count();
     let mean = |f: &dyn Fn(&Answer) -> f64| scored.iter().map(|s| f(&s.answer)).sum::<f64>() / n;
     lines.push(String::new());
@@ -561,6 +611,31 @@ mod tests {
             let err = ground_truth(&format!("{NOT_STATED} {unknown}\n{TRUTH}")).expect_err(unknown);
             assert!(err.contains(&format!("`{unknown}`")), "{err}");
         }
+    }
+
+    #[test]
+    fn accuracy_has_a_bootstrap_interval_and_a_difference_keeps_the_pairing() {
+        let case = |name: &str, right: u32, total: u32| {
+            let mut tally = Tally::default();
+            (0..total).for_each(|i| tally.add("type", i < right));
+            let answer = Answer { program: None, valid_round: None, rounds: 1, tokens: 0, seconds: 0.0 };
+            Scored { name: name.to_string(), answer, tally }
+        };
+        let before: Vec<Scored> = (0..20).map(|i| case(&format!("c{i}"), 10 + i % 10, 20)).collect();
+        let overall = accuracy(&before, 1);
+        assert!((overall.value - 72.5).abs() < 1e-9, "{overall}");
+        assert!(overall.low < 70.0 && overall.high > 75.0 && overall.high < 80.0, "{overall}");
+        assert_eq!(accuracy(&before, 1), overall, "seeded");
+        // one more right in each case: +5 points, and every draw agrees, however spread the cases are
+        let after: Vec<Scored> = (0..20).map(|i| case(&format!("c{i}"), 11 + i % 10, 20)).collect();
+        let (n, d) = difference(&before, &after, 1).expect("shared cases");
+        assert_eq!(n, 20);
+        assert!((d.value - 5.0).abs() < 1e-9 && (d.low - 5.0).abs() < 1e-9 && (d.high - 5.0).abs() < 1e-9, "{d}");
+        // only the cases both scored are compared
+        let (n, d) = difference(&before[..5], &after, 1).expect("shared cases");
+        assert_eq!(n, 5);
+        assert!(d.value > 0.0, "{d}");
+        assert!(difference(&before, &[case("other", 1, 1)], 1).is_none());
     }
 
     #[test]

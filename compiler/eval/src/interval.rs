@@ -24,7 +24,8 @@ pub struct Interval {
 }
 
 impl Interval {
-    fn of(value: f64, mut draws: Vec<f64>) -> Interval {
+    /// `value` with the 2.5 and 97.5 percentiles of its bootstrap `draws` (the finite ones).
+    pub fn of(value: f64, mut draws: Vec<f64>) -> Interval {
         draws.retain(|v| v.is_finite());
         draws.sort_by(f64::total_cmp);
         let at = |q: f64| draws.get(((draws.len() as f64 - 1.0) * q).round() as usize).copied().unwrap_or(value);

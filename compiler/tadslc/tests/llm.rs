@@ -261,6 +261,16 @@ fn bench_translate_scores_answers_against_the_ground_truth() {
     let rescored = run(&["bench", "--translate", "--answers", dir.to_str().unwrap()], &[]);
     assert_eq!(code(&rescored), 0, "{}", stderr(&rescored));
     assert!(stdout(&rescored).lines().any(|l| l == overall), "{}", stdout(&rescored));
+    assert!(stdout(&rescored).lines().any(|l| l.starts_with("overall ") && l.contains("95 % interval")));
+    // against itself: no difference, on every description
+    let dir_arg = dir.to_str().unwrap();
+    let paired = run(&["bench", "--translate", "--answers", dir_arg, "--against", dir_arg], &[]);
+    assert_eq!(code(&paired), 0, "{}", stderr(&paired));
+    assert!(
+        stdout(&paired).contains("+0.0 points [+0.0, +0.0] on the 88 descriptions both scored"),
+        "{}",
+        stdout(&paired)
+    );
     // valid@1, after repair and rounds; tokens and seconds are the run's own
     let validity = |out: &std::process::Output| {
         stdout(out).lines().find(|l| l.starts_with("valid@1 ")).map(|l| l.split(" rounds").next().unwrap().to_string())

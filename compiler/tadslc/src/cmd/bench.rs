@@ -18,7 +18,8 @@ pub struct Args {
     /// Number of generated scenarios
     #[arg(long, default_value_t = 10_000, conflicts_with_all = ["runtime", "lsp", "llm", "align", "translate"])]
     pub scenarios: usize,
-    /// Seed of the corpus generator (and of the alignment experiment)
+    /// Seed of the corpus generator (and of the alignment experiment, and of the
+    /// translation benchmark's bootstrap)
     #[arg(long, default_value_t = 1, conflicts_with_all = ["runtime", "lsp", "llm"])]
     pub seed: u64,
     /// Directory of real scenarios to measure as well
@@ -80,6 +81,11 @@ pub struct Args {
     /// server's, or an interrupted run's
     #[arg(long, value_name = "DIR", requires = "translate", conflicts_with_all = ["model", "out"])]
     pub answers: Option<PathBuf>,
+    /// Also score the translations kept in DIR (as `--answers` reads them) on the same
+    /// descriptions, and print how many points this run is above them, with a paired
+    /// bootstrap interval
+    #[arg(long, value_name = "DIR", requires = "translate")]
+    pub against: Option<PathBuf>,
     #[command(flatten)]
     pub shots: crate::cmd::translate::ShotArgs,
     /// Samples of each language server measurement
@@ -259,7 +265,7 @@ fn translate(args: &Args) -> Result<Status, CliError> {
 
     let cases = tad_bench::translate::cases(&args.descriptions, &args.truth).map_err(|e| CliError::usage(e.0))?;
     if let Some(dir) = &args.answers {
-        return answered(&cases, dir);
+        return answered(args, &cases, dir);
     }
     let backend = llm.open(1).map_err(CliError::usage)?;
     let checker = backend::checker(None).map_err(CliError::usage)?;
@@ -304,14 +310,38 @@ fn translate(args: &Args) -> Result<Status, CliError> {
         let scored = tad_bench::translate::run(&cases, &mut one, progress)?;
         match write_error {
             Some(e) => Err(BenchError(format!("cannot write the answers: {e}"))),
-            None => Ok(tad_bench::translate::report(&label, &scored, true)),
+            None => {
+                let mut report = tad_bench::translate::report(&label, &scored, true, args.seed);
+                against(args, &cases, &scored, &mut report)?;
+                Ok(report)
+            }
         }
     })
 }
 
-/// `bench --translate --answers DIR`: the answers `--out DIR` kept, scored; a case without
-/// one has no program. With a manifest, only the cases it records (an interrupted run's).
-fn answered(cases: &[tad_bench::translate::Case], dir: &std::path::Path) -> Result<Status, CliError> {
+/// `bench --translate --answers DIR`: the answers `--out DIR` kept, scored.
+fn answered(args: &Args, cases: &[tad_bench::translate::Case], dir: &std::path::Path) -> Result<Status, CliError> {
+    let (recorded, mut one) = kept(dir);
+    let cases: Vec<_> =
+        cases.iter().filter(|c| recorded.as_ref().is_none_or(|r| r.contains(&c.name))).cloned().collect();
+    let label = format!("the answers in `{}`", dir.display());
+    streamed("bench --translate: ", |progress| {
+        let scored = tad_bench::translate::run(&cases, &mut one, progress)?;
+        let mut report = tad_bench::translate::report(&label, &scored, recorded.is_some(), args.seed);
+        against(args, &cases, &scored, &mut report)?;
+        Ok(report)
+    })
+}
+
+/// The cases the manifest of `dir` records (an interrupted run's; `None` without one: every
+/// case), and the answers `--out DIR` kept there as the benchmark's callback, with the
+/// rounds, tokens and seconds the manifest holds; a case without a file has no program.
+fn kept(
+    dir: &std::path::Path,
+) -> (
+    Option<std::collections::HashSet<String>>,
+    impl FnMut(&tad_bench::translate::Case, &str) -> tad_bench::translate::Answer,
+) {
     use tad_bench::translate::{Answer, Case};
     use tad_frontend::store;
     let mut records = std::collections::HashMap::new();
@@ -322,25 +352,49 @@ fn answered(cases: &[tad_bench::translate::Case], dir: &std::path::Path) -> Resu
             }
         }
     }
-    let cases: Vec<Case> =
-        cases.iter().filter(|c| records.is_empty() || records.contains_key(&c.name)).cloned().collect();
-    let label = format!("the answers in `{}`", dir.display());
-    streamed("bench --translate: ", |progress| {
-        let mut one = |case: &Case, _: &str| {
-            let record = records.get(&case.name);
-            let outcome = |key: &str| record.map(|r| r["outcome"][key].clone()).unwrap_or_default();
-            let usage: tad_llm::Usage = serde_json::from_value(outcome("usage")).unwrap_or_default();
-            Answer {
-                program: std::fs::read_to_string(store::inside(dir, &case.name, "tad")).ok(),
-                valid_round: outcome("valid_round").as_u64().map(|r| r as u32),
-                rounds: outcome("rounds").as_u64().unwrap_or(0) as u32,
-                tokens: usage.total(),
-                seconds: record.and_then(|r| r["seconds"].as_f64()).unwrap_or(0.0),
-            }
-        };
-        let scored = tad_bench::translate::run(&cases, &mut one, progress)?;
-        Ok(tad_bench::translate::report(&label, &scored, !records.is_empty()))
-    })
+    let recorded = (!records.is_empty()).then(|| records.keys().cloned().collect());
+    let dir = dir.to_path_buf();
+    let one = move |case: &Case, _: &str| {
+        let record = records.get(&case.name);
+        let outcome = |key: &str| record.map(|r| r["outcome"][key].clone()).unwrap_or_default();
+        let usage: tad_llm::Usage = serde_json::from_value(outcome("usage")).unwrap_or_default();
+        Answer {
+            program: std::fs::read_to_string(store::inside(&dir, &case.name, "tad")).ok(),
+            valid_round: outcome("valid_round").as_u64().map(|r| r as u32),
+            rounds: outcome("rounds").as_u64().unwrap_or(0) as u32,
+            tokens: usage.total(),
+            seconds: record.and_then(|r| r["seconds"].as_f64()).unwrap_or(0.0),
+        }
+    };
+    (recorded, one)
+}
+
+/// With `--against DIR`: the answers kept there scored on the same cases, and how many
+/// points this run is above them, paired by description.
+fn against(
+    args: &Args,
+    cases: &[tad_bench::translate::Case],
+    scored: &[tad_bench::translate::Scored],
+    report: &mut tad_bench::Report,
+) -> Result<(), BenchError> {
+    let Some(dir) = &args.against else { return Ok(()) };
+    let (recorded, mut one) = kept(dir);
+    let cases: Vec<_> =
+        cases.iter().filter(|c| recorded.as_ref().is_none_or(|r| r.contains(&c.name))).cloned().collect();
+    let theirs = tad_bench::translate::run(&cases, &mut one, &mut |_| {})?;
+    let line = match tad_bench::translate::difference(&theirs, scored, args.seed) {
+        Some((n, d)) => format!(
+            "against the answers in `{}` ({:.1} %): {:+.1} points [{:+.1}, {:+.1}] on the {n} descriptions both scored",
+            dir.display(),
+            tad_bench::translate::accuracy(&theirs, args.seed).value,
+            d.value,
+            d.low,
+            d.high
+        ),
+        None => format!("against the answers in `{}`: no description both scored", dir.display()),
+    };
+    report.lines.push(line);
+    Ok(())
 }
 
 /// `bench --align`: the extra corpora read and the sentences embedded as `compare` does.
