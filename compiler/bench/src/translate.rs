@@ -430,9 +430,6 @@ pub fn run(
     Ok(scored)
 }
 
-/// The report: per-attribute and overall accuracy, valid@1, valid after repair, mean
-/// rounds, tokens and seconds per scenario (unless not `recorded`: answers read back
-/// without the run's manifest).
 /// The overall accuracy of `scored`, in percent, with its 95 % interval: the descriptions
 /// drawn with replacement ([`RESAMPLES`] draws from `seed`).
 pub fn accuracy(scored: &[Scored], seed: u64) -> Interval {
@@ -469,13 +466,14 @@ fn percent(tallies: impl Iterator<Item = (u32, u32)>) -> f64 {
 fn bootstrap(n: usize, seed: u64, measure: impl Fn(&[usize]) -> f64) -> Interval {
     let all: Vec<usize> = (0..n).collect();
     let mut rng = SplitMix64::new(seed);
-    let draws = (0..RESAMPLES)
-        .map(|_| measure(&(0..n).map(|_| rng.below(n.max(1))).collect::<Vec<_>>()))
-        .filter(|_| n > 0)
-        .collect();
+    let mut draw = || measure(&(0..n).map(|_| rng.below(n)).collect::<Vec<_>>());
+    let draws = if n == 0 { Vec::new() } else { (0..RESAMPLES).map(|_| draw()).collect() };
     Interval::of(measure(&all), draws)
 }
 
+/// The report: per-attribute and overall accuracy, the overall accuracy's interval
+/// ([`accuracy`]), valid@1, valid after repair, mean rounds, tokens and seconds per scenario
+/// (unless not `recorded`: answers read back without the run's manifest).
 pub fn report(model: &str, scored: &[Scored], recorded: bool, seed: u64) -> Report {
     let mut all = Tally::default();
     for s in scored {

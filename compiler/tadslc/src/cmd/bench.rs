@@ -369,8 +369,8 @@ fn kept(
     (recorded, one)
 }
 
-/// With `--against DIR`: the answers kept there scored on the same cases, and how many
-/// points this run is above them, paired by description.
+/// With `--against DIR`: the answers kept there scored on the cases both runs have, and how
+/// many points this run is above them, paired by description.
 fn against(
     args: &Args,
     cases: &[tad_bench::translate::Case],
@@ -381,7 +381,8 @@ fn against(
     let (recorded, mut one) = kept(dir);
     let cases: Vec<_> =
         cases.iter().filter(|c| recorded.as_ref().is_none_or(|r| r.contains(&c.name))).cloned().collect();
-    let theirs = tad_bench::translate::run(&cases, &mut one, &mut |_| {})?;
+    let mut theirs = tad_bench::translate::run(&cases, &mut one, &mut |_| {})?;
+    theirs.retain(|t| scored.iter().any(|s| s.name == t.name));
     let line = match tad_bench::translate::difference(&theirs, scored, args.seed) {
         Some((n, d)) => format!(
             "against the answers in `{}` ({:.1} %): {:+.1} points [{:+.1}, {:+.1}] on the {n} descriptions both scored",
