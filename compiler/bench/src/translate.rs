@@ -437,10 +437,21 @@ pub fn accuracy(scored: &[Scored], seed: u64) -> Interval {
     bootstrap(tallies.len(), seed, |pick| percent(pick.iter().map(|&i| tallies[i])))
 }
 
-/// How many points `after`'s accuracy is above `before`'s over the descriptions both
-/// scored, with its 95 % interval: each draw the same descriptions for both, so the
-/// interval keeps their pairing. `None` when they share none.
-pub fn difference(before: &[Scored], after: &[Scored], seed: u64) -> Option<(usize, Interval)> {
+/// Two runs compared on the descriptions both scored.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Paired {
+    /// The descriptions both scored.
+    pub cases: usize,
+    /// Each run's overall accuracy on them, in percent.
+    pub before: f64,
+    pub after: f64,
+    /// How many points `after` is above `before`, with its 95 % interval.
+    pub points: Interval,
+}
+
+/// `after` against `before` on the descriptions both scored: each draw of the interval the
+/// same descriptions for both, so it keeps their pairing. `None` when they share none.
+pub fn difference(before: &[Scored], after: &[Scored], seed: u64) -> Option<Paired> {
     let pairs: Vec<[(u32, u32); 2]> = before
         .iter()
         .filter_map(|b| after.iter().find(|a| a.name == b.name).map(|a| [b.tally.overall(), a.tally.overall()]))
@@ -448,11 +459,14 @@ pub fn difference(before: &[Scored], after: &[Scored], seed: u64) -> Option<(usi
     if pairs.is_empty() {
         return None;
     }
-    let points = |pick: &[usize]| {
-        let side = |k: usize| percent(pick.iter().map(|&i| pairs[i][k]));
-        side(1) - side(0)
-    };
-    Some((pairs.len(), bootstrap(pairs.len(), seed, points)))
+    let side = |pick: &[usize], k: usize| percent(pick.iter().map(|&i| pairs[i][k]));
+    let all: Vec<usize> = (0..pairs.len()).collect();
+    Some(Paired {
+        cases: pairs.len(),
+        before: side(&all, 0),
+        after: side(&all, 1),
+        points: bootstrap(pairs.len(), seed, |pick| side(pick, 1) - side(pick, 0)),
+    })
 }
 
 /// Right over total, in percent, of some tallies.
@@ -626,13 +640,15 @@ mod tests {
         assert_eq!(accuracy(&before, 1), overall, "seeded");
         // one more right in each case: +5 points, and every draw agrees, however spread the cases are
         let after: Vec<Scored> = (0..20).map(|i| case(&format!("c{i}"), 11 + i % 10, 20)).collect();
-        let (n, d) = difference(&before, &after, 1).expect("shared cases");
-        assert_eq!(n, 20);
+        let paired = difference(&before, &after, 1).expect("shared cases");
+        let d = paired.points;
+        assert_eq!(paired.cases, 20);
+        assert!((paired.before - 72.5).abs() < 1e-9 && (paired.after - 77.5).abs() < 1e-9, "{paired:?}");
         assert!((d.value - 5.0).abs() < 1e-9 && (d.low - 5.0).abs() < 1e-9 && (d.high - 5.0).abs() < 1e-9, "{d}");
         // only the cases both scored are compared
-        let (n, d) = difference(&before[..5], &after, 1).expect("shared cases");
-        assert_eq!(n, 5);
-        assert!(d.value > 0.0, "{d}");
+        let paired = difference(&before[..5], &after, 1).expect("shared cases");
+        assert_eq!(paired.cases, 5);
+        assert!(paired.points.value > 0.0, "{paired:?}");
         assert!(difference(&before, &[case("other", 1, 1)], 1).is_none());
     }
 

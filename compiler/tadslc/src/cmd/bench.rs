@@ -321,25 +321,26 @@ fn translate(args: &Args) -> Result<Status, CliError> {
 
 /// `bench --translate --answers DIR`: the answers `--out DIR` kept, scored.
 fn answered(args: &Args, cases: &[tad_bench::translate::Case], dir: &std::path::Path) -> Result<Status, CliError> {
-    let (recorded, mut one) = kept(dir);
-    let cases: Vec<_> =
-        cases.iter().filter(|c| recorded.as_ref().is_none_or(|r| r.contains(&c.name))).cloned().collect();
+    let (cases, recorded, mut one) = kept(cases, dir);
     let label = format!("the answers in `{}`", dir.display());
     streamed("bench --translate: ", |progress| {
         let scored = tad_bench::translate::run(&cases, &mut one, progress)?;
-        let mut report = tad_bench::translate::report(&label, &scored, recorded.is_some(), args.seed);
+        let mut report = tad_bench::translate::report(&label, &scored, recorded, args.seed);
         against(args, &cases, &scored, &mut report)?;
         Ok(report)
     })
 }
 
-/// The cases the manifest of `dir` records (an interrupted run's; `None` without one: every
-/// case), and the answers `--out DIR` kept there as the benchmark's callback, with the
-/// rounds, tokens and seconds the manifest holds; a case without a file has no program.
+/// The answers `--out DIR` kept in `dir`: the `cases` its manifest records (an interrupted
+/// run's; all of them without one), whether it has one, and the answers as the benchmark's
+/// callback, with the rounds, tokens and seconds the manifest holds; a case without a file
+/// has no program.
 fn kept(
+    cases: &[tad_bench::translate::Case],
     dir: &std::path::Path,
 ) -> (
-    Option<std::collections::HashSet<String>>,
+    Vec<tad_bench::translate::Case>,
+    bool,
     impl FnMut(&tad_bench::translate::Case, &str) -> tad_bench::translate::Answer,
 ) {
     use tad_bench::translate::{Answer, Case};
@@ -352,7 +353,8 @@ fn kept(
             }
         }
     }
-    let recorded = (!records.is_empty()).then(|| records.keys().cloned().collect());
+    let cases = cases.iter().filter(|c| records.is_empty() || records.contains_key(&c.name)).cloned().collect();
+    let recorded = !records.is_empty();
     let dir = dir.to_path_buf();
     let one = move |case: &Case, _: &str| {
         let record = records.get(&case.name);
@@ -366,7 +368,7 @@ fn kept(
             seconds: record.and_then(|r| r["seconds"].as_f64()).unwrap_or(0.0),
         }
     };
-    (recorded, one)
+    (cases, recorded, one)
 }
 
 /// With `--against DIR`: the answers kept there scored on the cases both runs have, and how
@@ -378,19 +380,17 @@ fn against(
     report: &mut tad_bench::Report,
 ) -> Result<(), BenchError> {
     let Some(dir) = &args.against else { return Ok(()) };
-    let (recorded, mut one) = kept(dir);
-    let cases: Vec<_> =
-        cases.iter().filter(|c| recorded.as_ref().is_none_or(|r| r.contains(&c.name))).cloned().collect();
-    let mut theirs = tad_bench::translate::run(&cases, &mut one, &mut |_| {})?;
-    theirs.retain(|t| scored.iter().any(|s| s.name == t.name));
+    let (cases, _, mut one) = kept(cases, dir);
+    let theirs = tad_bench::translate::run(&cases, &mut one, &mut |_| {})?;
     let line = match tad_bench::translate::difference(&theirs, scored, args.seed) {
-        Some((n, d)) => format!(
-            "against the answers in `{}` ({:.1} %): {:+.1} points [{:+.1}, {:+.1}] on the {n} descriptions both scored",
+        Some(paired) => format!(
+            "against the answers in `{}` ({:.1} %): {:+.1} points [{:+.1}, {:+.1}] on the {} descriptions both scored",
             dir.display(),
-            tad_bench::translate::accuracy(&theirs, args.seed).value,
-            d.value,
-            d.low,
-            d.high
+            paired.before,
+            paired.points.value,
+            paired.points.low,
+            paired.points.high,
+            paired.cases
         ),
         None => format!("against the answers in `{}`: no description both scored", dir.display()),
     };
