@@ -599,7 +599,7 @@ mod tests {
         let truth = attributes(&oncoming("straight_road", "front", -2)).expect("a scenario");
         let answer = |position, lane| score(&truth, attributes(&oncoming("straight_road", position, lane)).as_ref());
         assert_eq!(answer("opposite", -2).per["relation"], (1, 1));
-        assert_eq!(answer("oncoming", -1).per["relation"], (1, 1), "the alias too, whatever its lane");
+        assert_eq!(answer("oncoming", -1).per["relation"], (1, 1), "the alias too, in another oncoming lane");
         // in the ego's direction `opposite` says something else than `front`
         assert_eq!(answer("opposite", 2).per["relation"], (0, 1));
         assert_eq!(answer("opposite", 2).misses[0], "group 1 (car) relation: opposite of ego, truth front of ego");
