@@ -119,7 +119,7 @@ impl Label {
     }
 }
 
-/// How sure a fix is, as rustc says it.
+/// How sure a fix is, as rustc says it; from the surest, in order ([`fixes_at_least`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Applicability {
@@ -254,13 +254,23 @@ pub fn sort(diagnostics: &mut [Diagnostic]) {
 }
 
 /// The machine-applicable fixes of `diagnostics` that can be applied together to a text
-/// of `len` bytes: in order, each once (several diagnostics may ask for the same edit, such
-/// as one `use` line), none overlapping an earlier one or past the end.
+/// of `len` bytes ([`fixes_at_least`]).
 pub fn machine_fixes<'a>(diagnostics: impl IntoIterator<Item = &'a Diagnostic>, len: usize) -> Vec<&'a Fix> {
+    fixes_at_least(diagnostics, len, Applicability::MachineApplicable)
+}
+
+/// The fixes of `diagnostics` at least as sure as `sure` that can be applied together to
+/// a text of `len` bytes: in order, each once (several diagnostics may ask for the same
+/// edit, such as one `use` line), none overlapping an earlier one or past the end.
+pub fn fixes_at_least<'a>(
+    diagnostics: impl IntoIterator<Item = &'a Diagnostic>,
+    len: usize,
+    sure: Applicability,
+) -> Vec<&'a Fix> {
     let mut fixes: Vec<&Fix> = diagnostics
         .into_iter()
         .flat_map(|d| &d.fixes)
-        .filter(|f| f.applicability == Applicability::MachineApplicable && f.span.end <= len)
+        .filter(|f| f.applicability <= sure && f.span.end <= len)
         .collect();
     fixes.sort_by_key(|f| (f.span.start, f.span.end));
     fixes.dedup_by(|a, b| a.span == b.span && a.replacement == b.replacement);
@@ -279,13 +289,39 @@ pub fn machine_fixes<'a>(diagnostics: impl IntoIterator<Item = &'a Diagnostic>, 
 /// Returns the new text and how many fixes were applied.
 pub fn apply_fixes<'a>(text: &str, diagnostics: impl IntoIterator<Item = &'a Diagnostic>) -> (String, usize) {
     let fixes = machine_fixes(diagnostics, text.len());
+    (apply(text, &fixes), fixes.len())
+}
+
+/// `text` with `fixes`, in order and not overlapping ([`fixes_at_least`]), applied.
+pub fn apply(text: &str, fixes: &[&Fix]) -> String {
     let mut out = String::with_capacity(text.len());
     let mut cursor = 0;
-    for fix in &fixes {
+    for fix in fixes {
         out.push_str(&text[cursor..fix.span.start]);
         out.push_str(&fix.replacement);
         cursor = fix.span.end;
     }
     out.push_str(&text[cursor..]);
-    (out, fixes.len())
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fixes_at_least_as_sure_apply_in_order_and_never_a_placeholder() {
+        let text = "speed: 30 kmh; lane: too; type: bsu";
+        let fix = |d: Diagnostic, at: (usize, usize), to: &str, sure| d.with_fix(Span::new(at.0, at.1), to, sure);
+        let d = |start| Diagnostic::new(Code::E0402, "x", Span::new(start, start + 1), "x");
+        let diagnostics = [
+            fix(d(32), (32, 35), "bus", Applicability::MaybeIncorrect),
+            fix(d(10), (10, 13), "km/h", Applicability::MachineApplicable),
+            fix(d(21), (21, 24), "LANE", Applicability::HasPlaceholders),
+        ];
+        let machine = machine_fixes(&diagnostics, text.len());
+        assert_eq!(apply(text, &machine), "speed: 30 km/h; lane: too; type: bsu");
+        let guesses = fixes_at_least(&diagnostics, text.len(), Applicability::MaybeIncorrect);
+        assert_eq!(apply(text, &guesses), "speed: 30 km/h; lane: too; type: bus");
+    }
 }

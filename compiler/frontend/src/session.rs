@@ -11,10 +11,13 @@
 //!
 //! The outcome is the best program of the rounds (complete, then incomplete, then
 //! non-scenario, then invalid with the fewest errors; the later among equals), so a repair
-//! that makes things worse loses nothing. Only the newest exchange is kept in the conversation (the first request, the last answer
-//! and the request about it), so the context does not grow with the rounds. Every round is
-//! reported to the caller as a [`Round`] for the transcript. Bounds: rounds, tokens per
-//! answer, tokens per item, and wall time per item.
+//! that makes things worse loses nothing. A best program still invalid when the rounds are
+//! spent gets the checker's maybe-incorrect suggestions as a last resort, kept only when
+//! they leave no error ([`Checker::salvage`]). Only the newest exchange is kept in the
+//! conversation (the first request, the last answer and the request about it), so the
+//! context does not grow with the rounds. Every round is reported to the caller as a
+//! [`Round`] for the transcript. Bounds: rounds, tokens per answer, tokens per item, and
+//! wall time per item.
 
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -22,7 +25,7 @@ use std::time::{Duration, Instant};
 use serde::Serialize;
 use tad_check::{Class, Options};
 use tad_db::{Database, Language, NoFs};
-use tad_diagnostics::Severity;
+use tad_diagnostics::{Applicability, Severity};
 use tad_llm::{Chat, ChatFuture, Constraint, Message, OnText, Request, Role, Usage};
 
 use crate::extract;
@@ -80,6 +83,33 @@ impl Checker {
             }
             None => verdict,
         }
+    }
+
+    /// The last resort for a TAD program the rounds left with errors: the program with the
+    /// checker's suggestions applied, its maybe-incorrect guesses too (`did you mean
+    /// `delivery_van`?`), when that leaves it without errors; with its verdict and each
+    /// applied suggestion as ``CODE `was` → `now` ``.
+    pub fn salvage(&self, text: &str) -> Option<(String, Verdict, Vec<String>)> {
+        let mut db = Database::new(self.options.clone());
+        let file = db.set_source(PathBuf::from("answer.tad"), text.to_string(), Language::Tad, &NoFs);
+        let diagnostics = &tad_db::check(&db, file).diagnostics;
+        let errors: Vec<_> = diagnostics.iter().filter(|d| d.is_error()).collect();
+        let fixes = tad_diagnostics::fixes_at_least(errors.iter().copied(), text.len(), Applicability::MaybeIncorrect);
+        if fixes.is_empty() {
+            return None;
+        }
+        let applied = fixes
+            .iter()
+            .map(|fix| {
+                let code = errors.iter().find(|d| d.fixes.iter().any(|f| std::ptr::eq(f, *fix))).map(|d| d.code);
+                let code = code.map_or(String::new(), |c| format!("{} ", c.as_str()));
+                let was = text.get(fix.span.start..fix.span.end).unwrap_or_default();
+                format!("{code}`{was}` → `{}`", fix.replacement)
+            })
+            .collect();
+        let fixed = tad_diagnostics::apply(text, &fixes);
+        let (verdict, _) = self.check_as_is(&fixed, Language::Tad);
+        (verdict.errors == 0).then(|| (verdict.tad.clone().unwrap_or(fixed), verdict, applied))
     }
 
     /// The verdict on `text` as it is, and for a TAD program with errors that have
@@ -192,6 +222,11 @@ pub struct Outcome {
     pub requests: Vec<String>,
     /// The best program's diagnostics.
     pub diagnostics: Vec<String>,
+    /// The checker's suggestions applied to the best program when the rounds left it with
+    /// errors and they leave it without ([`Checker::salvage`]); `valid_round` stays the
+    /// model's.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub suggested: Vec<String>,
 }
 
 impl Outcome {
@@ -274,6 +309,36 @@ impl<'a> Session<'a> {
 
     /// Runs the loop from `first` (the first request's messages) for `item`.
     pub async fn run(
+        &self,
+        item: &str,
+        first: Vec<Message>,
+        first_prompt: &'static str,
+        on_round: &mut dyn FnMut(&Round),
+    ) -> Outcome {
+        let mut outcome = self.rounds(item, first, first_prompt, on_round).await;
+        self.salvage(&mut outcome);
+        outcome
+    }
+
+    /// The last resort for a best program with errors: the checker's suggestions, when
+    /// they leave it without ([`Checker::salvage`]).
+    fn salvage(&self, outcome: &mut Outcome) {
+        if outcome.verdict_class != Some(Class::Invalid) {
+            return;
+        }
+        let Some((program, verdict, applied)) = outcome.program.as_deref().and_then(|p| self.checker.salvage(p)) else {
+            return;
+        };
+        outcome.program = Some(program);
+        outcome.class = Some(verdict.class.as_str());
+        outcome.verdict_class = Some(verdict.class);
+        outcome.diagnostics = verdict.lines;
+        outcome.requests = verdict.requests;
+        outcome.suggested = applied;
+    }
+
+    /// The rounds: ask, check, repair or refine, until done or a bound is hit.
+    async fn rounds(
         &self,
         item: &str,
         first: Vec<Message>,

@@ -16,6 +16,9 @@ pub struct Summary {
     pub valid_first: usize,
     /// The best program had no errors.
     pub valid_after_repair: usize,
+    /// The best program had errors, and the checker's suggestions left it without
+    /// ([`Outcome::suggested`]); not counted as valid after repair.
+    pub valid_with_suggestions: usize,
     /// Over the items that became valid: the round it happened.
     pub mean_rounds_to_valid: Option<f64>,
     /// Items per final class (`complete`, `incomplete`, `non_scenario`, `invalid`, `no_program`).
@@ -44,8 +47,10 @@ impl Summary {
         self.syntax_valid_first += usize::from(o.syntax_valid_first);
         let counts = !(self.scenarios_asked && o.class == Some("non_scenario"));
         self.valid_first += usize::from(o.valid_round == Some(1) && counts);
-        let valid_now = o.class.is_some_and(|c| c != "invalid") && counts;
+        let valid = o.class.is_some_and(|c| c != "invalid") && counts;
+        let valid_now = valid && o.suggested.is_empty();
         self.valid_after_repair += usize::from(valid_now);
+        self.valid_with_suggestions += usize::from(valid && !o.suggested.is_empty());
         if let (Some(r), true) = (o.valid_round, valid_now) {
             self.rounds_to_valid.push(r);
             self.mean_rounds_to_valid =
@@ -73,6 +78,9 @@ impl Summary {
         );
         if let Some(m) = self.mean_rounds_to_valid {
             out.push_str(&format!(", mean rounds to valid {m:.2}"));
+        }
+        if self.valid_with_suggestions > 0 {
+            out.push_str(&format!(", valid with the checker's suggestions {}", self.valid_with_suggestions));
         }
         out.push_str(&format!(
             "\nclasses: {}; tokens: {} prompt + {} completion",

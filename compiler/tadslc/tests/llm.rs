@@ -184,6 +184,27 @@ fn an_answer_that_never_becomes_valid_stops_at_the_bound_and_keeps_the_last_prog
 }
 
 #[test]
+fn after_the_last_round_the_checkers_guess_makes_a_program_valid_and_is_said() {
+    let dir = scratch("llm-suggested");
+    let walker = "  actor walker: 1 pedestrian {\n    behavior: cross\n    position: behind of parked_bus\n    lane: 1\n  }\n}\n";
+    let guessed = COMPLETE.strip_suffix("}\n").unwrap().to_string() + walker;
+    let server = FakeLlm::script(vec![fenced(&guessed)]);
+    let out = run(&["translate", &description(&dir, "A bus ahead."), "--max-rounds", "1"], &env_of(&served(&server)));
+    // E0402's guess is maybe-incorrect: it is not applied while the model can still repair
+    assert_eq!(server.requests().len(), 2, "one answer and one repair");
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    assert!(stdout(&out).contains("position: behind of bus\n"), "{}", stdout(&out));
+    let said = "the checker's suggestions applied after the last round: E0402 `parked_bus` → `bus`";
+    assert!(stderr(&out).contains(said) && stdout(&out).contains(said), "{}", stderr(&out));
+    // a guess that leaves errors is not taken
+    let unfixable = guessed.replace("lanes: 1", "lanes: many");
+    let server = FakeLlm::script(vec![fenced(&unfixable)]);
+    let out = run(&["translate", &description(&dir, "A bus ahead."), "--max-rounds", "0"], &env_of(&served(&server)));
+    assert_eq!(code(&out), 1);
+    assert!(stdout(&out).contains("behind of parked_bus") && !stderr(&out).contains("suggestions applied"));
+}
+
+#[test]
 fn no_server_and_a_dead_server_are_clear_errors() {
     let dir = scratch("llm-none");
     let desc = description(&dir, "x");

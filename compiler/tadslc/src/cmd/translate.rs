@@ -145,6 +145,9 @@ pub fn run(t: &Args) -> Result<Status, CliError> {
         for line in &outcome.diagnostics {
             errln!("  {line}")?;
         }
+        if !outcome.suggested.is_empty() {
+            errln!("  the checker's suggestions applied after the last round: {}", outcome.suggested.join(", "))?;
+        }
         errln!(
             "{} after {} round{}; {} tokens{}",
             outcome.class.unwrap_or("no program"),
