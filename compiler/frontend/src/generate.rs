@@ -130,7 +130,10 @@ pub async fn run(
                     outcome.rounds,
                     if outcome.rounds == 1 { "" } else { "s" },
                     template.id
-                )],
+                )]
+                .into_iter()
+                .chain(outcome.suggested_line())
+                .collect(),
                 region: Some(spec.region.to_string()),
                 ..Default::default()
             };

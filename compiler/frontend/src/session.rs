@@ -230,6 +230,13 @@ pub struct Outcome {
 }
 
 impl Outcome {
+    /// The line that says which of the checker's suggestions made the program valid, for
+    /// its provenance and the terminal; `None` when the model's program needed none.
+    pub fn suggested_line(&self) -> Option<String> {
+        let applied = self.suggested.join(", ");
+        (!applied.is_empty()).then(|| format!("the checker's suggestions applied after the last round: {applied}"))
+    }
+
     /// Whether the model could not be used: no program, and the loop stopped early.
     pub fn unreachable(&self) -> bool {
         self.class.is_none() && self.stopped.is_some()

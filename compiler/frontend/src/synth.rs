@@ -363,7 +363,10 @@ async fn one(
                 if refinements == 1 { "" } else { "s" },
                 prompt::DESCRIBE.id,
                 prompt::TRANSLATE.id,
-            )],
+            )]
+            .into_iter()
+            .chain(outcome.suggested_line())
+            .collect(),
             video: video_name(spec),
             time_s: frame.time_s,
             frame: frame.time_s.is_none().then_some(frame.index as u64),

@@ -80,9 +80,7 @@ impl Translator<'_> {
             )]
             .into_iter()
             .chain(comments)
-            .chain((!outcome.suggested.is_empty()).then(|| {
-                format!("the checker's suggestions applied after the last round: {}", outcome.suggested.join(", "))
-            }))
+            .chain(outcome.suggested_line())
             .collect(),
             region: self.region.map(String::from),
             description: Some(text.to_string()),

@@ -145,8 +145,8 @@ pub fn run(t: &Args) -> Result<Status, CliError> {
         for line in &outcome.diagnostics {
             errln!("  {line}")?;
         }
-        if !outcome.suggested.is_empty() {
-            errln!("  the checker's suggestions applied after the last round: {}", outcome.suggested.join(", "))?;
+        if let Some(line) = outcome.suggested_line() {
+            errln!("  {line}")?;
         }
         errln!(
             "{} after {} round{}; {} tokens{}",
