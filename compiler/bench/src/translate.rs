@@ -384,6 +384,8 @@ pub struct Answer {
     pub program: Option<String>,
     /// The round whose program first had no errors.
     pub valid_round: Option<u32>,
+    /// The checker's suggestions that made the program valid after the last round.
+    pub suggested: usize,
     pub rounds: u32,
     pub tokens: u64,
     pub seconds: f64,
@@ -417,7 +419,11 @@ pub fn run(
         progress(&format!(
             "{}: {right}/{total} attributes, {}, {} round{}, {:.0} s",
             case.name,
-            answer.valid_round.map_or("never valid".to_string(), |r| format!("valid at round {r}")),
+            match (answer.valid_round, answer.suggested) {
+                (Some(r), _) => format!("valid at round {r}"),
+                (None, 0) => "never valid".to_string(),
+                (None, n) => format!("valid with {n} of the checker's suggestions"),
+            },
             answer.rounds,
             if answer.rounds == 1 { "" } else { "s" },
             answer.seconds
@@ -520,9 +526,10 @@ pub fn report(model: &str, scored: &[Scored], recorded: bool, seed: u64) -> Repo
     lines.push(String::new());
     lines.push(if recorded {
         format!(
-            "valid@1 {:.1} %, valid after repair {:.1} %, {:.2} rounds, {:.0} tokens and {:.1} s per scenario",
+            "valid@1 {:.1} %, valid after repair {:.1} % (and {:.1} % with the checker's suggestions), {:.2} rounds, {:.0} tokens and {:.1} s per scenario",
             100.0 * count(&|a| a.valid_round == Some(1)) as f64 / n,
             100.0 * count(&|a| a.valid_round.is_some()) as f64 / n,
+            100.0 * count(&|a| a.valid_round.is_none() && a.suggested > 0) as f64 / n,
             mean(&|a| a.rounds as f64),
             mean(&|a| a.tokens as f64),
             mean(&|a| a.seconds),
@@ -630,7 +637,7 @@ mod tests {
         let case = |name: &str, right: u32, total: u32| {
             let mut tally = Tally::default();
             (0..total).for_each(|i| tally.add("type", i < right));
-            let answer = Answer { program: None, valid_round: None, rounds: 1, tokens: 0, seconds: 0.0 };
+            let answer = Answer { program: None, valid_round: None, suggested: 0, rounds: 1, tokens: 0, seconds: 0.0 };
             Scored { name: name.to_string(), answer, tally }
         };
         let before: Vec<Scored> = (0..20).map(|i| case(&format!("c{i}"), 10 + i % 10, 20)).collect();

@@ -302,6 +302,7 @@ fn translate(args: &Args) -> Result<Status, CliError> {
             Answer {
                 program: outcome.program,
                 valid_round: outcome.valid_round,
+                suggested: outcome.suggested.len(),
                 rounds: outcome.rounds,
                 tokens: outcome.usage.total(),
                 seconds,
@@ -363,6 +364,7 @@ fn kept(
         Answer {
             program: std::fs::read_to_string(store::inside(&dir, &case.name, "tad")).ok(),
             valid_round: outcome("valid_round").as_u64().map(|r| r as u32),
+            suggested: outcome("suggested").as_array().map_or(0, Vec::len),
             rounds: outcome("rounds").as_u64().unwrap_or(0) as u32,
             tokens: usage.total(),
             seconds: record.and_then(|r| r["seconds"].as_f64()).unwrap_or(0.0),
