@@ -110,4 +110,25 @@ mod tests {
         assert_eq!((generated.valid_first, generated.valid_after_repair), (0, 0));
         assert_eq!(generated.classes["non_scenario"], 1);
     }
+
+    #[test]
+    fn a_program_the_checkers_suggestions_made_valid_is_counted_apart() {
+        let guessed = Outcome {
+            class: Some("complete"),
+            rounds: 4,
+            suggested: vec!["E0402 `parked_van` → `delivery_van`".into()],
+            ..Outcome::default()
+        };
+        let repaired = Outcome { class: Some("complete"), valid_round: Some(2), rounds: 2, ..Outcome::default() };
+        let mut summary = Summary::default();
+        summary.add(&guessed);
+        summary.add(&repaired);
+        assert_eq!((summary.valid_after_repair, summary.valid_with_suggestions), (1, 1));
+        assert_eq!(summary.mean_rounds_to_valid, Some(2.0));
+        assert!(
+            summary.render().contains(
+                "valid after repair 1 (50%), mean rounds to valid 2.00, valid with the checker's suggestions 1"
+            )
+        );
+    }
 }
