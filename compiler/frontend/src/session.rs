@@ -24,7 +24,7 @@ use std::time::{Duration, Instant};
 
 use serde::Serialize;
 use tad_check::{Class, Options};
-use tad_db::{Database, Language, NoFs};
+use tad_db::{Database, Language, NoFs, SourceFile};
 use tad_diagnostics::{Applicability, Severity};
 use tad_llm::{Chat, ChatFuture, Constraint, Message, OnText, Request, Role, Usage};
 
@@ -90,8 +90,7 @@ impl Checker {
     /// `delivery_van`?`), when that leaves it without errors; with its verdict and each
     /// applied suggestion as ``CODE `was` → `now` ``.
     pub fn salvage(&self, text: &str) -> Option<(String, Verdict, Vec<String>)> {
-        let mut db = Database::new(self.options.clone());
-        let file = db.set_source(PathBuf::from("answer.tad"), text.to_string(), Language::Tad, &NoFs);
+        let (db, file) = self.answer(text, Language::Tad);
         let diagnostics = &tad_db::check(&db, file).diagnostics;
         let errors: Vec<_> = diagnostics.iter().filter(|d| d.is_error()).collect();
         let fixes = tad_diagnostics::fixes_at_least(errors.iter().copied(), text.len(), Applicability::MaybeIncorrect);
@@ -112,12 +111,18 @@ impl Checker {
         (verdict.errors == 0).then(|| (verdict.tad.clone().unwrap_or(fixed), verdict, applied))
     }
 
-    /// The verdict on `text` as it is, and for a TAD program with errors that have
-    /// machine-applicable fixes, the text with those fixes applied.
-    fn check_as_is(&self, text: &str, language: Language) -> (Verdict, Option<String>) {
+    /// A database with the run's options holding `text` as the answer's file.
+    fn answer(&self, text: &str, language: Language) -> (Database, SourceFile) {
         let mut db = Database::new(self.options.clone());
         let path = PathBuf::from(if language == Language::Yaml { "answer.yaml" } else { "answer.tad" });
         let file = db.set_source(path, text.to_string(), language, &NoFs);
+        (db, file)
+    }
+
+    /// The verdict on `text` as it is, and for a TAD program with errors that have
+    /// machine-applicable fixes, the text with those fixes applied.
+    fn check_as_is(&self, text: &str, language: Language) -> (Verdict, Option<String>) {
+        let (db, file) = self.answer(text, language);
         let checked = tad_db::check(&db, file);
         let vocabulary = &tad_db::vocabulary(&db, file).vocabulary;
         let diagnostics = &checked.diagnostics;
