@@ -15,7 +15,13 @@ use crate::suggest;
 use tad_diagnostics::{Applicability, Code, Diagnostic, Payload, Span};
 
 pub fn lower(src: &str, file: &cst::File) -> (Module, Vec<Diagnostic>) {
-    let mut lowerer = Lowerer { src, diagnostics: Vec::new(), groups: Default::default(), rightmost: Vec::new() };
+    let mut lowerer = Lowerer {
+        src,
+        diagnostics: Vec::new(),
+        groups: Default::default(),
+        renames: Default::default(),
+        rightmost: Vec::new(),
+    };
     let module = lowerer.file(file);
     (module, lowerer.diagnostics)
 }
@@ -25,6 +31,9 @@ struct Lowerer<'a> {
     diagnostics: Vec<Diagnostic>,
     /// The scenario's actor groups by name, for duplicates without a quadratic search.
     groups: std::collections::HashMap<String, usize>,
+    /// The names E0209's fixes give redeclared groups, so that a name declared three
+    /// times gets two different ones.
+    renames: std::collections::HashSet<String>,
     /// Where the scenario's `lane: rightmost` values are: the road's `lanes`, known once
     /// the whole scenario is read.
     rightmost: Vec<Span>,
@@ -214,11 +223,14 @@ impl Lowerer<'_> {
                 .with_help("describe the ego vehicle in the `ego { ... }` section, or rename this group"),
             );
         } else if let Some(previous) = self.groups.get(&name.text).map(|&i| &scenario.actors[i]) {
-            // the first `NAME_N` no group of the scenario has: a rename the compiler can make
+            // the first `NAME_N` no group of the scenario has and no other fix gives: a
+            // rename the compiler can make
             let taken = |candidate: &str| {
-                members.iter().any(|m| matches!(m, cst::Member::Actor(a) if a.name.text == candidate))
+                self.renames.contains(candidate)
+                    || members.iter().any(|m| matches!(m, cst::Member::Actor(a) if a.name.text == candidate))
             };
             let free = (2..).map(|n| format!("{}_{n}", name.text)).find(|c| !taken(c)).unwrap_or_default();
+            self.renames.insert(free.clone());
             self.report(
                 Diagnostic::new(
                     Code::E0209,
@@ -851,5 +863,21 @@ mod tests {
         let (module, after) = crate::analyze(&fixed);
         assert!(after.iter().all(|d| d.code != Code::E0209), "{after:?}");
         assert_eq!(module.scenario.unwrap().actors.len(), 3);
+    }
+
+    #[test]
+    fn a_name_declared_three_times_gets_two_different_renames() {
+        let group = |n: u32| format!("  actor car_2: {n} car {{\n  }}\n");
+        let src =
+            format!("scenario demo {{\n{}{}{}  actor car_2_2: 1 van {{\n  }}\n}}\n", group(1), group(2), group(3));
+        let (_, diagnostics) = crate::analyze(&src);
+        let renames: Vec<_> =
+            diagnostics.iter().filter(|d| d.code == Code::E0209).map(|d| d.fixes[0].replacement.as_str()).collect();
+        assert_eq!(renames, ["car_2_3", "car_2_4"]);
+        let (fixed, applied) = tad_diagnostics::apply_fixes(&src, &diagnostics);
+        assert_eq!(applied, 2);
+        let (module, after) = crate::analyze(&fixed);
+        assert!(after.is_empty(), "{after:?}");
+        assert_eq!(module.scenario.unwrap().actors.len(), 4);
     }
 }
