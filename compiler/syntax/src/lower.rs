@@ -223,13 +223,14 @@ impl Lowerer<'_> {
                 .with_help("describe the ego vehicle in the `ego { ... }` section, or rename this group"),
             );
         } else if let Some(previous) = self.groups.get(&name.text).map(|&i| &scenario.actors[i]) {
-            // the first `NAME_N` no group of the scenario has and no other fix gives: a
-            // rename the compiler can make
+            // the next `NAME_N` no group of the scenario has and no other fix gives: a
+            // rename the compiler can make (`car_2` again is `car_3`, not `car_2_2`)
             let taken = |candidate: &str| {
                 self.renames.contains(candidate)
                     || members.iter().any(|m| matches!(m, cst::Member::Actor(a) if a.name.text == candidate))
             };
-            let free = (2..).map(|n| format!("{}_{n}", name.text)).find(|c| !taken(c)).unwrap_or_default();
+            let (stem, last) = numbered(&name.text);
+            let free = (last + 1..).map(|n| format!("{stem}_{n}")).find(|c| !taken(c)).unwrap_or_default();
             self.renames.insert(free.clone());
             self.report(
                 Diagnostic::new(
@@ -843,6 +844,17 @@ fn wrong(field: &str, expected: &str, found: &str) -> Payload {
     Payload::WrongValue { field: field.into(), expected: expected.into(), found: found.into() }
 }
 
+/// A name's stem and number: `car_2` is `car` and 2, `car` is `car` and 1.
+fn numbered(name: &str) -> (&str, u32) {
+    match name.rsplit_once('_') {
+        Some((stem, n)) if !stem.is_empty() && !n.starts_with('0') => match n.parse::<u32>() {
+            Ok(n) if n < u32::MAX / 2 => (stem, n),
+            _ => (name, 1),
+        },
+        _ => (name, 1),
+    }
+}
+
 fn join(words: &[Name]) -> String {
     words.iter().map(|w| w.text.as_str()).collect::<Vec<_>>().join("_")
 }
@@ -868,16 +880,26 @@ mod tests {
     #[test]
     fn a_name_declared_three_times_gets_two_different_renames() {
         let group = |n: u32| format!("  actor car_2: {n} car {{\n  }}\n");
-        let src =
-            format!("scenario demo {{\n{}{}{}  actor car_2_2: 1 van {{\n  }}\n}}\n", group(1), group(2), group(3));
+        let src = format!("scenario demo {{\n{}{}{}  actor car_3: 1 van {{\n  }}\n}}\n", group(1), group(2), group(3));
         let (_, diagnostics) = crate::analyze(&src);
         let renames: Vec<_> =
             diagnostics.iter().filter(|d| d.code == Code::E0209).map(|d| d.fixes[0].replacement.as_str()).collect();
-        assert_eq!(renames, ["car_2_3", "car_2_4"]);
+        assert_eq!(renames, ["car_4", "car_5"]);
         let (fixed, applied) = tad_diagnostics::apply_fixes(&src, &diagnostics);
         assert_eq!(applied, 2);
         let (module, after) = crate::analyze(&fixed);
         assert!(after.is_empty(), "{after:?}");
         assert_eq!(module.scenario.unwrap().actors.len(), 4);
+    }
+
+    #[test]
+    fn a_rename_counts_on_from_the_names_number() {
+        assert_eq!(super::numbered("car_2"), ("car", 2));
+        assert_eq!(super::numbered("car"), ("car", 1));
+        assert_eq!(super::numbered("bus_ahead"), ("bus_ahead", 1));
+        // not a count: a leading zero, no stem, a number with no room above it
+        assert_eq!(super::numbered("car_07"), ("car_07", 1));
+        assert_eq!(super::numbered("_2"), ("_2", 1));
+        assert_eq!(super::numbered("car_4294967295"), ("car_4294967295", 1));
     }
 }
