@@ -19,7 +19,8 @@ pub fn lower(src: &str, file: &cst::File) -> (Module, Vec<Diagnostic>) {
         src,
         diagnostics: Vec::new(),
         groups: Default::default(),
-        renames: Default::default(),
+        taken: Default::default(),
+        next: Default::default(),
         rightmost: Vec::new(),
     };
     let module = lowerer.file(file);
@@ -31,9 +32,12 @@ struct Lowerer<'a> {
     diagnostics: Vec<Diagnostic>,
     /// The scenario's actor groups by name, for duplicates without a quadratic search.
     groups: std::collections::HashMap<String, usize>,
-    /// The names E0209's fixes give redeclared groups, so that a name declared three
-    /// times gets two different ones.
-    renames: std::collections::HashSet<String>,
+    /// The names E0209's fixes may not give: every group's name in the scenario, and each
+    /// name a fix has given, so that a name declared three times gets two different ones.
+    taken: std::collections::HashSet<String>,
+    /// Per redeclared name, the number its next rename tries first: every number below
+    /// it is taken, so renaming many copies of a name stays linear.
+    next: std::collections::HashMap<String, u32>,
     /// Where the scenario's `lane: rightmost` values are: the road's `lanes`, known once
     /// the whole scenario is read.
     rightmost: Vec<Span>,
@@ -140,11 +144,20 @@ impl Lowerer<'_> {
             );
         }
         let mut scenario = Scenario { span: s.span, name: s.name.clone(), sections: Vec::new(), actors: Vec::new() };
+        self.taken = s
+            .body
+            .items
+            .iter()
+            .filter_map(|m| match m {
+                cst::Member::Actor(a) => Some(a.name.text.clone()),
+                _ => None,
+            })
+            .collect();
         for member in &s.body.items {
             match member {
                 cst::Member::Section(section) => self.section(section, &mut scenario),
                 cst::Member::Actor(actor) => {
-                    if let Some(group) = self.actor(actor, &scenario, &s.body.items) {
+                    if let Some(group) = self.actor(actor, &scenario) {
                         self.groups.entry(group.name.text.clone()).or_insert(scenario.actors.len());
                         scenario.actors.push(group);
                     }
@@ -208,8 +221,7 @@ impl Lowerer<'_> {
         scenario.sections.push(Section { def, span: section.span, name_span: name.span, attrs });
     }
 
-    /// `members`: the scenario's, for a name no group has.
-    fn actor(&mut self, actor: &cst::Actor, scenario: &Scenario, members: &[cst::Member]) -> Option<ActorGroup> {
+    fn actor(&mut self, actor: &cst::Actor, scenario: &Scenario) -> Option<ActorGroup> {
         let name = &actor.name;
         if name.text == "ego" {
             self.report(
@@ -225,13 +237,12 @@ impl Lowerer<'_> {
         } else if let Some(previous) = self.groups.get(&name.text).map(|&i| &scenario.actors[i]) {
             // the next `NAME_N` no group of the scenario has and no other fix gives: a
             // rename the compiler can make (`car_2` again is `car_3`, not `car_2_2`)
-            let taken = |candidate: &str| {
-                self.renames.contains(candidate)
-                    || members.iter().any(|m| matches!(m, cst::Member::Actor(a) if a.name.text == candidate))
-            };
             let (stem, last) = numbered(&name.text);
-            let free = (last + 1..).map(|n| format!("{stem}_{n}")).find(|c| !taken(c)).unwrap_or_default();
-            self.renames.insert(free.clone());
+            let first = self.next.get(&name.text).copied().unwrap_or(last + 1);
+            let n = (first..).find(|n| !self.taken.contains(&format!("{stem}_{n}"))).unwrap_or(first);
+            let free = format!("{stem}_{n}");
+            self.next.insert(name.text.clone(), n + 1);
+            self.taken.insert(free.clone());
             self.report(
                 Diagnostic::new(
                     Code::E0209,
