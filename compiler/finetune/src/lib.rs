@@ -5,6 +5,8 @@
 //! JSONL (TRL's messages or prompt/completion) ──tokenize: ChatML as tad-local reads it──▶ samples
 //! GGUF ──dequantize (f32, frozen)──▶ Weights        LoRA A (Kaiming-uniform, seeded), B = 0 ──▶ Vars
 //! for each epoch, examples shuffled (seeded), one at a time (accumulated):
+//!     (--frozen-prefix: the tokens all examples begin with read once by the base model,
+//!      their keys and values held fixed; each example reads only what follows)
 //!     forward (causal, each layer's input kept) ─▶ cross-entropy on the answer's tokens only
 //!     ─▶ backward, each layer recomputed from its input, last to first ─▶ AdamW
 //!     every N steps: checkpoint (adapter, optimizer moments, position, RNG) ──▶ resume
@@ -28,7 +30,7 @@ use candle_core::{Device, Tensor, Var};
 use serde::{Deserialize, Serialize};
 
 pub use data::{Example, Message, read_jsonl};
-pub use model::{LoraSet, Rng, Rope, Weights, uniform};
+pub use model::{LoraSet, Prefix, Rng, Rope, Weights, uniform};
 use tad_base::Rng as _;
 pub use tad_local::{Adapter, Target};
 
@@ -57,6 +59,10 @@ pub struct Config {
     /// Keep one layer's graph at a time and recompute each layer in the backward pass
     /// (activation checkpointing): a fraction of the memory for a second forward pass.
     pub recompute: bool,
+    /// Read the tokens every example begins with (a shared system message) once, with the
+    /// base model, and hold their keys and values fixed: an example then costs only its own
+    /// tokens, and no gradient flows through the prefix.
+    pub frozen_prefix: bool,
     /// The adapter's `base_model_name_or_path`: the model's upstream name
     /// (`tad_models::Model::upstream`).
     pub base_model: String,
@@ -78,6 +84,7 @@ impl Default for Config {
             checkpoint_every: 0,
             resume: false,
             recompute: true,
+            frozen_prefix: false,
             base_model: tad_local::model(tad_local::ALIGN_DEFAULT).map_or("", |m| m.upstream).to_string(),
         }
     }
@@ -115,6 +122,8 @@ pub struct Report {
     pub losses: Vec<f32>,
     /// The step a resumed run started after.
     pub resumed_at: Option<usize>,
+    /// Tokens of the frozen prefix, read once (0 without `frozen_prefix`).
+    pub prefix: usize,
     /// Examples cut or dropped, in words.
     pub warnings: Vec<String>,
     pub adapter: PathBuf,
@@ -221,6 +230,9 @@ struct State {
     examples: usize,
     accumulate: usize,
     epochs: usize,
+    /// Tokens of the frozen prefix (0: none).
+    #[serde(default)]
+    prefix: usize,
 }
 
 /// AdamW (candle-nn's update) with its moments kept by name, for checkpoints.
@@ -332,9 +344,20 @@ pub fn train_samples(
 ) -> Result<Report, FinetuneError> {
     check(samples, config)?;
     std::fs::create_dir_all(out).map_err(|e| FinetuneError::Io(format!("cannot create `{}`: {e}", out.display())))?;
-    let mut run = Run::start(weights, samples, config, out)?;
     let start = Instant::now();
+    let longest = samples.iter().map(|s| s.tokens.len()).max().unwrap_or(1);
+    let rope = Rope::new(&weights.shape, longest).map_err(FinetuneError::Setup)?;
+    let (prefix, suffixes) = match config.frozen_prefix {
+        true => {
+            let (prefix, suffixes) = split_prefix(samples);
+            (Some(weights.prefix(prefix, None, &rope).map_err(training)?), suffixes)
+        }
+        false => (None, samples.to_vec()),
+    };
+    let samples = &suffixes[..];
+    let mut run = Run::start(weights, samples, config, out, rope, prefix)?;
     run.epochs(weights, samples, config, out, start, progress)?;
+    let prefix = run.prefix.as_ref().map_or(0, |p| p.len);
     let Run { lora, optimizer, state, resumed_at, counts, .. } = run;
     let shape = weights.shape;
     let adapter = lora.to_adapter(&shape, &config.base_model).map_err(FinetuneError::Training)?;
@@ -354,9 +377,23 @@ pub fn train_samples(
         tokens_per_s: counts.tokens as f64 / seconds.max(1e-9),
         losses: state.losses,
         resumed_at,
+        prefix,
         warnings: Vec::new(),
         adapter: out.to_path_buf(),
     })
+}
+
+/// The longest run of tokens every sample begins with, leaving each at least one token
+/// before its answer (the one that predicts the answer's first), and the samples after it.
+fn split_prefix(samples: &[Sample]) -> (&[u32], Vec<Sample>) {
+    let first = &samples[0].tokens;
+    let mut len = samples.iter().map(|s| s.answer.saturating_sub(1)).min().unwrap_or(0);
+    for s in &samples[1..] {
+        len = len.min(first.iter().zip(&s.tokens).take_while(|(a, b)| a == b).count());
+    }
+    let suffixes =
+        samples.iter().map(|s| Sample { tokens: s.tokens[len..].to_vec(), answer: s.answer - len }).collect();
+    (&first[..len], suffixes)
 }
 
 /// A numerical failure while training.
@@ -394,13 +431,22 @@ struct Run {
     state: State,
     resumed_at: Option<usize>,
     rope: Rope,
+    /// The frozen prefix every sample follows.
+    prefix: Option<Prefix>,
     accumulate: usize,
     counts: Counts,
 }
 
 impl Run {
     /// A fresh run, or the checkpoint's when resuming one of the same settings.
-    fn start(weights: &Weights, samples: &[Sample], config: &Config, out: &Path) -> Result<Run, FinetuneError> {
+    fn start(
+        weights: &Weights,
+        samples: &[Sample],
+        config: &Config,
+        out: &Path,
+        rope: Rope,
+        prefix: Option<Prefix>,
+    ) -> Result<Run, FinetuneError> {
         let setup = FinetuneError::Setup;
         let shape = weights.shape;
         let accumulate = config.accumulate.max(1);
@@ -420,6 +466,7 @@ impl Run {
             examples: samples.len(),
             accumulate,
             epochs: config.epochs,
+            prefix: prefix.as_ref().map_or(0, |p| p.len),
         };
         let checkpoint = out.join(CHECKPOINT);
         let mut resumed_at = None;
@@ -429,10 +476,10 @@ impl Run {
                 .map_err(|e| FinetuneError::Io(format!("cannot read the checkpoint: {e}")))?;
             let saved: State =
                 serde_json::from_str(&text).map_err(|e| setup(format!("the checkpoint's state: {e}")))?;
-            let same = |s: &State| (s.seed, s.rank, s.alpha, s.targets.clone(), s.examples, s.accumulate);
+            let same = |s: &State| (s.seed, s.rank, s.alpha, s.targets.clone(), s.examples, s.accumulate, s.prefix);
             if same(&saved) != same(&state) {
                 return Err(setup(format!(
-                    "the checkpoint in `{}` is of another run (seed, rank, alpha, targets, examples or accumulation differ): remove it or train without --resume",
+                    "the checkpoint in `{}` is of another run (seed, rank, alpha, targets, examples, accumulation or frozen prefix differ): remove it or train without --resume",
                     checkpoint.display()
                 )));
             }
@@ -450,9 +497,7 @@ impl Run {
             lora = LoraSet::new(&shape, config.rank, config.alpha, &targets, config.seed).map_err(setup)?;
             optimizer = AdamW::new(lora.named(), config.learning_rate, config.weight_decay).map_err(setup)?;
         }
-        let longest = samples.iter().map(|s| s.tokens.len()).max().unwrap_or(1);
-        let rope = Rope::new(&shape, longest).map_err(setup)?;
-        Ok(Run { lora, optimizer, state, resumed_at, rope, accumulate, counts: Counts::default() })
+        Ok(Run { lora, optimizer, state, resumed_at, rope, prefix, accumulate, counts: Counts::default() })
     }
 
     /// Every remaining epoch, a step per `accumulate` examples, reporting each step.
@@ -477,7 +522,8 @@ impl Run {
                 for &i in batch {
                     let sample = &samples[i];
                     let (loss, store) =
-                        sample_loss(weights, &self.lora, &self.rope, sample, config.recompute).map_err(training)?;
+                        sample_loss(weights, &self.lora, &self.rope, self.prefix.as_ref(), sample, config.recompute)
+                            .map_err(training)?;
                     loss_sum += loss;
                     for (slot, (_, var)) in grads.iter_mut().zip(&self.optimizer.vars) {
                         if let Some(g) = store.get(var.as_tensor()) {
@@ -547,13 +593,14 @@ fn sample_loss(
     weights: &Weights,
     lora: &LoraSet,
     rope: &Rope,
+    prefix: Option<&Prefix>,
     sample: &Sample,
     recompute: bool,
 ) -> candle_core::Result<(f32, GradStore)> {
     let (tokens, from) = (&sample.tokens, sample.answer);
     if recompute {
-        return weights.loss_recomputed(tokens, from, lora, rope);
+        return weights.loss_recomputed(tokens, from, lora, rope, prefix);
     }
-    let loss = weights.loss(tokens, from, Some(lora), rope)?;
+    let loss = weights.loss(tokens, from, Some(lora), rope, prefix)?;
     Ok((loss.to_scalar::<f32>()?, loss.backward()?))
 }

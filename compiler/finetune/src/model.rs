@@ -289,9 +289,9 @@ impl Rope {
         Ok(Rope { cos: t(cos)?, sin: t(sin)?, interleaved: shape.arch.interleaved() })
     }
 
-    /// Rotates the pairs of `x` (`[heads, t, head_dim]`): `(x[2i], x[2i+1])` interleaved,
-    /// else `(x[i], x[i + head_dim/2])`.
-    fn apply(&self, x: &Tensor) -> candle_core::Result<Tensor> {
+    /// Rotates the pairs of `x` (`[heads, t, head_dim]`, positions from `offset`):
+    /// `(x[2i], x[2i+1])` interleaved, else `(x[i], x[i + head_dim/2])`.
+    fn apply(&self, x: &Tensor, offset: usize) -> candle_core::Result<Tensor> {
         let (heads, t, hd) = x.dims3()?;
         // the pair's members side by side in the last dimension (interleaved), or in two halves
         let (x, axis, angles) = match self.interleaved {
@@ -299,12 +299,20 @@ impl Rope {
             false => (x.reshape((heads, t, 2, hd / 2))?, 2, (1, t, 1, hd / 2)),
         };
         let (x0, x1) = (x.narrow(axis, 0, 1)?, x.narrow(axis, 1, 1)?);
-        let cos = self.cos.narrow(0, 0, t)?.reshape(angles)?;
-        let sin = self.sin.narrow(0, 0, t)?.reshape(angles)?;
+        let cos = self.cos.narrow(0, offset, t)?.reshape(angles)?;
+        let sin = self.sin.narrow(0, offset, t)?.reshape(angles)?;
         let y0 = (x0.broadcast_mul(&cos)? - x1.broadcast_mul(&sin)?)?;
         let y1 = (x0.broadcast_mul(&sin)? + x1.broadcast_mul(&cos)?)?;
         Tensor::cat(&[y0, y1], axis)?.reshape((heads, t, hd))
     }
+}
+
+/// The keys and values of tokens every example begins with (the system message of a
+/// prompt), per layer: `[kv_heads, len, head_dim]` each, keys rotated. Held fixed while
+/// training, so an example reads only its own tokens and attends to these.
+pub struct Prefix {
+    pub len: usize,
+    layers: Vec<(Tensor, Tensor)>,
 }
 
 /// `x Wᵀ` for a frozen `W` (`[out, in]`). candle's matmul would also compute `W`'s
@@ -352,25 +360,46 @@ impl Weights {
 
     /// The residual stream after the last layer (before the output norm), `[t, dim]`, of
     /// `tokens` read from the first position, attending causally.
-    fn residual(&self, tokens: &[u32], lora: Option<&LoraSet>, rope: &Rope) -> candle_core::Result<Tensor> {
-        let mask = causal_mask(tokens.len())?;
+    fn residual(
+        &self,
+        tokens: &[u32],
+        lora: Option<&LoraSet>,
+        rope: &Rope,
+        prefix: Option<&Prefix>,
+    ) -> candle_core::Result<Tensor> {
+        let mask = causal_mask(tokens.len(), prefix.map_or(0, |p| p.len))?;
         let mut x = self.embed(tokens)?;
         for li in 0..self.blocks.len() {
-            x = self.block(li, &x, lora, rope, &mask)?;
+            x = self.block(li, &x, lora, rope, &mask, prefix)?.0;
         }
         Ok(x)
     }
 
+    /// The keys and values of `tokens` read from the first position, with `lora` or without
+    /// (no graph is kept).
+    pub fn prefix(&self, tokens: &[u32], lora: Option<&LoraSet>, rope: &Rope) -> candle_core::Result<Prefix> {
+        let mask = causal_mask(tokens.len(), 0)?;
+        let mut x = self.embed(tokens)?;
+        let mut layers = Vec::with_capacity(self.blocks.len());
+        for li in 0..self.blocks.len() {
+            let (y, [k, v]) = self.block(li, &x, lora, rope, &mask, None)?;
+            layers.push((k.detach(), v.detach()));
+            x = y.detach();
+        }
+        Ok(Prefix { len: tokens.len(), layers })
+    }
+
     /// The final hidden states (after the output norm), `[t, dim]`.
     pub fn hidden(&self, tokens: &[u32], lora: Option<&LoraSet>, rope: &Rope) -> candle_core::Result<Tensor> {
-        rms_norm(&self.residual(tokens, lora, rope)?, &self.norm, self.shape.eps)
+        rms_norm(&self.residual(tokens, lora, rope, None)?, &self.norm, self.shape.eps)
     }
 
     fn embed(&self, tokens: &[u32]) -> candle_core::Result<Tensor> {
         self.embedding.index_select(&Tensor::new(tokens, &Device::Cpu)?, 0)
     }
 
-    /// Layer `li` applied to the residual stream `x` (`[t, dim]`).
+    /// Layer `li` applied to the residual stream `x` (`[t, dim]`) of the tokens after
+    /// `prefix`, which they also attend to; and the layer's keys and values of `x`.
     fn block(
         &self,
         li: usize,
@@ -378,7 +407,8 @@ impl Weights {
         lora: Option<&LoraSet>,
         rope: &Rope,
         mask: &Tensor,
-    ) -> candle_core::Result<Tensor> {
+        prefix: Option<&Prefix>,
+    ) -> candle_core::Result<(Tensor, [Tensor; 2])> {
         let Shape { dim, heads, kv_heads, head_dim, eps, .. } = self.shape;
         let block = &self.blocks[li];
         let n = x.dim(0)?;
@@ -393,20 +423,29 @@ impl Weights {
                 None => Ok(y),
             }
         };
-        let q = rope.apply(&split(qkv(0, Target::Q)?, heads)?)?;
-        let k = rope.apply(&split(qkv(1, Target::K)?, kv_heads)?)?;
+        let past = prefix.map_or(0, |p| p.len);
+        let q = rope.apply(&split(qkv(0, Target::Q)?, heads)?, past)?;
+        let k = rope.apply(&split(qkv(1, Target::K)?, kv_heads)?, past)?;
         let v = split(qkv(2, Target::V)?, kv_heads)?;
+        let (keys, values) = match prefix {
+            Some(p) => {
+                let (pk, pv) = &p.layers[li];
+                (Tensor::cat(&[pk, &k], 1)?, Tensor::cat(&[pv, &v], 1)?)
+            }
+            None => (k.clone(), v.clone()),
+        };
+        let m = past + n;
         // query heads h = kv·group + g read key/value head kv: [kv, group·t, hd]
         let q = q.reshape((kv_heads, group * n, head_dim))?;
-        let scores = (q.matmul(&k.t()?)? * scale)?.reshape((heads, n, n))?.broadcast_add(mask)?;
-        let weights = candle_nn::ops::softmax(&scores, D::Minus1)?.reshape((kv_heads, group * n, n))?;
-        let attn = weights.matmul(&v)?.reshape((heads, n, head_dim))?.transpose(0, 1)?.reshape((n, dim))?;
+        let scores = (q.matmul(&keys.t()?)? * scale)?.reshape((heads, n, m))?.broadcast_add(mask)?;
+        let weights = candle_nn::ops::softmax(&scores, D::Minus1)?.reshape((kv_heads, group * n, m))?;
+        let attn = weights.matmul(&values)?.reshape((heads, n, head_dim))?.transpose(0, 1)?.reshape((n, dim))?;
         let x = (x + self.linear(&attn, li, Target::O, lora)?)?;
         let h = rms_norm(&x, &block.ffn_norm, eps)?;
         let gate = self.linear(&h, li, Target::Gate, lora)?;
         let up = self.linear(&h, li, Target::Up, lora)?;
         let mlp = self.linear(&(gate.silu()? * up)?, li, Target::Down, lora)?;
-        x + mlp
+        Ok(((x + mlp)?, [k, v]))
     }
 
     /// The logits of `hidden` rows.
@@ -426,16 +465,17 @@ impl Weights {
     }
 
     /// The mean cross-entropy of predicting `tokens[from..]`, each from the tokens before
-    /// it (`from` ≥ 1): the loss on the answer only.
+    /// it (`from` ≥ 1) and `prefix`: the loss on the answer only.
     pub fn loss(
         &self,
         tokens: &[u32],
         from: usize,
         lora: Option<&LoraSet>,
         rope: &Rope,
+        prefix: Option<&Prefix>,
     ) -> candle_core::Result<Tensor> {
         answer_tokens(tokens, from)?;
-        self.answer_loss(&self.residual(tokens, lora, rope)?, tokens, from)
+        self.answer_loss(&self.residual(tokens, lora, rope, prefix)?, tokens, from)
     }
 
     /// The loss of [`Weights::loss`] and its gradients in `lora`'s pairs, holding one
@@ -448,14 +488,15 @@ impl Weights {
         from: usize,
         lora: &LoraSet,
         rope: &Rope,
+        prefix: Option<&Prefix>,
     ) -> candle_core::Result<(f32, GradStore)> {
         answer_tokens(tokens, from)?;
-        let mask = causal_mask(tokens.len())?;
+        let mask = causal_mask(tokens.len(), prefix.map_or(0, |p| p.len))?;
         // forward: each layer's graph is dropped as soon as its output is detached
         let mut inputs = Vec::with_capacity(self.blocks.len());
         let mut x = self.embed(tokens)?;
         for li in 0..self.blocks.len() {
-            let next = self.block(li, &x, Some(lora), rope, &mask)?.detach();
+            let next = self.block(li, &x, Some(lora), rope, &mask, prefix)?.0.detach();
             inputs.push(x);
             x = next;
         }
@@ -478,7 +519,7 @@ impl Weights {
             // constant it spares the backward pass the products that would compute one
             let var = (li > 0).then(|| Var::from_tensor(&input)).transpose()?;
             let x = var.as_ref().map_or(&input, |v| v.as_tensor());
-            let y = self.block(li, x, Some(lora), rope, &mask)?;
+            let y = self.block(li, x, Some(lora), rope, &mask, prefix)?.0;
             let mut layer = (y * &carry)?.sum_all()?.backward()?;
             if let Some(var) = &var {
                 carry = take_grad(&mut layer, var)?;
@@ -527,8 +568,10 @@ fn take_grad(grads: &mut GradStore, var: &Var) -> candle_core::Result<Tensor> {
     }
 }
 
-/// `[n, n]`: 0 where a position may attend (itself and before), −∞ after.
-fn causal_mask(n: usize) -> candle_core::Result<Tensor> {
-    let mask: Vec<f32> = (0..n * n).map(|i| if i % n > i / n { f32::NEG_INFINITY } else { 0.0 }).collect();
-    Tensor::from_vec(mask, (n, n), &Device::Cpu)
+/// `[n, past + n]`: 0 where a position may attend (the `past` positions before the first,
+/// itself and those before it), −∞ after.
+fn causal_mask(n: usize, past: usize) -> candle_core::Result<Tensor> {
+    let m = past + n;
+    let mask: Vec<f32> = (0..n * m).map(|i| if i % m > past + i / m { f32::NEG_INFINITY } else { 0.0 }).collect();
+    Tensor::from_vec(mask, (n, m), &Device::Cpu)
 }

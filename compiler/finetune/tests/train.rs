@@ -99,8 +99,9 @@ fn the_loss_falls_and_the_adapter_reloads(shape: Shape) {
     assert_eq!(adapter.targets, Target::ALL.to_vec());
     let lora = LoraSet::from_adapter(&adapter, &shape).unwrap();
     let rope = tad_finetune::Rope::new(&shape, 64).unwrap();
-    let reloaded = weights.loss(&sample.tokens, sample.answer, Some(&lora), &rope).unwrap().to_scalar::<f32>().unwrap();
-    let base = weights.loss(&sample.tokens, sample.answer, None, &rope).unwrap().to_scalar::<f32>().unwrap();
+    let reloaded =
+        weights.loss(&sample.tokens, sample.answer, Some(&lora), &rope, None).unwrap().to_scalar::<f32>().unwrap();
+    let base = weights.loss(&sample.tokens, sample.answer, None, &rope, None).unwrap().to_scalar::<f32>().unwrap();
     assert!((base - first).abs() < 1e-4, "step 1's loss {first} is the base model's {base}");
     assert!(reloaded < last * 1.01 + 1e-3, "reloaded {reloaded}, trained {last}");
     // and written again, the same tensors
@@ -202,7 +203,7 @@ fn b_zero_is_the_base_model_and_gradients_match(shape: Shape) {
     let adapter = random_adapter(&shape, 4, &Target::ALL, 2, 0.2);
     let lora = LoraSet::from_adapter(&adapter, &shape).unwrap();
     let rope = tad_finetune::Rope::new(&shape, tokens.len()).unwrap();
-    let loss = weights.loss(&tokens, 4, Some(&lora), &rope).unwrap();
+    let loss = weights.loss(&tokens, 4, Some(&lora), &rope, None).unwrap();
     let grads = loss.backward().unwrap();
     for (name, index) in [
         ("base_model.model.model.layers.0.self_attn.q_proj.lora_B.weight", 5),
@@ -216,7 +217,7 @@ fn b_zero_is_the_base_model_and_gradients_match(shape: Shape) {
             let mut v = original.clone();
             v[index] += delta;
             var.set(&candle_core::Tensor::from_vec(v, var.shape(), &candle_core::Device::Cpu).unwrap()).unwrap();
-            weights.loss(&tokens, 4, Some(&lora), &rope).unwrap().to_scalar::<f32>().unwrap() as f64
+            weights.loss(&tokens, 4, Some(&lora), &rope, None).unwrap().to_scalar::<f32>().unwrap() as f64
         };
         let h = 1e-2;
         let numeric = (at(h) - at(-h)) / (2.0 * h as f64);
@@ -244,9 +245,9 @@ fn recomputed_gradients_match(shape: Shape) {
     let tokens: Vec<u32> = (0..300u32).map(|i| (i * 7 + i / 3) % 40).collect();
     let lora = LoraSet::from_adapter(&random_adapter(&shape, 4, &Target::ALL, 3, 0.2), &shape).unwrap();
     let rope = tad_finetune::Rope::new(&shape, tokens.len()).unwrap();
-    let loss = weights.loss(&tokens, 5, Some(&lora), &rope).unwrap();
+    let loss = weights.loss(&tokens, 5, Some(&lora), &rope, None).unwrap();
     let whole = loss.backward().unwrap();
-    let (value, recomputed) = weights.loss_recomputed(&tokens, 5, &lora, &rope).unwrap();
+    let (value, recomputed) = weights.loss_recomputed(&tokens, 5, &lora, &rope, None).unwrap();
     let expected = loss.to_scalar::<f32>().unwrap();
     assert!((value - expected).abs() <= 1e-6 * expected, "{value} against {expected}");
     for (name, var) in lora.named() {
@@ -260,6 +261,63 @@ fn recomputed_gradients_match(shape: Shape) {
         let worst = a.iter().zip(&b).fold(0f32, |m, (x, y)| m.max((x - y).abs()));
         assert!(worst <= 1e-5 * scale.max(1e-3), "{:?} {name}: differs by {worst} (largest {scale})", shape.arch);
     }
+}
+
+#[test]
+fn a_frozen_prefix_gives_the_loss_of_the_whole_sequence() {
+    for arch in [Arch::Llama, Arch::Qwen2] {
+        frozen_prefix_matches(Shape { layers: 3, ..tiny(arch) });
+    }
+}
+
+fn frozen_prefix_matches(shape: Shape) {
+    let weights = Weights::random(shape, 40, 13).unwrap();
+    let tokens: Vec<u32> = (0..60u32).map(|i| (i * 11 + i / 5) % 40).collect();
+    let lora = LoraSet::from_adapter(&random_adapter(&shape, 4, &Target::ALL, 4, 0.2), &shape).unwrap();
+    let rope = tad_finetune::Rope::new(&shape, tokens.len()).unwrap();
+    let whole = weights.loss(&tokens, 30, Some(&lora), &rope, None).unwrap().to_scalar::<f32>().unwrap();
+    // the prefix read with the same adapter: the suffix's loss is the whole sequence's
+    let prefix = weights.prefix(&tokens[..20], Some(&lora), &rope).unwrap();
+    let kept = weights.loss(&tokens[20..], 10, Some(&lora), &rope, Some(&prefix)).unwrap();
+    let (recomputed, grads) = weights.loss_recomputed(&tokens[20..], 10, &lora, &rope, Some(&prefix)).unwrap();
+    let kept = kept.to_scalar::<f32>().unwrap();
+    assert!((kept - whole).abs() <= 1e-5 * whole, "{:?}: {kept} against {whole}", shape.arch);
+    assert!((recomputed - whole).abs() <= 1e-5 * whole, "{:?}: {recomputed} against {whole}", shape.arch);
+    assert!(lora.named().iter().all(|(_, v)| grads.get(v.as_tensor()).is_some()));
+    // read by the base model, the prefix differs: the answer's loss does too
+    let base = weights.prefix(&tokens[..20], None, &rope).unwrap();
+    let other = weights.loss(&tokens[20..], 10, Some(&lora), &rope, Some(&base)).unwrap().to_scalar::<f32>().unwrap();
+    assert!((other - whole).abs() > 1e-4, "{:?}: the prefix's keys and values were not read", shape.arch);
+}
+
+#[test]
+fn training_with_a_frozen_prefix_reads_it_once_and_learns() {
+    let shape = tiny_shape();
+    let weights = Weights::random(shape, 40, 17).unwrap();
+    let system: Vec<u32> = (0..24u32).map(|i| (i * 5 + 1) % 40).collect();
+    let samples: Vec<Sample> = (0..3u32)
+        .map(|k| {
+            let mut tokens = system.clone();
+            tokens.extend([30 + k, 31, 2, 3 + k, 4, 5 + k, 6]);
+            Sample { answer: system.len() + 2, tokens }
+        })
+        .collect();
+    let config = Config {
+        rank: 4,
+        alpha: 8.0,
+        epochs: 6,
+        learning_rate: 1e-2,
+        seed: 3,
+        frozen_prefix: true,
+        ..Config::default()
+    };
+    let out = scratch("frozen-prefix");
+    let report = tad_finetune::train_samples(&weights, &samples, &config, &out, &mut |_| {}).unwrap();
+    // the samples share the system tokens and nothing after them
+    assert_eq!(report.prefix, system.len());
+    assert_eq!(report.tokens, 6 * 3 * 7);
+    let (first, last) = (report.losses[0], *report.losses.last().unwrap());
+    assert!(last < 0.5 * first, "the loss fell only from {first} to {last}");
 }
 
 fn edit_tensors(d: &Path, edit: &dyn Fn(&mut std::collections::HashMap<String, candle_core::Tensor>)) {

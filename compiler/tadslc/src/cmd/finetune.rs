@@ -52,6 +52,11 @@ pub struct FinetuneArgs {
     /// faster, more memory
     #[arg(long)]
     pub keep_graph: bool,
+    /// Read the tokens every example begins with (a shared system message) once, with the
+    /// base model, and hold their keys and values fixed: each example costs only its own
+    /// tokens
+    #[arg(long)]
+    pub frozen_prefix: bool,
     /// The local model to adapt
     #[arg(long, default_value = tad_local::ALIGN_DEFAULT)]
     pub model: String,
@@ -97,6 +102,7 @@ impl FinetuneArgs {
             checkpoint_every: self.checkpoint_every,
             resume: self.resume,
             recompute: !self.keep_graph,
+            frozen_prefix: self.frozen_prefix,
             ..Config::default()
         })
     }
@@ -124,6 +130,9 @@ pub fn run(args: &FinetuneArgs) -> Result<Status, CliError> {
     })?;
     for w in &report.warnings {
         errln!("warning: {w}")?;
+    }
+    if report.prefix > 0 {
+        errln!("a prefix of {} tokens shared by every example was read once and held fixed", report.prefix)?;
     }
     if let Some(step) = report.resumed_at {
         errln!("resumed after step {step}")?;
