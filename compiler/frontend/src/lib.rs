@@ -84,6 +84,16 @@ fn example_parts(text: &str) -> (String, String) {
     (description.trim_end().to_string(), program.trim().to_string())
 }
 
+/// A truth as a translation answers: the line listing its road users (its groups' names,
+/// `none` without groups), then the program without `source` and comments.
+pub fn translation_answer(truth: &str) -> String {
+    let (module, _) = tad_syntax::analyze(truth);
+    let names: Vec<String> =
+        module.scenario.iter().flat_map(|s| &s.actors).map(|g| g.name.text.replace('_', " ")).collect();
+    let users = if names.is_empty() { "none".to_string() } else { names.join("; ") };
+    format!("{ROAD_USERS} {users}\n{}", with_provenance(truth, &Provenance::default()).trim())
+}
+
 /// The translate prompt's examples, as the model reads them: each description, then its
 /// program in a code block.
 pub fn translate_examples() -> String {

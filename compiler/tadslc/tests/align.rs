@@ -163,6 +163,52 @@ fn sft_export_writes_trl_conversations_with_checked_answers() {
     assert_eq!(first["completion"][0]["role"], "assistant");
 }
 
+#[test]
+fn sft_export_translate_answers_each_description_with_its_truth() {
+    let descriptions = scratch("align-sft-translate-desc");
+    for name in ["41_la_freeway_carpool_lane", "52_nyc_queens_snow_t_junction"] {
+        let from = repo().join(format!("tests/llm/descriptions/{name}.txt"));
+        std::fs::copy(from, descriptions.join(format!("{name}.txt"))).unwrap();
+    }
+    let dir = scratch("align-sft-translate");
+    let args = ["sft-export", "--translate", "--truth", "tests/llm/truth", path(&descriptions), "-o", path(&dir)];
+    let out = tadslc(&args, "");
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    let messages = std::fs::read_to_string(dir.join("messages.jsonl")).unwrap();
+    let lines: Vec<Value> = messages.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert_eq!(lines.len(), 2);
+    // every pair begins with the same system message: what --frozen-prefix reads once
+    assert_eq!(lines[0]["messages"][0], lines[1]["messages"][0]);
+    assert!(lines[0]["messages"][0]["content"].as_str().unwrap().contains("road users"));
+    let user = lines[1]["messages"][1]["content"].as_str().unwrap();
+    assert!(user.contains("Snowing at dusk in Queens"), "{user}");
+    let answer = lines[1]["messages"][2]["content"].as_str().unwrap();
+    let (users, program) = answer.split_once('\n').unwrap();
+    assert_eq!(users, "// road users: snowplow; following bus; waiting car");
+    assert!(program.starts_with("scenario nyc_queens_snow_t_junction {"), "{program}");
+    assert!(!program.contains("//") && !program.contains("source"), "{program}");
+    let check = tadslc(&["check", "-"], program);
+    assert_eq!(code(&check), 0, "{}", stdout(&check));
+
+    // a description without a truth, and a truth the checker rejects, stop the export
+    std::fs::write(descriptions.join("99_no_truth.txt"), "A car waits at a light.").unwrap();
+    let out = tadslc(&args, "");
+    assert_eq!(code(&out), 2);
+    assert!(stderr(&out).contains("no truth `99_no_truth.tad`"), "{}", stderr(&out));
+    std::fs::remove_file(descriptions.join("99_no_truth.txt")).unwrap();
+    let truth = scratch("align-sft-translate-truth");
+    for name in ["41_la_freeway_carpool_lane", "52_nyc_queens_snow_t_junction"] {
+        let text = std::fs::read_to_string(repo().join(format!("tests/llm/truth/{name}.tad"))).unwrap();
+        std::fs::write(truth.join(format!("{name}.tad")), text.replace("weather: snowy", "weather: sleet")).unwrap();
+    }
+    // the first directory holding a truth gives it
+    let dirs = ["--truth", path(&truth), "--truth", "tests/llm/truth"];
+    let args = [&["sft-export", "--translate"][..], &dirs, &[path(&descriptions), "-o", path(&dir)]].concat();
+    let out = tadslc(&args, "");
+    assert_eq!(code(&out), 2);
+    assert!(stderr(&out).contains("the truth is not valid"), "{}", stderr(&out));
+}
+
 /// The recovery test: corpora drawn from three labelled synthetic regions; the generator
 /// fitted to each region's training sample must be at least 3× closer to the region's
 /// held-out sample than the unaligned baseline, and closer than the other regions'
