@@ -302,6 +302,10 @@ fn bench_translate_scores_answers_against_the_ground_truth() {
     let bare = run(&["bench", "--translate", "--answers", dir.to_str().unwrap()], &[]);
     assert!(stdout(&bare).lines().any(|l| l == overall), "{}", stdout(&bare));
     assert!(validity(&bare).is_none() && stdout(&bare).contains("not recorded"), "{}", stdout(&bare));
+    // an adapter goes to the model as `translate --adapter` gives it: a server takes none
+    let adapter = run(&["bench", "--translate", "--adapter", dir_arg], &env_of(&served(&fixed)));
+    assert_eq!(code(&adapter), 2, "{}", stderr(&adapter));
+    assert!(stderr(&adapter).contains("--adapter applies to the local model only"), "{}", stderr(&adapter));
 }
 
 #[test]

@@ -76,6 +76,10 @@ pub struct Args {
     /// Repair and refinement requests after the first answer
     #[arg(long, value_name = "N", default_value_t = 3, requires = "translate")]
     pub max_rounds: u32,
+    /// A LoRA adapter for the local model that translates, as `translate --adapter` takes
+    /// it (a PEFT directory, as `tadslc finetune` writes)
+    #[arg(long, value_name = "DIR", requires = "translate", conflicts_with = "answers")]
+    pub adapter: Option<PathBuf>,
     /// Score the translations already in DIR (`NAME.tad`, and `faithfulness.jsonl` for the
     /// rounds, tokens and seconds, as `--out` writes them) instead of running a model: a
     /// server's, or an interrupted run's
@@ -261,6 +265,7 @@ fn translate(args: &Args) -> Result<Status, CliError> {
     let mut argv = vec!["bench".to_string(), "--constrain".into(), "--threads".into(), args.threads.to_string()];
     argv.extend(["--max-rounds".into(), args.max_rounds.to_string()]);
     argv.extend(args.model.iter().flat_map(|m| ["--model".to_string(), m.clone()]));
+    argv.extend(args.adapter.iter().flat_map(|a| ["--adapter".to_string(), a.display().to_string()]));
     let llm = <Flags as clap::Parser>::try_parse_from(argv).map_err(|e| CliError::usage(e.to_string()))?.llm;
 
     let cases = tad_bench::translate::cases(&args.descriptions, &args.truth).map_err(|e| CliError::usage(e.0))?;
