@@ -10,7 +10,8 @@
 //!     forward (causal, each layer's input kept) ─▶ cross-entropy on the answer's tokens only
 //!     ─▶ backward, each layer recomputed from its input, last to first ─▶ AdamW
 //!     every N steps: checkpoint (adapter, optimizer moments, position, RNG) ──▶ resume
-//! ──▶ adapter_model.safetensors + adapter_config.json (PEFT) ──▶ tad-local's decoder (--adapter)
+//! ──▶ adapter_model.safetensors + adapter_config.json (PEFT), base_prefix.json (the frozen
+//!     prefix's tokens: the decoder reads them without the adapter) ──▶ tad-local's decoder
 //! ──▶ adapter.gguf (the same adapter as llama.cpp's LoRA GGUF) ──▶ llama-server --lora
 //! ```
 //!
@@ -63,6 +64,9 @@ pub struct Config {
     /// base model, and hold their keys and values fixed: an example then costs only its own
     /// tokens, and no gradient flows through the prefix.
     pub frozen_prefix: bool,
+    /// Start from this adapter (of the same rank, alpha and targets) instead of B = 0: an
+    /// adapter trained further on new examples. A checkpoint resumed takes precedence.
+    pub from: Option<Adapter>,
     /// The adapter's `base_model_name_or_path`: the model's upstream name
     /// (`tad_models::Model::upstream`).
     pub base_model: String,
@@ -85,6 +89,7 @@ impl Default for Config {
             resume: false,
             recompute: true,
             frozen_prefix: false,
+            from: None,
             base_model: tad_local::model(tad_local::ALIGN_DEFAULT).map_or("", |m| m.upstream).to_string(),
         }
     }
@@ -313,18 +318,11 @@ fn epoch_order(count: usize, rng: &mut Rng) -> Vec<usize> {
 
 /// Writes the checkpoint into `out/checkpoint` whole or not at all (a new directory
 /// renamed over the old one).
-fn save_checkpoint(
-    out: &Path,
-    lora: &LoraSet,
-    shape: &tad_local::Shape,
-    base_model: &str,
-    optimizer: &AdamW,
-    state: &State,
-) -> Result<PathBuf, String> {
+fn save_checkpoint(out: &Path, adapter: &Adapter, optimizer: &AdamW, state: &State) -> Result<PathBuf, String> {
     let dir = out.join(CHECKPOINT);
     let partial = out.join(format!("{CHECKPOINT}.part"));
     let _ = std::fs::remove_dir_all(&partial);
-    lora.to_adapter(shape, base_model)?.save(&partial)?;
+    adapter.save(&partial)?;
     optimizer.save(&partial.join(OPTIMIZER_FILE))?;
     let text = serde_json::to_string_pretty(state).map_err(err)?;
     std::fs::write(partial.join(STATE_FILE), text).map_err(|e| format!("cannot write the checkpoint: {e}"))?;
@@ -348,23 +346,22 @@ pub fn train_samples(
     let longest = samples.iter().map(|s| s.tokens.len()).max().unwrap_or(1);
     let rope = Rope::new(&weights.shape, longest).map_err(FinetuneError::Setup)?;
     let (prefix, suffixes) = match config.frozen_prefix {
-        true => {
-            let (prefix, suffixes) = split_prefix(samples);
-            (Some(weights.prefix(prefix, None, &rope).map_err(training)?), suffixes)
-        }
-        false => (None, samples.to_vec()),
+        true => split_prefix(samples),
+        false => (&[][..], samples.to_vec()),
     };
     let samples = &suffixes[..];
+    // a checkpoint of another run is refused before the prefix is read (minutes for a 1.5B)
     let mut run = Run::start(weights, samples, config, out, rope, prefix)?;
+    if !prefix.is_empty() {
+        run.prefix = Some(weights.prefix(prefix, None, &run.rope).map_err(training)?);
+    }
     run.epochs(weights, samples, config, out, start, progress)?;
-    let prefix = run.prefix.as_ref().map_or(0, |p| p.len);
-    let Run { lora, optimizer, state, resumed_at, counts, .. } = run;
-    let shape = weights.shape;
-    let adapter = lora.to_adapter(&shape, &config.base_model).map_err(FinetuneError::Training)?;
+    let adapter = run.adapter(weights, config).map_err(FinetuneError::Training)?;
     adapter.save(out).map_err(FinetuneError::Io)?;
-    adapter.save_gguf(&out.join(tad_local::GGUF_FILE), &shape).map_err(FinetuneError::Io)?;
+    adapter.save_gguf(&out.join(tad_local::GGUF_FILE), &weights.shape).map_err(FinetuneError::Io)?;
+    let Run { optimizer, state, resumed_at, counts, .. } = run;
     if config.checkpoint_every > 0 {
-        save_checkpoint(out, &lora, &shape, &config.base_model, &optimizer, &state).map_err(FinetuneError::Io)?;
+        save_checkpoint(out, &adapter, &optimizer, &state).map_err(FinetuneError::Io)?;
     }
     let seconds = start.elapsed().as_secs_f64();
     Ok(Report {
@@ -377,7 +374,7 @@ pub fn train_samples(
         tokens_per_s: counts.tokens as f64 / seconds.max(1e-9),
         losses: state.losses,
         resumed_at,
-        prefix,
+        prefix: prefix.len(),
         warnings: Vec::new(),
         adapter: out.to_path_buf(),
     })
@@ -431,7 +428,8 @@ struct Run {
     state: State,
     resumed_at: Option<usize>,
     rope: Rope,
-    /// The frozen prefix every sample follows.
+    /// The frozen prefix every sample follows: its tokens, and their keys and values once read.
+    prefix_tokens: Vec<u32>,
     prefix: Option<Prefix>,
     accumulate: usize,
     counts: Counts,
@@ -445,7 +443,7 @@ impl Run {
         config: &Config,
         out: &Path,
         rope: Rope,
-        prefix: Option<Prefix>,
+        prefix: &[u32],
     ) -> Result<Run, FinetuneError> {
         let setup = FinetuneError::Setup;
         let shape = weights.shape;
@@ -466,7 +464,7 @@ impl Run {
             examples: samples.len(),
             accumulate,
             epochs: config.epochs,
-            prefix: prefix.as_ref().map_or(0, |p| p.len),
+            prefix: prefix.len(),
         };
         let checkpoint = out.join(CHECKPOINT);
         let mut resumed_at = None;
@@ -493,11 +491,40 @@ impl Run {
             state.position = saved.position;
             state.rng = saved.rng;
             state.losses = saved.losses;
+        } else if let Some(adapter) = &config.from {
+            if (adapter.rank, adapter.alpha, adapter.rslora, &adapter.targets)
+                != (config.rank, config.alpha, false, &targets)
+            {
+                return Err(setup(format!(
+                    "the adapter to start from has rank {}, alpha {} and targets {}: train it further with the same",
+                    adapter.rank,
+                    adapter.alpha,
+                    adapter.targets.iter().map(|t| t.module()).collect::<Vec<_>>().join(", ")
+                )));
+            }
+            lora = LoraSet::from_adapter(adapter, &shape).map_err(setup)?;
+            optimizer = AdamW::new(lora.named(), config.learning_rate, config.weight_decay).map_err(setup)?;
         } else {
             lora = LoraSet::new(&shape, config.rank, config.alpha, &targets, config.seed).map_err(setup)?;
             optimizer = AdamW::new(lora.named(), config.learning_rate, config.weight_decay).map_err(setup)?;
         }
-        Ok(Run { lora, optimizer, state, resumed_at, rope, prefix, accumulate, counts: Counts::default() })
+        let prefix_tokens = prefix.to_vec();
+        Ok(Run {
+            lora,
+            optimizer,
+            state,
+            resumed_at,
+            rope,
+            prefix_tokens,
+            prefix: None,
+            accumulate,
+            counts: Counts::default(),
+        })
+    }
+
+    /// The adapter as trained so far.
+    fn adapter(&self, weights: &Weights, config: &Config) -> Result<Adapter, String> {
+        adapter(&self.lora, &self.prefix_tokens, weights, config)
     }
 
     /// Every remaining epoch, a step per `accumulate` examples, reporting each step.
@@ -564,10 +591,9 @@ impl Run {
                     && state.step.is_multiple_of(config.checkpoint_every)
                     && state.step < steps
                 {
-                    written = Some(
-                        save_checkpoint(out, &self.lora, &weights.shape, &config.base_model, &self.optimizer, state)
-                            .map_err(FinetuneError::Io)?,
-                    );
+                    let adapter =
+                        adapter(&self.lora, &self.prefix_tokens, weights, config).map_err(FinetuneError::Training)?;
+                    written = Some(save_checkpoint(out, &adapter, &self.optimizer, state).map_err(FinetuneError::Io)?);
                 }
                 let seconds = start.elapsed().as_secs_f64();
                 progress(&Progress {
@@ -585,6 +611,12 @@ impl Run {
         }
         Ok(())
     }
+}
+
+/// `lora` as a PEFT adapter, with the prefix it was trained to follow.
+fn adapter(lora: &LoraSet, prefix: &[u32], weights: &Weights, config: &Config) -> Result<Adapter, String> {
+    let adapter = lora.to_adapter(&weights.shape, &config.base_model)?;
+    Ok(Adapter { base_prefix: prefix.to_vec(), ..adapter })
 }
 
 /// A sample's loss and its gradients, with each layer recomputed in the backward pass or

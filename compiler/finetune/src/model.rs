@@ -237,6 +237,7 @@ impl LoraSet {
             targets: self.targets.clone(),
             base_model: base_model.to_string(),
             layers,
+            base_prefix: Vec::new(),
         })
     }
 
@@ -455,11 +456,22 @@ impl Weights {
 
     /// The logits after the last of `tokens`.
     pub fn logits(&self, tokens: &[u32], lora: Option<&LoraSet>) -> Result<Vec<f32>, String> {
+        self.logits_after(&[], tokens, lora)
+    }
+
+    /// The logits after `tokens`, read with `lora` after `base` read by the base model (a
+    /// frozen prefix, as training reads it).
+    pub fn logits_after(&self, base: &[u32], tokens: &[u32], lora: Option<&LoraSet>) -> Result<Vec<f32>, String> {
         if tokens.is_empty() {
             return Err("no tokens".into());
         }
-        let rope = Rope::new(&self.shape, tokens.len())?;
-        let hidden = self.hidden(tokens, lora, &rope).map_err(err)?;
+        let rope = Rope::new(&self.shape, base.len() + tokens.len())?;
+        let prefix = match base.is_empty() {
+            true => None,
+            false => Some(self.prefix(base, None, &rope).map_err(err)?),
+        };
+        let residual = self.residual(tokens, lora, &rope, prefix.as_ref()).map_err(err)?;
+        let hidden = rms_norm(&residual, &self.norm, self.shape.eps).map_err(err)?;
         let last = hidden.narrow(0, tokens.len() - 1, 1).map_err(err)?;
         self.head(&last).and_then(|l| l.flatten_all()).and_then(|l| l.to_vec1()).map_err(err)
     }

@@ -66,6 +66,7 @@ fn random_adapter(shape: &Shape, rank: usize, targets: &[Target], seed: u64, bou
         targets: targets.to_vec(),
         base_model: Config::default().base_model,
         layers,
+        base_prefix: Vec::new(),
     }
 }
 
@@ -318,6 +319,16 @@ fn training_with_a_frozen_prefix_reads_it_once_and_learns() {
     assert_eq!(report.tokens, 6 * 3 * 7);
     let (first, last) = (report.losses[0], *report.losses.last().unwrap());
     assert!(last < 0.5 * first, "the loss fell only from {first} to {last}");
+    // the adapter keeps the prefix it learnt to follow
+    assert_eq!(Adapter::load(&out).unwrap().base_prefix, system);
+    // trained further from there, it starts where it ended, not from the base model
+    let further = Config { epochs: 1, from: Some(Adapter::load(&out).unwrap()), ..config.clone() };
+    let again = tad_finetune::train_samples(&weights, &samples, &further, &scratch("further"), &mut |_| {}).unwrap();
+    assert!(again.losses[0] < 0.5 * first, "from the adapter: {} against {first}", again.losses[0]);
+    // of another rank it is refused, before anything is read
+    let other = Config { rank: 2, ..further };
+    let e = tad_finetune::train_samples(&weights, &samples, &other, &scratch("other"), &mut |_| {}).unwrap_err();
+    assert!(matches!(&e, tad_finetune::FinetuneError::Setup(m) if m.contains("rank 4")), "{e}");
 }
 
 fn edit_tensors(d: &Path, edit: &dyn Fn(&mut std::collections::HashMap<String, candle_core::Tensor>)) {
@@ -356,6 +367,18 @@ fn a_malformed_adapter_is_an_error() {
         Adapter::load(&d).expect_err(name)
     };
     case("no-config", &|d| std::fs::remove_file(d.join("adapter_config.json")).unwrap());
+    // a frozen prefix round-trips; one that is not token ids is refused
+    let d = scratch("base-prefix");
+    let with_prefix = Adapter { base_prefix: vec![3, 0, 4_000_000_000], ..good.clone() };
+    write_adapter(&d, &with_prefix);
+    assert_eq!(Adapter::load(&d).unwrap(), with_prefix);
+    write_adapter(&d, &good);
+    assert_eq!(Adapter::load(&d).unwrap().base_prefix, Vec::<u32>::new());
+    for (name, text) in [("prefix-negative", r#"{"tokens":[1,-2]}"#), ("prefix-wide", r#"{"tokens":[4294967296]}"#)] {
+        let e = case(name, &|d| std::fs::write(d.join(tad_local::BASE_PREFIX_FILE), text).unwrap());
+        assert!(e.contains("token ids"), "{e}");
+    }
+    case("prefix-garbage", &|d| std::fs::write(d.join(tad_local::BASE_PREFIX_FILE), "[1, 2").unwrap());
     case("bad-config", &|d| std::fs::write(d.join("adapter_config.json"), "{not json").unwrap());
     case("not-lora", &|d| {
         std::fs::write(
@@ -548,6 +571,38 @@ fn an_adapter_agrees_on(path: &Path) {
             assert!(1.0 - w > 2.0 * (1.0 - c), "the wrong order agrees as well: {w} vs {c}");
         }
     }
+}
+
+#[test]
+fn the_decoder_reads_an_adapters_frozen_prefix_as_training_did() {
+    for path in ggufs() {
+        the_frozen_prefix_is_read_as_trained_on(&path);
+    }
+}
+
+fn the_frozen_prefix_is_read_as_trained_on(path: &Path) {
+    let tokens = prompt_tokens(path);
+    let (weights, _) = Weights::load(path).unwrap();
+    let shape = weights.shape;
+    let bound = if shape.arch.interleaved() { 0.5 } else { 0.05 };
+    let split = tokens.len() - 4;
+    let throughout = random_adapter(&shape, 8, &Target::ALL, 5, bound);
+    let dir = scratch(&format!("real-prefix-{:?}", shape.arch));
+    Adapter { base_prefix: tokens[..split].to_vec(), ..throughout.clone() }.save(&dir).unwrap();
+    let adapter = Adapter::load(&dir).unwrap();
+    let lora = LoraSet::from_adapter(&adapter, &shape).unwrap();
+    let trained = weights.logits_after(&tokens[..split], &tokens[split..], Some(&lora)).unwrap();
+    let whole = weights.logits(&tokens, Some(&lora)).unwrap();
+    let mut engine = tad_local::Engine::load_with(path, 1, Some(&adapter)).unwrap();
+    let decoded = engine.logits(&tokens);
+    let (c, w) = (cosine(&trained, &decoded), cosine(&whole, &decoded));
+    eprintln!("{:?}: cosine with the prefix read by the base model {c}, by the adapter {w}", shape.arch);
+    assert!(c > 0.995 && 1.0 - w > 2.0 * (1.0 - c), "{:?}: {c} against {w}", shape.arch);
+    // a prompt that does not start with the prefix reads all of it with the adapter
+    let mut other = tokens.clone();
+    other[1] = other[2];
+    let mut plain = tad_local::Engine::load_with(path, 1, Some(&throughout)).unwrap();
+    assert_eq!(engine.logits(&other), plain.logits(&other));
 }
 
 #[test]

@@ -10,6 +10,12 @@
 //! order; the scale is folded into `lora_b` and `adapter.lora.alpha` is the rank, so
 //! llama.cpp's `alpha / r` is 1 and rsLoRA's `alpha / √r` carries over.
 //!
+//! An adapter trained with a frozen prefix (`tadslc finetune --frozen-prefix`) learned to
+//! follow those tokens as the base model reads them; their ids are kept beside PEFT's files
+//! in [`BASE_PREFIX_FILE`], and the decoder reads a prompt's start that matches them without
+//! the adapter, as in training. PEFT and llama.cpp do not read that file: they apply the
+//! adapter throughout.
+//!
 //! An adapter is untrusted input: [`Adapter::load`] reads the files and checks that the
 //! config and the tensors agree with each other, [`Adapter::check`] that every tensor fits
 //! the model; neither panics on any file.
@@ -147,11 +153,15 @@ pub struct Adapter {
     pub targets: Vec<Target>,
     pub base_model: String,
     pub layers: BTreeMap<(usize, Target), Lora>,
+    /// The tokens it was trained to follow as the base model reads them (empty: none).
+    pub base_prefix: Vec<u32>,
 }
 
 /// The adapter's files.
 pub const CONFIG_FILE: &str = "adapter_config.json";
 pub const WEIGHTS_FILE: &str = "adapter_model.safetensors";
+/// The frozen prefix's token ids, `{"tokens": [...]}`; absent when there is none.
+pub const BASE_PREFIX_FILE: &str = "base_prefix.json";
 
 impl Adapter {
     pub fn scale(&self) -> f32 {
@@ -282,7 +292,8 @@ impl Adapter {
         if layers.is_empty() {
             return Err(bad("no LoRA tensors".into()));
         }
-        Ok(Adapter { rank, alpha, rslora, targets, base_model, layers })
+        let base_prefix = read_base_prefix(&dir.join(BASE_PREFIX_FILE))?;
+        Ok(Adapter { rank, alpha, rslora, targets, base_model, layers, base_prefix })
     }
 
     /// The number of layers the adapter covers.
@@ -343,8 +354,34 @@ impl Adapter {
         std::fs::rename(&partial, &weights).map_err(|e| format!("cannot write `{}`: {e}", weights.display()))?;
         let text = serde_json::to_string_pretty(&config).map_err(|e| e.to_string())?;
         std::fs::write(dir.join(CONFIG_FILE), text + "\n")
-            .map_err(|e| format!("cannot write `{}`: {e}", dir.join(CONFIG_FILE).display()))
+            .map_err(|e| format!("cannot write `{}`: {e}", dir.join(CONFIG_FILE).display()))?;
+        let prefix = dir.join(BASE_PREFIX_FILE);
+        match self.base_prefix.is_empty() {
+            true => match std::fs::remove_file(&prefix) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                    Err(format!("cannot remove `{}`: {e}", prefix.display()))
+                }
+                _ => Ok(()),
+            },
+            false => {
+                let text = serde_json::json!({ "tokens": self.base_prefix }).to_string();
+                std::fs::write(&prefix, text + "\n").map_err(|e| format!("cannot write `{}`: {e}", prefix.display()))
+            }
+        }
     }
+}
+
+/// The frozen prefix in `path`, or none when there is no such file.
+fn read_base_prefix(path: &Path) -> Result<Vec<u32>, String> {
+    let text = match std::fs::read_to_string(path) {
+        Ok(text) => text,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) => return Err(format!("cannot read `{}`: {e}", path.display())),
+    };
+    let bad = || format!("{}: not {{\"tokens\": [token ids]}}", path.display());
+    let value: serde_json::Value = serde_json::from_str(&text).map_err(|_| bad())?;
+    let tokens = value.get("tokens").and_then(|t| t.as_array()).ok_or_else(bad)?;
+    tokens.iter().map(|t| t.as_u64().and_then(|t| u32::try_from(t).ok()).ok_or_else(bad)).collect()
 }
 
 /// The adapter's file for llama.cpp, beside PEFT's in an adapter's directory.
@@ -533,6 +570,7 @@ mod tests {
             targets: vec![Target::Q, Target::V],
             base_model: "x".into(),
             layers,
+            base_prefix: Vec::new(),
         };
         let dir = std::env::temp_dir().join(format!("tad-local-gguf-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();

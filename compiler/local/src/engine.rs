@@ -44,6 +44,9 @@ pub struct Engine {
     identity: [u8; 32],
     /// Where system messages' caches are kept between processes, if anywhere.
     store: Option<PromptStore>,
+    /// The tokens the adapter was trained to follow as the base model reads them: a
+    /// prompt that starts with them reads them without the adapter.
+    base_prefix: Vec<u32>,
     tokenizer: Arc<Tokenizer>,
     /// `<|im_end|>`, and the end-of-text token.
     im_end: u32,
@@ -99,6 +102,7 @@ fn identity(path: &std::path::Path, adapter: Option<&Adapter>, kernels: &str) ->
     hash.update(kernels.as_bytes());
     if let Some(adapter) = adapter {
         hash.update(format!("{} {} {}", adapter.rank, adapter.alpha, adapter.rslora).as_bytes());
+        adapter.base_prefix.iter().for_each(|t| hash.update(t.to_le_bytes()));
         for ((layer, target), lora) in &adapter.layers {
             hash.update(format!("{layer} {}", target.module()).as_bytes());
             lora.a.iter().chain(&lora.b).for_each(|x| hash.update(x.to_le_bytes()));
@@ -214,6 +218,7 @@ impl Engine {
             cache,
             identity,
             store: None,
+            base_prefix: adapter.map(|a| a.base_prefix.clone()).unwrap_or_default(),
             tokenizer: Arc::new(tokenizer),
             im_end,
             end_of_text,
@@ -270,7 +275,8 @@ impl Engine {
         self.prefix = 0;
         self.held.clear();
         self.cache = self.model.new_cache();
-        self.model.forward(tokens, &mut self.cache)
+        let last = self.read(tokens);
+        self.model.logits(&last, None)
     }
 
     /// The tokens the model reads for `request` (for a peer fed the same input).
@@ -343,10 +349,23 @@ impl Engine {
         (last, prompt.len() - done)
     }
 
-    /// Reads `tokens` after the cache's, noting them as held.
+    /// Reads `tokens` after the cache's, noting them as held; those of the adapter's base
+    /// prefix (when what is held starts with it) without the adapter.
     fn read(&mut self, tokens: &[u32]) -> Last {
+        let start = self.held.len();
         self.held.extend_from_slice(tokens);
-        self.model.read(tokens, &mut self.cache)
+        let base = match self.held.starts_with(&self.base_prefix) {
+            true => self.base_prefix.len().saturating_sub(start).min(tokens.len()),
+            false => 0,
+        };
+        if base == 0 {
+            return self.model.read(tokens, &mut self.cache);
+        }
+        let last = self.model.read_base(&tokens[..base], &mut self.cache);
+        match base == tokens.len() {
+            true => last,
+            false => self.model.read(&tokens[base..], &mut self.cache),
+        }
     }
 
     /// The model's weights in memory, and the dot-product kernels chosen for this CPU.

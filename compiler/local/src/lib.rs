@@ -20,7 +20,9 @@ use std::sync::{Arc, Mutex};
 
 use tad_llm::{Chat, ChatFuture, Error, ErrorKind, OnText, Request};
 
-pub use adapter::{Adapter, GGUF_FILE, Lora, Target, gguf_to_hf_rows, hf_to_gguf_rows, interleave_rows, tensor_name};
+pub use adapter::{
+    Adapter, BASE_PREFIX_FILE, GGUF_FILE, Lora, Target, gguf_to_hf_rows, hf_to_gguf_rows, interleave_rows, tensor_name,
+};
 pub use engine::{Engine, Timing, chatml, tokenizer};
 pub use llama::{Arch, Shape};
 pub use prompts::PromptStore;

@@ -578,6 +578,7 @@ impl Model {
     }
 
     /// Reads `tokens` after what `cache` holds and returns the logits after the last one.
+    #[cfg(test)]
     pub fn forward(&mut self, tokens: &[u32], cache: &mut Cache) -> Vec<f32> {
         let last = self.read(tokens, cache);
         self.logits(&last, None)
@@ -591,6 +592,14 @@ impl Model {
         for chunk in tokens.chunks(CHUNK) {
             last = self.forward_chunk(chunk, cache);
         }
+        last
+    }
+
+    /// As [`Model::read`], without the adapter (the base model's keys and values).
+    pub fn read_base(&mut self, tokens: &[u32], cache: &mut Cache) -> Last {
+        let lora = self.lora.take();
+        let last = self.read(tokens, cache);
+        self.lora = lora;
         last
     }
 

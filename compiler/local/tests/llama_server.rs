@@ -31,7 +31,15 @@ fn random_adapter(shape: &Shape, seed: u64) -> Adapter {
             layers.insert((layer, target), Lora { a, b, inputs, outputs });
         }
     }
-    Adapter { rank, alpha: 8.0, rslora: false, targets: Target::ALL.to_vec(), base_model: "test".into(), layers }
+    Adapter {
+        rank,
+        alpha: 8.0,
+        rslora: false,
+        targets: Target::ALL.to_vec(),
+        base_model: "test".into(),
+        layers,
+        base_prefix: Vec::new(),
+    }
 }
 
 /// The probabilities of the whole vocabulary from logits.

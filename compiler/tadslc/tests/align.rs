@@ -280,4 +280,9 @@ fn finetune_and_adapters_refuse_bad_input_with_status_2() {
     let out = tadslc(&["gen", "--region", "yellowstone", "--tuned", "--adapter", path(&adapter), "-n", "1"], "");
     assert_eq!(code(&out), 2, "{}", stderr(&out));
     assert!(stderr(&out).contains("adapter_config.json"), "{}", stderr(&out));
+    // so is one to train further, whether or not the model is installed
+    let out =
+        tadslc(&["finetune", path(&dir.join("data.jsonl")), "-o", path(&dir.join("a")), "--from", path(&adapter)], "");
+    assert_eq!(code(&out), 2, "{}", stderr(&out));
+    assert!(stderr(&out).contains("adapter_config.json"), "{}", stderr(&out));
 }

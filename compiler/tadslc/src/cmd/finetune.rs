@@ -57,6 +57,10 @@ pub struct FinetuneArgs {
     /// tokens
     #[arg(long)]
     pub frozen_prefix: bool,
+    /// Start from the adapter in DIR (the same rank, alpha and targets) instead of from the
+    /// base model: train it further on new examples
+    #[arg(long, value_name = "DIR")]
+    pub from: Option<PathBuf>,
     /// The local model to adapt
     #[arg(long, default_value = tad_local::ALIGN_DEFAULT)]
     pub model: String,
@@ -103,6 +107,8 @@ impl FinetuneArgs {
             resume: self.resume,
             recompute: !self.keep_graph,
             frozen_prefix: self.frozen_prefix,
+            // read before the model: a bad adapter is reported at once
+            from: self.from.as_deref().map(tad_finetune::Adapter::load).transpose()?,
             ..Config::default()
         })
     }
