@@ -356,7 +356,7 @@ pub fn train_samples(
         run.prefix = Some(weights.prefix(prefix, None, &run.rope).map_err(training)?);
     }
     run.epochs(weights, samples, config, out, start, progress)?;
-    let adapter = run.adapter(weights, config).map_err(FinetuneError::Training)?;
+    let adapter = adapter(&run.lora, &run.prefix_tokens, weights, config).map_err(FinetuneError::Training)?;
     adapter.save(out).map_err(FinetuneError::Io)?;
     adapter.save_gguf(&out.join(tad_local::GGUF_FILE), &weights.shape).map_err(FinetuneError::Io)?;
     let Run { optimizer, state, resumed_at, counts, .. } = run;
@@ -520,11 +520,6 @@ impl Run {
             accumulate,
             counts: Counts::default(),
         })
-    }
-
-    /// The adapter as trained so far.
-    fn adapter(&self, weights: &Weights, config: &Config) -> Result<Adapter, String> {
-        adapter(&self.lora, &self.prefix_tokens, weights, config)
     }
 
     /// Every remaining epoch, a step per `accumulate` examples, reporting each step.

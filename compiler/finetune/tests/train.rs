@@ -488,6 +488,12 @@ fn ggufs() -> Vec<PathBuf> {
     [tad_local::SMALLEST, "qwen2.5-coder-0.5b"].into_iter().filter_map(tad_local::for_tests).collect()
 }
 
+/// The bounds of B's entries for a random adapter that changes a real model without wrecking
+/// it, on q and k alone and on every projection: Qwen2.5 takes smaller ones.
+fn adapter_bounds(shape: &Shape) -> (f32, f32) {
+    if shape.arch.interleaved() { (2.0, 0.5) } else { (0.3, 0.05) }
+}
+
 fn prompt_tokens(path: &Path) -> Vec<u32> {
     let mut file = std::fs::File::open(path).unwrap();
     let content = candle_core::quantized::gguf_file::Content::read(&mut file).unwrap();
@@ -526,8 +532,7 @@ fn an_adapter_agrees_on(path: &Path) {
     let shape = weights.shape;
     let base = weights.logits(&tokens, None).unwrap();
     // q and k alone first: a wrong row order between HF's layout and the GGUF's shows here
-    // adapters that change the model without wrecking it: Qwen2.5 takes smaller ones
-    let (qk, all) = if shape.arch.interleaved() { (2.0, 0.5) } else { (0.3, 0.05) };
+    let (qk, all) = adapter_bounds(&shape);
     for (targets, bound) in [(vec![Target::Q, Target::K], qk), (Target::ALL.to_vec(), all)] {
         let adapter = random_adapter(&shape, 8, &targets, 4, bound);
         let dir = scratch(&format!("real-{:?}-{}", shape.arch, targets.len()));
@@ -584,9 +589,8 @@ fn the_frozen_prefix_is_read_as_trained_on(path: &Path) {
     let tokens = prompt_tokens(path);
     let (weights, _) = Weights::load(path).unwrap();
     let shape = weights.shape;
-    let bound = if shape.arch.interleaved() { 0.5 } else { 0.05 };
     let split = tokens.len() - 4;
-    let throughout = random_adapter(&shape, 8, &Target::ALL, 5, bound);
+    let throughout = random_adapter(&shape, 8, &Target::ALL, 5, adapter_bounds(&shape).1);
     let dir = scratch(&format!("real-prefix-{:?}", shape.arch));
     Adapter { base_prefix: tokens[..split].to_vec(), ..throughout.clone() }.save(&dir).unwrap();
     let adapter = Adapter::load(&dir).unwrap();

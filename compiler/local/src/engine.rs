@@ -354,8 +354,9 @@ impl Engine {
     fn read(&mut self, tokens: &[u32]) -> Last {
         let start = self.held.len();
         self.held.extend_from_slice(tokens);
-        let base = match self.held.starts_with(&self.base_prefix) {
-            true => self.base_prefix.len().saturating_sub(start).min(tokens.len()),
+        // only a read that begins inside the prefix compares it (not every decoded token)
+        let base = match start < self.base_prefix.len() && self.held.starts_with(&self.base_prefix) {
+            true => (self.base_prefix.len() - start).min(tokens.len()),
             false => 0,
         };
         if base == 0 {
